@@ -1,0 +1,83 @@
+#pragma once
+// Rigid bodies (paper Sec. 3.1) and their shapes.
+
+#include "cps/math.h"
+
+namespace cps {
+
+/// The kinds of collision shape.
+enum class ShapeKind {
+  box,    ///< a cuboid given by its half extents
+  plane,  ///< an infinite half space; static bodies only
+};
+
+/// A collision shape in body space.
+/// - box: half_extents (m), each finite and > 0.
+/// - plane: the half space {x : dot(normal, x) <= offset} of body space is solid; normal is a
+///   unit 3-vector pointing out of the solid to the free side, offset in m.
+/// Build one with Shape::box or Shape::plane, which validate their input.
+struct Shape {
+  ShapeKind kind = ShapeKind::box;
+  Vec3 half_extents = Vec3::Constant(0.5);
+  Vec3 normal = Vec3::UnitY();
+  double offset = 0.0;
+
+  /// A box of half extents h (m, 3-vector). Throws std::invalid_argument naming the value if any
+  /// component is not finite and > 0.
+  static Shape box(const Vec3& h);
+  /// A plane with outward normal n (any non-zero finite 3-vector; it is normalised) at signed
+  /// distance offset (m) from the body origin along n. Throws std::invalid_argument on a zero or
+  /// non-finite normal or a non-finite offset.
+  static Shape plane(const Vec3& n, double offset);
+};
+
+/// What a body is made from. mass (kg): finite and > 0 for a movable body; ignored when
+/// is_static. position (m), orientation (unit quaternion, body to world; |o| within 1e-9 of 1),
+/// velocity (m/s) and angular_velocity (rad/s) are the initial state, all in world space.
+struct BodyDef {
+  Shape shape;
+  bool is_static = false;
+  double mass = 1.0;
+  Vec3 position = Vec3::Zero();
+  Quat orientation = Quat::Identity();
+  Vec3 velocity = Vec3::Zero();
+  Vec3 angular_velocity = Vec3::Zero();
+};
+
+/// A rigid body as the paper keeps it (Sec. 3.1): position x (m), orientation o (unit
+/// quaternion), linear momentum p = m v (N s), angular momentum l = I w (N m s), inverse mass
+/// m^-1 (1/kg) and body-space inverse inertia I_body^-1 (1/(kg m^2), 3 x 3). Static bodies have
+/// m^-1 = 0 and I^-1 = 0.
+struct Body {
+  Shape shape;
+  Vec3 x = Vec3::Zero();
+  Quat o = Quat::Identity();
+  Vec3 p = Vec3::Zero();
+  Vec3 l = Vec3::Zero();
+  double mass = 0.0;      ///< kg; 0 for a static body
+  double inv_mass = 0.0;  ///< 1/kg
+  Mat3 inv_inertia_body = Mat3::Zero();
+
+  bool is_static() const { return inv_mass == 0.0; }
+  /// Rotation matrix R of o (3 x 3, body to world).
+  Mat3 rotation() const { return o.toRotationMatrix(); }
+  /// World-space inverse inertia I^-1 = R I_body^-1 R^T (1/(kg m^2), 3 x 3).
+  Mat3 inv_inertia_world() const;
+  /// Linear velocity v = m^-1 p (m/s).
+  Vec3 velocity() const { return inv_mass * p; }
+  /// Angular velocity w = I^-1 l (rad/s).
+  Vec3 angular_velocity() const { return inv_inertia_world() * l; }
+  /// Kinetic energy 1/2 (p.v + l.w) (J).
+  double kinetic_energy() const;
+};
+
+/// Body-space inertia tensor (kg m^2, 3 x 3) of a solid box of the given mass (kg) and half
+/// extents (m): I = m/3 diag(hy^2 + hz^2, hx^2 + hz^2, hx^2 + hy^2).
+Mat3 box_inertia(double mass, const Vec3& half_extents);
+
+/// Builds a Body from a definition. Throws std::invalid_argument naming the bad value for a
+/// non-positive or non-finite mass of a movable body, a movable plane, a non-finite position or
+/// velocity, or an orientation whose norm differs from 1 by more than 1e-9.
+Body make_body(const BodyDef& def);
+
+}  // namespace cps

@@ -1,0 +1,62 @@
+#pragma once
+// Collision detection (paper Sec. 4): detect whether two bodies touch and build their contact
+// manifold. Box-box uses the separating axis test over 15 axes; a face contact clips the
+// incident face against the side planes of the reference face, an edge contact takes the
+// closest points of the two edges (as in Ericson, "Real-Time Collision Detection", 2005,
+// Sec. 4.4 and 5.1.9, and Gregorius, "The Separating Axis Test", GDC 2013).
+
+#include "cps/body.h"
+
+#include <array>
+
+namespace cps {
+
+/// One contact point. normal: unit 3-vector from body a to body b (the direction along which
+/// b must move to separate). depth: penetration along the normal (m, >= 0). point: world
+/// position (m), midway between the two surfaces.
+struct Contact {
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitY();
+  double depth = 0.0;
+};
+
+/// Most points a manifold holds: clipping a quadrilateral against four planes leaves at most 8.
+inline constexpr int kMaxManifoldPoints = 8;
+
+/// The contacts between bodies a and b (indices into the world's body list, a < b), all with the
+/// same normal. Fixed capacity, so collision detection does not allocate.
+struct Manifold {
+  int body_a = -1;
+  int body_b = -1;
+  int count = 0;
+  std::array<Contact, kMaxManifoldPoints> contacts{};
+
+  void add(const Contact& c) {
+    if (count < kMaxManifoldPoints) contacts[static_cast<std::size_t>(count++)] = c;
+  }
+};
+
+/// Tests bodies a and b and writes their contacts into `out` (out.count = 0 when they do not
+/// touch). Normals point from a to b. Returns out.count. Pairs of two planes, and pairs of
+/// static bodies, give no contact. No errors are raised.
+int collide(const Body& a, const Body& b, Manifold& out);
+
+/// A box in world space: centre c (m), rotation R (3 x 3, columns are the box axes in world
+/// space), half extents e (m).
+struct OrientedBox {
+  Vec3 c;
+  Mat3 R;
+  Vec3 e;
+};
+
+/// Box-plane contacts: every vertex of `box` below the plane {x : dot(n, x) = offset} (n unit,
+/// offset in m), with normal n (from plane to box) and depth offset - dot(n, v). Returns the
+/// number of contacts written to `out` (0..8). The caller flips normals if the box is body a.
+int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Manifold& out);
+
+/// Box-box contacts by the separating axis test over the 15 axes (3 face normals of each box and
+/// the 9 cross products of their edge directions). Normals point from box a to box b. Returns
+/// the number of contacts written to `out` (0 when a separating axis exists).
+int collide_box_box(const OrientedBox& a, const OrientedBox& b, Manifold& out);
+
+}  // namespace cps

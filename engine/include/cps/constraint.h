@@ -1,0 +1,63 @@
+#pragma once
+// Constraint rows (paper Sec. 5). Each row is j (12 numbers: linear and angular part for body a,
+// then for body b), a target velocity v (the push factor and any other bias, m/s) and force
+// limits [c_min, c_max] (N). With the unit axis convention of NOTES.md lambda is in newtons.
+
+#include "cps/collision.h"
+
+#include <vector>
+
+namespace cps {
+
+/// What a row constrains.
+enum class RowKind {
+  contact,   ///< Sec. 5.3: non-penetration along the contact normal
+  friction,  ///< Sec. 5.4: no sliding along a tangent
+};
+
+/// One row of J with its right-hand side terms.
+/// - j: 12-vector [-n, -(r_a x n), n, r_b x n] for a unit axis n (no unit / m).
+/// - push: the Baumgarte part of the target velocity, beta d / dt for a contact (m/s, Eq. 5.3.1);
+///   the single frame push factor (Sec. 8.1) drops it from the second solve.
+/// - bias: the part of the target velocity that must add velocity, e.g. restitution (m/s,
+///   Eq. 8.2.1); kept in both solves. Target v = push + bias.
+/// - c_min, c_max: force limits (N), c_min <= 0 <= c_max, possibly infinite.
+struct ConstraintRow {
+  RowKind kind = RowKind::contact;
+  int body_a = -1;
+  int body_b = -1;
+  Vec12 j = Vec12::Zero();
+  double push = 0.0;
+  double bias = 0.0;
+  double c_min = -kInfinity;
+  double c_max = kInfinity;
+};
+
+/// The 12-vector j = [-n, -(r_a x n), n, r_b x n] of a row along unit axis n between the points
+/// at offsets r_a, r_b (m) from the centres of mass of bodies a and b (Eq. 5.2.1 with a unit axis,
+/// Sec. 9.2). j . v_ab is the rate (m/s) at which the points separate along n.
+Vec12 axis_row(const Vec3& n, const Vec3& r_a, const Vec3& r_b);
+
+/// Two unit tangents t1, t2 with (n, t1, t2) a right-handed orthonormal basis; n must be unit.
+/// Deterministic: depends on n only.
+void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2);
+
+/// Parameters of the row builder. beta: push factor constant (dimensionless, [0, 1], typical
+/// 0.2); dt: time step (s); friction: coefficient mu (dimensionless, >= 0, typical 0.5; 0 builds
+/// no friction rows); gravity: (m/s^2) for the friction limit mu m |g . n|.
+struct RowParams {
+  double beta = 0.2;
+  double dt = 1.0 / 60.0;
+  double friction = 0.5;
+  Vec3 gravity = Vec3(0.0, -10.0, 0.0);
+};
+
+/// Appends the rows of one manifold to `rows`: per contact point a contact row (Sec. 5.3:
+/// c_min = 0, c_max = +inf, push = beta d / dt) and, when friction > 0, two friction rows
+/// (Sec. 5.4: target 0, limits +-mu m |g . n| where m is the combined mass of the two bodies
+/// divided over the manifold's points, the movable body's mass when the other is static).
+/// Rows come per point in the order contact, friction t1, friction t2.
+void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
+                         const RowParams& params, std::vector<ConstraintRow>& rows);
+
+}  // namespace cps

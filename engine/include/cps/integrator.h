@@ -1,0 +1,22 @@
+#pragma once
+// Semi-implicit Euler integration (paper Sec. 3.2, Eqs. 3.2.1-3.2.4).
+
+#include "cps/body.h"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace cps {
+
+/// Advances every movable body by dt (s, > 0).
+/// f_position and f_momentum (6n each): force and torque per body (N, N m), external plus
+/// constraint forces. Momenta advanced with f_position move the bodies (Eqs. 3.2.3, 3.2.4):
+///   x += (p + f dt) / m dt;  o += 1/2 [0, I^-1 (l + tau dt)] o dt, then o is normalised;
+/// the stored momenta are advanced with f_momentum (Eqs. 3.2.1, 3.2.2). For the ordinary step
+/// both are the same vector; the single frame push factor (Sec. 8.1) passes f_cv and f_c0.
+/// I^-1 is taken at the orientation before the step. Static bodies do not move.
+void integrate(std::vector<Body>& bodies, const Eigen::VectorXd& f_position,
+               const Eigen::VectorXd& f_momentum, double dt);
+
+}  // namespace cps

@@ -1,0 +1,57 @@
+#pragma once
+// The system of paper Sec. 6: J, M^-1, f_ext, v1 and A lambda = b (Eq. 6.2.9).
+//
+// For n bodies and c rows:
+//   v1     6n     system velocity [v_1, w_1, ..., v_n, w_n] (m/s, rad/s)        (Eq. 6.1.1)
+//   J      c x 6n one row j_c per constraint, at the columns of its two bodies  (Sec. 6.1.2)
+//   M^-1   6n x 6n block diagonal [m_i^-1 D, I_i^-1]                            (Eq. 6.1.2)
+//   f_ext  6n     force and torque per body (N, N m)                           (Eq. 6.1.3)
+//   v      c      target velocities, push factor and bias (m/s)                 (Eq. 6.1.4)
+//   A = J M^-1 J^T (c x c),  b = v / dt - J (v1 / dt + M^-1 f_ext) (c)          (Eq. 6.2.9)
+// The constraint force is f_c = J^T lambda (6n, Eq. 6.2.1).
+
+#include "cps/body.h"
+#include "cps/constraint.h"
+
+#include <Eigen/SparseCore>
+
+#include <vector>
+
+namespace cps {
+
+using SparseRowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+/// Which parts of each row's target velocity enter v: the full push + bias (the ordinary solve,
+/// and the first solve of Sec. 8.1), or bias only (the second solve of Sec. 8.1, v without the
+/// constraint-correcting push factor).
+enum class TargetTerms { push_and_bias, bias_only };
+
+/// The assembled system. Sizes as in the header comment.
+struct System {
+  SparseRowMatrix J;
+  Eigen::SparseMatrix<double> M_inv;
+  SparseRowMatrix A;
+  Eigen::VectorXd b;
+  Eigen::VectorXd c_min;
+  Eigen::VectorXd c_max;
+};
+
+/// v1 (6n): [v_i, w_i] per body in body order.
+Eigen::VectorXd system_velocity(const std::vector<Body>& bodies);
+
+/// f_ext (6n): [m_i g, 0] per movable body (gravity in m/s^2), zero for static bodies.
+Eigen::VectorXd gravity_forces(const std::vector<Body>& bodies, const Vec3& gravity);
+
+/// Assembles J, M^-1, A and b from the rows (Eq. 6.2.9). v1 and f_ext have 6n entries for
+/// n = bodies.size(); dt > 0 in s. Throws std::invalid_argument on mismatched sizes or a row
+/// whose body indices are out of range.
+System assemble_system(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
+                       const Eigen::VectorXd& v1, const Eigen::VectorXd& f_ext, double dt,
+                       TargetTerms terms);
+
+/// Right-hand side b alone (c), for a second solve that reuses J and A (Eq. 6.2.9).
+Eigen::VectorXd assemble_rhs(const std::vector<ConstraintRow>& rows, const SparseRowMatrix& J,
+                             const Eigen::SparseMatrix<double>& M_inv, const Eigen::VectorXd& v1,
+                             const Eigen::VectorXd& f_ext, double dt, TargetTerms terms);
+
+}  // namespace cps

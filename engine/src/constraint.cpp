@@ -1,0 +1,68 @@
+// Contact (Sec. 5.3) and friction (Sec. 5.4) rows.
+#include "cps/constraint.h"
+
+#include <cmath>
+
+namespace cps {
+
+Vec12 axis_row(const Vec3& n, const Vec3& r_a, const Vec3& r_b) {
+  // Eq. 5.2.1 with p_b - p_a replaced by the unit axis n (Sec. 5.3, Sec. 9.2):
+  //   c_dot = n . (v_b + w_b x r_b - v_a - w_a x r_a)
+  //         = [-n, -(r_a x n), n, r_b x n] . [v_a, w_a, v_b, w_b]   (scalar triple product)
+  Vec12 j;
+  j << -n, -r_a.cross(n), n, r_b.cross(n);
+  return j;
+}
+
+void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
+  // Cross n with the world axis least aligned with it, so the result is never degenerate.
+  const Vec3 a = n.cwiseAbs();
+  const Vec3 helper = (a.x() <= a.y() && a.x() <= a.z()) ? Vec3::UnitX()
+                      : (a.y() <= a.z())                 ? Vec3::UnitY()
+                                                         : Vec3::UnitZ();
+  t1 = n.cross(helper).normalized();
+  t2 = n.cross(t1);
+}
+
+void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
+                         const RowParams& params, std::vector<ConstraintRow>& rows) {
+  if (m.count == 0) return;
+  const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
+  const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
+  // Sec. 5.4: m is the combined mass of both bodies divided over the contact points (a static
+  // body has mass 0 here, so the movable body's mass remains).
+  const double mass_per_point = (a.mass + b.mass) / static_cast<double>(m.count);
+  for (int i = 0; i < m.count; ++i) {
+    const Contact& c = m.contacts[static_cast<std::size_t>(i)];
+    const Vec3 r_a = c.point - a.x;
+    const Vec3 r_b = c.point - b.x;
+
+    ConstraintRow contact;
+    contact.kind = RowKind::contact;
+    contact.body_a = m.body_a;
+    contact.body_b = m.body_b;
+    contact.j = axis_row(c.normal, r_a, r_b);
+    // Eq. 5.3.1 with the sign of NOTES.md: C = -d, v = -beta C / dt = beta d / dt > 0 opens it.
+    contact.push = params.beta * c.depth / params.dt;
+    contact.c_min = 0.0;
+    contact.c_max = kInfinity;
+    rows.push_back(contact);
+
+    if (params.friction <= 0.0) continue;
+    const double limit = params.friction * mass_per_point * std::abs(params.gravity.dot(c.normal));
+    Vec3 t[2];
+    tangent_basis(c.normal, t[0], t[1]);
+    for (const Vec3& tangent : t) {
+      ConstraintRow friction;
+      friction.kind = RowKind::friction;
+      friction.body_a = m.body_a;
+      friction.body_b = m.body_b;
+      friction.j = axis_row(tangent, r_a, r_b);
+      friction.c_min = -limit;
+      friction.c_max = limit;
+      rows.push_back(friction);
+    }
+  }
+}
+
+}  // namespace cps

@@ -1,0 +1,28 @@
+// Semi-implicit Euler, paper Sec. 3.2.
+#include "cps/integrator.h"
+
+namespace cps {
+
+void integrate(std::vector<Body>& bodies, const Eigen::VectorXd& f_position,
+               const Eigen::VectorXd& f_momentum, double dt) {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    Body& body = bodies[i];
+    if (body.is_static()) continue;
+    const auto k = 6 * static_cast<Eigen::Index>(i);
+    // Momenta that move the body this step (Eqs. 3.2.1, 3.2.2 with the position forces).
+    const Vec3 p_next = body.p + f_position.segment<3>(k) * dt;
+    const Vec3 l_next = body.l + f_position.segment<3>(k + 3) * dt;
+    // Eq. 3.2.3: x += p / m dt.
+    body.x += body.inv_mass * p_next * dt;
+    // Eq. 3.2.4: o += 1/2 [0, I^-1 l] o dt, then normalise.
+    const Vec3 w = body.inv_inertia_world() * l_next;
+    const Quat spin(0.0, 0.5 * w.x() * dt, 0.5 * w.y() * dt, 0.5 * w.z() * dt);
+    body.o.coeffs() += (spin * body.o).coeffs();
+    body.o.normalize();
+    // The stored momenta (Eqs. 3.2.1, 3.2.2).
+    body.p += f_momentum.segment<3>(k) * dt;
+    body.l += f_momentum.segment<3>(k + 3) * dt;
+  }
+}
+
+}  // namespace cps

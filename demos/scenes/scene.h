@@ -1,0 +1,82 @@
+#pragma once
+// The scene library: the paper's result scenes (Sec. 10), one file each, listed in one table.
+// The `cps` command, the tests and the benchmarks all link it. It knows the engine, never GL.
+
+#include "cps/world.h"
+
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string_view>
+
+namespace cps::scenes {
+
+/// Per-scene measurements, fed after every step and reported as JSON (the names of the keys
+/// are part of the `cps simulate --json` interface; each carries its unit as a suffix).
+class Metrics {
+ public:
+  virtual ~Metrics() = default;
+  /// Called once after each World::step().
+  virtual void observe(const World& world) = 0;
+  /// The measurements so far.
+  virtual nlohmann::json report() const = 0;
+};
+
+/// A scene: its name (as typed on the command line), a one-line summary, its default duration
+/// (s), its world parameters, how to add its bodies and how to measure it.
+struct Scene {
+  std::string_view name;
+  std::string_view summary;
+  double default_seconds = 10.0;
+  WorldDef (*world_def)() = nullptr;
+  void (*populate)(World& world) = nullptr;
+  std::unique_ptr<Metrics> (*make_metrics)(const World& world) = nullptr;
+};
+
+/// Every scene, in the order `cps list` prints them.
+std::span<const Scene> all_scenes();
+
+/// The scene called `name`, or nullptr.
+const Scene* find_scene(std::string_view name);
+
+/// Values that replace a scene's own world parameters (units as in WorldDef).
+struct Overrides {
+  std::optional<double> dt;
+  std::optional<int> iterations;
+  std::optional<double> beta;
+  std::optional<double> friction;
+};
+
+/// The scene's WorldDef with the overrides applied. Not validated here: World's constructor does.
+WorldDef world_def_with(const Scene& scene, const Overrides& overrides);
+
+/// A world built from a scene, with its metrics, ready to step.
+struct Run {
+  World world;
+  std::unique_ptr<Metrics> metrics;
+
+  /// Steps once and feeds the metrics.
+  void step() {
+    world.step();
+    metrics->observe(world);
+  }
+  /// Steps until world.time() reaches t (s), within half a step.
+  void advance_to(double t) {
+    while (world.time() + 0.5 * world.def().dt < t) step();
+  }
+};
+
+/// Builds a scene's world. Throws std::invalid_argument if the parameters are invalid.
+Run make_run(const Scene& scene, const Overrides& overrides = {});
+
+/// Deepest penetration (m) among the contacts of the world's last step; 0 if none.
+double deepest_contact(const World& world);
+
+// The scenes (one file each).
+WorldDef stack_world_def();
+void populate_stack(World& world);
+std::unique_ptr<Metrics> make_stack_metrics(const World& world);
+
+}  // namespace cps::scenes

@@ -33,6 +33,16 @@ Shape Shape::box(const Vec3& h) {
   return s;
 }
 
+Shape Shape::sphere(double r) {
+  if (!(std::isfinite(r) && r > 0.0)) {
+    throw std::invalid_argument("sphere radius " + std::to_string(r) + " m must be finite and > 0");
+  }
+  Shape s;
+  s.kind = ShapeKind::sphere;
+  s.radius = r;
+  return s;
+}
+
 Shape Shape::plane(const Vec3& n, double offset) {
   const double len = n.norm();
   if (!n.allFinite() || !(len > 0.0)) {
@@ -61,6 +71,22 @@ Mat3 box_inertia(double mass, const Vec3& h) {
   return (mass / 3.0) * Vec3(s.y() + s.z(), s.x() + s.z(), s.x() + s.y()).asDiagonal();
 }
 
+Mat3 sphere_inertia(double mass, double radius) {
+  return Mat3::Identity() * (0.4 * mass * radius * radius);
+}
+
+Mat3 shape_inertia(const Shape& shape, double mass) {
+  switch (shape.kind) {
+    case ShapeKind::box:
+      return box_inertia(mass, shape.half_extents);
+    case ShapeKind::sphere:
+      return sphere_inertia(mass, shape.radius);
+    case ShapeKind::plane:
+      break;
+  }
+  throw std::invalid_argument("a plane has no inertia: it must be a static body");
+}
+
 Body make_body(const BodyDef& def) {
   require_finite(def.position, "body position");
   require_finite(def.velocity, "body velocity");
@@ -78,6 +104,7 @@ Body make_body(const BodyDef& def) {
                                 " kg must be finite and > 0 for a movable body");
   }
   if (def.shape.kind == ShapeKind::box) Shape::box(def.shape.half_extents);  // validates
+  if (def.shape.kind == ShapeKind::sphere) Shape::sphere(def.shape.radius);    // validates
 
   Body b;
   b.shape = def.shape;
@@ -86,7 +113,7 @@ Body make_body(const BodyDef& def) {
   if (!def.is_static) {
     b.mass = def.mass;
     b.inv_mass = 1.0 / def.mass;
-    const Mat3 I_body = box_inertia(def.mass, def.shape.half_extents);
+    const Mat3 I_body = shape_inertia(def.shape, def.mass);
     b.inv_inertia_body = I_body.inverse();
     b.p = def.mass * def.velocity;
     const Mat3 R = b.rotation();

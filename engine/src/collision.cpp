@@ -1,6 +1,8 @@
 // Collision dispatch and the box-plane test (paper Sec. 4).
 #include "cps/collision.h"
 
+#include <cmath>
+
 namespace cps {
 namespace {
 
@@ -33,29 +35,94 @@ int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Mani
   return out.count - before;
 }
 
+int collide_sphere_plane(const Vec3& c, double r, const Vec3& n, double offset, Manifold& out) {
+  const double separation = n.dot(c) - offset - r;
+  if (separation >= 0.0) return 0;
+  // Midway between the deepest point of the sphere, c - r n, and the plane.
+  out.add({c - (r + 0.5 * separation) * n, n, -separation});
+  return 1;
+}
+
+int collide_sphere_sphere(const Vec3& c_a, double r_a, const Vec3& c_b, double r_b, Manifold& out) {
+  const Vec3 d = c_b - c_a;
+  const double dist = d.norm();
+  const double depth = r_a + r_b - dist;
+  if (depth <= 0.0) return 0;
+  const Vec3 n = dist > 1e-12 ? Vec3(d / dist) : Vec3(Vec3::UnitY());
+  out.add({c_a + (r_a - 0.5 * depth) * n, n, depth});
+  return 1;
+}
+
+int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold& out) {
+  const Vec3 p = box.R.transpose() * (c - box.c);  // sphere centre in box space
+  const Vec3 q = p.cwiseMax(-box.e).cwiseMin(box.e);  // closest point of the box
+  Vec3 n_local;
+  double depth;
+  Vec3 surface;  // box surface point, box space
+  if (q == p) {
+    // The centre is inside: leave through the nearest face.
+    int axis = 0;
+    double nearest = kInfinity;
+    for (int i = 0; i < 3; ++i) {
+      const double to_face = box.e[i] - std::abs(p[i]);
+      if (to_face < nearest) {
+        nearest = to_face;
+        axis = i;
+      }
+    }
+    n_local = Vec3::Zero();
+    n_local[axis] = p[axis] >= 0.0 ? 1.0 : -1.0;
+    depth = nearest + r;
+    surface = p;
+    surface[axis] = n_local[axis] * box.e[axis];
+  } else {
+    const Vec3 delta = p - q;
+    const double dist = delta.norm();
+    if (dist >= r) return 0;
+    n_local = delta / dist;
+    depth = r - dist;
+    surface = q;
+  }
+  const Vec3 n = box.R * n_local;
+  const Vec3 surface_world = box.c + box.R * surface;
+  // Midway between the box surface and the deepest point of the sphere, c - r n.
+  out.add({0.5 * (surface_world + c - r * n), n, depth});
+  return 1;
+}
+
 int collide(const Body& a, const Body& b, Manifold& out) {
   out.count = 0;
   if (a.is_static() && b.is_static()) return 0;
-  const ShapeKind ka = a.shape.kind;
-  const ShapeKind kb = b.shape.kind;
-  if (ka == ShapeKind::box && kb == ShapeKind::box) {
-    return collide_box_box(oriented_box(a), oriented_box(b), out);
-  }
-  if (ka == ShapeKind::plane && kb == ShapeKind::box) {
-    Vec3 n;
-    double offset;
-    world_plane(a, n, offset);
-    return collide_box_plane(oriented_box(b), n, offset, out);  // normal plane -> box = a -> b
-  }
-  if (ka == ShapeKind::box && kb == ShapeKind::plane) {
-    Vec3 n;
-    double offset;
-    world_plane(b, n, offset);
-    collide_box_plane(oriented_box(a), n, offset, out);
-    flip_normals(out);  // from the box (a) into the plane (b)
+  // Order the pair as (box, sphere, plane) by kind; flip the normals back if it was swapped.
+  const auto rank = [](ShapeKind k) { return k == ShapeKind::box ? 0 : k == ShapeKind::sphere ? 1 : 2; };
+  const bool swapped = rank(a.shape.kind) > rank(b.shape.kind);
+  const Body& first = swapped ? b : a;
+  const Body& second = swapped ? a : b;
+  const ShapeKind k1 = first.shape.kind;
+  const ShapeKind k2 = second.shape.kind;
+  Vec3 n;
+  double offset;
+  if (k2 == ShapeKind::plane) {
+    if (k1 == ShapeKind::plane) return 0;
+    world_plane(second, n, offset);
+    // Contacts come from the plane to the shape: from `second` to `first`.
+    if (k1 == ShapeKind::box) {
+      collide_box_plane(oriented_box(first), n, offset, out);
+    } else {
+      collide_sphere_plane(first.x, first.shape.radius, n, offset, out);
+    }
+    if (!swapped) flip_normals(out);  // a = first: normals must point from first to the plane
     return out.count;
   }
-  return 0;  // plane-plane
+  if (k1 == ShapeKind::box && k2 == ShapeKind::box) {
+    collide_box_box(oriented_box(first), oriented_box(second), out);
+  } else if (k1 == ShapeKind::box) {
+    collide_box_sphere(oriented_box(first), second.x, second.shape.radius, out);
+  } else {
+    collide_sphere_sphere(first.x, first.shape.radius, second.x, second.shape.radius, out);
+  }
+  if (swapped) flip_normals(out);
+  return out.count;
 }
 
 }  // namespace cps

@@ -24,6 +24,18 @@ void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
   t2 = n.cross(t1);
 }
 
+namespace {
+
+// j . v_ab for the current body velocities (m/s).
+double relative_velocity(const Vec12& j, const Body* a, const Body* b) {
+  double rate = 0.0;
+  if (a) rate += j.segment<3>(0).dot(a->velocity()) + j.segment<3>(3).dot(a->angular_velocity());
+  if (b) rate += j.segment<3>(6).dot(b->velocity()) + j.segment<3>(9).dot(b->angular_velocity());
+  return rate;
+}
+
+}  // namespace
+
 void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
                          const RowParams& params, std::vector<ConstraintRow>& rows) {
   if (m.count == 0) return;
@@ -44,8 +56,14 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
     contact.j = axis_row(c.normal, r_a, r_b);
     // Eq. 5.3.1 with the sign of NOTES.md: C = -d, v = -beta C / dt = beta d / dt > 0 opens it.
     contact.push = params.beta * c.depth / params.dt;
+    if (params.restitution > 0.0) {
+      // Eq. 8.2.1: v_r = -eps j . v1, only for points approaching faster than the threshold.
+      const double approach = relative_velocity(contact.j, &a, &b);
+      if (approach < -params.restitution_threshold) contact.bias = -params.restitution * approach;
+    }
     contact.c_min = 0.0;
     contact.c_max = kInfinity;
+    const int normal_row = static_cast<int>(rows.size());
     rows.push_back(contact);
 
     if (params.friction <= 0.0) continue;
@@ -60,9 +78,46 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
       friction.j = axis_row(tangent, r_a, r_b);
       friction.c_min = -limit;
       friction.c_max = limit;
+      friction.normal_row = normal_row;
+      friction.mu = params.friction;
       rows.push_back(friction);
     }
   }
+}
+
+void distance_endpoints(const DistanceConstraint& d, const std::vector<Body>& bodies, Vec3& p_a,
+                        Vec3& p_b) {
+  const Body& a = bodies[static_cast<std::size_t>(d.body_a)];
+  p_a = a.x + a.rotation() * d.local_a;
+  if (d.body_b == kWorldBody) {
+    p_b = d.local_b;
+  } else {
+    const Body& b = bodies[static_cast<std::size_t>(d.body_b)];
+    p_b = b.x + b.rotation() * d.local_b;
+  }
+}
+
+void append_distance_row(const DistanceConstraint& d, const std::vector<Body>& bodies,
+                         const RowParams& params, std::vector<ConstraintRow>& rows) {
+  Vec3 p_a;
+  Vec3 p_b;
+  distance_endpoints(d, bodies, p_a, p_b);
+  const Vec3 p_ab = p_b - p_a;
+  const double dist = p_ab.norm();
+  const Vec3 n = dist > 1e-12 ? Vec3(p_ab / dist) : Vec3(Vec3::UnitY());
+  const Vec3 r_a = p_a - bodies[static_cast<std::size_t>(d.body_a)].x;
+  const Vec3 r_b = d.body_b == kWorldBody ? Vec3::Zero()
+                                          : Vec3(p_b - bodies[static_cast<std::size_t>(d.body_b)].x);
+  ConstraintRow row;
+  row.kind = RowKind::distance;
+  row.body_a = d.body_a;
+  row.body_b = d.body_b;
+  row.j = axis_row(n, r_a, r_b);
+  // C = |p_ab| - l; target v = -beta C / dt (NOTES.md sign: a stretched rod shrinks).
+  row.push = -params.beta * (dist - d.length) / params.dt;
+  row.c_min = -kInfinity;
+  row.c_max = kInfinity;
+  rows.push_back(row);
 }
 
 }  // namespace cps

@@ -1,4 +1,4 @@
-// Projected Gauss-Seidel, paper Sec. 7.2.
+// Projected Gauss-Seidel (paper Sec. 7.2) and projected Jacobi (Sec. 7.1).
 #include "cps/solver.h"
 
 #include <algorithm>
@@ -6,39 +6,83 @@
 #include <string>
 
 namespace cps {
+namespace {
+
+// (b_j - sum_{i != j} A_ji lambda_i) and A_jj for row j (Eq. 7.1.1).
+void row_sum(const SparseRowMatrix& A, const Eigen::VectorXd& b, const Eigen::VectorXd& lambda,
+             Eigen::Index j, double& sum, double& diagonal) {
+  sum = b[j];
+  diagonal = 0.0;
+  for (SparseRowMatrix::InnerIterator it(A, j); it; ++it) {
+    if (it.col() == j) {
+      diagonal = it.value();
+    } else {
+      sum -= it.value() * lambda[it.col()];
+    }
+  }
+}
+
+}  // namespace
+
+Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
+                          const RowLimits& limits, FrictionModel friction, SolverKind kind,
+                          int iterations) {
+  const Eigen::Index c = b.size();
+  if (A.rows() != c || A.cols() != c || limits.c_min.size() != c || limits.c_max.size() != c) {
+    throw std::invalid_argument("solve_lcp: A is " + std::to_string(A.rows()) + " x " +
+                                std::to_string(A.cols()) + ", b, c_min, c_max have " +
+                                std::to_string(c) + ", " + std::to_string(limits.c_min.size()) +
+                                ", " + std::to_string(limits.c_max.size()) +
+                                " entries; A must be c x c");
+  }
+  const bool coupled = friction == FrictionModel::coupled;
+  if (coupled && (static_cast<Eigen::Index>(limits.normal_row.size()) != c || limits.mu.size() != c)) {
+    throw std::invalid_argument("solve_lcp: coupled friction needs normal_row and mu for every row");
+  }
+  if (iterations < 0) {
+    throw std::invalid_argument("solve_lcp: iterations " + std::to_string(iterations) +
+                                " must be >= 0");
+  }
+  // Bounds of row j given the lambda the row reads from.
+  const auto bounds = [&](Eigen::Index j, const Eigen::VectorXd& lambda, double& lo, double& hi) {
+    const int n = coupled ? limits.normal_row[static_cast<std::size_t>(j)] : -1;
+    if (n >= 0) {
+      hi = limits.mu[j] * lambda[n];
+      lo = -hi;
+    } else {
+      lo = limits.c_min[j];
+      hi = limits.c_max[j];
+    }
+  };
+
+  // PGS writes into lambda as it goes; Jacobi writes into `next` and swaps after the sweep.
+  const bool jacobi = kind == SolverKind::jacobi;
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(c);  // initial guess 0
+  Eigen::VectorXd next = Eigen::VectorXd::Zero(jacobi ? c : 0);
+  for (int k = 0; k < iterations; ++k) {
+    Eigen::VectorXd& out = jacobi ? next : lambda;
+    for (Eigen::Index j = 0; j < c; ++j) {
+      double sum;
+      double diagonal;
+      row_sum(A, b, lambda, j, sum, diagonal);
+      if (!(diagonal > 0.0)) continue;  // the row touches no movable body: lambda_j stays 0
+      double lo;
+      double hi;
+      bounds(j, lambda, lo, hi);
+      out[j] = std::clamp(sum / diagonal, lo, hi);
+    }
+    if (jacobi) lambda.swap(next);
+  }
+  return lambda;
+}
 
 Eigen::VectorXd solve_pgs(const SparseRowMatrix& A, const Eigen::VectorXd& b,
                           const Eigen::VectorXd& c_min, const Eigen::VectorXd& c_max,
                           int iterations) {
-  const Eigen::Index c = b.size();
-  if (A.rows() != c || A.cols() != c || c_min.size() != c || c_max.size() != c) {
-    throw std::invalid_argument("solve_pgs: A is " + std::to_string(A.rows()) + " x " +
-                                std::to_string(A.cols()) + ", b, c_min, c_max have " +
-                                std::to_string(c) + ", " + std::to_string(c_min.size()) + ", " +
-                                std::to_string(c_max.size()) + " entries; A must be c x c");
-  }
-  if (iterations < 0) {
-    throw std::invalid_argument("solve_pgs: iterations " + std::to_string(iterations) +
-                                " must be >= 0");
-  }
-  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(c);  // initial guess 0
-  for (int k = 0; k < iterations; ++k) {
-    for (Eigen::Index j = 0; j < c; ++j) {
-      // lambda_j = (b_j - sum_{i != j} A_ji lambda_i) / A_jj   (Eq. 7.1.1)
-      double sum = b[j];
-      double diagonal = 0.0;
-      for (SparseRowMatrix::InnerIterator it(A, j); it; ++it) {
-        if (it.col() == j) {
-          diagonal = it.value();
-        } else {
-          sum -= it.value() * lambda[it.col()];
-        }
-      }
-      if (!(diagonal > 0.0)) continue;  // the row touches no movable body
-      lambda[j] = std::clamp(sum / diagonal, c_min[j], c_max[j]);
-    }
-  }
-  return lambda;
+  RowLimits limits;
+  limits.c_min = c_min;
+  limits.c_max = c_max;
+  return solve_lcp(A, b, limits, FrictionModel::fixed, SolverKind::pgs, iterations);
 }
 
 }  // namespace cps

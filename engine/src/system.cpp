@@ -57,23 +57,28 @@ System assemble_system(const std::vector<ConstraintRow>& rows, const std::vector
   // J: one row per constraint, 12 entries at the columns of its two bodies (Sec. 6.1.2).
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(static_cast<std::size_t>(12 * c));
-  s.c_min.resize(c);
-  s.c_max.resize(c);
+  s.limits.c_min.resize(c);
+  s.limits.c_max.resize(c);
+  s.limits.mu.resize(c);
+  s.limits.normal_row.resize(static_cast<std::size_t>(c));
   for (Eigen::Index r = 0; r < c; ++r) {
     const ConstraintRow& row = rows[static_cast<std::size_t>(r)];
     for (int body : {row.body_a, row.body_b}) {
-      if (body < 0 || body >= n) {
+      if (body != kWorldBody && (body < 0 || body >= n)) {
         throw std::invalid_argument("assemble_system: row " + std::to_string(r) +
                                     " refers to body " + std::to_string(body) + "; there are " +
                                     std::to_string(n));
       }
     }
+    // A fixed world point (kWorldBody) has no columns: its half of j acts on nothing.
     for (int k = 0; k < 6; ++k) {
-      triplets.emplace_back(r, body_column(row.body_a) + k, row.j[k]);
-      triplets.emplace_back(r, body_column(row.body_b) + k, row.j[k + 6]);
+      if (row.body_a != kWorldBody) triplets.emplace_back(r, body_column(row.body_a) + k, row.j[k]);
+      if (row.body_b != kWorldBody) triplets.emplace_back(r, body_column(row.body_b) + k, row.j[k + 6]);
     }
-    s.c_min[r] = row.c_min;
-    s.c_max[r] = row.c_max;
+    s.limits.c_min[r] = row.c_min;
+    s.limits.c_max[r] = row.c_max;
+    s.limits.mu[r] = row.mu;
+    s.limits.normal_row[static_cast<std::size_t>(r)] = row.normal_row;
   }
   s.J.resize(c, 6 * n);
   s.J.setFromTriplets(triplets.begin(), triplets.end());

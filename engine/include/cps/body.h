@@ -7,24 +7,29 @@ namespace cps {
 
 /// The kinds of collision shape.
 enum class ShapeKind {
-  box,    ///< a cuboid given by its half extents
-  plane,  ///< an infinite half space; static bodies only
+  box,     ///< a cuboid given by its half extents
+  sphere,  ///< a ball given by its radius
+  plane,   ///< an infinite half space; static bodies only
 };
 
 /// A collision shape in body space.
 /// - box: half_extents (m), each finite and > 0.
+/// - sphere: radius (m), finite and > 0, centred on the body origin.
 /// - plane: the half space {x : dot(normal, x) <= offset} of body space is solid; normal is a
 ///   unit 3-vector pointing out of the solid to the free side, offset in m.
-/// Build one with Shape::box or Shape::plane, which validate their input.
+/// Build one with Shape::box, Shape::sphere or Shape::plane, which validate their input.
 struct Shape {
   ShapeKind kind = ShapeKind::box;
   Vec3 half_extents = Vec3::Constant(0.5);
+  double radius = 0.5;
   Vec3 normal = Vec3::UnitY();
   double offset = 0.0;
 
   /// A box of half extents h (m, 3-vector). Throws std::invalid_argument naming the value if any
   /// component is not finite and > 0.
   static Shape box(const Vec3& h);
+  /// A sphere of radius r (m). Throws std::invalid_argument naming the value unless finite > 0.
+  static Shape sphere(double r);
   /// A plane with outward normal n (any non-zero finite 3-vector; it is normalised) at signed
   /// distance offset (m) from the body origin along n. Throws std::invalid_argument on a zero or
   /// non-finite normal or a non-finite offset.
@@ -74,6 +79,12 @@ struct Body {
 /// Body-space inertia tensor (kg m^2, 3 x 3) of a solid box of the given mass (kg) and half
 /// extents (m): I = m/3 diag(hy^2 + hz^2, hx^2 + hz^2, hx^2 + hy^2).
 Mat3 box_inertia(double mass, const Vec3& half_extents);
+
+/// Body-space inertia tensor (kg m^2, 3 x 3) of a solid ball: I = 2/5 m r^2 D.
+Mat3 sphere_inertia(double mass, double radius);
+
+/// Body-space inertia tensor (kg m^2, 3 x 3) of a movable body of the given shape and mass (kg).
+Mat3 shape_inertia(const Shape& shape, double mass);
 
 /// Builds a Body from a definition. Throws std::invalid_argument naming the bad value for a
 /// non-positive or non-finite mass of a movable body, a movable plane, a non-finite position or

@@ -59,4 +59,20 @@ int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Mani
 /// the number of contacts written to `out` (0 when a separating axis exists).
 int collide_box_box(const OrientedBox& a, const OrientedBox& b, Manifold& out);
 
+/// Sphere-plane contact: sphere of centre c (m) and radius r (m) against the plane
+/// {x : dot(n, x) = offset}; normal n (from plane to sphere), depth r - (dot(n, c) - offset).
+/// Returns 0 or 1 contacts written to `out`.
+int collide_sphere_plane(const Vec3& c, double r, const Vec3& n, double offset, Manifold& out);
+
+/// Sphere-sphere contact between spheres (c_a, r_a) and (c_b, r_b) (m); normal from a to b,
+/// depth r_a + r_b - |c_b - c_a|. Coincident centres (closer than 1e-12 m) get the normal +y,
+/// so the pair still separates. Returns 0 or 1 contacts written to `out`.
+int collide_sphere_sphere(const Vec3& c_a, double r_a, const Vec3& c_b, double r_b, Manifold& out);
+
+/// Box-sphere contact by the closest point of the box to the sphere centre c (m), radius r (m)
+/// (Ericson 2005, Sec. 5.1.4). Normal from the box to the sphere. A centre inside the box is
+/// pushed out through the face it is nearest to (depth = distance to that face + r). Returns 0
+/// or 1 contacts written to `out`.
+int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold& out);
+
 }  // namespace cps

@@ -13,7 +13,11 @@ namespace cps {
 enum class RowKind {
   contact,   ///< Sec. 5.3: non-penetration along the contact normal
   friction,  ///< Sec. 5.4: no sliding along a tangent
+  distance,  ///< Sec. 5.2: two points at a fixed distance (a rod)
 };
+
+/// Body index that stands for the static world (a fixed point) in a row or distance constraint.
+inline constexpr int kWorldBody = -1;
 
 /// One row of J with its right-hand side terms.
 /// - j: 12-vector [-n, -(r_a x n), n, r_b x n] for a unit axis n (no unit / m).
@@ -22,6 +26,10 @@ enum class RowKind {
 /// - bias: the part of the target velocity that must add velocity, e.g. restitution (m/s,
 ///   Eq. 8.2.1); kept in both solves. Target v = push + bias.
 /// - c_min, c_max: force limits (N), c_min <= 0 <= c_max, possibly infinite.
+/// - normal_row: for a friction row, the index of its contact row (for the coupled friction
+///   limit mu lambda_n); -1 otherwise.
+/// - mu: for a friction row, the friction coefficient (dimensionless).
+/// body_a or body_b may be kWorldBody (a fixed world point): that half of j then acts on nothing.
 struct ConstraintRow {
   RowKind kind = RowKind::contact;
   int body_a = -1;
@@ -31,6 +39,8 @@ struct ConstraintRow {
   double bias = 0.0;
   double c_min = -kInfinity;
   double c_max = kInfinity;
+  int normal_row = -1;
+  double mu = 0.0;
 };
 
 /// The 12-vector j = [-n, -(r_a x n), n, r_b x n] of a row along unit axis n between the points
@@ -44,20 +54,49 @@ void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2);
 
 /// Parameters of the row builder. beta: push factor constant (dimensionless, [0, 1], typical
 /// 0.2); dt: time step (s); friction: coefficient mu (dimensionless, >= 0, typical 0.5; 0 builds
-/// no friction rows); gravity: (m/s^2) for the friction limit mu m |g . n|.
+/// no friction rows); gravity: (m/s^2) for the friction limit mu m |g . n|; restitution:
+/// coefficient eps (dimensionless, [0, 1], typical 0 to 0.5); restitution_threshold: approach
+/// speed (m/s, >= 0, typical 1) below which a contact gets no restitution, so resting contacts
+/// do not bounce.
 struct RowParams {
   double beta = 0.2;
   double dt = 1.0 / 60.0;
   double friction = 0.5;
   Vec3 gravity = Vec3(0.0, -10.0, 0.0);
+  double restitution = 0.0;
+  double restitution_threshold = 1.0;
 };
 
 /// Appends the rows of one manifold to `rows`: per contact point a contact row (Sec. 5.3:
 /// c_min = 0, c_max = +inf, push = beta d / dt) and, when friction > 0, two friction rows
 /// (Sec. 5.4: target 0, limits +-mu m |g . n| where m is the combined mass of the two bodies
 /// divided over the manifold's points, the movable body's mass when the other is static).
-/// Rows come per point in the order contact, friction t1, friction t2.
+/// Rows come per point in the order contact, friction t1, friction t2. With restitution > 0 a
+/// contact whose points approach faster than the threshold (j . v1 < -threshold) gets the bias
+/// v_r = -eps j . v1 (Eq. 8.2.1).
 void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
+                         const RowParams& params, std::vector<ConstraintRow>& rows);
+
+/// A distance constraint (Sec. 5.2): point local_a of body_a and point local_b of body_b stay
+/// `length` apart (m, >= 0). local_a, local_b are in body space (m); when body_b is kWorldBody,
+/// local_b is a fixed world point (m). The row is unbounded (c_min = -inf, c_max = +inf).
+struct DistanceConstraint {
+  int body_a = 0;
+  Vec3 local_a = Vec3::Zero();
+  int body_b = kWorldBody;
+  Vec3 local_b = Vec3::Zero();
+  double length = 1.0;
+};
+
+/// World positions (m) of the two end points of a distance constraint.
+void distance_endpoints(const DistanceConstraint& d, const std::vector<Body>& bodies, Vec3& p_a,
+                        Vec3& p_b);
+
+/// Appends the row of one distance constraint: unit axis n = (p_b - p_a) / |p_b - p_a| (Sec. 9.2;
+/// +y if the points coincide), j = [-n, -(r_a x n), n, r_b x n] and, with C = |p_b - p_a| - l
+/// (m), push = -beta C / dt (NOTES.md: a stretched rod gets a negative target and shrinks;
+/// Eq. 5.2.3 prints the opposite sign).
+void append_distance_row(const DistanceConstraint& d, const std::vector<Body>& bodies,
                          const RowParams& params, std::vector<ConstraintRow>& rows);
 
 }  // namespace cps

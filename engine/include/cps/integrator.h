@@ -9,14 +9,22 @@
 
 namespace cps {
 
+/// How the orientation follows the angular velocity w = I^-1 l over a step.
+enum class RotationUpdate {
+  linear,  ///< o += 1/2 [0, w] o dt, then normalise (Eq. 3.2.4)
+  exact,   ///< o = [cos(|w| dt / 2), sin(|w| dt / 2) w / |w|] o (Eq. 12.4.1)
+};
+
 /// Advances every movable body by dt (s, > 0).
 /// f_position and f_momentum (6n each): force and torque per body (N, N m), external plus
 /// constraint forces. Momenta advanced with f_position move the bodies (Eqs. 3.2.3, 3.2.4):
-///   x += (p + f dt) / m dt;  o += 1/2 [0, I^-1 (l + tau dt)] o dt, then o is normalised;
+///   x += (p + f dt) / m dt;  o += 1/2 [0, I^-1 (l + tau dt)] o dt, then o is normalised
+///   (or the exact axis-angle step of Eq. 12.4.1 with RotationUpdate::exact);
 /// the stored momenta are advanced with f_momentum (Eqs. 3.2.1, 3.2.2). For the ordinary step
 /// both are the same vector; the single frame push factor (Sec. 8.1) passes f_cv and f_c0.
 /// I^-1 is taken at the orientation before the step. Static bodies do not move.
 void integrate(std::vector<Body>& bodies, const Eigen::VectorXd& f_position,
-               const Eigen::VectorXd& f_momentum, double dt);
+               const Eigen::VectorXd& f_momentum, double dt,
+               RotationUpdate rotation = RotationUpdate::linear);
 
 }  // namespace cps

@@ -1,17 +1,38 @@
 #pragma once
-// Projected Gauss-Seidel (paper Sec. 7): solves A lambda = b with c_min <= lambda <= c_max.
+// Iterative solution of A lambda = b with bounds on lambda (paper Sec. 6.2.3 and 7):
+// projected Gauss-Seidel, and Jacobi for comparison.
 
 #include "cps/system.h"
 
 namespace cps {
 
-/// Projected Gauss-Seidel exactly as the pseudo code of Sec. 7.2: initial guess lambda = 0,
-/// `iterations` sweeps over the rows in order, each row
-///   lambda_j = clamp((b_j - sum_{i != j} A_ji lambda_i) / A_jj, c_min_j, c_max_j)   (Eq. 7.1.1)
-/// using the new values at once. A: c x c (row-major sparse, symmetric, A_jj > 0); b, c_min,
-/// c_max: c. Returns lambda (c, in N for unit-axis rows). A row with A_jj <= 0 (it touches no
-/// movable body) keeps lambda_j = 0. Throws std::invalid_argument on mismatched sizes or
-/// iterations < 0.
+/// The iteration used for A lambda = b.
+enum class SolverKind {
+  pgs,     ///< projected Gauss-Seidel: new values used at once (Sec. 7.2)
+  jacobi,  ///< projected Jacobi: new values used after the sweep (Sec. 7.1)
+};
+
+/// How friction rows are bounded.
+enum class FrictionModel {
+  fixed,    ///< the paper's limit +-mu m |g . n| set when the row is built (Sec. 5.4)
+  coupled,  ///< +-mu lambda_n with lambda_n the current value of the row's contact row, as
+            ///< sequential impulse solvers do (Catto, "Iterative Dynamics", GDC 2005)
+};
+
+/// Solves A lambda = b subject to the bounds of each row (Eq. 7.1.1 with clamping):
+///   lambda_j = clamp((b_j - sum_{i != j} A_ji lambda_i) / A_jj, lo_j, hi_j)
+/// with initial guess 0 and a fixed number of sweeps over the rows in order. lo_j, hi_j are
+/// limits.c_min_j, limits.c_max_j, except for friction rows under FrictionModel::coupled, where
+/// they are -+mu_j lambda_{normal_row_j} with the current contact-row value.
+/// A: c x c (row-major sparse, symmetric, A_jj > 0); b: c. Returns lambda (c, N for unit-axis
+/// rows). A row with A_jj <= 0 (it touches no movable body) keeps lambda_j = 0.
+/// Throws std::invalid_argument on mismatched sizes or iterations < 0.
+Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
+                          const RowLimits& limits, FrictionModel friction, SolverKind kind,
+                          int iterations);
+
+/// Projected Gauss-Seidel exactly as the pseudo code of Sec. 7.2, with fixed bounds c_min, c_max
+/// (c each): solve_lcp with SolverKind::pgs and FrictionModel::fixed.
 Eigen::VectorXd solve_pgs(const SparseRowMatrix& A, const Eigen::VectorXd& b,
                           const Eigen::VectorXd& c_min, const Eigen::VectorXd& c_max,
                           int iterations);

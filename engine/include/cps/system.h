@@ -26,14 +26,23 @@ using SparseRowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 /// constraint-correcting push factor).
 enum class TargetTerms { push_and_bias, bias_only };
 
+/// The bounds on lambda, per row (c each): c_min, c_max (N); for friction rows also the index
+/// of their contact row and mu (dimensionless), for the coupled friction limit; -1 and 0 for
+/// other rows.
+struct RowLimits {
+  Eigen::VectorXd c_min;
+  Eigen::VectorXd c_max;
+  std::vector<int> normal_row;
+  Eigen::VectorXd mu;
+};
+
 /// The assembled system. Sizes as in the header comment.
 struct System {
   SparseRowMatrix J;
   Eigen::SparseMatrix<double> M_inv;
   SparseRowMatrix A;
   Eigen::VectorXd b;
-  Eigen::VectorXd c_min;
-  Eigen::VectorXd c_max;
+  RowLimits limits;
 };
 
 /// v1 (6n): [v_i, w_i] per body in body order.

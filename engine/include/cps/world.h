@@ -1,14 +1,18 @@
 #pragma once
 // The world and its step. One step reads as the paper's stages, in order:
-//   1. collide          Sec. 4    manifolds for every pair that can touch
-//   2. build rows       Sec. 5    contact and friction rows per contact point
+//   1. collide          Sec. 4    manifolds for every pair that can touch (skipped when the
+//                                 world has collision off)
+//   2. build rows       Sec. 5    contact, friction (only with mu > 0) and distance rows
 //   3. assemble         Sec. 6    J, M^-1, A and b of Eq. 6.2.9
-//   4. solve            Sec. 7    projected Gauss-Seidel for lambda
+//   4. solve            Sec. 7    lambda by PGS (or Jacobi); with the single frame push factor a
+//                                 second solve with the push left out of v (Sec. 8.1)
 //   5. integrate        Sec. 3.2  f = f_ext + J^T lambda, semi-implicit Euler
 
 #include "cps/body.h"
 #include "cps/collision.h"
 #include "cps/constraint.h"
+#include "cps/integrator.h"
+#include "cps/solver.h"
 
 #include <Eigen/Core>
 
@@ -17,13 +21,27 @@
 
 namespace cps {
 
+/// How violated constraints are corrected.
+enum class PushMode {
+  baumgarte,  ///< the push factor stays in the velocity (Eq. 5.2.3, 5.3.1): one solve a step
+  split,      ///< the single frame push factor (Sec. 8.1): positions move with f_cv, the stored
+              ///< momenta with f_c0 from a second solve without the push
+};
+
 /// World parameters, each with its unit and a typical value. Validate with validate().
 struct WorldDef {
   Vec3 gravity = Vec3(0.0, -10.0, 0.0);  ///< m/s^2; the paper uses (0, -10, 0)
   double dt = 1.0 / 60.0;                ///< time step (s), > 0; the paper uses 1/60
-  int iterations = 25;                   ///< PGS sweeps per solve, >= 1; the paper uses 25
+  int iterations = 25;                   ///< solver sweeps per solve, >= 1; the paper uses 25
   double beta = 0.2;                     ///< push factor constant (dimensionless) in [0, 1]; 0.2
   double friction = 0.5;                 ///< friction coefficient mu (dimensionless) >= 0; 0.5
+  double restitution = 0.0;              ///< coefficient of restitution eps in [0, 1]; 0
+  double restitution_threshold = 1.0;    ///< approach speed (m/s) >= 0 below which no bounce; 1
+  PushMode push = PushMode::baumgarte;   ///< Sec. 5 (baumgarte) or Sec. 8.1 (split)
+  SolverKind solver = SolverKind::pgs;   ///< Sec. 7.2 PGS, or Jacobi
+  FrictionModel friction_model = FrictionModel::fixed;  ///< Sec. 5.4 fixed, or coupled
+  RotationUpdate rotation = RotationUpdate::linear;     ///< Eq. 3.2.4, or Eq. 12.4.1
+  bool collision = true;  ///< false: the bodies never collide and stage 1 is skipped
 
   /// Throws std::invalid_argument naming the parameter, its value and what is allowed.
   void validate() const;
@@ -34,12 +52,13 @@ struct StepCounters {
   std::int64_t steps = 0;
   std::int64_t pairs_tested = 0;  ///< body pairs handed to the narrow phase
   std::int64_t contacts = 0;      ///< contact points found
-  std::int64_t rows = 0;          ///< constraint rows solved (counted once per solve)
-  std::int64_t solves = 0;        ///< PGS solves
+  std::int64_t rows = 0;          ///< constraint rows built
+  std::int64_t solves = 0;        ///< solves of A lambda = b
 };
 
-/// A set of bodies stepped by the constraint solver. Bodies are referred to by index, in the
-/// order they were added; the order of every loop depends on indices only.
+/// A set of bodies and distance constraints stepped by the constraint solver. Bodies are
+/// referred to by index, in the order they were added; the order of every loop depends on
+/// indices only.
 class World {
  public:
   /// Throws std::invalid_argument if def is invalid (see WorldDef::validate).
@@ -49,18 +68,25 @@ class World {
   /// the world unchanged on bad input.
   int add_body(const BodyDef& def);
 
+  /// Adds a distance constraint (Sec. 5.2) and returns its index. Throws std::invalid_argument
+  /// naming the value, leaving the world unchanged, for a body index that does not exist or is
+  /// static (body_a must be movable; body_b may be kWorldBody), equal bodies, non-finite points,
+  /// or a length that is negative or not finite (m).
+  int add_distance(const DistanceConstraint& d);
+
   /// Advances the world by def().dt (s).
   void step();
 
   const WorldDef& def() const { return def_; }
   const std::vector<Body>& bodies() const { return bodies_; }
   const Body& body(int i) const { return bodies_.at(static_cast<std::size_t>(i)); }
+  const std::vector<DistanceConstraint>& distances() const { return distances_; }
   /// Simulated time (s): steps taken times dt.
   double time() const { return static_cast<double>(counters_.steps) * def_.dt; }
   const StepCounters& counters() const { return counters_; }
   /// Manifolds found by the last step's collision stage (normals from a to b, depths in m).
   const std::vector<Manifold>& manifolds() const { return manifolds_; }
-  /// Rows built by the last step (c of them) and their lambda (c, N).
+  /// Rows built by the last step (c of them) and lambda of its (first) solve (c, N).
   const std::vector<ConstraintRow>& rows() const { return rows_; }
   const Eigen::VectorXd& lambda() const { return lambda_; }
 
@@ -68,9 +94,11 @@ class World {
   void collide();
   void build_rows();
   void solve_and_integrate();
+  Eigen::VectorXd solve(const SparseRowMatrix& A, const Eigen::VectorXd& b, const RowLimits& l);
 
   WorldDef def_;
   std::vector<Body> bodies_;
+  std::vector<DistanceConstraint> distances_;
   std::vector<Manifold> manifolds_;
   std::vector<ConstraintRow> rows_;
   Eigen::VectorXd lambda_;

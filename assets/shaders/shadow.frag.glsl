@@ -1,0 +1,3 @@
+// Depth-only pass: only the depth buffer is written.
+
+void main() {}

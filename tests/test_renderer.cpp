@@ -1,0 +1,304 @@
+// Tests of the offscreen renderer (OSMesa), PNG round trip and camera framing helpers.
+
+#include "cps/render/draw_list.h"
+#include "cps/render/renderer.h"
+
+#include <catch2/catch.hpp>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <array>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+namespace fs = std::filesystem;
+using namespace cps::render;
+
+namespace {
+
+struct Rgb {
+  int r, g, b;
+};
+
+Rgb pixel(const Image& img, int x, int y) {
+  const auto i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) +
+                  static_cast<std::size_t>(x)) * 3u;
+  return {img.pixels[i], img.pixels[i + 1], img.pixels[i + 2]};
+}
+
+int max_channel_diff(const Rgb& a, const Rgb& b) {
+  return std::max({std::abs(a.r - b.r), std::abs(a.g - b.g), std::abs(a.b - b.b)});
+}
+
+Rgb to_bytes(const glm::vec3& c) {
+  return {static_cast<int>(std::lround(c.r * 255.0f)), static_cast<int>(std::lround(c.g * 255.0f)),
+          static_cast<int>(std::lround(c.b * 255.0f))};
+}
+
+/// A fresh, empty folder under the system temp folder, removed at scope exit.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    std::random_device rd;
+    path = fs::temp_directory_path() / ("cps_test_renderer_" + std::to_string(rd()));
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+};
+
+DrawList red_box_scene() {
+  DrawList list;
+  BoxItem box;
+  box.center = glm::vec3(0.0f);
+  box.half_extents = glm::vec3(1.0f);
+  box.color = glm::vec3(0.9f, 0.1f, 0.1f);
+  list.boxes.push_back(box);
+  PlaneItem ground;
+  ground.normal = glm::vec3(0.0f, 1.0f, 0.0f);
+  ground.offset = -1.0f;  // y = -1, under the box
+  list.planes.push_back(ground);
+  list.camera.eye = glm::vec3(0.0f, 2.0f, 8.0f);
+  list.camera.target = glm::vec3(0.0f);
+  list.camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
+  list.camera.fov_y_deg = 45.0f;
+  list.camera.near_m = 0.1f;
+  list.camera.far_m = 200.0f;
+  list.background = glm::vec3(0.86f, 0.90f, 0.95f);
+  return list;
+}
+
+/// Pixel (column, row from the top) where world point p lands, with the renderer's camera model.
+std::array<int, 2> project_to_pixel(const Camera& cam, int width, int height, const glm::vec3& p) {
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  const glm::mat4 proj =
+      glm::perspective(glm::radians(cam.fov_y_deg), aspect, cam.near_m, cam.far_m);
+  const glm::mat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
+  const glm::vec3 win = glm::project(p, view, proj,
+                                     glm::vec4(0.0f, 0.0f, static_cast<float>(width),
+                                               static_cast<float>(height)));
+  const int x = static_cast<int>(win.x);
+  const int y = height - 1 - static_cast<int>(win.y);  // window y goes up, image rows go down
+  return {x, y};
+}
+
+}  // namespace
+
+TEST_CASE("renderer draws a lit box over a plane and the PNG round trips", "[renderer]") {
+  constexpr int w = 160;
+  constexpr int h = 120;
+  Renderer renderer(w, h);
+  REQUIRE(renderer.width() == w);
+  REQUIRE(renderer.height() == h);
+
+  const DrawList list = red_box_scene();
+  const Image img = renderer.draw(list);
+  REQUIRE(img.width == w);
+  REQUIRE(img.height == h);
+  REQUIRE(img.pixels.size() == static_cast<std::size_t>(w * h * 3));
+
+  const Rgb bg = to_bytes(list.background);
+  const auto [cx, cy] = project_to_pixel(list.camera, w, h, glm::vec3(0.0f));
+  REQUIRE(cx >= 0);
+  REQUIRE(cx < w);
+  REQUIRE(cy >= 0);
+  REQUIRE(cy < h);
+  const Rgb centre = pixel(img, cx, cy);
+  INFO("box centre pixel (" << cx << ", " << cy << ") = " << centre.r << " " << centre.g << " "
+                            << centre.b);
+  CHECK(max_channel_diff(centre, bg) > 60);
+  CHECK(centre.r > centre.g + 40);  // it is the red box, not the grey ground
+  CHECK(centre.r > centre.b + 40);
+
+  // Top corners look over the horizon: pure background.
+  for (int x : {0, w - 1}) {
+    const Rgb sky = pixel(img, x, 0);
+    INFO("sky pixel (" << x << ", 0) = " << sky.r << " " << sky.g << " " << sky.b);
+    CHECK(max_channel_diff(sky, bg) <= 2);
+  }
+  // The ground straight below the box, near the bottom of the frame, is drawn (not background).
+  const Rgb ground = pixel(img, w / 2, h - 2);
+  CHECK(max_channel_diff(ground, bg) > 10);
+
+  // Drawing the same list again gives the same frame (no state leaks between frames).
+  const Image again = renderer.draw(list);
+  CHECK(again.pixels == img.pixels);
+
+  TempDir dir;
+  const fs::path png = dir.path / "frame.png";
+  write_png(png, img);
+  REQUIRE(fs::exists(png));
+  const Image back = read_png(png);
+  CHECK(back.width == w);
+  CHECK(back.height == h);
+  CHECK(back.pixels == img.pixels);
+  for (const fs::directory_entry& e : fs::directory_iterator(dir.path)) {
+    INFO("left in the folder: " << e.path());
+    CHECK(e.path().extension() != ".tmp");
+  }
+  // Overwriting an existing frame works too.
+  write_png(png, again);
+  CHECK(read_png(png).pixels == again.pixels);
+}
+
+TEST_CASE("renderer shows the background when the list is empty", "[renderer]") {
+  Renderer renderer(32, 24);
+  DrawList list;
+  list.background = glm::vec3(0.2f, 0.4f, 0.6f);
+  const Image img = renderer.draw(list);
+  const Rgb bg = to_bytes(list.background);
+  for (int y : {0, 12, 23}) {
+    for (int x : {0, 16, 31}) CHECK(max_channel_diff(pixel(img, x, y), bg) <= 1);
+  }
+}
+
+TEST_CASE("renderer draws spheres, lines and translucent planes", "[renderer]") {
+  constexpr int w = 120;
+  constexpr int h = 90;
+  Renderer renderer(w, h);
+  DrawList list;
+  SphereItem ball;
+  ball.center = glm::vec3(0.0f, 0.0f, 0.0f);
+  ball.radius = 1.0f;
+  ball.color = glm::vec3(0.1f, 0.2f, 0.9f);
+  list.spheres.push_back(ball);
+  LineItem rod;
+  rod.a = glm::vec3(-3.0f, 2.0f, 0.0f);
+  rod.b = glm::vec3(3.0f, 2.0f, 0.0f);
+  rod.color = glm::vec3(0.0f);
+  rod.width_px = 3.0f;
+  list.lines.push_back(rod);
+  list.camera.eye = glm::vec3(0.0f, 0.0f, 10.0f);
+  list.camera.target = glm::vec3(0.0f);
+  const Rgb bg = to_bytes(list.background);
+
+  const Image opaque = renderer.draw(list);
+  const auto [sx, sy] = project_to_pixel(list.camera, w, h, ball.center);
+  const Rgb s = pixel(opaque, sx, sy);
+  CHECK(s.b > s.r + 30);  // the blue ball
+  const auto [lx, ly] = project_to_pixel(list.camera, w, h, glm::vec3(2.5f, 2.0f, 0.0f));
+  const Rgb l = pixel(opaque, lx, ly);
+  INFO("line pixel " << l.r << " " << l.g << " " << l.b);
+  CHECK(max_channel_diff(l, bg) > 100);  // the black rod
+
+  // A half-transparent plane in front of the ball (between it and the camera): the ball still
+  // shows through, but its pixel changes.
+  PlaneItem glass;
+  glass.normal = glm::vec3(0.0f, 0.0f, 1.0f);
+  glass.offset = 2.0f;  // z = 2
+  glass.half_size = 4.0f;
+  glass.alpha = 0.5f;
+  glass.color_a = glass.color_b = glm::vec3(1.0f, 1.0f, 0.0f);
+  list.planes.push_back(glass);
+  const Image behind = renderer.draw(list);
+  const Rgb t = pixel(behind, sx, sy);
+  CHECK(max_channel_diff(t, s) > 20);
+  CHECK(t.b > 40);  // blue still contributes
+}
+
+TEST_CASE("renderer rejects invalid sizes", "[renderer]") {
+  CHECK_THROWS_AS(Renderer(0, 10), std::invalid_argument);
+  CHECK_THROWS_AS(Renderer(-1, 10), std::invalid_argument);
+  CHECK_THROWS_AS(Renderer(9000, 10), std::invalid_argument);
+  CHECK_THROWS_AS(Renderer(10, 0), std::invalid_argument);
+  CHECK_THROWS_AS(Renderer(10, -1), std::invalid_argument);
+  CHECK_THROWS_AS(Renderer(10, 9000), std::invalid_argument);
+  CHECK_THROWS_WITH(Renderer(9000, 10), Catch::Contains("9000"));
+  CHECK_NOTHROW(Renderer(1, 1));
+}
+
+TEST_CASE("write_png and read_png report failures with the path", "[renderer]") {
+  TempDir dir;
+  const fs::path missing_dir = dir.path / "does_not_exist" / "frame.png";
+  Image img;
+  img.width = 4;
+  img.height = 3;
+  img.pixels.assign(4 * 3 * 3, 128);
+  CHECK_THROWS_AS(write_png(missing_dir, img), std::runtime_error);
+  CHECK_THROWS_WITH(write_png(missing_dir, img), Catch::Contains("does_not_exist"));
+  CHECK_FALSE(fs::exists(dir.path / "does_not_exist"));
+
+  Image empty;
+  CHECK_THROWS_AS(write_png(dir.path / "empty.png", empty), std::runtime_error);
+  Image short_pixels = img;
+  short_pixels.pixels.pop_back();
+  CHECK_THROWS_AS(write_png(dir.path / "short.png", short_pixels), std::runtime_error);
+  CHECK(fs::is_empty(dir.path));
+
+  CHECK_THROWS_AS(read_png(dir.path / "nope.png"), std::runtime_error);
+  CHECK_THROWS_WITH(read_png(dir.path / "nope.png"), Catch::Contains("nope.png"));
+}
+
+TEST_CASE("bounds covers rotated boxes and spheres", "[renderer]") {
+  DrawList list;
+  glm::vec3 lo(7.0f);
+  glm::vec3 hi(7.0f);
+  CHECK_FALSE(bounds(list, lo, hi));
+  CHECK(lo == glm::vec3(7.0f));  // untouched
+  CHECK(hi == glm::vec3(7.0f));
+
+  BoxItem box;
+  box.center = glm::vec3(1.0f, 2.0f, 3.0f);
+  box.half_extents = glm::vec3(1.0f, 2.0f, 3.0f);
+  box.orientation = glm::angleAxis(glm::radians(90.0f), glm::vec3(0.0f, 1.0f, 0.0f));
+  list.boxes.push_back(box);
+  SphereItem ball;
+  ball.center = glm::vec3(-5.0f, 0.0f, 3.0f);
+  ball.radius = 0.5f;
+  list.spheres.push_back(ball);
+  REQUIRE(bounds(list, lo, hi));
+  // 90 degrees about y swaps the x and z half extents.
+  CHECK(lo.x == Approx(-5.5f));
+  CHECK(hi.x == Approx(1.0f + 3.0f).margin(1e-5));
+  CHECK(lo.y == Approx(-0.5f));
+  CHECK(hi.y == Approx(4.0f));
+  CHECK(lo.z == Approx(2.0f).margin(1e-5));
+  CHECK(hi.z == Approx(4.0f).margin(1e-5));
+}
+
+TEST_CASE("frame_bounds keeps the whole box in view", "[renderer]") {
+  const glm::vec3 lo(-1.2f, 0.0f, -1.2f);
+  const glm::vec3 hi(1.2f, 12.0f, 1.2f);  // a tall stack
+  const glm::vec3 lo2(-6.0f, 0.0f, -0.5f);
+  const glm::vec3 hi2(6.0f, 1.0f, 0.5f);  // a wide row
+  for (const auto& [l, h] : {std::pair{lo, hi}, std::pair{lo2, hi2}}) {
+    for (float aspect : {16.0f / 9.0f, 1.0f}) {
+      const Camera cam = frame_bounds(l, h, aspect);
+      INFO("aspect " << aspect << ", box height " << (h.y - l.y));
+      CHECK(cam.eye.z > cam.target.z);  // in front
+      CHECK(cam.eye.y > cam.target.y);  // above
+      CHECK(cam.eye.x != Approx(cam.target.x));  // to the side
+      CHECK(cam.near_m > 0.0f);
+      CHECK(cam.far_m > cam.near_m);
+      CHECK(glm::all(glm::lessThan(glm::abs(cam.target - 0.5f * (l + h)), glm::vec3(1e-5f))));
+      const glm::mat4 proj =
+          glm::perspective(glm::radians(cam.fov_y_deg), aspect, cam.near_m, cam.far_m);
+      const glm::mat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
+      float max_ndc = 0.0f;
+      for (int i = 0; i < 8; ++i) {
+        const glm::vec3 c((i & 1) ? h.x : l.x, (i & 2) ? h.y : l.y, (i & 4) ? h.z : l.z);
+        const glm::vec4 clip = proj * view * glm::vec4(c, 1.0f);
+        REQUIRE(clip.w > 0.0f);
+        const glm::vec3 ndc = glm::vec3(clip) / clip.w;
+        CHECK(std::abs(ndc.x) < 1.0f);
+        CHECK(std::abs(ndc.y) < 1.0f);
+        CHECK(std::abs(ndc.z) < 1.0f);
+        max_ndc = std::max({max_ndc, std::abs(ndc.x), std::abs(ndc.y)});
+      }
+      // Not absurdly far away either: the box fills a fair part of the frame.
+      CHECK(max_ndc > 0.4f);
+    }
+  }
+  CHECK_THROWS_AS(frame_bounds(glm::vec3(1.0f), glm::vec3(0.0f), 1.0f), std::invalid_argument);
+  CHECK_THROWS_AS(frame_bounds(lo, hi, 0.0f), std::invalid_argument);
+  CHECK_THROWS_AS(frame_bounds(lo, hi, -1.0f), std::invalid_argument);
+}

@@ -24,6 +24,14 @@ class Metrics {
   virtual nlohmann::json report() const = 0;
 };
 
+/// Where the camera of a scene's pictures stands: eye and target (m), vertical field of view
+/// (degrees). A scene without one is framed automatically.
+struct CameraPreset {
+  Vec3 eye = Vec3::Zero();
+  Vec3 target = Vec3::Zero();
+  double fov_y_deg = 45.0;
+};
+
 /// A scene: its name (as typed on the command line), a one-line summary, its default duration
 /// (s), its world parameters, how to add its bodies and how to measure it.
 struct Scene {
@@ -33,6 +41,10 @@ struct Scene {
   WorldDef (*world_def)() = nullptr;
   void (*populate)(World& world) = nullptr;
   std::unique_ptr<Metrics> (*make_metrics)(const World& world) = nullptr;
+  /// Opacity of the scene's planes when drawn, in [0, 1]: below 1 for walls that bodies sit
+  /// behind (the funnel).
+  double plane_opacity = 1.0;
+  std::optional<CameraPreset> camera;
 };
 
 /// Every scene, in the order `cps list` prints them.
@@ -47,6 +59,11 @@ struct Overrides {
   std::optional<int> iterations;
   std::optional<double> beta;
   std::optional<double> friction;
+  std::optional<double> restitution;
+  std::optional<PushMode> push;
+  std::optional<SolverKind> solver;
+  std::optional<FrictionModel> friction_model;
+  std::optional<RotationUpdate> rotation;
 };
 
 /// The scene's WorldDef with the overrides applied. Not validated here: World's constructor does.
@@ -74,9 +91,35 @@ Run make_run(const Scene& scene, const Overrides& overrides = {});
 /// Deepest penetration (m) among the contacts of the world's last step; 0 if none.
 double deepest_contact(const World& world);
 
+/// Kinetic energy of all bodies (J), translational plus rotational.
+double kinetic_energy(const World& world);
+
+/// Largest |distance - length| (m) over the world's distance constraints now; 0 if none.
+double max_rod_error(const World& world);
+
+/// Deepest overlap (m) over every pair of bodies, from the geometry as it is now (runs the
+/// narrow phase on all pairs; independent of the last step's contacts).
+double max_penetration_now(const World& world);
+
 // The scenes (one file each).
 WorldDef stack_world_def();
 void populate_stack(World& world);
 std::unique_ptr<Metrics> make_stack_metrics(const World& world);
+
+WorldDef intersecting_stack_world_def();
+void populate_intersecting_stack(World& world);
+std::unique_ptr<Metrics> make_intersecting_stack_metrics(const World& world);
+
+WorldDef funnel_world_def();
+void populate_funnel(World& world);
+std::unique_ptr<Metrics> make_funnel_metrics(const World& world);
+
+WorldDef pendulum_grid_world_def();
+void populate_pendulum_grid(World& world);
+std::unique_ptr<Metrics> make_pendulum_grid_metrics(const World& world);
+
+WorldDef pendulum_wave_world_def();
+void populate_pendulum_wave(World& world);
+std::unique_ptr<Metrics> make_pendulum_wave_metrics(const World& world);
 
 }  // namespace cps::scenes

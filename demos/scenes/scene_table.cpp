@@ -2,13 +2,52 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace cps::scenes {
 namespace {
 
 const std::array kScenes = {
-    Scene{"stack", "5 cubes of 2.4 m and 1.2 kg dropped in a column onto the ground (Sec. 10.1)",
-          10.0, &stack_world_def, &populate_stack, &make_stack_metrics},
+    Scene{.name = "stack",
+          .summary = "5 cubes of 2.4 m and 1.2 kg dropped in a column onto the ground (Sec. 10.1)",
+          .default_seconds = 10.0,
+          .world_def = &stack_world_def,
+          .populate = &populate_stack,
+          .make_metrics = &make_stack_metrics,
+          .plane_opacity = 1.0,
+          .camera = std::nullopt},
+    Scene{.name = "intersecting_stack",
+          .summary = "the stack started 0.4 m into each other and 1.2 m into the ground (Sec. 10.2)",
+          .default_seconds = 4.0,
+          .world_def = &intersecting_stack_world_def,
+          .populate = &populate_intersecting_stack,
+          .make_metrics = &make_intersecting_stack_metrics,
+          .plane_opacity = 1.0,
+          .camera = CameraPreset{Vec3(18.0, 16.0, 40.0), Vec3(0.0, 10.0, 0.0), 45.0}},
+    Scene{.name = "funnel",
+          .summary = "20 balls poured into a funnel of 4 infinite planes (Sec. 10.3)",
+          .default_seconds = 10.0,
+          .world_def = &funnel_world_def,
+          .populate = &populate_funnel,
+          .make_metrics = &make_funnel_metrics,
+          .plane_opacity = 0.35,
+          .camera = CameraPreset{Vec3(9.0, 16.0, 15.0), Vec3(0.0, 2.5, 0.0), 40.0}},
+    Scene{.name = "pendulum_grid",
+          .summary = "5 x 5 balls on 3 m rods holding 4 boxes and a ball on top (Sec. 10.3)",
+          .default_seconds = 10.0,
+          .world_def = &pendulum_grid_world_def,
+          .populate = &populate_pendulum_grid,
+          .make_metrics = &make_pendulum_grid_metrics,
+          .plane_opacity = 1.0,
+          .camera = CameraPreset{Vec3(8.0, 13.0, 14.0), Vec3(0.0, 5.0, 0.0), 45.0}},
+    Scene{.name = "pendulum_wave",
+          .summary = "50 pendulums whose periods make a wave that realigns after 60 s (Sec. 10.3)",
+          .default_seconds = 62.0,
+          .world_def = &pendulum_wave_world_def,
+          .populate = &populate_pendulum_wave,
+          .make_metrics = &make_pendulum_wave_metrics,
+          .plane_opacity = 1.0,
+          .camera = CameraPreset{Vec3(2.2, 2.1, 1.7), Vec3(1.225, 0.72, 0.0), 45.0}},
 };
 
 }  // namespace
@@ -27,6 +66,11 @@ WorldDef world_def_with(const Scene& scene, const Overrides& o) {
   if (o.iterations) def.iterations = *o.iterations;
   if (o.beta) def.beta = *o.beta;
   if (o.friction) def.friction = *o.friction;
+  if (o.restitution) def.restitution = *o.restitution;
+  if (o.push) def.push = *o.push;
+  if (o.solver) def.solver = *o.solver;
+  if (o.friction_model) def.friction_model = *o.friction_model;
+  if (o.rotation) def.rotation = *o.rotation;
   return def;
 }
 
@@ -35,6 +79,38 @@ Run make_run(const Scene& scene, const Overrides& overrides) {
   scene.populate(run.world);
   run.metrics = scene.make_metrics(run.world);
   return run;
+}
+
+double kinetic_energy(const World& world) {
+  double e = 0.0;
+  for (const Body& b : world.bodies()) e += b.kinetic_energy();
+  return e;
+}
+
+double max_rod_error(const World& world) {
+  double worst = 0.0;
+  for (const DistanceConstraint& d : world.distances()) {
+    Vec3 p_a;
+    Vec3 p_b;
+    distance_endpoints(d, world.bodies(), p_a, p_b);
+    worst = std::max(worst, std::abs((p_b - p_a).norm() - d.length));
+  }
+  return worst;
+}
+
+double max_penetration_now(const World& world) {
+  double deepest = 0.0;
+  const auto& bodies = world.bodies();
+  Manifold m;
+  for (std::size_t a = 0; a < bodies.size(); ++a) {
+    for (std::size_t b = a + 1; b < bodies.size(); ++b) {
+      collide(bodies[a], bodies[b], m);
+      for (int i = 0; i < m.count; ++i) {
+        deepest = std::max(deepest, m.contacts[static_cast<std::size_t>(i)].depth);
+      }
+    }
+  }
+  return deepest;
 }
 
 double deepest_contact(const World& world) {

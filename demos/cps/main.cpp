@@ -1,0 +1,162 @@
+// The cps command: list the scenes, simulate them headless, render them to PNG frames.
+#include "options.h"
+#include "simulate.h"
+
+#ifdef CPS_HAVE_RENDERER
+#include "render.h"
+#endif
+
+#include <cstdio>
+#include <iostream>
+#include <regex>
+
+namespace {
+
+using namespace cps;
+
+struct SizeWxH {
+  int width = 1280;
+  int height = 720;
+};
+
+SizeWxH parse_size(const std::string& text) {
+  static const std::regex pattern(R"((\d{1,5})x(\d{1,5}))");
+  std::smatch m;
+  if (!std::regex_match(text, m, pattern)) {
+    throw cli::UsageError("--size " + text + " is not WxH (e.g. 1280x720)");
+  }
+  SizeWxH s{std::stoi(m[1]), std::stoi(m[2])};
+  if (s.width < 16 || s.width > 8192 || s.height < 16 || s.height > 8192) {
+    throw cli::UsageError("--size " + text + ": width and height must be in [16, 8192] pixels");
+  }
+  return s;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"cps: the constraint based physics solver of Tamis & Maggiore (2015)"};
+  app.require_subcommand(1);
+
+  CLI::App* list = app.add_subcommand("list", "print the scenes");
+
+  std::string sim_scene;
+  std::optional<double> sim_seconds;
+  bool sim_json = false;
+  scenes::Overrides sim_overrides;
+  CLI::App* simulate = app.add_subcommand("simulate", "run a scene headless and report metrics");
+  simulate->add_option("scene", sim_scene, "scene name (see 'cps list')")->required();
+  simulate->add_option("--seconds", sim_seconds, "simulated time (s), > 0; default: the scene's")
+      ->check(cli::kFinitePositive);
+  simulate->add_flag("--json", sim_json, "print one JSON object");
+  cli::add_world_options(*simulate, sim_overrides);
+
+#ifdef CPS_HAVE_RENDERER
+  std::string render_scene;
+  std::optional<double> render_seconds;
+  double fps = 30.0;
+  std::string size_text = "1280x720";
+  std::string out_dir = "out";
+  std::string compare;
+  scenes::Overrides render_overrides;
+  CLI::App* render = app.add_subcommand("render", "render scenes into PNG frame sequences");
+  render->add_option("scene", render_scene, "scene name or 'all'")->required();
+  render->add_option("--seconds", render_seconds, "simulated time (s), > 0; default: the scene's")
+      ->check(cli::kFinitePositive);
+  render->add_option("--fps", fps, "frames per simulated second, > 0")->capture_default_str()
+      ->check(cli::kFinitePositive);
+  render->add_option("--size", size_text, "frame size WxH in pixels, each in [16, 8192]")->capture_default_str();
+  render->add_option("--out", out_dir, "output folder; frames go to OUT/SCENE/")->capture_default_str();
+  render->add_option("--compare", compare,
+                     "render the two variants of this option side by side, labelled, into "
+                     "OUT/SCENE-compare-OPTION/")
+      ->check(CLI::IsMember({"push", "solver", "friction-model", "rotation"}));
+  cli::add_world_options(*render, render_overrides);
+#endif
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "cps: " << e.what() << "\nRun 'cps --help' or 'cps COMMAND --help' for usage.\n";
+    return 2;
+  }
+
+  try {
+    if (*list) {
+      for (const scenes::Scene& s : scenes::all_scenes()) {
+        std::printf("%-20s %5.0f s  %s\n", std::string(s.name).c_str(), s.default_seconds,
+                    std::string(s.summary).c_str());
+      }
+      return 0;
+    }
+    if (*simulate) {
+      const scenes::Scene* scene = cli::select_scenes(sim_scene).front();
+      if (sim_scene == "all") throw cli::UsageError("simulate takes one scene, not 'all'");
+      scenes::Run r = cli::make_run_or_usage_error(*scene, sim_overrides);
+      const nlohmann::json report =
+          cli::simulate(*scene, r, sim_seconds.value_or(scene->default_seconds));
+      if (sim_json) {
+        std::cout << report.dump(2) << "\n";
+      } else {
+        std::cout << scene->name << ": " << report["steps"] << " steps, "
+                  << report["simulated_s"] << " s simulated in " << report["wall_s"] << " s ("
+                  << report["us_per_step"] << " us/step)\nmetrics: " << report["metrics"].dump()
+                  << "\n";
+      }
+      return 0;
+    }
+#ifdef CPS_HAVE_RENDERER
+    if (*render) {
+      // Everything is checked before anything is written.
+      const SizeWxH size = parse_size(size_text);
+      const std::vector<const scenes::Scene*> selected = cli::select_scenes(render_scene);
+      const std::vector<cli::Variant> variants = cli::compare_variants(compare, render_overrides);
+      if (!compare.empty() && size.width < 32) {
+        throw cli::UsageError("--size " + size_text + ": --compare needs a width of at least 32");
+      }
+      struct Job {
+        const scenes::Scene* scene;
+        std::vector<scenes::Run> runs;
+      };
+      std::vector<Job> jobs;
+      for (const scenes::Scene* s : selected) {
+        Job job{s, {}};
+        for (const cli::Variant& v : variants) {
+          job.runs.push_back(cli::make_run_or_usage_error(*s, v.overrides));
+        }
+        jobs.push_back(std::move(job));
+      }
+      const int panel_width = size.width / static_cast<int>(variants.size());
+      render::Renderer renderer(panel_width, size.height);
+      for (Job& job : jobs) {
+        std::vector<cli::Panel> panels;
+        for (std::size_t v = 0; v < variants.size(); ++v) {
+          panels.push_back({&job.runs[v], variants[v].label});
+        }
+        cli::RenderJob spec;
+        spec.seconds = render_seconds.value_or(job.scene->default_seconds);
+        spec.fps = fps;
+        const std::string folder = std::string(job.scene->name) +
+                                   (compare.empty() ? "" : "-compare-" + compare);
+        spec.folder = std::filesystem::path(out_dir) / folder;
+        const int frames = cli::render_frames(*job.scene, panels, spec, renderer);
+        std::printf("%s: %d frames in %s\n", folder.c_str(), frames, spec.folder.c_str());
+      }
+      return 0;
+    }
+#endif
+  } catch (const cli::UsageError& e) {
+    std::cerr << "cps: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "cps: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return run(argc, argv); }

@@ -1,0 +1,55 @@
+// The funnel, paper Sec. 10.3: 20 balls in an upside-down square pyramid made of 4 static
+// infinite planes through the origin (the free side is y > |x| and y > |z|). The paper reports it
+// becomes reasonably stable without contact caching. No ground: it would only touch the apex.
+#include "scene.h"
+
+#include <cmath>
+
+namespace cps::scenes {
+namespace {
+
+constexpr double kRadius = 0.5;  // m
+constexpr double kMass = 1.0;    // kg
+
+class FunnelMetrics final : public Metrics {
+ public:
+  void observe(const World& world) override { world_ = &world; }
+  nlohmann::json report() const override {
+    return {{"kinetic_energy_J", world_ ? kinetic_energy(*world_) : 0.0},
+            {"max_penetration_m", world_ ? max_penetration_now(*world_) : 0.0}};
+  }
+
+ private:
+  const World* world_ = nullptr;
+};
+
+}  // namespace
+
+WorldDef funnel_world_def() { return stack_world_def(); }  // g, dt, 25 iterations, beta, mu 0.5
+
+void populate_funnel(World& world) {
+  const double s = 1.0 / std::sqrt(2.0);
+  for (const Vec3& n : {Vec3(s, s, 0.0), Vec3(-s, s, 0.0), Vec3(0.0, s, s), Vec3(0.0, s, -s)}) {
+    BodyDef wall;
+    wall.shape = Shape::plane(n, 0.0);
+    wall.is_static = true;
+    world.add_body(wall);
+  }
+  for (int i = 0; i < 5; ++i) {
+    for (int k = 0; k < 4; ++k) {
+      BodyDef ball;
+      ball.shape = Shape::sphere(kRadius);
+      ball.mass = kMass;
+      ball.position = Vec3(-2.4 + 1.2 * i, 8.0, -1.8 + 1.2 * k);
+      world.add_body(ball);
+    }
+  }
+}
+
+std::unique_ptr<Metrics> make_funnel_metrics(const World& world) {
+  auto m = std::make_unique<FunnelMetrics>();
+  m->observe(world);
+  return m;
+}
+
+}  // namespace cps::scenes

@@ -1,0 +1,32 @@
+# Sourced by the quick-start scripts: installs the Debian 12 packages cps needs that are missing.
+# apt-get update runs once, and only when something is missing.
+cps_packages=(
+  cmake g++ make pkg-config
+  libeigen3-dev libosmesa6-dev libglm-dev libstb-dev catch2 libcli11-dev nlohmann-json3-dev
+)
+
+cps_install_missing() {
+  local missing=()
+  local pkg
+  for pkg in "${cps_packages[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q '^install ok installed$'; then
+      missing+=("$pkg")
+    fi
+  done
+  if [ ${#missing[@]} -eq 0 ]; then
+    return 0
+  fi
+  echo "cps: installing missing packages: ${missing[*]}"
+  local sudo=()
+  if [ "$(id -u)" -ne 0 ]; then
+    sudo=(sudo)
+  fi
+  "${sudo[@]}" apt-get update
+  DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y --no-install-recommends "${missing[@]}"
+}
+
+# Configures and builds into build/ (Release).
+cps_build() {
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@"
+  cmake --build build --parallel "$(nproc)"
+}

@@ -147,3 +147,84 @@ TEST_CASE("the edge-edge contact follows the edges when they are offset", "[coll
   REQUIRE(collide_box_box(a, b, m) == 1);
   CHECK((m.contacts[0].point - Vec3(s2 - 0.025, 0.0, 0.3)).norm() <= 1e-12);
 }
+
+TEST_CASE("sphere contacts: plane, sphere, coincident centres", "[collision][sphere]") {
+  Manifold m;
+  SECTION("a sphere 0.1 m into a plane") {
+    REQUIRE(collide_sphere_plane(Vec3(0, 0.4, 0), 0.5, Vec3::UnitY(), 0.0, m) == 1);
+    CHECK(m.contacts[0].normal.isApprox(Vec3::UnitY()));
+    CHECK(m.contacts[0].depth == Approx(0.1).margin(1e-12));
+    CHECK((m.contacts[0].point - Vec3(0, -0.05, 0)).norm() <= 1e-12);
+  }
+  SECTION("a sphere above a plane") {
+    CHECK(collide_sphere_plane(Vec3(0, 0.51, 0), 0.5, Vec3::UnitY(), 0.0, m) == 0);
+  }
+  SECTION("two overlapping spheres") {
+    REQUIRE(collide_sphere_sphere(Vec3(0, 0, 0), 0.5, Vec3(0.6, 0.8, 0), 0.5, m) == 0);
+    REQUIRE(collide_sphere_sphere(Vec3(0, 0, 0), 0.5, Vec3(0.54, 0.72, 0), 0.5, m) == 1);
+    CHECK(m.contacts[0].normal.isApprox(Vec3(0.6, 0.8, 0)));
+    CHECK(m.contacts[0].depth == Approx(0.1).margin(1e-12));  // |c_b - c_a| = 0.9
+    CHECK((m.contacts[0].point - 0.45 * Vec3(0.6, 0.8, 0)).norm() <= 1e-12);
+  }
+  SECTION("coincident centres still give a unit normal and the full depth") {
+    REQUIRE(collide_sphere_sphere(Vec3(1, 2, 3), 0.5, Vec3(1, 2, 3), 0.25, m) == 1);
+    CHECK(m.contacts[0].normal.norm() == Approx(1.0));
+    CHECK(m.contacts[0].depth == Approx(0.75));
+  }
+}
+
+TEST_CASE("box-sphere contacts by the closest point of the box", "[collision][sphere]") {
+  const Mat3 R = rotation(0.3, Vec3(1, 2, 3));
+  const OrientedBox box = box_at(Vec3(1, 0, 0), Vec3(1, 2, 3), R);
+  Manifold m;
+  SECTION("facing a face") {
+    const Vec3 c = box.c + R * Vec3(1.4, 0.5, -1.0);  // 0.4 m out of the +x face
+    REQUIRE(collide_box_sphere(box, c, 0.5, m) == 1);
+    CHECK(m.contacts[0].normal.isApprox(R.col(0)));
+    CHECK(m.contacts[0].depth == Approx(0.1).margin(1e-12));
+  }
+  SECTION("facing a corner") {
+    const Vec3 corner = box.c + R * Vec3(1, 2, 3);
+    const Vec3 dir = R * Vec3(1, 1, 1).normalized();
+    REQUIRE(collide_box_sphere(box, corner + 0.45 * dir, 0.5, m) == 1);
+    CHECK(m.contacts[0].normal.isApprox(dir));
+    CHECK(m.contacts[0].depth == Approx(0.05).margin(1e-12));
+    CHECK(collide_box_sphere(box, corner + 0.55 * dir, 0.5, m) == 0);
+  }
+  SECTION("centre inside the box leaves through the nearest face") {
+    const Vec3 c = box.c + R * Vec3(0.2, 1.7, 0.5);  // 0.3 m below the +y face
+    REQUIRE(collide_box_sphere(box, c, 0.5, m) == 1);
+    CHECK(m.contacts[0].normal.isApprox(R.col(1)));
+    CHECK(m.contacts[0].depth == Approx(0.8).margin(1e-12));
+  }
+  SECTION("the dispatcher orients the normal from body a to body b") {
+    BodyDef sphere_def;
+    sphere_def.shape = Shape::sphere(0.5);
+    sphere_def.position = Vec3(0, 1.4, 0);
+    BodyDef box_def;
+    box_def.shape = Shape::box(Vec3::Ones());
+    const Body s = make_body(sphere_def);
+    const Body b = make_body(box_def);
+    REQUIRE(collide(s, b, m) == 1);
+    CHECK(m.contacts[0].normal.isApprox(-Vec3::UnitY()));
+    REQUIRE(collide(b, s, m) == 1);
+    CHECK(m.contacts[0].normal.isApprox(Vec3::UnitY()));
+  }
+}
+
+TEST_CASE("a speculative margin reports near features with a negative depth", "[collision]") {
+  Manifold m;
+  // 2 mm apart: nothing without a margin, one contact per vertex / point with a 5 mm margin.
+  CHECK(collide_box_plane(box_at(Vec3(0, 1.002, 0), Vec3::Ones()), Vec3::UnitY(), 0.0, m) == 0);
+  REQUIRE(collide_box_plane(box_at(Vec3(0, 1.002, 0), Vec3::Ones()), Vec3::UnitY(), 0.0, m, 0.005) == 4);
+  CHECK(m.contacts[0].depth == Approx(-0.002).margin(1e-12));
+  m.count = 0;
+  REQUIRE(collide_box_box(box_at(Vec3::Zero(), Vec3::Ones()), box_at(Vec3(0, 2.002, 0), Vec3::Ones()),
+                          m, 0.005) == 4);
+  CHECK(m.contacts[0].depth == Approx(-0.002).margin(1e-12));
+  m.count = 0;
+  CHECK(collide_box_box(box_at(Vec3::Zero(), Vec3::Ones()), box_at(Vec3(0, 2.01, 0), Vec3::Ones()),
+                        m, 0.005) == 0);
+  REQUIRE(collide_sphere_sphere(Vec3::Zero(), 0.5, Vec3(1.003, 0, 0), 0.5, m, 0.005) == 1);
+  CHECK(m.contacts[0].depth == Approx(-0.003).margin(1e-12));
+}

@@ -72,6 +72,17 @@ int run(int argc, char** argv) {
   cli::add_world_options(*render, render_overrides);
 #endif
 
+  std::string names;
+  bool known = false;
+  for (const CLI::App* sub : app.get_subcommands({})) {
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+    known = known || (argc > 1 && sub->get_name() == argv[1]);
+  }
+  if (argc > 1 && argv[1][0] != '-' && !known) {
+    std::cerr << "cps: unknown command '" << argv[1] << "'; the commands are: " << names
+              << "\nRun 'cps --help' for usage.\n";
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -53,6 +53,10 @@ void add_world_options(CLI::App& cmd, scenes::Overrides& o) {
   cmd.add_option("--restitution", o.restitution,
                  "coefficient of restitution eps (dimensionless) in [0, 1]; scenes use 0")
       ->check(CLI::Range(0.0, 1.0));
+  cmd.add_option("--contact-margin", o.contact_margin,
+                 "speculative contact distance (m), >= 0; 0 = contacts only on overlap, as in the "
+                 "paper")
+      ->check(CLI::Range(0.0, 1e6));
   cmd.add_option("--push", o.push,
                  "baumgarte: push factor kept in the velocity (Sec. 5); split: single frame push "
                  "factor, two solves (Sec. 8.1)")

@@ -60,6 +60,7 @@ struct Overrides {
   std::optional<double> beta;
   std::optional<double> friction;
   std::optional<double> restitution;
+  std::optional<double> contact_margin;
   std::optional<PushMode> push;
   std::optional<SolverKind> solver;
   std::optional<FrictionModel> friction_model;

@@ -67,6 +67,7 @@ WorldDef world_def_with(const Scene& scene, const Overrides& o) {
   if (o.beta) def.beta = *o.beta;
   if (o.friction) def.friction = *o.friction;
   if (o.restitution) def.restitution = *o.restitution;
+  if (o.contact_margin) def.contact_margin = *o.contact_margin;
   if (o.push) def.push = *o.push;
   if (o.solver) def.solver = *o.solver;
   if (o.friction_model) def.friction_model = *o.friction_model;

@@ -20,14 +20,15 @@ void flip_normals(Manifold& m) {
 
 }  // namespace
 
-int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Manifold& out) {
+int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Manifold& out,
+                      double margin) {
   const int before = out.count;
   for (int corner = 0; corner < 8; ++corner) {
     const Vec3 sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0,
                     (corner & 4) ? 1.0 : -1.0);
     const Vec3 v = box.c + box.R * sign.cwiseProduct(box.e);
     const double separation = n.dot(v) - offset;
-    if (separation < 0.0) {
+    if (separation < margin) {
       // Midway between the vertex and its projection on the plane.
       out.add({v - 0.5 * separation * n, n, -separation});
     }
@@ -35,25 +36,28 @@ int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Mani
   return out.count - before;
 }
 
-int collide_sphere_plane(const Vec3& c, double r, const Vec3& n, double offset, Manifold& out) {
+int collide_sphere_plane(const Vec3& c, double r, const Vec3& n, double offset, Manifold& out,
+                         double margin) {
   const double separation = n.dot(c) - offset - r;
-  if (separation >= 0.0) return 0;
+  if (separation >= margin) return 0;
   // Midway between the deepest point of the sphere, c - r n, and the plane.
   out.add({c - (r + 0.5 * separation) * n, n, -separation});
   return 1;
 }
 
-int collide_sphere_sphere(const Vec3& c_a, double r_a, const Vec3& c_b, double r_b, Manifold& out) {
+int collide_sphere_sphere(const Vec3& c_a, double r_a, const Vec3& c_b, double r_b, Manifold& out,
+                          double margin) {
   const Vec3 d = c_b - c_a;
   const double dist = d.norm();
   const double depth = r_a + r_b - dist;
-  if (depth <= 0.0) return 0;
+  if (depth <= -margin) return 0;
   const Vec3 n = dist > 1e-12 ? Vec3(d / dist) : Vec3(Vec3::UnitY());
   out.add({c_a + (r_a - 0.5 * depth) * n, n, depth});
   return 1;
 }
 
-int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold& out) {
+int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold& out,
+                       double margin) {
   const Vec3 p = box.R.transpose() * (c - box.c);  // sphere centre in box space
   const Vec3 q = p.cwiseMax(-box.e).cwiseMin(box.e);  // closest point of the box
   Vec3 n_local;
@@ -78,7 +82,7 @@ int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold
   } else {
     const Vec3 delta = p - q;
     const double dist = delta.norm();
-    if (dist >= r) return 0;
+    if (dist >= r + margin) return 0;
     n_local = delta / dist;
     depth = r - dist;
     surface = q;
@@ -90,7 +94,7 @@ int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold
   return 1;
 }
 
-int collide(const Body& a, const Body& b, Manifold& out) {
+int collide(const Body& a, const Body& b, Manifold& out, double margin) {
   out.count = 0;
   if (a.is_static() && b.is_static()) return 0;
   // Order the pair as (box, sphere, plane) by kind; flip the normals back if it was swapped.
@@ -107,19 +111,20 @@ int collide(const Body& a, const Body& b, Manifold& out) {
     world_plane(second, n, offset);
     // Contacts come from the plane to the shape: from `second` to `first`.
     if (k1 == ShapeKind::box) {
-      collide_box_plane(oriented_box(first), n, offset, out);
+      collide_box_plane(oriented_box(first), n, offset, out, margin);
     } else {
-      collide_sphere_plane(first.x, first.shape.radius, n, offset, out);
+      collide_sphere_plane(first.x, first.shape.radius, n, offset, out, margin);
     }
     if (!swapped) flip_normals(out);  // a = first: normals must point from first to the plane
     return out.count;
   }
   if (k1 == ShapeKind::box && k2 == ShapeKind::box) {
-    collide_box_box(oriented_box(first), oriented_box(second), out);
+    collide_box_box(oriented_box(first), oriented_box(second), out, margin);
   } else if (k1 == ShapeKind::box) {
-    collide_box_sphere(oriented_box(first), second.x, second.shape.radius, out);
+    collide_box_sphere(oriented_box(first), second.x, second.shape.radius, out, margin);
   } else {
-    collide_sphere_sphere(first.x, first.shape.radius, second.x, second.shape.radius, out);
+    collide_sphere_sphere(first.x, first.shape.radius, second.x, second.shape.radius, out,
+                          margin);
   }
   if (swapped) flip_normals(out);
   return out.count;

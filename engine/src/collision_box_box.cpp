@@ -43,10 +43,10 @@ double projected_radius(const OrientedBox& b, const Vec3& L) {
 
 // Tests unit axis L; returns false if it separates the boxes. d = b.c - a.c.
 bool test_axis(const OrientedBox& a, const OrientedBox& b, const Vec3& d, const Vec3& L, int index,
-               Axis& best) {
+               double margin, Axis& best) {
   const double dist = d.dot(L);
   const double separation = std::abs(dist) - (projected_radius(a, L) + projected_radius(b, L));
-  if (separation > 0.0) return false;
+  if (separation > margin) return false;
   if (separation > best.separation) {
     best.separation = separation;
     best.index = index;
@@ -77,7 +77,7 @@ int clip(const Polygon& in, int n_in, const Vec3& m, double offset, Polygon& out
 // Face contact with reference face `axis` of `ref` whose outward normal is n_ref (pointing at
 // `inc`). normal_ab is the manifold normal from box a to box b.
 void face_contact(const OrientedBox& ref, int axis, const Vec3& n_ref, const OrientedBox& inc,
-                  const Vec3& normal_ab, Manifold& out) {
+                  const Vec3& normal_ab, double margin, Manifold& out) {
   // Incident face: the face of inc whose outward normal is most anti-parallel to n_ref.
   int k = 0;
   double best = -1.0;
@@ -114,7 +114,7 @@ void face_contact(const OrientedBox& ref, int axis, const Vec3& n_ref, const Ori
   for (int i = 0; i < count; ++i) {
     const Vec3& p = poly[static_cast<std::size_t>(i)];
     const double separation = n_ref.dot(p) - ref_offset;
-    if (separation <= 0.0) out.add({p - 0.5 * separation * n_ref, normal_ab, -separation});
+    if (separation <= margin) out.add({p - 0.5 * separation * n_ref, normal_ab, -separation});
   }
 }
 
@@ -154,39 +154,39 @@ void edge_contact(const OrientedBox& a, const OrientedBox& b, const Axis& axis, 
 
 }  // namespace
 
-int collide_box_box(const OrientedBox& a, const OrientedBox& b, Manifold& out) {
+int collide_box_box(const OrientedBox& a, const OrientedBox& b, Manifold& out, double margin) {
   const int before = out.count;
   const Vec3 d = b.c - a.c;
   Axis face_a;
   Axis face_b;
   Axis edge;
   for (int i = 0; i < 3; ++i) {
-    if (!test_axis(a, b, d, a.R.col(i), i, face_a)) return 0;
+    if (!test_axis(a, b, d, a.R.col(i), i, margin, face_a)) return 0;
   }
   for (int k = 0; k < 3; ++k) {
-    if (!test_axis(a, b, d, b.R.col(k), k, face_b)) return 0;
+    if (!test_axis(a, b, d, b.R.col(k), k, margin, face_b)) return 0;
   }
   for (int i = 0; i < 3; ++i) {
     for (int k = 0; k < 3; ++k) {
       Vec3 L = a.R.col(i).cross(b.R.col(k));
       const double len = L.norm();
       if (len < kParallelSin) continue;
-      if (!test_axis(a, b, d, L / len, 3 * i + k, edge)) return 0;
+      if (!test_axis(a, b, d, L / len, 3 * i + k, margin, edge)) return 0;
     }
   }
 
   const double abs_tol = kAbsoluteTolerance * std::min(a.e.minCoeff(), b.e.minCoeff());
   const auto clearly_better = [abs_tol](double candidate, double current) {
-    return candidate > kRelativeTolerance * current + abs_tol;
+    return candidate > current + (1.0 - kRelativeTolerance) * std::abs(current) + abs_tol;
   };
   const bool use_b = clearly_better(face_b.separation, face_a.separation);
   const Axis& face = use_b ? face_b : face_a;
   if (edge.index >= 0 && clearly_better(edge.separation, face.separation)) {
     edge_contact(a, b, edge, out);
   } else if (use_b) {
-    face_contact(b, face_b.index, -face_b.n, a, face_b.n, out);
+    face_contact(b, face_b.index, -face_b.n, a, face_b.n, margin, out);
   } else {
-    face_contact(a, face_a.index, face_a.n, b, face_a.n, out);
+    face_contact(a, face_a.index, face_a.n, b, face_a.n, margin, out);
   }
   return out.count - before;
 }

@@ -1,6 +1,7 @@
 // Contact (Sec. 5.3) and friction (Sec. 5.4) rows.
 #include "cps/constraint.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace cps {
@@ -27,11 +28,9 @@ void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
 namespace {
 
 // j . v_ab for the current body velocities (m/s).
-double relative_velocity(const Vec12& j, const Body* a, const Body* b) {
-  double rate = 0.0;
-  if (a) rate += j.segment<3>(0).dot(a->velocity()) + j.segment<3>(3).dot(a->angular_velocity());
-  if (b) rate += j.segment<3>(6).dot(b->velocity()) + j.segment<3>(9).dot(b->angular_velocity());
-  return rate;
+double relative_velocity(const Vec12& j, const Body& a, const Body& b) {
+  return j.segment<3>(0).dot(a.velocity()) + j.segment<3>(3).dot(a.angular_velocity()) +
+         j.segment<3>(6).dot(b.velocity()) + j.segment<3>(9).dot(b.angular_velocity());
 }
 
 }  // namespace
@@ -54,12 +53,21 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
     contact.body_a = m.body_a;
     contact.body_b = m.body_b;
     contact.j = axis_row(c.normal, r_a, r_b);
-    // Eq. 5.3.1 with the sign of NOTES.md: C = -d, v = -beta C / dt = beta d / dt > 0 opens it.
-    contact.push = params.beta * c.depth / params.dt;
-    if (params.restitution > 0.0) {
-      // Eq. 8.2.1: v_r = -eps j . v1, only for points approaching faster than the threshold.
-      const double approach = relative_velocity(contact.j, &a, &b);
-      if (approach < -params.restitution_threshold) contact.bias = -params.restitution * approach;
+    const double approach = relative_velocity(contact.j, a, b);  // j . v1 (m/s)
+    if (c.depth >= 0.0) {
+      // Eq. 5.3.1 with the sign of NOTES.md: C = -d, v = -beta C / dt = beta d / dt > 0 opens it.
+      contact.push = params.beta * c.depth / params.dt;
+    } else {
+      // Speculative contact (gap -d within the margin): the points may approach by the gap in this
+      // step, no further. This is a limit on the velocity, not a correction, so it stays in both
+      // solves of Sec. 8.1.
+      contact.bias = c.depth / params.dt;
+    }
+    // Eq. 8.2.1: v_r = -eps j . v1, for points approaching faster than the threshold that touch,
+    // or will close their gap within this step.
+    if (params.restitution > 0.0 && approach < -params.restitution_threshold &&
+        approach * params.dt <= std::min(c.depth, 0.0)) {
+      contact.bias = -params.restitution * approach;
     }
     contact.c_min = 0.0;
     contact.c_max = kInfinity;

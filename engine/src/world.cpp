@@ -31,6 +31,9 @@ void WorldDef::validate() const {
   if (!(restitution >= 0.0 && restitution <= 1.0)) {
     bad_parameter("restitution", restitution, "it must be in [0, 1]");
   }
+  if (!(std::isfinite(contact_margin) && contact_margin >= 0.0)) {
+    bad_parameter("contact_margin", contact_margin, "it must be finite and >= 0 m");
+  }
   if (!(std::isfinite(restitution_threshold) && restitution_threshold >= 0.0)) {
     bad_parameter("restitution_threshold", restitution_threshold, "it must be finite and >= 0 m/s");
   }
@@ -86,7 +89,7 @@ void World::collide() {
       Manifold m;
       m.body_a = a;
       m.body_b = b;
-      if (cps::collide(ba, bb, m) > 0) {
+      if (cps::collide(ba, bb, m, def_.contact_margin) > 0) {
         counters_.contacts += m.count;
         manifolds_.push_back(m);
       }

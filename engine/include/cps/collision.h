@@ -12,7 +12,8 @@
 namespace cps {
 
 /// One contact point. normal: unit 3-vector from body a to body b (the direction along which
-/// b must move to separate). depth: penetration along the normal (m, >= 0). point: world
+/// b must move to separate). depth: penetration along the normal (m); negative for a
+/// speculative contact, where -depth is the gap (less than the collision margin). point: world
 /// position (m), midway between the two surfaces.
 struct Contact {
   Vec3 point = Vec3::Zero();
@@ -36,10 +37,12 @@ struct Manifold {
   }
 };
 
-/// Tests bodies a and b and writes their contacts into `out` (out.count = 0 when they do not
-/// touch). Normals point from a to b. Returns out.count. Pairs of two planes, and pairs of
-/// static bodies, give no contact. No errors are raised.
-int collide(const Body& a, const Body& b, Manifold& out);
+/// Tests bodies a and b and writes their contacts into `out` (out.count = 0 when they are
+/// further apart than `margin`). Normals point from a to b. Returns out.count. margin (m, >= 0):
+/// the speculative distance; features closer than it give a contact with negative depth (0: only
+/// overlapping features, as in the paper). Pairs of two planes, and pairs of static bodies, give
+/// no contact. No errors are raised. Every collide_* function below takes the same margin.
+int collide(const Body& a, const Body& b, Manifold& out, double margin = 0.0);
 
 /// A box in world space: centre c (m), rotation R (3 x 3, columns are the box axes in world
 /// space), half extents e (m).
@@ -52,27 +55,32 @@ struct OrientedBox {
 /// Box-plane contacts: every vertex of `box` below the plane {x : dot(n, x) = offset} (n unit,
 /// offset in m), with normal n (from plane to box) and depth offset - dot(n, v). Returns the
 /// number of contacts written to `out` (0..8). The caller flips normals if the box is body a.
-int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Manifold& out);
+int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Manifold& out,
+                      double margin = 0.0);
 
 /// Box-box contacts by the separating axis test over the 15 axes (3 face normals of each box and
 /// the 9 cross products of their edge directions). Normals point from box a to box b. Returns
 /// the number of contacts written to `out` (0 when a separating axis exists).
-int collide_box_box(const OrientedBox& a, const OrientedBox& b, Manifold& out);
+int collide_box_box(const OrientedBox& a, const OrientedBox& b, Manifold& out,
+                    double margin = 0.0);
 
 /// Sphere-plane contact: sphere of centre c (m) and radius r (m) against the plane
 /// {x : dot(n, x) = offset}; normal n (from plane to sphere), depth r - (dot(n, c) - offset).
 /// Returns 0 or 1 contacts written to `out`.
-int collide_sphere_plane(const Vec3& c, double r, const Vec3& n, double offset, Manifold& out);
+int collide_sphere_plane(const Vec3& c, double r, const Vec3& n, double offset, Manifold& out,
+                         double margin = 0.0);
 
 /// Sphere-sphere contact between spheres (c_a, r_a) and (c_b, r_b) (m); normal from a to b,
 /// depth r_a + r_b - |c_b - c_a|. Coincident centres (closer than 1e-12 m) get the normal +y,
 /// so the pair still separates. Returns 0 or 1 contacts written to `out`.
-int collide_sphere_sphere(const Vec3& c_a, double r_a, const Vec3& c_b, double r_b, Manifold& out);
+int collide_sphere_sphere(const Vec3& c_a, double r_a, const Vec3& c_b, double r_b, Manifold& out,
+                          double margin = 0.0);
 
 /// Box-sphere contact by the closest point of the box to the sphere centre c (m), radius r (m)
 /// (Ericson 2005, Sec. 5.1.4). Normal from the box to the sphere. A centre inside the box is
 /// pushed out through the face it is nearest to (depth = distance to that face + r). Returns 0
 /// or 1 contacts written to `out`.
-int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold& out);
+int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold& out,
+                       double margin = 0.0);
 
 }  // namespace cps

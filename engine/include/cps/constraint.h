@@ -68,12 +68,13 @@ struct RowParams {
 };
 
 /// Appends the rows of one manifold to `rows`: per contact point a contact row (Sec. 5.3:
-/// c_min = 0, c_max = +inf, push = beta d / dt) and, when friction > 0, two friction rows
+/// c_min = 0, c_max = +inf, push = beta d / dt; for a speculative contact with d < 0 instead
+/// bias = d / dt, which lets the points close the gap within the step and no further) and, when friction > 0, two friction rows
 /// (Sec. 5.4: target 0, limits +-mu m |g . n| where m is the combined mass of the two bodies
 /// divided over the manifold's points, the movable body's mass when the other is static).
 /// Rows come per point in the order contact, friction t1, friction t2. With restitution > 0 a
-/// contact whose points approach faster than the threshold (j . v1 < -threshold) gets the bias
-/// v_r = -eps j . v1 (Eq. 8.2.1).
+/// contact whose points approach faster than the threshold (j . v1 < -threshold) and touch or
+/// close their gap within the step gets the bias v_r = -eps j . v1 (Eq. 8.2.1).
 void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
                          const RowParams& params, std::vector<ConstraintRow>& rows);
 

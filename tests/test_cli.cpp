@@ -1,0 +1,142 @@
+// The cps command as a user runs it: exit codes, messages, and that bad input writes nothing.
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs `cps ARGS` in `dir` and captures its exit code, stdout and stderr.
+Result cps(const std::string& args, const fs::path& dir) {
+  const fs::path out = dir / "stdout.txt";
+  const fs::path err = dir / "stderr.txt";
+  const std::string command = "cd '" + dir.string() + "' && '" CPS_EXE "' " + args + " > '" +
+                              out.string() + "' 2> '" + err.string() + "'";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  fs::remove(out);
+  fs::remove(err);
+  return r;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("cps_cli_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST_CASE("bad arguments exit with 2, name the problem and write nothing", "[cli]") {
+  const fs::path dir = fresh_dir("bad");
+  struct Case {
+    std::string args;
+    std::string says;
+  };
+  const Case cases[] = {
+      {"render nosuchscene", "unknown scene 'nosuchscene'"},
+      {"simulate nosuchscene", "stack"},  // lists the scenes that exist
+      {"render stack --size 12x", "--size"},
+      {"render stack --size 8x8", "[16, 8192]"},
+      {"render stack --fps 0", "--fps"},
+      {"render stack --seconds -1", "--seconds"},
+      {"render stack --seconds nan", "--seconds"},
+      {"render stack --dt abc", "--dt"},
+      {"render stack --iterations 0", "--iterations"},
+      {"simulate stack --beta 1.5", "--beta"},
+      {"simulate stack --friction -0.1", "--friction"},
+      {"simulate stack --push sideways", "baumgarte, split"},
+      {"render stack --compare push --push split", "--compare push"},
+      {"frobnicate", "unknown command 'frobnicate'"},
+  };
+  for (const Case& c : cases) {
+    INFO("cps " << c.args);
+    const bool render = c.args.rfind("render", 0) == 0;
+    const Result r = cps(c.args + (render ? " --out out" : ""), dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find(c.says) != std::string::npos);
+    CHECK(!fs::exists(dir / "out"));
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps list names every scene of the paper", "[cli]") {
+  const fs::path dir = fresh_dir("list");
+  const Result r = cps("list", dir);
+  CHECK(r.exit_code == 0);
+  for (const char* scene :
+       {"stack", "intersecting_stack", "funnel", "pendulum_grid", "pendulum_wave"}) {
+    CHECK(r.out.find(scene) != std::string::npos);
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps simulate --json reports parameters, metrics and the final bodies", "[cli]") {
+  const fs::path dir = fresh_dir("json");
+  const Result r = cps("simulate stack --seconds 1 --dt 0.01 --json", dir);
+  REQUIRE(r.exit_code == 0);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  CHECK(j["scene"] == "stack");
+  CHECK(j["parameters"]["dt_s"].get<double>() == Approx(0.01));
+  CHECK(j["parameters"]["iterations"] == 25);
+  CHECK(j["steps"] == 100);
+  CHECK(j["simulated_s"].get<double>() == Approx(1.0));
+  for (const char* key : {"wall_s", "us_per_step"}) CHECK(j[key].get<double>() > 0.0);
+  for (const char* key : {"topple_time_s", "max_drift_m", "max_tilt_deg", "max_penetration_m"}) {
+    CHECK(j["metrics"].contains(key));
+  }
+  for (const char* key : {"pairs_tested", "contacts", "rows", "solves"}) {
+    CHECK(j["counters"].contains(key));
+  }
+  REQUIRE(j["bodies"].size() == 5);
+  // After 1 s the lowest cube has fallen 0.8 m onto the ground: centre at about 1.2 m.
+  CHECK(j["bodies"][0]["position"][1].get<double>() == Approx(1.2).margin(0.05));
+  CHECK(j["bodies"][0]["orientation"].size() == 4);
+  fs::remove_all(dir);
+}
+
+#ifdef CPS_HAVE_RENDERER
+TEST_CASE("cps render writes numbered frames of the requested size", "[cli][renderer]") {
+  const fs::path dir = fresh_dir("render");
+  const Result r = cps("render stack --seconds 0.2 --fps 10 --size 64x48 --out out", dir);
+  REQUIRE(r.exit_code == 0);
+  CHECK(fs::exists(dir / "out/stack/frame_000000.png"));
+  CHECK(fs::exists(dir / "out/stack/frame_000002.png"));
+  CHECK(!fs::exists(dir / "out/stack/frame_000003.png"));
+  // PNG header: the IHDR chunk holds width and height big-endian at bytes 16..23.
+  std::ifstream png(dir / "out/stack/frame_000001.png", std::ios::binary);
+  unsigned char header[24] = {};
+  png.read(reinterpret_cast<char*>(header), sizeof header);
+  const int width = (header[16] << 24) | (header[17] << 16) | (header[18] << 8) | header[19];
+  const int height = (header[20] << 24) | (header[21] << 16) | (header[22] << 8) | header[23];
+  CHECK(width == 64);
+  CHECK(height == 48);
+  fs::remove_all(dir);
+}
+#endif

@@ -56,9 +56,7 @@ void populate_funnel(World& world) {
 }
 
 std::unique_ptr<Metrics> make_funnel_metrics(const World& world) {
-  auto m = std::make_unique<FunnelMetrics>();
-  m->observe(world);
-  return m;
+  return observed<FunnelMetrics>(world);
 }
 
 }  // namespace cps::scenes

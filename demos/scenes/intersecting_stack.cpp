@@ -9,10 +9,6 @@
 namespace cps::scenes {
 namespace {
 
-constexpr int kCubes = 5;
-constexpr double kHalfEdge = 1.2;  // m
-constexpr double kMass = 1.2;      // kg
-
 class IntersectingStackMetrics final : public Metrics {
  public:
   void observe(const World& world) override { world_ = &world; }
@@ -43,24 +39,11 @@ WorldDef intersecting_stack_world_def() {
   return def;
 }
 
-void populate_intersecting_stack(World& world) {
-  BodyDef ground;
-  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
-  ground.is_static = true;
-  world.add_body(ground);
-  for (int i = 0; i < kCubes; ++i) {
-    BodyDef cube;
-    cube.shape = Shape::box(Vec3::Constant(kHalfEdge));
-    cube.mass = kMass;
-    cube.position = Vec3(0.0, 2.0 * i, 0.0);
-    world.add_body(cube);
-  }
-}
+// Centres 2 m apart (0.4 m overlaps), the bottom one at the ground (1.2 m into it).
+void populate_intersecting_stack(World& world) { add_ground_and_cube_column(world, 0.0, 2.0); }
 
 std::unique_ptr<Metrics> make_intersecting_stack_metrics(const World& world) {
-  auto m = std::make_unique<IntersectingStackMetrics>();
-  m->observe(world);
-  return m;
+  return observed<IntersectingStackMetrics>(world);
 }
 
 }  // namespace cps::scenes

@@ -91,9 +91,7 @@ void populate_pendulum_grid(World& world) {
 }
 
 std::unique_ptr<Metrics> make_pendulum_grid_metrics(const World& world) {
-  auto m = std::make_unique<PendulumGridMetrics>(25);
-  m->observe(world);
-  return m;
+  return observed<PendulumGridMetrics>(world, 25);
 }
 
 }  // namespace cps::scenes

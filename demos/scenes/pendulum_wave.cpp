@@ -133,9 +133,7 @@ void populate_pendulum_wave(World& world) {
 }
 
 std::unique_ptr<Metrics> make_pendulum_wave_metrics(const World& world) {
-  auto m = std::make_unique<PendulumWaveMetrics>();
-  m->observe(world);
-  return m;
+  return observed<PendulumWaveMetrics>(world);
 }
 
 }  // namespace cps::scenes

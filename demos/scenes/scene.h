@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <utility>
 #include <string_view>
 
 namespace cps::scenes {
@@ -101,6 +102,19 @@ double max_rod_error(const World& world);
 /// Deepest overlap (m) over every pair of bodies, from the geometry as it is now (runs the
 /// narrow phase on all pairs; independent of the last step's contacts).
 double max_penetration_now(const World& world);
+
+/// Adds the static ground plane y = 0 and the paper's column of five cubes (edge 2.4 m, mass
+/// 1.2 kg) with centres (0, bottom + spacing i, 0), i = 0..4 (m). Shared by the stack (Sec. 10.1)
+/// and the intersecting stack (Sec. 10.2).
+void add_ground_and_cube_column(World& world, double bottom, double spacing);
+
+/// A metrics object of type M built from `args`, having observed the world as built.
+template <class M, class... Args>
+std::unique_ptr<Metrics> observed(const World& world, Args&&... args) {
+  auto m = std::make_unique<M>(std::forward<Args>(args)...);
+  m->observe(world);
+  return m;
+}
 
 // The scenes (one file each).
 WorldDef stack_world_def();

@@ -65,7 +65,7 @@ WorldDef stack_world_def() {
   return def;
 }
 
-void populate_stack(World& world) {
+void add_ground_and_cube_column(World& world, double bottom, double spacing) {
   BodyDef ground;
   ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
   ground.is_static = true;
@@ -74,11 +74,14 @@ void populate_stack(World& world) {
     BodyDef cube;
     cube.shape = Shape::box(Vec3::Constant(kHalfEdge));
     cube.mass = kMass;
-    cube.position = Vec3(0.0, 2.0 + 3.0 * i, 0.0);
+    cube.position = Vec3(0.0, bottom + spacing * i, 0.0);
     world.add_body(cube);
   }
 }
 
-std::unique_ptr<Metrics> make_stack_metrics(const World&) { return std::make_unique<StackMetrics>(); }
+// Centres 3 m apart (0.6 m gaps), the bottom one 2 m up: the cubes fall and settle.
+void populate_stack(World& world) { add_ground_and_cube_column(world, 2.0, 3.0); }
+
+std::unique_ptr<Metrics> make_stack_metrics(const World& world) { return observed<StackMetrics>(world); }
 
 }  // namespace cps::scenes

@@ -96,15 +96,23 @@ int run(int argc, char** argv) {
 
   try {
     if (*list) {
-      for (const scenes::Scene& s : scenes::all_scenes()) {
-        std::printf("%-20s %5.0f s  %s\n", std::string(s.name).c_str(), s.default_seconds,
-                    std::string(s.summary).c_str());
-      }
+      const auto print = [](const char* title, std::span<const scenes::Scene> table) {
+        std::printf("%s\n", title);
+        for (const scenes::Scene& s : table) {
+          std::printf("  %-22s %5.0f s  %s\n", std::string(s.name).c_str(), s.default_seconds,
+                      std::string(s.summary).c_str());
+        }
+      };
+      print("The paper's scenes (Sec. 10; 'all'):", scenes::paper_scenes());
+      print("Stress scenes ('stress'):", scenes::stress_scenes());
       return 0;
     }
     if (*simulate) {
-      const scenes::Scene* scene = cli::select_scenes(sim_scene).front();
-      if (sim_scene == "all") throw cli::UsageError("simulate takes one scene, not 'all'");
+      const std::vector<const scenes::Scene*> chosen = cli::select_scenes(sim_scene);
+      if (sim_scene == "all" || sim_scene == "stress") {
+        throw cli::UsageError("simulate takes one scene, not '" + sim_scene + "'");
+      }
+      const scenes::Scene* scene = chosen.front();
       scenes::Run r = cli::make_run_or_usage_error(*scene, sim_overrides);
       const nlohmann::json report =
           cli::simulate(*scene, r, sim_seconds.value_or(scene->default_seconds));

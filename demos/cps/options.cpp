@@ -76,15 +76,18 @@ void add_world_options(CLI::App& cmd, scenes::Overrides& o) {
 
 std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
   std::vector<const scenes::Scene*> selected;
-  if (name == "all") {
-    for (const scenes::Scene& s : scenes::all_scenes()) selected.push_back(&s);
+  if (name == "all" || name == "stress") {
+    for (const scenes::Scene& s : name == "all" ? scenes::paper_scenes() : scenes::stress_scenes()) {
+      selected.push_back(&s);
+    }
     return selected;
   }
   if (const scenes::Scene* s = scenes::find_scene(name)) return {s};
   std::string known;
   for (const scenes::Scene& s : scenes::all_scenes()) known += std::string(known.empty() ? "" : ", ") + std::string(s.name);
   throw UsageError("unknown scene '" + name + "'; the scenes are: " + known +
-                   " (or 'all'); 'cps list' describes them");
+                   " (or 'all' for the paper's scenes, 'stress' for the stress scenes); 'cps list' "
+                   "describes them");
 }
 
 std::vector<Variant> compare_variants(const std::string& option, const scenes::Overrides& base) {

@@ -48,7 +48,15 @@ struct Scene {
   std::optional<CameraPreset> camera;
 };
 
-/// Every scene, in the order `cps list` prints them.
+/// The paper's result scenes (Sec. 10), in the order `cps list` prints them ("all" on the
+/// command line).
+std::span<const Scene> paper_scenes();
+
+/// The stress scenes (stiff and extreme cases), listed apart ("stress" on the command line).
+/// Defined in scenes/stress/stress_table.cpp.
+std::span<const Scene> stress_scenes();
+
+/// Paper scenes, then stress scenes.
 std::span<const Scene> all_scenes();
 
 /// The scene called `name`, or nullptr.

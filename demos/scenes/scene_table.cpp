@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <vector>
 
 namespace cps::scenes {
 namespace {
@@ -52,12 +53,23 @@ const std::array kScenes = {
 
 }  // namespace
 
-std::span<const Scene> all_scenes() { return kScenes; }
+std::span<const Scene> paper_scenes() { return kScenes; }
+
+std::span<const Scene> all_scenes() {
+  static const std::vector<Scene> all = [] {
+    std::vector<Scene> v(kScenes.begin(), kScenes.end());
+    const std::span<const Scene> stress = stress_scenes();
+    v.insert(v.end(), stress.begin(), stress.end());
+    return v;
+  }();
+  return all;
+}
 
 const Scene* find_scene(std::string_view name) {
-  const auto it = std::find_if(kScenes.begin(), kScenes.end(),
-                               [name](const Scene& s) { return s.name == name; });
-  return it == kScenes.end() ? nullptr : &*it;
+  const std::span<const Scene> all = all_scenes();
+  const auto it =
+      std::find_if(all.begin(), all.end(), [name](const Scene& s) { return s.name == name; });
+  return it == all.end() ? nullptr : &*it;
 }
 
 WorldDef world_def_with(const Scene& scene, const Overrides& o) {

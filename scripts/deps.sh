@@ -3,6 +3,7 @@
 cps_packages=(
   cmake g++ make pkg-config
   libeigen3-dev libosmesa6-dev libglm-dev libstb-dev catch2 libcli11-dev nlohmann-json3-dev
+  gnuplot-nox
 )
 
 cps_install_missing() {

@@ -4,6 +4,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -140,3 +141,40 @@ TEST_CASE("cps render writes numbered frames of the requested size", "[cli][rend
   fs::remove_all(dir);
 }
 #endif
+
+TEST_CASE("cps report writes CSVs with units, plots and report.md; runs spread and merge",
+          "[cli][report]") {
+  const fs::path dir = fresh_dir("report");
+  SECTION("one id, run on its own, then merged with another") {
+    const char* ids[] = {"stack.pgs.split.fixed.it4.ss1", "stack.jacobi.split.fixed.it4.ss1"};
+    for (const char* id : ids) {
+      const Result r = cps(std::string("report --run ") + id + " --out runs --quick", dir);
+      REQUIRE(r.exit_code == 0);
+      CHECK(fs::exists(dir / "runs" / (std::string(id) + ".csv")));
+    }
+    const Result merged = cps("report --merge runs --out merged", dir);
+    REQUIRE(merged.exit_code == 0);
+    const std::string csv = slurp(dir / "merged/stack.csv");
+    CHECK(csv.find("wall_s_per_sim_s") != std::string::npos);
+    CHECK(csv.find("residual_rms_N") != std::string::npos);
+    CHECK(csv.find("penetration_max_m") != std::string::npos);
+    CHECK(std::count(csv.begin(), csv.end(), '\n') == 3);  // header and two runs
+    CHECK(fs::exists(dir / "merged/report.md"));
+    CHECK(fs::file_size(dir / "merged/stack_residual_rms_N.png") > 1000);
+    CHECK(fs::exists(dir / "merged/stack_residual_rms_N.svg"));
+  }
+  SECTION("--list-runs prints one command per run") {
+    const Result r = cps("report pendulum_wave --quick --list-runs --out o", dir);
+    REQUIRE(r.exit_code == 0);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 25);  // 24 runs and the merge line
+    CHECK(r.out.find("report --run pendulum_wave.pgs.baumgarte.fixed.it25.ss1") != std::string::npos);
+    CHECK(r.out.find("--merge") != std::string::npos);
+  }
+  SECTION("a malformed run id is a usage error") {
+    const Result r = cps("report --run stack.pgs.sideways.fixed.it4.ss1 --out o", dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("unknown push 'sideways'") != std::string::npos);
+    CHECK(!fs::exists(dir / "o"));
+  }
+  fs::remove_all(dir);
+}

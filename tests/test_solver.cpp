@@ -143,3 +143,22 @@ TEST_CASE("assemble_system builds A = J M^-1 J^T and b of Eq. 6.2.9", "[solver]"
   const double rate = Vec3::UnitY().dot(b1.velocity() + b1.angular_velocity().cross(r_b));
   CHECK((J * v1)[0] == Approx(rate).margin(1e-12));
 }
+
+TEST_CASE("the natural-map LCP residual is zero at the solution and only there", "[solver]") {
+  const int n = 12;
+  const SparseRowMatrix A = random_spd(n, 11);
+  const Eigen::VectorXd b = random_vector(n, 12);
+  RowLimits limits;
+  limits.c_min = Eigen::VectorXd::Zero(n);
+  limits.c_max = Eigen::VectorXd::Constant(n, 0.3);
+  const Eigen::VectorXd converged = solve_pgs(A, b, limits.c_min, limits.c_max, 500);
+  CHECK(lcp_residual(A, b, limits, FrictionModel::fixed, converged).maxCoeff() < 1e-9);
+  const Eigen::VectorXd early = solve_pgs(A, b, limits.c_min, limits.c_max, 1);
+  CHECK(lcp_residual(A, b, limits, FrictionModel::fixed, early).maxCoeff() > 1e-3);
+  // Unbounded rows: the residual is |A lambda - b|_j / A_jj.
+  limits.c_min.setConstant(-kInfinity);
+  limits.c_max.setConstant(kInfinity);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd r = lcp_residual(A, b, limits, FrictionModel::fixed, zero);
+  for (int j = 0; j < n; ++j) CHECK(r[j] == Approx(std::abs(b[j]) / A.coeff(j, j)));
+}

@@ -2,9 +2,14 @@
 #include "options.h"
 #include "simulate.h"
 
+#include "report.h"
+
 #ifdef CPS_HAVE_RENDERER
 #include "render.h"
 #endif
+
+#include <chrono>
+#include <unistd.h>
 
 #include <cstdio>
 #include <iostream>
@@ -32,6 +37,60 @@ SizeWxH parse_size(const std::string& text) {
   return s;
 }
 
+// The absolute path of this executable, for commands that must run anywhere.
+std::string self_path() {
+  char path[4096];
+  const ssize_t n = readlink("/proc/self/exe", path, sizeof path - 1);
+  if (n <= 0) return "cps";
+  path[n] = '\0';
+  return path;
+}
+
+int run_report(const std::string& scene_name, const std::string& out, bool quick, bool list,
+               const std::vector<std::string>& merge, const std::string& one_run) {
+  namespace fs = std::filesystem;
+  const int repeats = quick ? 1 : 3;
+  if (!merge.empty()) {
+    std::vector<fs::path> dirs(merge.begin(), merge.end());
+    const std::vector<cli::Row> rows = cli::read_rows(dirs);
+    if (rows.empty()) throw cli::UsageError("--merge: no report CSV found below the given folders");
+    cli::write_report(out, rows);
+    std::printf("merged %zu runs into %s/report.md\n", rows.size(), out.c_str());
+    return 0;
+  }
+  if (!one_run.empty()) {
+    const cli::RunSpec spec = cli::RunSpec::parse(one_run);
+    const cli::Row row = cli::execute_run(spec, repeats);
+    fs::create_directories(out);
+    cli::write_csv(fs::path(out) / (spec.id() + ".csv"), {row});
+    return 0;
+  }
+  const std::vector<cli::RunSpec> runs = cli::plan_runs(cli::select_scenes(scene_name), quick);
+  if (list) {
+    const std::string exe = self_path();
+    for (const cli::RunSpec& r : runs) {
+      std::printf("'%s' report --run %s --out '%s/runs'%s\n", exe.c_str(), r.id().c_str(),
+                  out.c_str(), quick ? " --quick" : "");
+    }
+    std::printf("# when all have finished: '%s' report --merge '%s/runs' --out '%s'\n",
+                exe.c_str(), out.c_str(), out.c_str());
+    return 0;
+  }
+  std::vector<cli::Row> rows;
+  const auto start = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    rows.push_back(cli::execute_run(runs[i], repeats));
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double left = elapsed / static_cast<double>(i + 1) * static_cast<double>(runs.size() - i - 1);
+    std::fprintf(stderr, "report: %zu/%zu %s (%.0f s elapsed, about %.0f s left)\n", i + 1,
+                 runs.size(), runs[i].id().c_str(), elapsed, left);
+  }
+  cli::write_report(out, rows);
+  std::printf("%zu runs: %s/report.md\n", rows.size(), out.c_str());
+  return 0;
+}
+
 int run(int argc, char** argv) {
   CLI::App app{"cps: the constraint based physics solver of Tamis & Maggiore (2015)"};
   app.require_subcommand(1);
@@ -48,6 +107,24 @@ int run(int argc, char** argv) {
       ->check(cli::kFinitePositive);
   simulate->add_flag("--json", sim_json, "print one JSON object");
   cli::add_world_options(*simulate, sim_overrides);
+
+  std::string report_scene = "all";
+  std::string report_out = "out/report";
+  bool report_quick = false;
+  bool report_list = false;
+  std::vector<std::string> report_merge;
+  std::string report_run;
+  CLI::App* report = app.add_subcommand(
+      "report", "error against run time: sweep solver settings, write CSV, plots, report.md");
+  report->add_option("scene", report_scene, "scene name, 'all' (the paper's) or 'stress'")
+      ->capture_default_str();
+  report->add_option("--out", report_out, "output folder")->capture_default_str();
+  report->add_flag("--quick", report_quick, "a reduced sweep (about 2 minutes for all scenes)");
+  report->add_flag("--list-runs", report_list,
+                   "print one self-contained command per run, to spread the sweep over machines");
+  report->add_option("--merge", report_merge,
+                     "combine the CSV files below these folders into one report in --out");
+  report->add_option("--run", report_run, "execute one run by its id (see --list-runs)");
 
 #ifdef CPS_HAVE_RENDERER
   std::string render_scene;
@@ -114,17 +191,21 @@ int run(int argc, char** argv) {
       }
       const scenes::Scene* scene = chosen.front();
       scenes::Run r = cli::make_run_or_usage_error(*scene, sim_overrides);
-      const nlohmann::json report =
+      const nlohmann::json summary =
           cli::simulate(*scene, r, sim_seconds.value_or(scene->default_seconds));
       if (sim_json) {
-        std::cout << report.dump(2) << "\n";
+        std::cout << summary.dump(2) << "\n";
       } else {
-        std::cout << scene->name << ": " << report["steps"] << " steps, "
-                  << report["simulated_s"] << " s simulated in " << report["wall_s"] << " s ("
-                  << report["us_per_step"] << " us/step)\nmetrics: " << report["metrics"].dump()
+        std::cout << scene->name << ": " << summary["steps"] << " steps, "
+                  << summary["simulated_s"] << " s simulated in " << summary["wall_s"] << " s ("
+                  << summary["us_per_step"] << " us/step)\nmetrics: " << summary["metrics"].dump()
                   << "\n";
       }
       return 0;
+    }
+    if (*report) {
+      return run_report(report_scene, report_out, report_quick, report_list, report_merge,
+                        report_run);
     }
 #ifdef CPS_HAVE_RENDERER
     if (*render) {

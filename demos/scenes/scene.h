@@ -74,6 +74,7 @@ struct Overrides {
   std::optional<SolverKind> solver;
   std::optional<FrictionModel> friction_model;
   std::optional<RotationUpdate> rotation;
+  bool measure_residual = false;  ///< sets WorldDef::measure_residual
 };
 
 /// The scene's WorldDef with the overrides applied. Not validated here: World's constructor does.

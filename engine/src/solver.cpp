@@ -2,6 +2,7 @@
 #include "cps/solver.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -74,6 +75,39 @@ Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
     if (jacobi) lambda.swap(next);
   }
   return lambda;
+}
+
+Eigen::VectorXd lcp_residual(const SparseRowMatrix& A, const Eigen::VectorXd& b,
+                             const RowLimits& limits, FrictionModel friction,
+                             const Eigen::VectorXd& lambda) {
+  const Eigen::Index c = b.size();
+  if (A.rows() != c || A.cols() != c || lambda.size() != c || limits.c_min.size() != c ||
+      limits.c_max.size() != c) {
+    throw std::invalid_argument("lcp_residual: A is " + std::to_string(A.rows()) + " x " +
+                                std::to_string(A.cols()) + ", b and lambda have " +
+                                std::to_string(c) + " and " + std::to_string(lambda.size()) +
+                                " entries; they must match");
+  }
+  const bool coupled = friction == FrictionModel::coupled && !limits.normal_row.empty();
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(c);
+  for (Eigen::Index j = 0; j < c; ++j) {
+    double Ax = 0.0;
+    double diagonal = 0.0;
+    for (SparseRowMatrix::InnerIterator it(A, j); it; ++it) {
+      Ax += it.value() * lambda[it.col()];
+      if (it.col() == j) diagonal = it.value();
+    }
+    if (!(diagonal > 0.0)) continue;
+    double lo = limits.c_min[j];
+    double hi = limits.c_max[j];
+    const int n = coupled ? limits.normal_row[static_cast<std::size_t>(j)] : -1;
+    if (n >= 0) {
+      hi = limits.mu[j] * lambda[n];
+      lo = -hi;
+    }
+    r[j] = std::abs(lambda[j] - std::clamp(lambda[j] - (Ax - b[j]) / diagonal, lo, hi));
+  }
+  return r;
 }
 
 Eigen::VectorXd solve_pgs(const SparseRowMatrix& A, const Eigen::VectorXd& b,

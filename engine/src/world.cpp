@@ -110,7 +110,14 @@ void World::build_rows() {
 Eigen::VectorXd World::solve(const SparseRowMatrix& A, const Eigen::VectorXd& b,
                              const RowLimits& limits) {
   ++counters_.solves;
-  return solve_lcp(A, b, limits, def_.friction_model, def_.solver, def_.iterations);
+  Eigen::VectorXd lambda = solve_lcp(A, b, limits, def_.friction_model, def_.solver, def_.iterations);
+  if (def_.measure_residual) {
+    const Eigen::VectorXd r = lcp_residual(A, b, limits, def_.friction_model, lambda);
+    residual_.max = std::max(residual_.max, r.size() > 0 ? r.maxCoeff() : 0.0);
+    residual_.sum_squares += r.squaredNorm();
+    residual_.rows += r.size();
+  }
+  return lambda;
 }
 
 // Stages 3-5, Secs. 6, 7, 3.2.

@@ -31,6 +31,16 @@ Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
                           const RowLimits& limits, FrictionModel friction, SolverKind kind,
                           int iterations);
 
+/// The natural-map residual of the bounded problem at `lambda` (c), per row
+///   r_j = |lambda_j - clamp(lambda_j - (A lambda - b)_j / A_jj, lo_j, hi_j)|   (N)
+/// with the bounds of solve_lcp (coupled friction bounds from lambda's own contact rows). It is 0
+/// exactly when lambda solves the LCP, whatever method produced it, so PGS and Jacobi are compared
+/// on the same footing. Rows with A_jj <= 0 count as 0. Returns the per-row residuals (c).
+/// Throws std::invalid_argument on mismatched sizes.
+Eigen::VectorXd lcp_residual(const SparseRowMatrix& A, const Eigen::VectorXd& b,
+                             const RowLimits& limits, FrictionModel friction,
+                             const Eigen::VectorXd& lambda);
+
 /// Projected Gauss-Seidel exactly as the pseudo code of Sec. 7.2, with fixed bounds c_min, c_max
 /// (c each): solve_lcp with SolverKind::pgs and FrictionModel::fixed.
 Eigen::VectorXd solve_pgs(const SparseRowMatrix& A, const Eigen::VectorXd& b,

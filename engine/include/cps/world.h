@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -47,6 +48,9 @@ struct WorldDef {
   /// 1e-3 m for bodies of 0.5 to 3 m.
   double contact_margin = 0.0;
   bool collision = true;  ///< false: the bodies never collide and stage 1 is skipped
+  /// true: after every solve, measure the LCP residual (lcp_residual) into World::residual();
+  /// it costs one pass over A per solve, so it is off unless a report asks for it.
+  bool measure_residual = false;
 
   /// Throws std::invalid_argument naming the parameter, its value and what is allowed.
   void validate() const;
@@ -59,6 +63,15 @@ struct StepCounters {
   std::int64_t contacts = 0;      ///< contact points found
   std::int64_t rows = 0;          ///< constraint rows built
   std::int64_t solves = 0;        ///< solves of A lambda = b
+};
+
+/// LCP residuals (N) of the solves so far, when WorldDef::measure_residual is set: the largest
+/// row residual, and the sum of squares and count of row residuals (for an RMS).
+struct ResidualStats {
+  double max = 0.0;
+  double sum_squares = 0.0;
+  std::int64_t rows = 0;
+  double rms() const { return rows > 0 ? std::sqrt(sum_squares / static_cast<double>(rows)) : 0.0; }
 };
 
 /// A set of bodies and distance constraints stepped by the constraint solver. Bodies are
@@ -89,6 +102,7 @@ class World {
   /// Simulated time (s): steps taken times dt.
   double time() const { return static_cast<double>(counters_.steps) * def_.dt; }
   const StepCounters& counters() const { return counters_; }
+  const ResidualStats& residual() const { return residual_; }
   /// Manifolds found by the last step's collision stage (normals from a to b, depths in m).
   const std::vector<Manifold>& manifolds() const { return manifolds_; }
   /// Rows built by the last step (c of them) and lambda of its (first) solve (c, N).
@@ -108,6 +122,7 @@ class World {
   std::vector<ConstraintRow> rows_;
   Eigen::VectorXd lambda_;
   StepCounters counters_;
+  ResidualStats residual_;
 };
 
 }  // namespace cps

@@ -1,0 +1,548 @@
+#include "report.h"
+
+#include "options.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace cps::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// How long each scene runs in the sweep (s): long enough for its own metrics (the intersecting
+// stack is judged at 0.5 s as in the paper's Fig. 7, the pendulum wave realigns near 60.26 s).
+double horizon_of(const scenes::Scene& scene) {
+  if (scene.name == "intersecting_stack") return 0.5;
+  return scene.default_seconds;
+}
+
+// The trajectory error compares positions with a reference run (16 substeps, 256 iterations) at
+// this time (s). Contacts make these scenes chaotic: once a stack starts to slide or balls start
+// to roll past each other, nearby trajectories part exponentially and a difference measures
+// chaos, not accuracy. Before the first impacts have settled they do not: 1 s covers the stack's
+// fall and landing, the funnel's fall onto the walls and the grid's catch of its load; the
+// intersecting stack is compared at 0.5 s, the time the paper shows.
+double trajectory_time_of(const scenes::Scene& scene) {
+  return std::min(1.0, horizon_of(scene));
+}
+
+const char* name_of(SolverKind s) { return s == SolverKind::pgs ? "pgs" : "jacobi"; }
+const char* name_of(PushMode p) { return p == PushMode::baumgarte ? "baumgarte" : "split"; }
+const char* name_of(FrictionModel f) { return f == FrictionModel::fixed ? "fixed" : "coupled"; }
+
+std::string number(double v) {
+  if (!std::isfinite(v)) return "";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+bool has_friction(const scenes::Scene& scene) { return scene.world_def().friction > 0.0; }
+
+scenes::Overrides overrides_of(const RunSpec& spec) {
+  scenes::Overrides o;
+  o.solver = spec.solver;
+  o.push = spec.push;
+  o.friction_model = spec.friction_model;
+  o.iterations = spec.iterations;
+  o.dt = 1.0 / (60.0 * spec.substeps);
+  return o;
+}
+
+const scenes::Scene& scene_of(const RunSpec& spec) {
+  const scenes::Scene* scene = scenes::find_scene(spec.scene);
+  if (!scene) throw UsageError("report: unknown scene '" + spec.scene + "'");
+  return *scene;
+}
+
+std::vector<Vec3> positions(const World& world) {
+  std::vector<Vec3> x;
+  for (const Body& b : world.bodies()) {
+    if (!b.is_static()) x.push_back(b.x);
+  }
+  return x;
+}
+
+bool finite_state(const World& world) {
+  for (const Body& b : world.bodies()) {
+    if (!b.x.allFinite() || !b.p.allFinite() || !b.l.allFinite() || !b.o.coeffs().allFinite()) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Positions of the reference run (pgs, 256 iterations, 16 substeps, same push and friction
+// model) at the trajectory time; computed once per process and kept.
+std::vector<Vec3> reference_positions(const RunSpec& spec) {
+  static std::mutex mutex;
+  static std::map<std::string, std::vector<Vec3>> cache;
+  RunSpec ref = spec;
+  ref.solver = SolverKind::pgs;
+  ref.iterations = 256;
+  ref.substeps = 16;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto it = cache.find(ref.id());
+  if (it != cache.end()) return it->second;
+  const scenes::Scene& scene = scene_of(ref);
+  scenes::Run run = scenes::make_run(scene, overrides_of(ref));
+  run.world.step();  // at least one step, as every run below
+  while (run.world.time() + 0.5 * run.world.def().dt < trajectory_time_of(scene)) run.world.step();
+  return cache[ref.id()] = positions(run.world);
+}
+
+// The numeric entries of a scene's metrics, as "metric.NAME" columns (booleans as 0/1, arrays
+// and nulls left out).
+void add_metrics(const nlohmann::json& metrics, Row& row) {
+  for (const auto& [key, value] : metrics.items()) {
+    if (value.is_number()) row["metric." + key] = number(value.get<double>());
+    if (value.is_boolean()) row["metric." + key] = value.get<bool>() ? "1" : "0";
+  }
+}
+
+double to_double(const Row& row, const std::string& column) {
+  const auto it = row.find(column);
+  if (it == row.end() || it->second.empty()) return std::nan("");
+  return std::strtod(it->second.c_str(), nullptr);
+}
+
+// Columns in the order a reader wants them: the settings, then the measures, then metrics.
+std::vector<std::string> ordered_columns(const std::vector<Row>& rows) {
+  static const std::vector<std::string> first = {
+      "scene", "solver", "push", "friction_model", "iterations", "substeps", "dt_s", "horizon_s",
+      "diverged", "wall_s_per_sim_s", "us_per_step", "trajectory_time_s", "trajectory_error_m",
+      "phase_error_deg", "residual_max_N", "residual_rms_N", "penetration_max_m",
+      "penetration_rms_m", "rod_error_max_m", "rod_error_rms_m", "energy_drift_rel"};
+  std::set<std::string> all;
+  for (const Row& r : rows) {
+    for (const auto& kv : r) all.insert(kv.first);
+  }
+  std::vector<std::string> columns;
+  for (const std::string& c : first) {
+    if (all.erase(c)) columns.push_back(c);
+  }
+  columns.insert(columns.end(), all.begin(), all.end());
+  return columns;
+}
+
+// What the work-precision diagrams show, with axis labels.
+struct Measure {
+  const char* column;
+  const char* label;
+};
+constexpr Measure kMeasures[] = {
+    {"trajectory_error_m", "trajectory error against the reference run (m)"},
+    {"phase_error_deg", "largest phase error against the reduced-coordinate reference (deg)"},
+    {"residual_rms_N", "RMS LCP residual (N)"},
+    {"penetration_max_m", "largest penetration (m)"},
+    {"rod_error_max_m", "largest rod length error (m)"},
+    {"energy_drift_rel", "largest relative energy drift"},
+    {"metric.max_speed_mps", "largest body speed at the end (m/s)"},
+};
+
+// The error measure a scene's headline uses. The intersecting stack's is its largest speed at
+// 0.5 s (the right answer is a stack at rest): its trajectory has no converged reference under
+// Baumgarte, whose correcting velocity beta d / dt grows as dt shrinks.
+const char* primary_measure(const std::string& scene) {
+  if (scene == "pendulum_wave") return "phase_error_deg";
+  if (scene == "intersecting_stack") return "metric.max_speed_mps";
+  return "trajectory_error_m";
+}
+
+std::string variant_of(const Row& r) {
+  return r.at("solver") + " " + r.at("push") + " " + r.at("friction_model");
+}
+
+bool is_paper_setting(const Row& r) {
+  return r.at("solver") == "pgs" && r.at("push") == "baumgarte" &&
+         r.at("friction_model") == "fixed" && r.at("iterations") == "25" && r.at("substeps") == "1";
+}
+
+void run_gnuplot(const fs::path& script) {
+  const std::string command = "gnuplot '" + script.string() + "' 2>&1";
+  std::FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) throw std::runtime_error("report: cannot start gnuplot");
+  std::string output;
+  char buffer[512];
+  while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+  const int status = pclose(pipe);
+  if (status != 0) {
+    throw std::runtime_error(
+        "report: gnuplot failed on " + script.string() + " (exit " + std::to_string(status) +
+        "): " + output.substr(0, 400) +
+        (status == 127 * 256 ? "\nInstall it with: apt-get install gnuplot-nox" : ""));
+  }
+}
+
+// One diagram: error against physics time, log-log, a line per variant and sweep, points
+// labelled by iterations (solid lines) or substeps (dashed).
+bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& m,
+                  const std::vector<const Row*>& rows) {
+  struct Line {
+    std::string title;
+    bool substeps;
+    std::vector<std::tuple<double, double, std::string>> points;
+  };
+  std::map<std::string, Line> lines;
+  for (const Row* r : rows) {
+    const double t = to_double(*r, "wall_s_per_sim_s");
+    const double e = to_double(*r, m.column);
+    if (!(t > 0.0) || !(e > 0.0)) continue;  // log axes: only positive values
+    const bool iteration_sweep = r->at("substeps") == "1";
+    const bool substep_sweep = r->at("iterations") == "25";
+    if (iteration_sweep) {
+      Line& line = lines[variant_of(*r) + ", iterations"];
+      line.title = variant_of(*r) + ", iterations";
+      line.points.emplace_back(t, e, r->at("iterations"));
+    }
+    if (substep_sweep) {
+      Line& line = lines[variant_of(*r) + ", substeps"];
+      line.title = variant_of(*r) + ", substeps";
+      line.substeps = true;
+      line.points.emplace_back(t, e, "s" + r->at("substeps"));
+    }
+  }
+  if (lines.empty()) return false;
+  const std::string stem = scene + "_" + m.column;
+  const fs::path data = dir / "plots" / (stem + ".dat");
+  const fs::path script = dir / "plots" / (stem + ".gp");
+  fs::create_directories(dir / "plots");
+  {
+    std::ofstream out(data);
+    for (auto& [key, line] : lines) {
+      std::sort(line.points.begin(), line.points.end());
+      out << "# " << line.title << "\n";
+      for (const auto& [t, e, label] : line.points) out << t << " " << e << " " << label << "\n";
+      out << "\n\n";
+    }
+  }
+  std::ofstream gp(script);
+  gp << "set logscale xy\nset grid\nset key outside right top font ',9'\n"
+     << "set xlabel 'physics wall time per simulated second (s/s)'\n"
+     << "set ylabel '" << m.label << "'\n"
+     << "set title '" << scene << ": " << m.label << " against run time'\n";
+  std::string plot = "plot ";
+  int index = 0;
+  for (const auto& [key, line] : lines) {
+    plot += (index ? ", " : "") + std::string("'") + data.string() + "' index " +
+            std::to_string(index) + " using 1:2 with linespoints lw 1.5 pt 7 ps 0.6 dt " +
+            (line.substeps ? "2" : "1") + " lc " + std::to_string(index + 1) + " title '" +
+            line.title + "', '' index " + std::to_string(index) +
+            " using 1:2:3 with labels offset 0.6,0.6 font ',7' tc lt " +
+            std::to_string(index + 1) + " notitle";
+    ++index;
+  }
+  gp << "set terminal pngcairo size 1100,650 font ',10'\nset output '"
+     << (dir / (stem + ".png")).string() << "'\n" << plot << "\n";
+  gp << "set terminal svg size 1100,650 font ',10'\nset output '"
+     << (dir / (stem + ".svg")).string() << "'\n" << plot << "\nunset output\n";
+  gp.close();
+  run_gnuplot(script);
+  return true;
+}
+
+}  // namespace
+
+std::string RunSpec::id() const {
+  return scene + "." + name_of(solver) + "." + name_of(push) + "." + name_of(friction_model) +
+         ".it" + std::to_string(iterations) + ".ss" + std::to_string(substeps);
+}
+
+RunSpec RunSpec::parse(const std::string& id) {
+  std::vector<std::string> parts;
+  std::stringstream s(id);
+  for (std::string part; std::getline(s, part, '.');) parts.push_back(part);
+  const auto bad = [&id](const std::string& why) {
+    return UsageError("run id '" + id + "': " + why +
+                      "; expected scene.pgs|jacobi.baumgarte|split.fixed|coupled.itN.ssM");
+  };
+  if (parts.size() != 6) throw bad("it has " + std::to_string(parts.size()) + " parts, not 6");
+  RunSpec r;
+  r.scene = parts[0];
+  if (!scenes::find_scene(r.scene)) throw bad("unknown scene");
+  if (parts[1] != "pgs" && parts[1] != "jacobi") throw bad("unknown solver '" + parts[1] + "'");
+  r.solver = parts[1] == "pgs" ? SolverKind::pgs : SolverKind::jacobi;
+  if (parts[2] != "baumgarte" && parts[2] != "split") throw bad("unknown push '" + parts[2] + "'");
+  r.push = parts[2] == "baumgarte" ? PushMode::baumgarte : PushMode::split;
+  if (parts[3] != "fixed" && parts[3] != "coupled") throw bad("unknown friction model");
+  r.friction_model = parts[3] == "fixed" ? FrictionModel::fixed : FrictionModel::coupled;
+  const auto count = [&](const std::string& p, const char* prefix) {
+    if (p.rfind(prefix, 0) != 0) throw bad("'" + p + "' does not start with " + prefix);
+    const int n = std::atoi(p.c_str() + 2);
+    if (n < 1 || n > 100000) throw bad("'" + p + "' is not a count in [1, 100000]");
+    return n;
+  };
+  r.iterations = count(parts[4], "it");
+  r.substeps = count(parts[5], "ss");
+  return r;
+}
+
+std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, bool quick) {
+  const std::vector<int> iterations =
+      quick ? std::vector<int>{1, 4, 16, 25, 64} : std::vector<int>{1, 2, 4, 8, 16, 25, 32, 64, 128, 256};
+  const std::vector<int> substeps = quick ? std::vector<int>{4} : std::vector<int>{2, 4, 8, 16};
+  std::vector<RunSpec> runs;
+  for (const scenes::Scene* scene : scenes) {
+    std::vector<FrictionModel> frictions = {FrictionModel::fixed};
+    if (!quick && has_friction(*scene)) frictions.push_back(FrictionModel::coupled);
+    for (const FrictionModel f : frictions) {
+      for (const PushMode p : {PushMode::baumgarte, PushMode::split}) {
+        for (const SolverKind s : {SolverKind::pgs, SolverKind::jacobi}) {
+          for (const int it : iterations) runs.push_back({std::string(scene->name), s, p, f, it, 1});
+          for (const int ss : substeps) runs.push_back({std::string(scene->name), s, p, f, 25, ss});
+        }
+      }
+    }
+  }
+  return runs;
+}
+
+Row execute_run(const RunSpec& spec, int repeats) {
+  const scenes::Scene& scene = scene_of(spec);
+  const double horizon = horizon_of(scene);
+  const double t_traj = trajectory_time_of(scene);
+  scenes::Overrides o = overrides_of(spec);
+  Row row;
+  row["scene"] = spec.scene;
+  row["solver"] = name_of(spec.solver);
+  row["push"] = name_of(spec.push);
+  row["friction_model"] = name_of(spec.friction_model);
+  row["iterations"] = std::to_string(spec.iterations);
+  row["substeps"] = std::to_string(spec.substeps);
+  row["dt_s"] = number(*o.dt);
+  row["horizon_s"] = number(horizon);
+
+  // The error run: residuals on, every step observed.
+  o.measure_residual = true;
+  const auto error_start = std::chrono::steady_clock::now();
+  scenes::Run run = scenes::make_run(scene, o);
+  double pen_max = 0.0, pen_sq = 0.0, rod_max = 0.0, rod_sq = 0.0;
+  std::int64_t pen_n = 0, rod_n = 0;
+  std::vector<Vec3> at_traj;
+  bool diverged = false;
+  while (run.world.time() + 0.5 * run.world.def().dt < horizon) {
+    run.step();
+    if (!finite_state(run.world)) {
+      diverged = true;
+      break;
+    }
+    for (const Manifold& m : run.world.manifolds()) {
+      for (int i = 0; i < m.count; ++i) {
+        const double d = std::max(0.0, m.contacts[static_cast<std::size_t>(i)].depth);
+        pen_max = std::max(pen_max, d);
+        pen_sq += d * d;
+        ++pen_n;
+      }
+    }
+    for (const DistanceConstraint& d : run.world.distances()) {
+      Vec3 a;
+      Vec3 b;
+      distance_endpoints(d, run.world.bodies(), a, b);
+      const double e = std::abs((b - a).norm() - d.length);
+      rod_max = std::max(rod_max, e);
+      rod_sq += e * e;
+      ++rod_n;
+    }
+    if (at_traj.empty() && run.world.time() + 0.5 * run.world.def().dt >= t_traj) {
+      at_traj = positions(run.world);
+    }
+  }
+  row["diverged"] = diverged ? "1" : "0";
+  const ResidualStats& res = run.world.residual();
+  row["residual_max_N"] = number(res.max);
+  row["residual_rms_N"] = number(res.rms());
+  if (run.world.def().collision) {
+    row["penetration_max_m"] = number(pen_max);
+    row["penetration_rms_m"] = number(pen_n ? std::sqrt(pen_sq / static_cast<double>(pen_n)) : 0.0);
+  }
+  if (!run.world.distances().empty()) {
+    row["rod_error_max_m"] = number(rod_max);
+    row["rod_error_rms_m"] = number(std::sqrt(rod_sq / static_cast<double>(rod_n ? rod_n : 1)));
+  }
+  if (!diverged) {
+    const nlohmann::json metrics = run.metrics->report();
+    add_metrics(metrics, row);
+    if (metrics.contains("max_phase_error_deg")) {
+      row["phase_error_deg"] = number(metrics["max_phase_error_deg"].get<double>());
+    }
+    if (metrics.contains("energy_drift_rel")) {
+      row["energy_drift_rel"] = number(metrics["energy_drift_rel"].get<double>());
+    }
+    if (!at_traj.empty() && spec.scene != "pendulum_wave") {
+      const std::vector<Vec3> ref = reference_positions(spec);
+      double sq = 0.0;
+      for (std::size_t i = 0; i < ref.size() && i < at_traj.size(); ++i) {
+        sq += (at_traj[i] - ref[i]).squaredNorm();
+      }
+      row["trajectory_time_s"] = number(t_traj);
+      row["trajectory_error_m"] = number(std::sqrt(sq / static_cast<double>(ref.size())));
+    }
+  }
+
+  // Timing runs: the physics step alone, residuals off, metrics not fed; the median of repeats.
+  // The error run above was the warm-up. A run whose error run took over 2 s is timed once.
+  if (std::chrono::duration<double>(std::chrono::steady_clock::now() - error_start).count() > 2.0) {
+    repeats = std::min(repeats, 1);
+  }
+  o.measure_residual = false;
+  std::vector<double> seconds;
+  std::int64_t steps = 0;
+  for (int r = 0; r < (diverged ? 0 : repeats); ++r) {
+    scenes::Run timed = scenes::make_run(scene, o);
+    const auto start = std::chrono::steady_clock::now();
+    while (timed.world.time() + 0.5 * timed.world.def().dt < horizon) timed.world.step();
+    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    steps = timed.world.counters().steps;
+  }
+  if (!seconds.empty()) {
+    std::sort(seconds.begin(), seconds.end());
+    const double median = seconds[seconds.size() / 2];
+    row["wall_s_per_sim_s"] = number(median / horizon);
+    row["us_per_step"] = number(1e6 * median / static_cast<double>(std::max<std::int64_t>(steps, 1)));
+  }
+  return row;
+}
+
+void write_csv(const fs::path& file, const std::vector<Row>& rows) {
+  const std::vector<std::string> columns = ordered_columns(rows);
+  const fs::path temporary = file.string() + ".tmp";
+  {
+    std::ofstream out(temporary);
+    if (!out) throw std::runtime_error("report: cannot write " + file.string());
+    for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c];
+    out << "\n";
+    for (const Row& r : rows) {
+      for (std::size_t c = 0; c < columns.size(); ++c) {
+        const auto it = r.find(columns[c]);
+        out << (c ? "," : "") << (it == r.end() ? "" : it->second);
+      }
+      out << "\n";
+    }
+  }
+  fs::rename(temporary, file);
+}
+
+std::vector<Row> read_rows(const std::vector<fs::path>& dirs) {
+  std::vector<Row> rows;
+  for (const fs::path& dir : dirs) {
+    if (!fs::is_directory(dir)) throw std::runtime_error("report --merge: no folder " + dir.string());
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+      if (entry.is_regular_file() && entry.path().extension() == ".csv") files.push_back(entry.path());
+    }
+    std::sort(files.begin(), files.end());
+    for (const fs::path& file : files) {
+      std::ifstream in(file);
+      std::string line;
+      std::getline(in, line);
+      std::vector<std::string> header;
+      std::stringstream hs(line);
+      for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
+      if (header.empty() || header[0] != "scene") {
+        throw std::runtime_error("report --merge: " + file.string() + " is not a cps report CSV");
+      }
+      while (std::getline(in, line)) {
+        if (line.empty()) continue;
+        Row r;
+        std::stringstream ls(line);
+        std::string value;
+        for (const std::string& c : header) {
+          if (!std::getline(ls, value, ',')) value.clear();
+          if (!value.empty()) r[c] = value;
+        }
+        rows.push_back(r);
+      }
+    }
+  }
+  return rows;
+}
+
+void write_report(const fs::path& dir, const std::vector<Row>& rows) {
+  fs::create_directories(dir);
+  std::map<std::string, std::vector<const Row*>> by_scene;
+  std::vector<std::string> order;
+  for (const Row& r : rows) {
+    if (!by_scene.count(r.at("scene"))) order.push_back(r.at("scene"));
+    by_scene[r.at("scene")].push_back(&r);
+  }
+  std::ostringstream md;
+  md << "# Error against run time\n\n"
+     << "Made by `cps report`. Each run steps the scene for its horizon with the settings in its "
+        "row; the physics wall time per simulated second is the median of timing runs of the "
+        "step alone (no metrics, no residual), after the error run as warm-up. Trajectory error: "
+        "RMS distance of the bodies from a reference run (PGS, 256 iterations, 16 substeps, same "
+        "push and friction model) at the trajectory time, kept short because contacts make "
+        "these scenes chaotic. The LCP residual is the natural-map residual "
+        "|lambda - clamp(lambda - (A lambda - b) / A_jj, c_min, c_max)| over every row of every "
+        "solve. Substeps are steps per 1/60 s frame.\n\n"
+     << "## Headline: error at the paper's settings and the time needed to halve it\n\n"
+     << "| scene | measure | paper settings (pgs, baumgarte, fixed, 25 it, 60 Hz) | time (s/s) "
+        "| cheapest run with half the error | its time (s/s) | time ratio |\n|---|---|---|---|---|---|---|\n";
+  for (const std::string& scene : order) {
+    const char* measure = primary_measure(scene);
+    const Row* base = nullptr;
+    for (const Row* r : by_scene[scene]) {
+      if (is_paper_setting(*r)) base = r;
+    }
+    if (!base) continue;
+    const double e0 = to_double(*base, measure);
+    const double t0 = to_double(*base, "wall_s_per_sim_s");
+    const Row* best = nullptr;
+    for (const Row* r : by_scene[scene]) {
+      if (r->at("push") != base->at("push") || r->at("friction_model") != base->at("friction_model")) continue;
+      const double e = to_double(*r, measure);
+      const double t = to_double(*r, "wall_s_per_sim_s");
+      if (e <= 0.5 * e0 && std::isfinite(t) && (!best || t < to_double(*best, "wall_s_per_sim_s"))) best = r;
+    }
+    md << "| " << scene << " | " << measure << " | " << number(e0) << " | " << number(t0) << " | ";
+    if (best) {
+      const double t1 = to_double(*best, "wall_s_per_sim_s");
+      md << best->at("solver") << ", " << best->at("iterations") << " it, " << best->at("substeps")
+         << " substeps: " << number(to_double(*best, measure)) << " | " << number(t1) << " | "
+         << number(t1 / t0) << " |\n";
+    } else {
+      md << "none in this sweep | | |\n";
+    }
+  }
+  md << "\n";
+  for (const std::string& scene : order) {
+    std::vector<Row> scene_rows;
+    for (const Row* r : by_scene[scene]) scene_rows.push_back(*r);
+    write_csv(dir / (scene + ".csv"), scene_rows);
+    md << "## " << scene << "\n\nAll runs: [" << scene << ".csv](" << scene << ".csv).\n\n";
+    for (const Measure& m : kMeasures) {
+      if (plot_measure(dir, scene, m, by_scene[scene])) {
+        md << "![" << scene << " " << m.column << "](" << scene << "_" << m.column << ".png)\n\n";
+      }
+    }
+    const char* measure = primary_measure(scene);
+    md << "| solver | push | friction | iterations | substeps | time (s/s) | " << measure
+       << " | residual RMS (N) | penetration max (m) | rod error max (m) | diverged |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const Row* r : by_scene[scene]) {
+      const auto cell = [r](const char* c) {
+        const auto it = r->find(c);
+        return it == r->end() ? std::string() : it->second;
+      };
+      md << "| " << cell("solver") << " | " << cell("push") << " | " << cell("friction_model")
+         << " | " << cell("iterations") << " | " << cell("substeps") << " | "
+         << cell("wall_s_per_sim_s") << " | " << cell(measure) << " | " << cell("residual_rms_N")
+         << " | " << cell("penetration_max_m") << " | " << cell("rod_error_max_m") << " | "
+         << cell("diverged") << " |\n";
+    }
+    md << "\n";
+  }
+  std::ofstream out(dir / "report.md");
+  if (!out) throw std::runtime_error("report: cannot write " + (dir / "report.md").string());
+  out << md.str();
+}
+
+}  // namespace cps::cli

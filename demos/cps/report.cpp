@@ -71,11 +71,14 @@ std::vector<Vec3> positions(const World& world) {
   return x;
 }
 
-bool finite_state(const World& world) {
+// False once the state is not finite, or a body is further than 1e6 m away or faster than
+// 1e6 m/s: the run has blown up and goes no further.
+bool sane_state(const World& world) {
   for (const Body& b : world.bodies()) {
     if (!b.x.allFinite() || !b.p.allFinite() || !b.l.allFinite() || !b.o.coeffs().allFinite()) {
       return false;
     }
+    if (b.x.norm() > 1e6 || b.velocity().norm() > 1e6) return false;
   }
   return true;
 }
@@ -211,6 +214,13 @@ bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& 
     }
   }
   if (lines.empty()) return false;
+  // Runs that blow up (Jacobi on contact stacks) would squash every other line into the bottom
+  // of the diagram: the y range stops a decade above the largest PGS value; the table and the
+  // CSV keep every figure.
+  double pgs_max = 0.0;
+  for (const Row* r : rows) {
+    if (r->at("solver") == "pgs") pgs_max = std::max(pgs_max, to_double(*r, m.column));
+  }
   const std::string stem = scene + "_" + m.column;
   const fs::path data = dir / "plots" / (stem + ".dat");
   const fs::path script = dir / "plots" / (stem + ".gp");
@@ -229,20 +239,28 @@ bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& 
      << "set xlabel 'physics wall time per simulated second (s/s)'\n"
      << "set ylabel '" << m.label << "'\n"
      << "set title '" << scene << ": " << m.label << " against run time'\n";
+  if (pgs_max > 0.0) gp << "set yrange [*:" << 10.0 * pgs_max << "]\n";
+  // One colour per variant (solver, push, friction model); iterations solid, substeps dashed.
+  std::map<std::string, int> colour;
+  for (const auto& [key, line] : lines) {
+    const std::string variant = key.substr(0, key.rfind(','));
+    colour.emplace(variant, static_cast<int>(colour.size()) + 1);
+  }
   std::string plot = "plot ";
   int index = 0;
   for (const auto& [key, line] : lines) {
+    const int lc = colour.at(key.substr(0, key.rfind(',')));
     plot += (index ? ", " : "") + std::string("'") + data.string() + "' index " +
             std::to_string(index) + " using 1:2 with linespoints lw 1.5 pt 7 ps 0.6 dt " +
-            (line.substeps ? "2" : "1") + " lc " + std::to_string(index + 1) + " title '" +
+            (line.substeps ? "2" : "1") + " lc " + std::to_string(lc) + " title '" +
             line.title + "', '' index " + std::to_string(index) +
-            " using 1:2:3 with labels offset 0.6,0.6 font ',7' tc lt " +
-            std::to_string(index + 1) + " notitle";
+            " using 1:2:3 with labels offset 0.6,0.6 font ',7' tc lt " + std::to_string(lc) +
+            " notitle";
     ++index;
   }
-  gp << "set terminal pngcairo size 1100,650 font ',10'\nset output '"
+  gp << "set terminal pngcairo size 1100,650 font ',10' noenhanced\nset output '"
      << (dir / (stem + ".png")).string() << "'\n" << plot << "\n";
-  gp << "set terminal svg size 1100,650 font ',10'\nset output '"
+  gp << "set terminal svg size 1100,650 font ',10' noenhanced\nset output '"
      << (dir / (stem + ".svg")).string() << "'\n" << plot << "\nunset output\n";
   gp.close();
   run_gnuplot(script);
@@ -330,7 +348,7 @@ Row execute_run(const RunSpec& spec, int repeats) {
   bool diverged = false;
   while (run.world.time() + 0.5 * run.world.def().dt < horizon) {
     run.step();
-    if (!finite_state(run.world)) {
+    if (!sane_state(run.world)) {
       diverged = true;
       break;
     }

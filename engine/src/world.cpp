@@ -41,6 +41,11 @@ void WorldDef::validate() const {
 
 World::World(const WorldDef& def) : def_(def) { def_.validate(); }
 
+void World::set_def(const WorldDef& def) {
+  def.validate();
+  def_ = def;
+}
+
 int World::add_body(const BodyDef& def) {
   bodies_.push_back(make_body(def));  // make_body throws before anything is added
   return static_cast<int>(bodies_.size()) - 1;
@@ -107,44 +112,81 @@ void World::build_rows() {
   counters_.rows += static_cast<std::int64_t>(rows_.size());
 }
 
+void World::count_residual(double max, double sum_squares, std::int64_t rows) {
+  residual_.max = std::max(residual_.max, max);
+  residual_.sum_squares += sum_squares;
+  residual_.rows += rows;
+}
+
 Eigen::VectorXd World::solve(const SparseRowMatrix& A, const Eigen::VectorXd& b,
                              const RowLimits& limits) {
   ++counters_.solves;
   Eigen::VectorXd lambda = solve_lcp(A, b, limits, def_.friction_model, def_.solver, def_.iterations);
   if (def_.measure_residual) {
     const Eigen::VectorXd r = lcp_residual(A, b, limits, def_.friction_model, lambda);
-    residual_.max = std::max(residual_.max, r.size() > 0 ? r.maxCoeff() : 0.0);
-    residual_.sum_squares += r.squaredNorm();
-    residual_.rows += r.size();
+    count_residual(r.size() > 0 ? r.maxCoeff() : 0.0, r.squaredNorm(), r.size());
   }
   return lambda;
 }
 
 // Stages 3-5, Secs. 6, 7, 3.2.
 void World::solve_and_integrate() {
-  const Eigen::VectorXd f_ext = gravity_forces(bodies_, def_.gravity);
+  // f_ext: gravity m g per movable body (6n), into a buffer that keeps its size.
+  const auto n6 = 6 * static_cast<Eigen::Index>(bodies_.size());
+  f_ext_.resize(n6);
+  f_ext_.setZero();
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (!bodies_[i].is_static()) f_ext_.segment<3>(6 * static_cast<Eigen::Index>(i)) = bodies_[i].mass * def_.gravity;
+  }
+  lambda0_.clear();
   if (rows_.empty()) {
-    lambda_.resize(0);
-    integrate(bodies_, f_ext, f_ext, def_.dt, def_.rotation);
+    lambda_.clear();
+    integrate(bodies_, f_ext_, f_ext_, def_.dt, def_.rotation);
     return;
   }
+  if (def_.assembly == Assembly::explicit_matrices) {
+    solve_explicit();
+  } else {
+    solve_matrix_free();
+  }
+  // Positions move with f_cv; the stored momenta with f_c0 (Sec. 8.1), or f_cv for Baumgarte.
+  integrate(bodies_, f_cv_, def_.push == PushMode::split ? f_c0_ : f_cv_, def_.dt, def_.rotation);
+}
+
+void World::solve_explicit() {
   const Eigen::VectorXd v1 = system_velocity(bodies_);
   const System sys =
-      assemble_system(rows_, bodies_, v1, f_ext, def_.dt, TargetTerms::push_and_bias);
-  lambda_ = solve(sys.A, sys.b, sys.limits);
+      assemble_system(rows_, bodies_, v1, f_ext_, def_.dt, TargetTerms::push_and_bias);
+  const Eigen::VectorXd lambda = solve(sys.A, sys.b, sys.limits);
+  lambda_.assign(lambda.data(), lambda.data() + lambda.size());
   // f = f_ext + f_c with f_c = J^T lambda (Eq. 6.2.1).
-  const Eigen::VectorXd f_cv = f_ext + sys.J.transpose() * lambda_;
-  if (def_.push == PushMode::baumgarte) {
-    integrate(bodies_, f_cv, f_cv, def_.dt, def_.rotation);
-    return;
-  }
-  // Sec. 8.1: solve again with v holding only the bias (restitution), not the push; positions
-  // move with f_cv, the stored momenta with f_c0.
+  f_cv_ = f_ext_ + sys.J.transpose() * lambda;
+  if (def_.push == PushMode::baumgarte) return;
+  // Sec. 8.1: solve again with v holding only the bias (restitution), not the push.
   const Eigen::VectorXd b0 =
-      assemble_rhs(rows_, sys.J, sys.M_inv, v1, f_ext, def_.dt, TargetTerms::bias_only);
+      assemble_rhs(rows_, sys.J, sys.M_inv, v1, f_ext_, def_.dt, TargetTerms::bias_only);
   const Eigen::VectorXd lambda0 = solve(sys.A, b0, sys.limits);
-  const Eigen::VectorXd f_c0 = f_ext + sys.J.transpose() * lambda0;
-  integrate(bodies_, f_cv, f_c0, def_.dt, def_.rotation);
+  lambda0_.assign(lambda0.data(), lambda0.data() + lambda0.size());
+  f_c0_ = f_ext_ + sys.J.transpose() * lambda0;
+}
+
+void World::solve_matrix_free() {
+  prepare(mf_, rows_, bodies_);
+  const auto solve_once = [this](TargetTerms terms, std::vector<double>& lambda, Eigen::VectorXd& f) {
+    rhs(mf_, rows_, bodies_, def_.gravity, def_.dt, terms);
+    cps::solve(mf_, rows_, def_.friction_model, def_.solver, def_.iterations, lambda);
+    ++counters_.solves;
+    if (def_.measure_residual) {
+      double max;
+      double sum_squares;
+      cps::residual(mf_, rows_, def_.friction_model, lambda, max, sum_squares);
+      count_residual(max, sum_squares, static_cast<std::int64_t>(rows_.size()));
+    }
+    f = f_ext_;  // same size every step: no allocation
+    add_constraint_forces(rows_, lambda, f);
+  };
+  solve_once(TargetTerms::push_and_bias, lambda_, f_cv_);
+  if (def_.push == PushMode::split) solve_once(TargetTerms::bias_only, lambda0_, f_c0_);
 }
 
 }  // namespace cps

@@ -12,6 +12,7 @@
 #include "cps/collision.h"
 #include "cps/constraint.h"
 #include "cps/integrator.h"
+#include "cps/matrix_free.h"
 #include "cps/solver.h"
 
 #include <Eigen/Core>
@@ -29,6 +30,13 @@ enum class PushMode {
               ///< momenta with f_c0 from a second solve without the push
 };
 
+/// How A lambda = b is represented while it is solved.
+enum class Assembly {
+  explicit_matrices,  ///< sparse J, M^-1 and A = J M^-1 J^T built every step (Sec. 6), as the
+                      ///< paper states it
+  matrix_free,        ///< per body w = M^-1 J^T lambda, O(12) a row update (matrix_free.h)
+};
+
 /// World parameters, each with its unit and a typical value. Validate with validate().
 struct WorldDef {
   Vec3 gravity = Vec3(0.0, -10.0, 0.0);  ///< m/s^2; the paper uses (0, -10, 0)
@@ -42,6 +50,7 @@ struct WorldDef {
   SolverKind solver = SolverKind::pgs;   ///< Sec. 7.2 PGS, or Jacobi
   FrictionModel friction_model = FrictionModel::fixed;  ///< Sec. 5.4 fixed, or coupled
   RotationUpdate rotation = RotationUpdate::linear;     ///< Eq. 3.2.4, or Eq. 12.4.1
+  Assembly assembly = Assembly::matrix_free;  ///< same lambda to round-off; matrix-free is faster
   /// Speculative contact distance (m) >= 0: features closer than this already get a contact row
   /// that lets them close the gap within a step and no further, so resting contacts do not
   /// break and re-form each step. 0 gives the paper's contacts, made only on overlap. Typical:
@@ -105,22 +114,38 @@ class World {
   const ResidualStats& residual() const { return residual_; }
   /// Manifolds found by the last step's collision stage (normals from a to b, depths in m).
   const std::vector<Manifold>& manifolds() const { return manifolds_; }
-  /// Rows built by the last step (c of them) and lambda of its (first) solve (c, N).
+  /// Rows built by the last step (c of them) and lambda of its first solve (c, N).
   const std::vector<ConstraintRow>& rows() const { return rows_; }
-  const Eigen::VectorXd& lambda() const { return lambda_; }
+  const std::vector<double>& lambda() const { return lambda_; }
+  /// lambda of the last step's second solve (c, N; Sec. 8.1, push split only; empty otherwise).
+  const std::vector<double>& lambda_second() const { return lambda0_; }
+
+  /// Replaces the parameters (validated first: throws std::invalid_argument and keeps the old
+  /// ones on a bad value). The bodies and constraints stay as they are.
+  void set_def(const WorldDef& def);
 
  private:
   void collide();
   void build_rows();
   void solve_and_integrate();
+  void solve_explicit();
+  void solve_matrix_free();
   Eigen::VectorXd solve(const SparseRowMatrix& A, const Eigen::VectorXd& b, const RowLimits& l);
+  void count_residual(double max, double sum_squares, std::int64_t rows);
 
   WorldDef def_;
   std::vector<Body> bodies_;
   std::vector<DistanceConstraint> distances_;
   std::vector<Manifold> manifolds_;
   std::vector<ConstraintRow> rows_;
-  Eigen::VectorXd lambda_;
+  std::vector<double> lambda_;
+  std::vector<double> lambda0_;
+  // Buffers reused from step to step (the matrix-free path allocates nothing once they are big
+  // enough): external and constraint forces per body (6n), the matrix-free system.
+  Eigen::VectorXd f_ext_;
+  Eigen::VectorXd f_cv_;
+  Eigen::VectorXd f_c0_;
+  MatrixFreeSystem mf_;
   StepCounters counters_;
   ResidualStats residual_;
 };

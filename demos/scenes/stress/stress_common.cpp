@@ -1,0 +1,100 @@
+// Measurements shared by the stress scenes: total energy, finiteness, the push-work bound.
+#include "stress/stress.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cps::scenes {
+
+double total_energy(const World& world) {
+  const Vec3& g = world.def().gravity;
+  double e = 0.0;
+  for (const Body& b : world.bodies()) {
+    if (b.is_static()) continue;
+    e += b.kinetic_energy() - b.mass * g.dot(b.x);
+  }
+  return e;
+}
+
+bool all_finite(const World& world) {
+  for (const Body& b : world.bodies()) {
+    if (!b.x.allFinite() || !b.o.coeffs().allFinite() || !b.p.allFinite() || !b.l.allFinite()) {
+      return false;
+    }
+  }
+  return true;
+}
+
+void EnergyTracker::observe(const World& world) {
+  if (!all_finite(world)) {
+    nonfinite_ = true;
+    return;  // nothing below means anything once a state is not finite
+  }
+  const auto& bodies = world.bodies();
+  const double dt = world.def().dt;
+  const Vec3& g = world.def().gravity;
+  if (previous_.size() == bodies.size() && world.counters().steps > 0) {
+    double work = 0.0;
+    if (world.def().push == PushMode::baumgarte) {
+      // dt sum_r max(0, lambda_r t_r) over the rows of the step just taken.
+      const auto& rows = world.rows();
+      const std::vector<double>& lambda = world.lambda();
+      for (std::size_t r = 0; r < rows.size() && r < lambda.size(); ++r) {
+        work += dt * std::max(0.0, lambda[r] * (rows[r].push + rows[r].bias));
+      }
+    } else {
+      // The push displacement x2 - x1 - v2 dt against gravity.
+      for (std::size_t i = 0; i < bodies.size(); ++i) {
+        const Body& b = bodies[i];
+        if (b.is_static()) continue;
+        const Vec3 dx_push = b.x - previous_[i].x - b.velocity() * dt;
+        work += std::max(0.0, -b.mass * g.dot(dx_push));
+      }
+    }
+    push_work_ += work;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      const Body& b = bodies[i];
+      if (b.is_static()) continue;
+      const Mat3 R1 = previous_[i].o.toRotationMatrix();
+      const Mat3 inv_i1 = R1 * b.inv_inertia_body * R1.transpose();
+      rotation_drift_ += std::max(0.0, 0.5 * b.l.dot((b.inv_inertia_world() - inv_i1) * b.l));
+    }
+  }
+  previous_.resize(bodies.size());
+  for (std::size_t i = 0; i < bodies.size(); ++i) previous_[i] = {bodies[i].x, bodies[i].o};
+
+  current_ = total_energy(world);
+  if (!initial_) initial_ = current_;
+  max_ = std::max(max_, current_);
+  max_gain_ = std::max(max_gain_, current_ - *initial_);
+  max_unaccounted_ =
+      std::max(max_unaccounted_, current_ - *initial_ - push_work_ - rotation_drift_);
+}
+
+void EnergyTracker::add_to(nlohmann::json& j) const {
+  j["initial_energy_J"] = initial();
+  j["max_energy_J"] = max_;
+  j["energy_J"] = current_;
+  j["max_energy_gain_J"] = max_gain_;
+  j["push_work_J"] = push_work_;
+  j["rotation_drift_J"] = rotation_drift_;
+  j["max_unaccounted_energy_J"] = max_unaccounted_;
+  j["nan"] = nonfinite_;
+}
+
+void EnergyMetrics::observe(const World& world) {
+  world_ = &world;
+  energy_.observe(world);
+  if (!energy_.nonfinite()) max_penetration_ = std::max(max_penetration_, deepest_contact(world));
+}
+
+nlohmann::json EnergyMetrics::report() const {
+  nlohmann::json j = nlohmann::json::object();
+  energy_.add_to(j);
+  j["max_penetration_m"] = max_penetration_;
+  j["final_penetration_m"] =
+      world_ && !energy_.nonfinite() ? nlohmann::json(max_penetration_now(*world_)) : nlohmann::json();
+  return j;
+}
+
+}  // namespace cps::scenes

@@ -1,0 +1,56 @@
+#pragma once
+// The matrix-free form of the solve of Sec. 6-7. A = J M^-1 J^T is never built: each body keeps
+// w = M^-1 J^T lambda (6 numbers), so that sum_i A_ji lambda_i = j_j . w over the row's two
+// bodies and a row update costs O(12). In the same row order it computes the same lambda as the
+// explicit path (solve_lcp over the assembled A) up to round-off.
+
+#include "cps/body.h"
+#include "cps/constraint.h"
+#include "cps/solver.h"
+#include "cps/system.h"
+
+#include <array>
+#include <vector>
+
+namespace cps {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;  ///< per body: linear then angular part
+
+/// Buffers of the matrix-free solve, sized by prepare() and reused from step to step, so a step
+/// allocates nothing once they have reached their largest size.
+struct MatrixFreeSystem {
+  std::vector<std::array<double, 12>> minv_jt;  ///< per row: [M_a^-1 j_a (6), M_b^-1 j_b (6)]
+  std::vector<double> diagonal;                 ///< per row: A_jj = j M^-1 j^T (1/kg)
+  std::vector<double> b;                        ///< per row: right-hand side of Eq. 6.2.9 (N)
+  std::vector<double> next;                     ///< Jacobi: the sweep's new values (N)
+  std::vector<Vec6> w;                          ///< per body: M^-1 J^T lambda (m/s^2, rad/s^2)
+};
+
+/// Fills minv_jt and diagonal for the rows (c) and bodies (n), resizing the buffers.
+/// Rows refer to bodies by index or kWorldBody. Source: Eq. 6.2.9, A_jj = j M^-1 j^T.
+void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
+             const std::vector<Body>& bodies);
+
+/// Fills s.b (c): b_j = v_j / dt - j_j . (v1 / dt + M^-1 f_ext) (Eq. 6.2.9) with f_ext the
+/// gravity force m g (m/s^2 given) of every movable body, and v_j the row's push and bias
+/// (TargetTerms as in assemble_rhs). dt in s, > 0.
+void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
+         const std::vector<Body>& bodies, const Vec3& gravity, double dt, TargetTerms terms);
+
+/// Solves the bounded system from lambda = 0 with `iterations` sweeps of PGS or Jacobi, the
+/// bounds of solve_lcp (c_min, c_max from the rows, or the coupled friction limit), into
+/// lambda (resized to c, N). s must be prepared for these rows and s.b filled.
+void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
+           SolverKind kind, int iterations, std::vector<double>& lambda);
+
+/// The natural-map residual of lcp_residual for the lambda that solve() left (using its w),
+/// per row: the largest value and the sum of squares (N, N^2).
+void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
+              FrictionModel friction, const std::vector<double>& lambda, double& max,
+              double& sum_squares);
+
+/// Adds f_c = J^T lambda (Eq. 6.2.1) to f (6n: force and torque per body, N and N m).
+void add_constraint_forces(const std::vector<ConstraintRow>& rows,
+                           const std::vector<double>& lambda, Eigen::VectorXd& f);
+
+}  // namespace cps

@@ -80,24 +80,72 @@ void World::step() {
   ++counters_.steps;
 }
 
-// Stage 1, Sec. 4: every pair with at least one movable body, in index order.
+// Stage 1, Sec. 4. Broad phase: sort and sweep along x over axis-aligned bounds (grown by the
+// contact margin), every plane against every movable body; the candidate pairs are then sorted
+// by index, so the narrow phase, the manifolds and the rows come in the same order as testing
+// every pair would give (Baraff 1992; Ericson 2005, Sec. 7.5).
 void World::collide() {
   manifolds_.clear();
   if (!def_.collision) return;
   const int n = static_cast<int>(bodies_.size());
-  for (int a = 0; a < n; ++a) {
-    for (int b = a + 1; b < n; ++b) {
-      const Body& ba = bodies_[static_cast<std::size_t>(a)];
-      const Body& bb = bodies_[static_cast<std::size_t>(b)];
-      if (ba.is_static() && bb.is_static()) continue;
-      ++counters_.pairs_tested;
-      Manifold m;
-      m.body_a = a;
-      m.body_b = b;
-      if (cps::collide(ba, bb, m, def_.contact_margin) > 0) {
-        counters_.contacts += m.count;
-        manifolds_.push_back(m);
+  bounds_.resize(bodies_.size());
+  sweep_order_.clear();
+  planes_.clear();
+  pairs_.clear();
+  const double grow = 0.5 * def_.contact_margin;
+  for (int i = 0; i < n; ++i) {
+    const Body& b = bodies_[static_cast<std::size_t>(i)];
+    Vec3 half = Vec3::Zero();
+    switch (b.shape.kind) {
+      case ShapeKind::plane:
+        planes_.push_back(i);
+        continue;
+      case ShapeKind::box:
+        half = b.rotation().cwiseAbs() * b.shape.half_extents;
+        break;
+      case ShapeKind::sphere:
+        half = Vec3::Constant(b.shape.radius);
+        break;
+    }
+    bounds_[static_cast<std::size_t>(i)] = {b.x - half - Vec3::Constant(grow),
+                                            b.x + half + Vec3::Constant(grow)};
+    sweep_order_.push_back(i);
+  }
+  std::sort(sweep_order_.begin(), sweep_order_.end(), [this](int a, int b) {
+    const double xa = bounds_[static_cast<std::size_t>(a)].lo.x();
+    const double xb = bounds_[static_cast<std::size_t>(b)].lo.x();
+    return xa < xb || (xa == xb && a < b);
+  });
+  for (std::size_t k = 0; k < sweep_order_.size(); ++k) {
+    const int a = sweep_order_[k];
+    const Bounds& ba = bounds_[static_cast<std::size_t>(a)];
+    for (std::size_t m = k + 1; m < sweep_order_.size(); ++m) {
+      const int b = sweep_order_[m];
+      const Bounds& bb = bounds_[static_cast<std::size_t>(b)];
+      if (bb.lo.x() > ba.hi.x()) break;
+      if (bb.lo.y() > ba.hi.y() || ba.lo.y() > bb.hi.y() || bb.lo.z() > ba.hi.z() ||
+          ba.lo.z() > bb.hi.z()) {
+        continue;
       }
+      if (bodies_[static_cast<std::size_t>(a)].is_static() && bodies_[static_cast<std::size_t>(b)].is_static()) continue;
+      pairs_.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  for (const int p : planes_) {
+    for (const int i : sweep_order_) {
+      if (!bodies_[static_cast<std::size_t>(i)].is_static()) pairs_.emplace_back(std::min(p, i), std::max(p, i));
+    }
+  }
+  std::sort(pairs_.begin(), pairs_.end());
+  for (const auto& [a, b] : pairs_) {
+    ++counters_.pairs_tested;
+    Manifold m;
+    m.body_a = a;
+    m.body_b = b;
+    if (cps::collide(bodies_[static_cast<std::size_t>(a)], bodies_[static_cast<std::size_t>(b)], m,
+                     def_.contact_margin) > 0) {
+      counters_.contacts += m.count;
+      manifolds_.push_back(m);
     }
   }
 }

@@ -19,11 +19,20 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;  ///< per body: linear then angular pa
 /// Buffers of the matrix-free solve, sized by prepare() and reused from step to step, so a step
 /// allocates nothing once they have reached their largest size.
 struct MatrixFreeSystem {
-  std::vector<std::array<double, 12>> minv_jt;  ///< per row: [M_a^-1 j_a (6), M_b^-1 j_b (6)]
-  std::vector<double> diagonal;                 ///< per row: A_jj = j M^-1 j^T (1/kg)
-  std::vector<double> b;                        ///< per row: right-hand side of Eq. 6.2.9 (N)
-  std::vector<double> next;                     ///< Jacobi: the sweep's new values (N)
-  std::vector<Vec6> w;                          ///< per body: M^-1 J^T lambda (m/s^2, rad/s^2)
+  /// One row packed for the sweep: its bodies (a fixed world point is the extra slot n, whose w
+  /// stays 0), j (12) and M^-1 j^T (12) side by side.
+  struct Row {
+    int a = 0;
+    int b = 0;
+    std::array<double, 12> j{};
+    std::array<double, 12> minv_jt{};  ///< [M_a^-1 j_a (6), M_b^-1 j_b (6)]
+  };
+  std::vector<Row> rows;
+  std::vector<double> diagonal;  ///< per row: A_jj = j M^-1 j^T (1/kg)
+  std::vector<double> b;         ///< per row: right-hand side of Eq. 6.2.9 (N)
+  std::vector<double> next;      ///< Jacobi: the sweep's new values (N)
+  std::vector<Vec6> w;           ///< per body, and one zero slot: M^-1 J^T lambda
+  std::vector<Mat3> inv_inertia; ///< per body: world inverse inertia this step (1/(kg m^2))
 };
 
 /// Fills minv_jt and diagonal for the rows (c) and bodies (n), resizing the buffers.

@@ -19,6 +19,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace cps {
@@ -146,6 +147,15 @@ class World {
   Eigen::VectorXd f_cv_;
   Eigen::VectorXd f_c0_;
   MatrixFreeSystem mf_;
+  // Broad phase buffers: per body bounds, the sweep order, candidate pairs.
+  struct Bounds {
+    Vec3 lo;
+    Vec3 hi;
+  };
+  std::vector<Bounds> bounds_;
+  std::vector<int> sweep_order_;
+  std::vector<int> planes_;
+  std::vector<std::pair<int, int>> pairs_;
   StepCounters counters_;
   ResidualStats residual_;
 };

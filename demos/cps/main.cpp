@@ -2,6 +2,7 @@
 #include "options.h"
 #include "simulate.h"
 
+#include "bench.h"
 #include "report.h"
 
 #ifdef CPS_HAVE_RENDERER
@@ -126,6 +127,11 @@ int run(int argc, char** argv) {
                      "combine the CSV files below these folders into one report in --out");
   report->add_option("--run", report_run, "execute one run by its id (see --list-runs)");
 
+  bool bench_quick = false;
+  CLI::App* bench = app.add_subcommand(
+      "bench", "microseconds per step (explicit and matrix-free), cost growth, ms per frame");
+  bench->add_flag("--quick", bench_quick, "smaller scenes and fewer steps");
+
 #ifdef CPS_HAVE_RENDERER
   std::string render_scene;
   std::optional<double> render_seconds;
@@ -203,6 +209,7 @@ int run(int argc, char** argv) {
       }
       return 0;
     }
+    if (*bench) return cli::run_bench(bench_quick);
     if (*report) {
       return run_report(report_scene, report_out, report_quick, report_list, report_merge,
                         report_run);

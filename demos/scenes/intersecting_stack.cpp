@@ -40,7 +40,7 @@ WorldDef intersecting_stack_world_def() {
 }
 
 // Centres 2 m apart (0.4 m overlaps), the bottom one at the ground (1.2 m into it).
-void populate_intersecting_stack(World& world) { add_ground_and_cube_column(world, 0.0, 2.0); }
+void populate_intersecting_stack(World& world) { add_ground_and_cube_column(world, 0.0, 2.0, 5); }
 
 std::unique_ptr<Metrics> make_intersecting_stack_metrics(const World& world) {
   return observed<IntersectingStackMetrics>(world);

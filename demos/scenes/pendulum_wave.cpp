@@ -140,15 +140,17 @@ WorldDef pendulum_wave_world_def() {
   return def;
 }
 
-void populate_pendulum_wave(World& world) {
+void add_pendulum_wave_rows(World& world, int count) {
   const double a = kReleaseDeg / kDeg;
   const Vec3 down(0.0, -std::cos(a), std::sin(a));  // from the fixed point towards the ball
-  for (int n = 0; n < kPendulums; ++n) {
+  for (int k = 0; k < count; ++k) {
+    const int n = k % kPendulums;
     const double l = rod_length(n);
+    const Vec3 fixed = pivot(n) + Vec3(0.0, 0.0, 0.3 * (k / kPendulums));
     BodyDef ball;
     ball.shape = Shape::sphere(kRadius);
     ball.mass = kMass;
-    ball.position = pivot(n) + (l + kRadius) * down;
+    ball.position = fixed + (l + kRadius) * down;
     // Rod and ball aligned: the ball's top point (0, r, 0) faces the fixed point.
     ball.orientation = Quat(Eigen::AngleAxisd(-a, Vec3::UnitX()));
     const int index = world.add_body(ball);
@@ -156,11 +158,13 @@ void populate_pendulum_wave(World& world) {
     rod.body_a = index;
     rod.local_a = Vec3(0.0, kRadius, 0.0);
     rod.body_b = kWorldBody;
-    rod.local_b = pivot(n);
+    rod.local_b = fixed;
     rod.length = l;
     world.add_distance(rod);
   }
 }
+
+void populate_pendulum_wave(World& world) { add_pendulum_wave_rows(world, kPendulums); }
 
 std::unique_ptr<Metrics> make_pendulum_wave_metrics(const World& world) {
   return observed<PendulumWaveMetrics>(world);

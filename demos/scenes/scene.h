@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -39,9 +40,9 @@ struct Scene {
   std::string_view name;
   std::string_view summary;
   double default_seconds = 10.0;
-  WorldDef (*world_def)() = nullptr;
-  void (*populate)(World& world) = nullptr;
-  std::unique_ptr<Metrics> (*make_metrics)(const World& world) = nullptr;
+  std::function<WorldDef()> world_def;
+  std::function<void(World& world)> populate;
+  std::function<std::unique_ptr<Metrics>(const World& world)> make_metrics;
   /// Opacity of the scene's planes when drawn, in [0, 1]: below 1 for walls that bodies sit
   /// behind (the funnel).
   double plane_opacity = 1.0;
@@ -59,8 +60,19 @@ std::span<const Scene> stress_scenes();
 /// Paper scenes, then stress scenes.
 std::span<const Scene> all_scenes();
 
-/// The scene called `name`, or nullptr.
+/// The scene called `name`, or nullptr. Besides the tables, scaled scenes for benchmarks are
+/// made on demand from a family name and a size: stack_N (N cubes, 1..40), pyramid_N (a
+/// pyramid of about N boxes, 1..20000), funnel_N (N balls, 1..20000), pendulum_wave_N (N
+/// pendulums, 1..20000), pendulum_grid_N (an N x N grid, 1..100). The returned pointer stays
+/// valid for the whole program.
 const Scene* find_scene(std::string_view name);
+
+/// The scaled scene families, with the size range each takes ("stack_N 1..40", ...).
+std::span<const std::string_view> scaled_families();
+
+/// Builds a scaled scene (see find_scene). Throws std::invalid_argument naming the size and
+/// the allowed range, or an unknown family.
+Scene scaled_scene(std::string_view family, int n);
 
 /// Values that replace a scene's own world parameters (units as in WorldDef).
 struct Overrides {
@@ -115,7 +127,7 @@ double max_penetration_now(const World& world);
 /// Adds the static ground plane y = 0 and the paper's column of five cubes (edge 2.4 m, mass
 /// 1.2 kg) with centres (0, bottom + spacing i, 0), i = 0..4 (m). Shared by the stack (Sec. 10.1)
 /// and the intersecting stack (Sec. 10.2).
-void add_ground_and_cube_column(World& world, double bottom, double spacing);
+void add_ground_and_cube_column(World& world, double bottom, double spacing, int count = 5);
 
 /// A metrics object of type M built from `args`, having observed the world as built.
 template <class M, class... Args>
@@ -144,6 +156,9 @@ std::unique_ptr<Metrics> make_pendulum_grid_metrics(const World& world);
 
 WorldDef pendulum_wave_world_def();
 void populate_pendulum_wave(World& world);
+/// `count` pendulums (>= 1) in rows of 50 along x, rows 0.3 m apart along z, each row the
+/// scene's 50 periods. count = 50 is the paper's scene.
+void add_pendulum_wave_rows(World& world, int count);
 std::unique_ptr<Metrics> make_pendulum_wave_metrics(const World& world);
 
 }  // namespace cps::scenes

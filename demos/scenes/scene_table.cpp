@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <deque>
+#include <mutex>
 #include <vector>
 
 namespace cps::scenes {
@@ -69,7 +71,26 @@ const Scene* find_scene(std::string_view name) {
   const std::span<const Scene> all = all_scenes();
   const auto it =
       std::find_if(all.begin(), all.end(), [name](const Scene& s) { return s.name == name; });
-  return it == all.end() ? nullptr : &*it;
+  if (it != all.end()) return &*it;
+  // A scaled scene: FAMILY_N with N in the family's range. Made once per name and kept.
+  const std::size_t cut = name.rfind('_');
+  if (cut == std::string_view::npos || cut + 1 >= name.size()) return nullptr;
+  const std::string_view digits = name.substr(cut + 1);
+  if (digits.size() > 6 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    return nullptr;
+  }
+  static std::mutex mutex;
+  static std::deque<Scene> made;
+  const std::lock_guard<std::mutex> lock(mutex);
+  for (const Scene& s : made) {
+    if (s.name == name) return &s;
+  }
+  try {
+    made.push_back(scaled_scene(name.substr(0, cut), std::stoi(std::string(digits))));
+  } catch (const std::invalid_argument&) {
+    return nullptr;
+  }
+  return &made.back();
 }
 
 WorldDef world_def_with(const Scene& scene, const Overrides& o) {

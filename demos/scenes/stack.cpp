@@ -65,12 +65,12 @@ WorldDef stack_world_def() {
   return def;
 }
 
-void add_ground_and_cube_column(World& world, double bottom, double spacing) {
+void add_ground_and_cube_column(World& world, double bottom, double spacing, int count) {
   BodyDef ground;
   ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
   ground.is_static = true;
   world.add_body(ground);
-  for (int i = 0; i < kCubes; ++i) {
+  for (int i = 0; i < count; ++i) {
     BodyDef cube;
     cube.shape = Shape::box(Vec3::Constant(kHalfEdge));
     cube.mass = kMass;
@@ -80,7 +80,7 @@ void add_ground_and_cube_column(World& world, double bottom, double spacing) {
 }
 
 // Centres 3 m apart (0.6 m gaps), the bottom one 2 m up: the cubes fall and settle.
-void populate_stack(World& world) { add_ground_and_cube_column(world, 2.0, 3.0); }
+void populate_stack(World& world) { add_ground_and_cube_column(world, 2.0, 3.0, kCubes); }
 
 std::unique_ptr<Metrics> make_stack_metrics(const World& world) { return observed<StackMetrics>(world); }
 

@@ -52,13 +52,16 @@ void EnergyTracker::observe(const World& world) {
       }
     }
     push_work_ += work;
+    double rotation = 0.0;
     for (std::size_t i = 0; i < bodies.size(); ++i) {
       const Body& b = bodies[i];
       if (b.is_static()) continue;
       const Mat3 R1 = previous_[i].o.toRotationMatrix();
       const Mat3 inv_i1 = R1 * b.inv_inertia_body * R1.transpose();
-      rotation_drift_ += std::max(0.0, 0.5 * b.l.dot((b.inv_inertia_world() - inv_i1) * b.l));
+      rotation += std::max(0.0, 0.5 * b.l.dot((b.inv_inertia_world() - inv_i1) * b.l));
     }
+    rotation_drift_ += rotation;
+    max_step_excess_ = std::max(max_step_excess_, total_energy(world) - current_ - work - rotation);
   }
   previous_.resize(bodies.size());
   for (std::size_t i = 0; i < bodies.size(); ++i) previous_[i] = {bodies[i].x, bodies[i].o};
@@ -79,6 +82,7 @@ void EnergyTracker::add_to(nlohmann::json& j) const {
   j["push_work_J"] = push_work_;
   j["rotation_drift_J"] = rotation_drift_;
   j["max_unaccounted_energy_J"] = max_unaccounted_;
+  j["max_step_energy_excess_J"] = max_step_excess_;
   j["nan"] = nonfinite_;
 }
 

@@ -36,7 +36,7 @@ WorldDef funnel_world_def() {
   return def;
 }
 
-void populate_funnel(World& world) {
+void add_funnel_walls(World& world) {
   const double s = 1.0 / std::sqrt(2.0);
   for (const Vec3& n : {Vec3(s, s, 0.0), Vec3(-s, s, 0.0), Vec3(0.0, s, s), Vec3(0.0, s, -s)}) {
     BodyDef wall;
@@ -44,6 +44,10 @@ void populate_funnel(World& world) {
     wall.is_static = true;
     world.add_body(wall);
   }
+}
+
+void populate_funnel(World& world) {
+  add_funnel_walls(world);
   for (int i = 0; i < 5; ++i) {
     for (int k = 0; k < 4; ++k) {
       BodyDef ball;

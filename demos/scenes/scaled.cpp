@@ -63,13 +63,7 @@ void populate_pyramid(World& world, int boxes) {
 
 // N balls (radius 0.5 m, 1 kg) in layers of m x m above the funnel of the paper's scene.
 void populate_funnel_n(World& world, int balls) {
-  const double s = 1.0 / std::sqrt(2.0);
-  for (const Vec3& n : {Vec3(s, s, 0.0), Vec3(-s, s, 0.0), Vec3(0.0, s, s), Vec3(0.0, s, -s)}) {
-    BodyDef wall;
-    wall.shape = Shape::plane(n, 0.0);
-    wall.is_static = true;
-    world.add_body(wall);
-  }
+  add_funnel_walls(world);
   const int m = std::max(4, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(balls)) / 3.0)));
   const double half = 0.6 * (m - 1);
   for (int i = 0; i < balls; ++i) {

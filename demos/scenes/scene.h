@@ -147,6 +147,9 @@ void populate_intersecting_stack(World& world);
 std::unique_ptr<Metrics> make_intersecting_stack_metrics(const World& world);
 
 WorldDef funnel_world_def();
+/// The funnel's four static planes through the origin, normals (+-1, 1, 0)/sqrt 2 and
+/// (0, 1, +-1)/sqrt 2: the free side is y > |x| and y > |z|.
+void add_funnel_walls(World& world);
 void populate_funnel(World& world);
 std::unique_ptr<Metrics> make_funnel_metrics(const World& world);
 

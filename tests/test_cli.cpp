@@ -142,7 +142,7 @@ TEST_CASE("cps render writes numbered frames of the requested size", "[cli][rend
 }
 #endif
 
-TEST_CASE("cps report writes CSVs with units, plots and report.md; runs spread and merge",
+TEST_CASE("cps report writes CSVs with units and plots and report.md and runs spread and merge",
           "[cli][report]") {
   const fs::path dir = fresh_dir("report");
   SECTION("one id, run on its own, then merged with another") {

@@ -75,6 +75,20 @@ TEST_CASE("invalid parameters and bodies are rejected and leave the world unchan
   bad.orientation = Quat(2.0, 0.0, 0.0, 0.0);
   CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("unit quaternion"));
   CHECK_THROWS_WITH(Shape::box(Vec3(1.0, 0.0, 1.0)), Catch::Contains("half extents"));
+  // Values whose reciprocals or products leave double precision, checked with the floating
+  // point traps on (the checks themselves must not raise).
+  bad.orientation = Quat::Identity();
+  bad.mass = 1e-310;  // subnormal: 1 / m would be inf
+  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("mass"));
+  bad.mass = 1.0;
+  bad.shape = Shape::box(Vec3::Constant(1e-200));  // inertia underflows to 0
+  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("inertia"));
+  bad.shape = Shape::box(Vec3::Ones());
+  bad.velocity = Vec3(INFINITY, 0, 0);
+  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("velocity"));
+  bad.velocity = Vec3(1e10, 0, 0);
+  bad.mass = 1e300;  // momentum overflows
+  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("momentum"));
   CHECK(world.bodies().empty());
 }
 

@@ -48,13 +48,23 @@ std::string number(double v) {
 
 bool has_friction(const scenes::Scene& scene) { return scene.world_def().friction > 0.0; }
 
+bool is_paper_scene(const std::string& name) {
+  for (const scenes::Scene& s : scenes::paper_scenes()) {
+    if (s.name == name) return true;
+  }
+  return false;
+}
+
+// dt is 1 / (60 substeps) for the paper's scenes (substeps of the paper's 60 Hz frame), and the
+// scene's own dt / substeps for the others (stress scenes choose their dt on purpose).
 scenes::Overrides overrides_of(const RunSpec& spec) {
   scenes::Overrides o;
   o.solver = spec.solver;
   o.push = spec.push;
   o.friction_model = spec.friction_model;
   o.iterations = spec.iterations;
-  o.dt = 1.0 / (60.0 * spec.substeps);
+  o.dt = is_paper_scene(spec.scene) ? 1.0 / (60.0 * spec.substeps)
+                                     : scenes::find_scene(spec.scene)->world_def().dt / spec.substeps;
   return o;
 }
 

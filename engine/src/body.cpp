@@ -1,6 +1,7 @@
 #include "cps/body.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -14,8 +15,14 @@ std::string str(const Vec3& v) {
   return s.str();
 }
 
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
 void require_finite(const Vec3& v, const char* what) {
-  if (!v.allFinite()) {
+  if (!all_finite(v)) {
     throw std::invalid_argument(std::string(what) + " " + str(v) + " is not finite");
   }
 }
@@ -23,7 +30,7 @@ void require_finite(const Vec3& v, const char* what) {
 }  // namespace
 
 Shape Shape::box(const Vec3& h) {
-  if (!h.allFinite() || (h.array() <= 0.0).any()) {
+  if (!all_finite(h) || (h.array() <= 0.0).any()) {
     throw std::invalid_argument("box half extents " + str(h) +
                                 " must be finite and > 0 m in every component");
   }
@@ -35,7 +42,7 @@ Shape Shape::box(const Vec3& h) {
 
 Shape Shape::sphere(double r) {
   if (!(std::isfinite(r) && r > 0.0)) {
-    throw std::invalid_argument("sphere radius " + std::to_string(r) + " m must be finite and > 0");
+    throw std::invalid_argument("sphere radius " + num(r) + " m must be finite and > 0");
   }
   Shape s;
   s.kind = ShapeKind::sphere;
@@ -45,11 +52,11 @@ Shape Shape::sphere(double r) {
 
 Shape Shape::plane(const Vec3& n, double offset) {
   const double len = n.norm();
-  if (!n.allFinite() || !(len > 0.0)) {
+  if (!all_finite(n) || !(len > 0.0)) {
     throw std::invalid_argument("plane normal " + str(n) + " must be finite and non-zero");
   }
   if (!std::isfinite(offset)) {
-    throw std::invalid_argument("plane offset " + std::to_string(offset) + " m must be finite");
+    throw std::invalid_argument("plane offset " + num(offset) + " m must be finite");
   }
   Shape s;
   s.kind = ShapeKind::plane;
@@ -93,15 +100,16 @@ Body make_body(const BodyDef& def) {
   require_finite(def.angular_velocity, "body angular velocity");
   const double qn = def.orientation.norm();
   if (!std::isfinite(qn) || std::abs(qn - 1.0) > 1e-9) {
-    throw std::invalid_argument("body orientation has norm " + std::to_string(qn) +
+    throw std::invalid_argument("body orientation has norm " + num(qn) +
                                 "; it must be a unit quaternion (norm 1 within 1e-9)");
   }
   if (!def.is_static && def.shape.kind == ShapeKind::plane) {
     throw std::invalid_argument("a plane must be a static body (set is_static)");
   }
-  if (!def.is_static && !(std::isfinite(def.mass) && def.mass > 0.0)) {
-    throw std::invalid_argument("body mass " + std::to_string(def.mass) +
-                                " kg must be finite and > 0 for a movable body");
+  // A normal double, so that 1 / m is finite.
+  if (!def.is_static && !(std::isfinite(def.mass) && def.mass >= std::numeric_limits<double>::min())) {
+    throw std::invalid_argument("body mass " + num(def.mass) +
+                                " kg must be finite and > 0 (at least 2.2e-308) for a movable body");
   }
   if (def.shape.kind == ShapeKind::box) Shape::box(def.shape.half_extents);  // validates
   if (def.shape.kind == ShapeKind::sphere) Shape::sphere(def.shape.radius);    // validates
@@ -114,7 +122,26 @@ Body make_body(const BodyDef& def) {
     b.mass = def.mass;
     b.inv_mass = 1.0 / def.mass;
     const Mat3 I_body = shape_inertia(def.shape, def.mass);
-    b.inv_inertia_body = I_body.inverse();
+    // The tensor is diagonal: invertible in double precision iff each entry is a normal number
+    // whose reciprocal is finite.
+    const bool invertible = all_finite(I_body) &&
+                            I_body.diagonal().minCoeff() >= std::numeric_limits<double>::min();
+    if (invertible) b.inv_inertia_body = I_body.diagonal().cwiseInverse().asDiagonal();
+    if (!invertible || !all_finite(b.inv_inertia_body)) {
+      throw std::invalid_argument("body of mass " + num(def.mass) +
+                                  " kg and this size has an inertia tensor that is zero or not "
+                                  "finite in double precision; use a mass and size nearer 1");
+    }
+    // m v and I w must stay finite; compared in logarithms so the check itself cannot overflow.
+    const auto product_overflows = [](double x, double y) {
+      return x > 0.0 && y > 0.0 &&
+             std::log(x) + std::log(y) > std::log(std::numeric_limits<double>::max()) - 2.0;
+    };
+    if (product_overflows(def.velocity.cwiseAbs().maxCoeff(), def.mass) ||
+        product_overflows(def.angular_velocity.cwiseAbs().maxCoeff(), I_body.diagonal().maxCoeff())) {
+      throw std::invalid_argument("body momentum overflows: mass " + num(def.mass) +
+                                  " kg times its velocity is not finite in double precision");
+    }
     b.p = def.mass * def.velocity;
     const Mat3 R = b.rotation();
     b.l = R * I_body * R.transpose() * def.angular_velocity;

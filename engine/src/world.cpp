@@ -21,7 +21,7 @@ namespace {
 }  // namespace
 
 void WorldDef::validate() const {
-  if (!gravity.allFinite()) bad_parameter("gravity", gravity.norm(), "it must be finite (m/s^2)");
+  if (!all_finite(gravity)) bad_parameter("gravity", gravity.norm(), "it must be finite (m/s^2)");
   if (!(std::isfinite(dt) && dt > 0.0)) bad_parameter("dt", dt, "it must be finite and > 0 s");
   if (iterations < 1) bad_parameter("iterations", iterations, "it must be >= 1");
   if (!(beta >= 0.0 && beta <= 1.0)) bad_parameter("beta", beta, "it must be in [0, 1]");
@@ -63,7 +63,7 @@ int World::add_distance(const DistanceConstraint& d) {
         << " bodies; use kWorldBody for a fixed point)";
   } else if (d.body_b == d.body_a) {
     why << "body_a and body_b are both " << d.body_a;
-  } else if (!d.local_a.allFinite() || !d.local_b.allFinite()) {
+  } else if (!all_finite(d.local_a) || !all_finite(d.local_b)) {
     why << "the end points must be finite";
   } else if (!(std::isfinite(d.length) && d.length >= 0.0)) {
     why << "length " << d.length << " m must be finite and >= 0";

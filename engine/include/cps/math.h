@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <cmath>
 #include <limits>
 
 namespace cps {
@@ -15,5 +16,15 @@ using Vec12 = Eigen::Matrix<double, 12, 1>;  ///< one constraint row j_c: [lin a
 
 /// Positive infinity, used for unbounded constraint force limits c_max (N).
 inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+/// True if every component of v is finite. Unlike Eigen's allFinite() (which computes x - x)
+/// it raises no floating point exception on inf, so validation works with traps enabled.
+template <class Derived>
+bool all_finite(const Eigen::MatrixBase<Derived>& v) {
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(v.derived().coeff(i))) return false;
+  }
+  return true;
+}
 
 }  // namespace cps

@@ -68,6 +68,11 @@ void add_world_options(CLI::App& cmd, scenes::Overrides& o) {
                  "row's lambda")
       ->transform(one_of<FrictionModel>({
           {"fixed", FrictionModel::fixed}, {"coupled", FrictionModel::coupled}}));
+  cmd.add_option("--assembly", o.assembly,
+                 "explicit: sparse J, M^-1 and A = J M^-1 J^T as in the paper; matrix-free: w = "
+                 "M^-1 J^T lambda per body (default; the same lambda to round-off)")
+      ->transform(one_of<Assembly>({{"explicit", Assembly::explicit_matrices},
+                                    {"matrix-free", Assembly::matrix_free}}));
   cmd.add_option("--rotation", o.rotation,
                  "linear: Eq. 3.2.4 then normalise; exact: the axis-angle step of Eq. 12.4.1")
       ->transform(one_of<RotationUpdate>({

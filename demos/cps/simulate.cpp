@@ -21,6 +21,7 @@ nlohmann::json parameters_json(const WorldDef& def) {
           {"solver", def.solver == SolverKind::jacobi ? "jacobi" : "pgs"},
           {"friction_model", def.friction_model == FrictionModel::coupled ? "coupled" : "fixed"},
           {"rotation", def.rotation == RotationUpdate::exact ? "exact" : "linear"},
+          {"assembly", def.assembly == Assembly::matrix_free ? "matrix-free" : "explicit"},
           {"contact_margin_m", def.contact_margin},
           {"collision", def.collision},
           {"contact_caching", false}};

@@ -86,6 +86,7 @@ struct Overrides {
   std::optional<SolverKind> solver;
   std::optional<FrictionModel> friction_model;
   std::optional<RotationUpdate> rotation;
+  std::optional<Assembly> assembly;
   bool measure_residual = false;  ///< sets WorldDef::measure_residual
 };
 

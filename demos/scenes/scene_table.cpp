@@ -105,6 +105,7 @@ WorldDef world_def_with(const Scene& scene, const Overrides& o) {
   if (o.solver) def.solver = *o.solver;
   if (o.friction_model) def.friction_model = *o.friction_model;
   if (o.rotation) def.rotation = *o.rotation;
+  if (o.assembly) def.assembly = *o.assembly;
   if (o.measure_residual) def.measure_residual = true;
   return def;
 }

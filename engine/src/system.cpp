@@ -21,11 +21,17 @@ Eigen::VectorXd system_velocity(const std::vector<Body>& bodies) {
   return v1;
 }
 
-Eigen::VectorXd gravity_forces(const std::vector<Body>& bodies, const Vec3& gravity) {
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(6 * static_cast<Eigen::Index>(bodies.size()));
+void gravity_forces(const std::vector<Body>& bodies, const Vec3& gravity, Eigen::VectorXd& f) {
+  f.resize(6 * static_cast<Eigen::Index>(bodies.size()));  // no allocation when the size is kept
+  f.setZero();
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (!bodies[i].is_static()) f.segment<3>(body_column(static_cast<int>(i))) = bodies[i].mass * gravity;
   }
+}
+
+Eigen::VectorXd gravity_forces(const std::vector<Body>& bodies, const Vec3& gravity) {
+  Eigen::VectorXd f;
+  gravity_forces(bodies, gravity, f);
   return f;
 }
 

@@ -179,13 +179,7 @@ Eigen::VectorXd World::solve(const SparseRowMatrix& A, const Eigen::VectorXd& b,
 
 // Stages 3-5, Secs. 6, 7, 3.2.
 void World::solve_and_integrate() {
-  // f_ext: gravity m g per movable body (6n), into a buffer that keeps its size.
-  const auto n6 = 6 * static_cast<Eigen::Index>(bodies_.size());
-  f_ext_.resize(n6);
-  f_ext_.setZero();
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    if (!bodies_[i].is_static()) f_ext_.segment<3>(6 * static_cast<Eigen::Index>(i)) = bodies_[i].mass * def_.gravity;
-  }
+  gravity_forces(bodies_, def_.gravity, f_ext_);  // f_ext (6n), into a buffer that keeps its size
   lambda0_.clear();
   if (rows_.empty()) {
     lambda_.clear();

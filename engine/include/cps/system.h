@@ -51,6 +51,9 @@ Eigen::VectorXd system_velocity(const std::vector<Body>& bodies);
 /// f_ext (6n): [m_i g, 0] per movable body (gravity in m/s^2), zero for static bodies.
 Eigen::VectorXd gravity_forces(const std::vector<Body>& bodies, const Vec3& gravity);
 
+/// The same into `f`, resized to 6n (no allocation when f already has that size).
+void gravity_forces(const std::vector<Body>& bodies, const Vec3& gravity, Eigen::VectorXd& f);
+
 /// Assembles J, M^-1, A and b from the rows (Eq. 6.2.9). v1 and f_ext have 6n entries for
 /// n = bodies.size(); dt > 0 in s. Throws std::invalid_argument on mismatched sizes or a row
 /// whose body indices are out of range.

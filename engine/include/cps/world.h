@@ -1,9 +1,10 @@
 #pragma once
 // The world and its step. One step reads as the paper's stages, in order:
-//   1. collide          Sec. 4    manifolds for every pair that can touch (skipped when the
-//                                 world has collision off)
+//   1. collide          Sec. 4    sort-and-sweep broad phase, then manifolds for every pair
+//                                 that can touch (skipped when the world has collision off)
 //   2. build rows       Sec. 5    contact, friction (only with mu > 0) and distance rows
-//   3. assemble         Sec. 6    J, M^-1, A and b of Eq. 6.2.9
+//   3. assemble         Sec. 6    J, M^-1, A and b of Eq. 6.2.9 (explicit), or per-row
+//                                 M^-1 j^T, A_jj and b (matrix-free, the default)
 //   4. solve            Sec. 7    lambda by PGS (or Jacobi); with the single frame push factor a
 //                                 second solve with the push left out of v (Sec. 8.1)
 //   5. integrate        Sec. 3.2  f = f_ext + J^T lambda, semi-implicit Euler

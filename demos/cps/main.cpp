@@ -153,6 +153,12 @@ int run(int argc, char** argv) {
                      "OUT/SCENE-compare-OPTION/")
       ->check(CLI::IsMember({"push", "solver", "friction-model", "rotation"}));
   cli::add_world_options(*render, render_overrides);
+  std::string render_backend = "osmesa";
+  render->add_option("--backend", render_backend,
+                     "OpenGL context: osmesa (libOSMesa, CPU) or egl (headless EGL: GPU if any, "
+                     "else llvmpipe)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"osmesa", "egl"}));
 #endif
 
   std::string names;
@@ -236,7 +242,9 @@ int run(int argc, char** argv) {
         jobs.push_back(std::move(job));
       }
       const int panel_width = size.width / static_cast<int>(variants.size());
-      render::Renderer renderer(panel_width, size.height);
+      render::Renderer renderer(panel_width, size.height,
+                                *render::parse_backend(render_backend));
+      std::fprintf(stderr, "render: %s\n", renderer.context_description().c_str());
       for (Job& job : jobs) {
         std::vector<cli::Panel> panels;
         for (std::size_t v = 0; v < variants.size(); ++v) {

@@ -607,9 +607,9 @@ struct Renderer::Impl {
 };
 
 // Renderer(width, height, backend): width and height in pixels, each in [1, 8192], else
-// std::invalid_argument naming the value. Creates the backend's context (OpenGL 3.3 core or newer,
-// RGBA8, 24-bit depth; see gl_context.h), compiles the embedded shaders (std::runtime_error with the info log on
-// failure), builds the unit cube and icosphere, the 2048x2048 shadow map and, when llvmpipe allows
+// std::invalid_argument naming the value. Creates the backend's context (OpenGL 3.3 core or
+// newer, RGBA8, 24-bit depth; see gl_context.h), compiles the embedded shaders
+// (std::runtime_error with the info log on failure), builds the unit cube and icosphere, the 2048x2048 shadow map and, when llvmpipe allows
 // it and the frame has at most 4096x4096 pixels, a 4x multisampled framebuffer (GL_MAX_SAMPLES is
 // queried; otherwise the frame is rendered without MSAA).
 Renderer::Renderer(int width, int height, Backend backend) {

@@ -7,6 +7,7 @@
 
 #ifdef CPS_HAVE_RENDERER
 #include "render.h"
+#include "video.h"
 #endif
 
 #include <chrono>
@@ -153,6 +154,17 @@ int run(int argc, char** argv) {
                      "OUT/SCENE-compare-OPTION/")
       ->check(CLI::IsMember({"push", "solver", "friction-model", "rotation"}));
   cli::add_world_options(*render, render_overrides);
+  std::string render_backend = "osmesa";
+  render->add_option("--backend", render_backend,
+                     "OpenGL context: osmesa (libOSMesa, CPU) or egl (headless EGL: GPU if any, "
+                     "else llvmpipe)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"osmesa", "egl"}));
+  std::string render_video;
+  render->add_option("--video", render_video,
+                     "after the frames, assemble them with ffmpeg into OUT/SCENE.mp4 (H.264) or "
+                     "OUT/SCENE.gif")
+      ->check(CLI::IsMember({"mp4", "gif"}));
 #endif
 
   std::string names;
@@ -235,8 +247,23 @@ int run(int argc, char** argv) {
         }
         jobs.push_back(std::move(job));
       }
+      // --video: ffmpeg is looked for before rendering; without it the frames are still
+      // rendered and kept, and the command ends with an error saying how to finish the video.
+      std::optional<std::filesystem::path> ffmpeg;
+      std::vector<cli::VideoJob> videos_left;
+      if (!render_video.empty()) {
+        ffmpeg = cli::find_on_path("ffmpeg");
+        if (!ffmpeg) {
+          std::fprintf(stderr,
+                       "cps: warning: --video %s: ffmpeg is not on PATH; the frames will be "
+                       "rendered and kept, but no video made (install it: apt-get install ffmpeg)\n",
+                       render_video.c_str());
+        }
+      }
       const int panel_width = size.width / static_cast<int>(variants.size());
-      render::Renderer renderer(panel_width, size.height);
+      render::Renderer renderer(panel_width, size.height,
+                                *render::parse_backend(render_backend));
+      std::fprintf(stderr, "render: %s\n", renderer.context_description().c_str());
       for (Job& job : jobs) {
         std::vector<cli::Panel> panels;
         for (std::size_t v = 0; v < variants.size(); ++v) {
@@ -250,6 +277,33 @@ int run(int argc, char** argv) {
         spec.folder = std::filesystem::path(out_dir) / folder;
         const int frames = cli::render_frames(*job.scene, panels, spec, renderer);
         std::printf("%s: %d frames in %s\n", folder.c_str(), frames, spec.folder.c_str());
+        if (!render_video.empty()) {
+          cli::VideoJob video;
+          video.format = *cli::parse_video_format(render_video);
+          video.frames_folder = spec.folder;
+          video.frames = frames;
+          video.fps = fps;
+          video.width = panel_width * static_cast<int>(variants.size());
+          video.height = size.height;
+          video.output = std::filesystem::path(out_dir) / (folder + "." + render_video);
+          if (!ffmpeg) {
+            videos_left.push_back(video);
+            continue;
+          }
+          cli::encode_video(*ffmpeg, video);
+          std::printf("%s: video %s (%ju bytes)\n", folder.c_str(), video.output.c_str(),
+                      static_cast<std::uintmax_t>(std::filesystem::file_size(video.output)));
+        }
+      }
+      if (!videos_left.empty()) {
+        std::string how;
+        for (const cli::VideoJob& v : videos_left) {
+          how += "\n  " + cli::shell_command(cli::ffmpeg_arguments("ffmpeg", v, v.output));
+        }
+        throw cli::VideoError("--video " + render_video +
+                              ": ffmpeg is not on PATH, so no video was made; install it "
+                              "(apt-get install ffmpeg). The frames are kept; to assemble them "
+                              "without rendering again, run:" + how);
       }
       return 0;
     }

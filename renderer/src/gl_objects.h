@@ -1,16 +1,12 @@
 #pragma once
 // Private: OpenGL declarations and move-only RAII owners for GL object names.
 //
-// GL entry points are linked directly from libOSMesa (it exports the whole core API), so the
-// prototypes are enabled here instead of going through a loader. Every owner deletes its name in
+// GL entry points come from the current context's function table (gl_functions.h: glXxx calls
+// are routed there by macros), never from a linked GL library. Every owner deletes its name in
 // its destructor; the OpenGL context that created it must be current at that moment (Renderer
 // makes its context current before its members are destroyed).
 
-#ifndef GL_GLEXT_PROTOTYPES
-#define GL_GLEXT_PROTOTYPES 1
-#endif
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_functions.h"
 
 #include <utility>
 

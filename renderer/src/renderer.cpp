@@ -6,13 +6,13 @@
 //      projection fitted to the bodies and to the part of each plane their shadows can reach;
 //   2. main pass into a 4x multisampled framebuffer: bodies, opaque planes, lines, then planes
 //      with alpha < 1 back to front, blended, without depth writes;
-//   3. resolve (blit) into OSMesa's framebuffer, glFinish, read back top row first.
+//   3. resolve (blit) into the context's framebuffer, glFinish, read back top row first.
 
 #include "cps/render/renderer.h"
 
 #include "gl_objects.h"
 #include "meshes.h"
-#include "osmesa_context.h"
+#include "gl_context.h"
 #include "shader_program.h"
 
 #include "cps_render_embedded_shaders.h"
@@ -207,7 +207,7 @@ glm::vec3 least_aligned_axis(const glm::vec3& n) {
 }  // namespace
 
 struct Renderer::Impl {
-  OsMesaContext context;  // first member: created first, destroyed last
+  GlContext context;  // first member: created first, destroyed last
   ShaderProgram body_program;
   ShaderProgram shadow_program;
   ShaderProgram plane_program;
@@ -232,8 +232,8 @@ struct Renderer::Impl {
   std::vector<LineInstance> line_data;
   std::vector<PlaneDraw> planes;
 
-  Impl(int width, int height)
-      : context(width, height),
+  Impl(int width, int height, Backend backend)
+      : context(backend, width, height),
         body_program("body", {shaders::quat, shaders::body_vert},
                      {shaders::lighting, shaders::body_frag}),
         shadow_program("shadow", {shaders::quat, shaders::shadow_vert}, {shaders::shadow_frag}),
@@ -298,7 +298,8 @@ struct Renderer::Impl {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
   }
 
-  /// 4x MSAA when the implementation allows it; otherwise render straight into OSMesa's buffer.
+  /// 4x MSAA when the implementation allows it; otherwise render straight into the context's
+  /// framebuffer.
   void init_msaa(int width, int height) {
     GLint max_samples = 0;
     glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
@@ -528,7 +529,7 @@ struct Renderer::Impl {
     }
 
     // 2. Main pass.
-    glBindFramebuffer(GL_FRAMEBUFFER, samples > 0 ? msaa_fbo.id() : 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, samples > 0 ? msaa_fbo.id() : context.framebuffer());
     glViewport(0, 0, width, height);
     const glm::vec3 bg = glm::clamp(finite(list.background) ? list.background : glm::vec3(0.0f),
                                     0.0f, 1.0f);
@@ -590,10 +591,10 @@ struct Renderer::Impl {
     }
     glBindVertexArray(0);
 
-    // 3. Resolve the multisampled image into OSMesa's framebuffer.
+    // 3. Resolve the multisampled image into the context's framebuffer.
     if (samples > 0) {
       glBindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo.id());
-      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, context.framebuffer());
       glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
       glBindFramebuffer(GL_FRAMEBUFFER, 0);
     }
@@ -605,22 +606,34 @@ struct Renderer::Impl {
   }
 };
 
-// Renderer(width, height): width and height in pixels, each in [1, 8192], else
-// std::invalid_argument naming the value. Creates the OSMesa context (OpenGL 3.3 core or newer,
-// RGBA8, 24-bit depth), compiles the embedded shaders (std::runtime_error with the info log on
-// failure), builds the unit cube and icosphere, the 2048x2048 shadow map and, when llvmpipe allows
+// Renderer(width, height, backend): width and height in pixels, each in [1, 8192], else
+// std::invalid_argument naming the value. Creates the backend's context (OpenGL 3.3 core or
+// newer, RGBA8, 24-bit depth; see gl_context.h), compiles the embedded shaders
+// (std::runtime_error with the info log on failure), builds the unit cube and icosphere, the 2048x2048 shadow map and, when llvmpipe allows
 // it and the frame has at most 4096x4096 pixels, a 4x multisampled framebuffer (GL_MAX_SAMPLES is
 // queried; otherwise the frame is rendered without MSAA).
-Renderer::Renderer(int width, int height) {
+Renderer::Renderer(int width, int height, Backend backend) {
   check_size("width", width);
   check_size("height", height);
-  impl_ = std::make_unique<Impl>(width, height);
+  impl_ = std::make_unique<Impl>(width, height, backend);
 }
 
 Renderer::~Renderer() = default;
 
 int Renderer::width() const { return impl_->context.width(); }
 int Renderer::height() const { return impl_->context.height(); }
+Backend Renderer::backend() const { return impl_->context.backend(); }
+std::string Renderer::context_description() { return impl_->context.description(); }
+
+std::string_view backend_name(Backend backend) {
+  return backend == Backend::egl ? "egl" : "osmesa";
+}
+
+std::optional<Backend> parse_backend(std::string_view name) {
+  if (name == "osmesa") return Backend::osmesa;
+  if (name == "egl") return Backend::egl;
+  return std::nullopt;
+}
 
 // draw(list): renders one frame (lengths in metres, camera field of view in degrees) and returns
 // it as width x height RGB8, rows top to bottom. Items with non-finite values or non-positive sizes

@@ -1,11 +1,14 @@
 #pragma once
-// Offscreen OpenGL renderer through OSMesa (Mesa's software rasterizer, llvmpipe) and PNG output.
+// Offscreen OpenGL renderer (OSMesa or EGL, both headless) and PNG output.
 
 #include "cps/render/draw_list.h"
 
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace cps::render {
@@ -17,21 +20,42 @@ struct Image {
   std::vector<std::uint8_t> pixels;
 };
 
-/// Owns one OSMesa context and its frame buffer of width x height pixels (both in [1, 8192]).
+/// How the renderer gets its OpenGL context. Both render headless, without any window system.
+enum class Backend {
+  /// OSMesa (libOSMesa, Mesa's llvmpipe on the CPU): the default. Upstream Mesa removed OSMesa
+  /// in 25.1; Debian 12 ships it (libosmesa6).
+  osmesa,
+  /// EGL without a surface: Mesa's surfaceless platform (GPU render node, else llvmpipe), or an
+  /// EGL device (e.g. NVIDIA's driver). Needs libEGL.so.1 and a vendor driver (libegl-mesa0).
+  egl,
+};
+
+/// "osmesa" or "egl".
+std::string_view backend_name(Backend backend);
+
+/// The backend named `name` ("osmesa", "egl"), or nullopt for any other text.
+std::optional<Backend> parse_backend(std::string_view name);
+
+/// Owns one OpenGL context and its frame buffer of width x height pixels (both in [1, 8192]).
 /// Draws lit, shaded boxes, spheres, checkered planes and lines with a shadow map from the sun.
-/// Not copyable; one renderer per thread.
+/// Not copyable; one renderer per thread (renderers of either backend may be used in turn).
 class Renderer {
  public:
-  /// Creates the context (OpenGL 3.3 core or newer). Throws std::invalid_argument for a size out
-  /// of range, std::runtime_error if OSMesa cannot create a context or a shader fails to build
-  /// (the message holds the GL info log).
-  Renderer(int width, int height);
+  /// Creates the context (OpenGL 3.3 core or newer) through `backend`. Throws
+  /// std::invalid_argument for a size out of range, std::runtime_error if the backend cannot
+  /// create a context (the message names the step that failed) or a shader fails to build (the
+  /// message holds the GL info log).
+  Renderer(int width, int height, Backend backend = Backend::osmesa);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
   int width() const;
   int height() const;
+  Backend backend() const;
+  /// The backend, GL version and renderer, e.g. "osmesa: OpenGL 4.5 (Core Profile) Mesa 22.3.6,
+  /// llvmpipe (LLVM 15.0.6, 256 bits)".
+  std::string context_description();
 
   /// Draws one frame of `list` into the frame buffer and returns it as an RGB8 image, rows top to
   /// bottom. Throws std::runtime_error on a GL error.

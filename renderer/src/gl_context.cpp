@@ -1,0 +1,66 @@
+// GlContext: which backend context is current on each thread, and the GL function table loader.
+
+#include "gl_context.h"
+
+#include "egl_context.h"
+#include "osmesa_context.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace cps::render {
+
+thread_local constinit const GlFunctions* t_current_gl = nullptr;
+
+namespace {
+// The cps context current on this thread (nullptr: none). Kept by us rather than asked from
+// OSMesa or EGL, because with Mesa both APIs share one dispatch (libglapi): after an OSMesa bind,
+// eglGetCurrentContext still names the EGL context although GL calls no longer reach it.
+thread_local OffscreenContext* t_current_context = nullptr;
+
+void release_current() noexcept {
+  if (t_current_context != nullptr) t_current_context->unbind();
+  t_current_context = nullptr;
+  t_current_gl = nullptr;
+}
+}  // namespace
+
+void load_gl_functions(GlFunctions& out, GlProcLookup lookup, void* user, const char* backend) {
+#define CPS_GL_LOAD(name)                                                                    \
+  out.name = reinterpret_cast<decltype(out.name)>(lookup("gl" #name, user));                \
+  if (out.name == nullptr) {                                                                 \
+    throw std::runtime_error(std::string("cps::render: ") + backend +                        \
+                             ": the OpenGL function gl" #name " could not be loaded");       \
+  }
+  CPS_GL_FUNCTIONS(CPS_GL_LOAD)
+#undef CPS_GL_LOAD
+}
+
+GlContext::GlContext(Backend backend, int width, int height) : backend_(backend) {
+  release_current();  // a backend binds its new context while creating it
+  switch (backend) {
+    case Backend::osmesa: impl_ = make_osmesa_context(width, height); break;
+    case Backend::egl: impl_ = make_egl_context(width, height); break;
+  }
+  if (!impl_) throw std::invalid_argument("cps::render: unknown backend");
+  t_current_context = impl_.get();
+  t_current_gl = &impl_->functions();
+}
+
+GlContext::~GlContext() {
+  // The backend's destructor binds its context itself to delete what it owns, then unbinds.
+  if (t_current_context != impl_.get()) release_current();
+  t_current_context = nullptr;
+  t_current_gl = nullptr;
+  impl_.reset();
+}
+
+void GlContext::make_current() {
+  if (t_current_context == impl_.get()) return;
+  release_current();
+  impl_->bind();
+  t_current_context = impl_.get();
+  t_current_gl = &impl_->functions();
+}
+
+}  // namespace cps::render

@@ -1,0 +1,210 @@
+// `cps render --video mp4|gif`, run as a user runs it: the video is made by ffmpeg from the
+// frames and checked with ffprobe (codec, frame count, even size). Without ffmpeg on this machine
+// the video tests WARN and skip; the missing-ffmpeg test always runs (it hides ffmpeg itself).
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs `ENV cps ARGS` in `dir` (ENV: variable assignments, may be empty) and captures its exit
+// code, stdout and stderr.
+Result cps(const std::string& env, const std::string& args, const fs::path& dir) {
+  const fs::path out = dir / "stdout.txt";
+  const fs::path err = dir / "stderr.txt";
+  const std::string command = "cd '" + dir.string() + "' && " + env + " '" CPS_EXE "' " + args +
+                              " > '" + out.string() + "' 2> '" + err.string() + "'";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  fs::remove(out);
+  fs::remove(err);
+  return r;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("cps_cli_video_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+bool have_ffmpeg() {
+  return std::system("command -v ffmpeg > /dev/null 2>&1 && command -v ffprobe > /dev/null 2>&1") == 0;
+}
+
+/// ffprobe's view of the first video stream: codec_name, width, height, pix_fmt, r_frame_rate and
+/// nb_read_frames (frames decoded, counted by ffprobe).
+nlohmann::json probe(const fs::path& video) {
+  const std::string command = "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+                              "stream=codec_name,width,height,pix_fmt,r_frame_rate,nb_read_frames "
+                              "-of json '" + video.string() + "'";
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::string text;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) text.append(buf, n);
+  const int status = pclose(pipe);
+  INFO("ffprobe output: " << text);
+  REQUIRE(WIFEXITED(status));
+  REQUIRE(WEXITSTATUS(status) == 0);
+  const nlohmann::json j = nlohmann::json::parse(text);
+  REQUIRE(j.contains("streams"));
+  REQUIRE(j["streams"].size() == 1);
+  return j["streams"][0];
+}
+
+int count_frames(const fs::path& folder) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(folder)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("frame_", 0) == 0 && e.path().extension() == ".png") ++n;
+  }
+  return n;
+}
+
+/// No temporary (.partial) file is left in `dir`.
+bool no_partial_files(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() == ".partial") return false;
+  }
+  return true;
+}
+
+// --seconds 0.4 at --fps 10: frames at t = 0, 0.1, 0.2, 0.3, 0.4.
+constexpr int k_frames = 5;
+const std::string k_small = "--seconds 0.4 --fps 10";
+
+}  // namespace
+
+TEST_CASE("cps render --video mp4 writes H.264 with even dimensions from an odd size",
+          "[cli][video]") {
+  if (!have_ffmpeg()) {
+    WARN("ffmpeg or ffprobe is not installed (apt-get install ffmpeg): video test skipped");
+    return;
+  }
+  const fs::path dir = fresh_dir("mp4");
+  // An earlier, longer render leaves frames 5..9 in the folder: the video must not include them.
+  const Result longer = cps("", "render stack --size 65x49 --seconds 0.9 --fps 10 --out out", dir);
+  REQUIRE(longer.exit_code == 0);
+  REQUIRE(count_frames(dir / "out" / "stack") == 10);
+
+  const Result r = cps("", "render stack --size 65x49 " + k_small + " --video mp4 --out out", dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  const fs::path video = dir / "out" / "stack.mp4";
+  REQUIRE(fs::exists(video));
+  CHECK(r.out.find("stack.mp4") != std::string::npos);
+  const nlohmann::json s = probe(video);
+  INFO(s.dump());
+  CHECK(s["codec_name"] == "h264");
+  CHECK(s["pix_fmt"] == "yuv420p");
+  CHECK(s["width"] == 66);  // 65 padded to even
+  CHECK(s["height"] == 50);
+  CHECK(s["r_frame_rate"] == "10/1");
+  CHECK(s["nb_read_frames"] == std::to_string(k_frames));
+  CHECK(count_frames(dir / "out" / "stack") == 10);  // the frames stay
+  CHECK(no_partial_files(dir / "out"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps render --video gif writes a GIF with every frame", "[cli][video]") {
+  if (!have_ffmpeg()) {
+    WARN("ffmpeg or ffprobe is not installed (apt-get install ffmpeg): video test skipped");
+    return;
+  }
+  const fs::path dir = fresh_dir("gif");
+  const Result r = cps("", "render stack --size 64x48 " + k_small + " --video gif --out out", dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  const fs::path video = dir / "out" / "stack.gif";
+  REQUIRE(fs::exists(video));
+  const nlohmann::json s = probe(video);
+  INFO(s.dump());
+  CHECK(s["codec_name"] == "gif");
+  CHECK(s["width"] == 64);
+  CHECK(s["height"] == 48);
+  CHECK(s["nb_read_frames"] == std::to_string(k_frames));
+  CHECK(count_frames(dir / "out" / "stack") == k_frames);
+  CHECK(no_partial_files(dir / "out"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps render --video with --compare names the video after the compare folder",
+          "[cli][video]") {
+  if (!have_ffmpeg()) {
+    WARN("ffmpeg or ffprobe is not installed (apt-get install ffmpeg): video test skipped");
+    return;
+  }
+  const fs::path dir = fresh_dir("compare");
+  const Result r =
+      cps("", "render stack --size 64x48 " + k_small + " --compare push --video mp4 --out out", dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  const fs::path video = dir / "out" / "stack-compare-push.mp4";
+  REQUIRE(fs::exists(video));
+  CHECK_FALSE(fs::exists(dir / "out" / "stack.mp4"));
+  const nlohmann::json s = probe(video);
+  CHECK(s["width"] == 64);  // two 32-pixel panels side by side
+  CHECK(s["height"] == 48);
+  CHECK(s["nb_read_frames"] == std::to_string(k_frames));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps render --video without ffmpeg fails clearly and keeps the frames", "[cli][video]") {
+  // PATH names only an empty folder: no ffmpeg can be found, whatever this machine has.
+  const fs::path dir = fresh_dir("no_ffmpeg");
+  fs::create_directories(dir / "empty_bin");
+  const Result r = cps("PATH='" + (dir / "empty_bin").string() + "'",
+                       "render stack --size 64x48 " + k_small + " --video mp4 --out out", dir);
+  INFO("exit " << r.exit_code << ", stderr: " << r.err);
+  CHECK(r.exit_code == 1);
+  CHECK(r.err.find("ffmpeg is not on PATH") != std::string::npos);
+  CHECK(r.err.find("apt-get install ffmpeg") != std::string::npos);
+  CHECK(r.err.find("frame_%06d.png") != std::string::npos);  // the command that finishes the job
+  REQUIRE(fs::exists(dir / "out" / "stack"));
+  CHECK(count_frames(dir / "out" / "stack") == k_frames);
+  CHECK_FALSE(fs::exists(dir / "out" / "stack.mp4"));
+  CHECK(no_partial_files(dir / "out"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps render --video with an unknown format is a usage error that writes nothing",
+          "[cli][video]") {
+  const fs::path dir = fresh_dir("bad_format");
+  const Result r = cps("", "render stack --size 64x48 " + k_small + " --video avi --out out", dir);
+  INFO("stderr: " << r.err);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("--video") != std::string::npos);
+  CHECK(r.err.find("mp4") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "out"));
+  fs::remove_all(dir);
+}

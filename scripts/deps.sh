@@ -2,8 +2,11 @@
 # apt-get update runs once, and only when something is missing.
 cps_packages=(
   cmake g++ make pkg-config
-  libeigen3-dev libosmesa6-dev libglm-dev libstb-dev catch2 libcli11-dev nlohmann-json3-dev
-  gnuplot-nox
+  libeigen3-dev libglm-dev libstb-dev libpng-dev catch2 libcli11-dev nlohmann-json3-dev
+  # The two GL backends (both loaded at run time): OSMesa, and EGL with Mesa's driver.
+  libosmesa6-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri
+  # Plots of `cps report`, videos of `cps render --video`.
+  gnuplot-nox ffmpeg
 )
 
 cps_install_missing() {

@@ -101,7 +101,8 @@ std::string format_time(double t) {
 }  // namespace
 
 render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer) {
-  const scenes::Scene& scene = *spec.scene;
+  scenes::Scene scene = *spec.scene;
+  if (spec.preset) scene.camera = spec.preset;
   std::vector<scenes::Run> runs;
   for (const Variant& v : spec.variants) runs.push_back(make_run_or_usage_error(scene, v.overrides));
 
@@ -196,6 +197,11 @@ nlohmann::json figure_json(const FigureSpec& spec, const std::string& command_li
           {"panel_size_px", {spec.panel_width, spec.panel_height}},
           {"image_size_px", {columns * spec.panel_width, rows * spec.panel_height}},
           {"camera", spec.camera},
+          {"camera_preset",
+           spec.preset ? nlohmann::json{{"eye_m", {spec.preset->eye.x(), spec.preset->eye.y(), spec.preset->eye.z()}},
+                                        {"target_m", {spec.preset->target.x(), spec.preset->target.y(), spec.preset->target.z()}},
+                                        {"fov_y_deg", spec.preset->fov_y_deg}}
+                       : nlohmann::json("the scene's")},
           {"overlays",
            {{"contacts", spec.overlays.contacts},
             {"rods", spec.overlays.rods},
@@ -234,20 +240,26 @@ void write_figure(const fs::path& png, const render::Image& image, const nlohman
 
 const std::vector<PaperFigure>& paper_figures() {
   static const std::vector<PaperFigure> figures = {
-      {"fig6_stack.png", "paper Fig. 6", "stack", "", {0.0, 1.0, 3.0, 10.0}, {},
-       "the stack test: five cubes dropped in a column settle into a stack that stands"},
+      {"fig6_stack.png", "paper Fig. 6", "stack", "", {0.0, 1.0, 10.0, 85.0}, {}, std::nullopt,
+       "the stack test: five cubes dropped 0.6 m apart land and stand; the paper's stack falls "
+       "after about 85 s, so the last column is t = 85 s"},
       {"fig7_intersecting_stack.png", "paper Fig. 7", "intersecting_stack", "push",
-       {0.0, 0.5, 2.0},
+       {0.0, 0.5, 1.0},
        {{"(a)", "(b)", ""}, {"(a)", "(c)", ""}},
+       // Far enough back that the cubes of the original push factor stay in view at 0.5 s.
+       scenes::CameraPreset{Vec3(15.0, 17.0, 36.0), Vec3(0.0, 11.5, 0.0), 45.0},
        "(a) the intersecting start; (b) the original push factor at 0.5 s: the cubes fly apart; "
        "(c) the single frame push factor at 0.5 s: the cubes stop once the overlap is gone"},
-      {"fig8_funnel.png", "paper Fig. 8", "funnel", "", {0.0, 1.5, 4.0, 10.0}, {},
+      {"fig8_funnel.png", "paper Fig. 8", "funnel", "", {0.0, 0.6, 1.5, 10.0}, {}, std::nullopt,
        "20 balls poured into a funnel of 4 planes come to rest"},
-      {"fig9_pendulum_grid.png", "paper Fig. 9", "pendulum_grid", "", {0.0, 1.5, 4.0, 10.0}, {},
-       "a 5 x 5 grid of pendulums holds the shapes dropped on top"},
-      {"fig10_pendulum_wave.png", "paper Fig. 10", "pendulum_wave", "", {0.0, 5.0, 15.0, 30.0},
-       {},
-       "50 pendulums of varied length: the wave-like procession of a pendulum wave"},
+      {"fig9_pendulum_grid.png", "paper Fig. 9", "pendulum_grid", "", {0.0, 2.0, 10.0}, {},
+       std::nullopt, "a 5 x 5 grid of pendulums holds the shapes resting on top"},
+      {"fig10_pendulum_wave.png", "paper Fig. 10", "pendulum_wave", "",
+       {0.0, 5.0, 15.0, 30.0, 60.0}, {},
+       // From above (tilted 3 degrees): the pendulums swing in the y-z plane, so the wave shows as the
+       // line of balls snaking across the picture.
+       scenes::CameraPreset{Vec3(1.225, 3.2, 0.13), Vec3(1.225, 0.6, 0.0), 45.0},
+       "50 pendulums of varied length: the wave-like procession, realigned after the 60 s cycle"},
   };
   return figures;
 }

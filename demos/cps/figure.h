@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,8 @@ struct FigureSpec {
   int panel_height = 360;
   /// A name from camera_names(); the same camera for every panel (turned by overlays.orbit).
   std::string camera = "preset";
+  /// Replaces the scene's own preset (for "preset", "front", "side", "top") if set.
+  std::optional<scenes::CameraPreset> preset;
   Overlays overlays;
   /// Write a label on each panel: caption, tag, scene, variant, time.
   bool label = true;
@@ -82,6 +85,7 @@ struct PaperFigure {
   std::string compare;  ///< "" or a compare_variants option
   std::vector<double> times;  ///< s
   std::vector<std::vector<std::string>> tags;
+  std::optional<scenes::CameraPreset> preset;  ///< replaces the scene's camera preset if set
   std::string what;     ///< one sentence: what the paper's figure shows and what to look for
 };
 

@@ -178,6 +178,7 @@ int run_figure(int argc, char** argv, const std::string& scene_name, const std::
       spec.variants = cli::compare_variants(f.compare, overrides);
       spec.caption = f.caption + " counterpart";
       spec.tags = f.tags;
+      spec.preset = f.preset;
       plan.push_back({spec, folder / f.file});
     }
   } else {

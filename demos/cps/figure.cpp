@@ -19,6 +19,7 @@ namespace fs = std::filesystem;
 
 std::vector<double> parse_times(const std::string& text) {
   constexpr std::size_t kMaxTimes = 64;
+  constexpr double kMaxTime = 36000.0;  // s: ten hours of simulated time, far beyond any scene
   std::vector<double> times;
   std::size_t start = 0;
   while (true) {
@@ -42,6 +43,10 @@ std::vector<double> parse_times(const std::string& text) {
       throw UsageError("--times: " + quoted + " is not finite; times are finite seconds >= 0");
     }
     if (t < 0.0) throw UsageError("--times: " + quoted + " is negative; times are seconds >= 0");
+    if (t > kMaxTime) {
+      throw UsageError("--times: " + quoted + " is beyond " + std::to_string(static_cast<int>(kMaxTime)) +
+                       " s of simulated time; give shorter times");
+    }
     if (!times.empty() && !(t > times.back())) {
       char before[64];
       std::snprintf(before, sizeof before, "%g", times.back());

@@ -45,8 +45,8 @@ struct FigureSpec {
 };
 
 /// Parses "t1,t2,..." (s). Throws UsageError naming the bad entry and what is allowed if an
-/// entry is not a number, not finite, negative, or not greater than the one before it, or if
-/// the list is empty or longer than 64 entries.
+/// entry is not a number, not finite, negative, beyond 36000 s, or not greater than the one
+/// before it, or if an entry is empty or there are more than 64.
 std::vector<double> parse_times(const std::string& text);
 
 /// Steps one run per variant through the times and draws every panel. Returns the composed

@@ -14,7 +14,9 @@
 #include <chrono>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <iostream>
 #include <regex>
 
@@ -63,13 +65,12 @@ void add_view_options(CLI::App& cmd, ViewFlags& v, bool label_default) {
   v.label = label_default;
   cmd.add_flag("--contacts", v.overlays.contacts,
                "draw the last step's contact points (red spheres) and normals (red segments, about "
-               "one body size long, from body a towards body b)")
-      ->capture_default_str();
+               "one body size long (m), from body a towards body b); default: off");
   cmd.add_flag("--rods,!--no-rods", v.overlays.rods,
-               "draw distance constraints as rods (--no-rods hides them)")
-      ->capture_default_str();
-  cmd.add_flag("--label,!--no-label", v.label, "write scene, variant and time (s) on each picture")
-      ->capture_default_str();
+               "draw distance constraints as rods; default: on (--no-rods hides them)");
+  cmd.add_flag("--label,!--no-label", v.label,
+               std::string("write scene, variant and time (s) on each picture; default: ") +
+                   (label_default ? "on (--no-label leaves the pictures bare)" : "off (variants of --compare are always labelled)"));
   std::string names;
   for (std::string_view n : cli::camera_names()) names += (names.empty() ? "" : ", ") + std::string(n);
   cmd.add_option("--camera", v.camera,
@@ -82,7 +83,16 @@ void add_view_options(CLI::App& cmd, ViewFlags& v, bool label_default) {
                  "turn the camera about the vertical axis through its target (degrees per "
                  "simulated second; 0 = fixed, typical 10)")
       ->capture_default_str()
-      ->check(CLI::Range(-36000.0, 36000.0));
+      ->check(CLI::Validator(
+          [](std::string& input) -> std::string {
+            double value = 0.0;
+            std::istringstream in(input);
+            if (!(in >> value) || !in.eof() || !std::isfinite(value) || std::abs(value) > 36000.0) {
+              return "--orbit " + input + ": give a finite rate in degrees per second, |rate| <= 36000";
+            }
+            return {};
+          },
+          "DEG/S"));
 }
 #endif
 
@@ -263,11 +273,9 @@ int run(int argc, char** argv) {
   report->add_option("scene", report_scene, "scene name, 'all' (the paper's) or 'stress'")
       ->capture_default_str();
   report->add_option("--out", report_out, "output folder")->capture_default_str();
-  report->add_flag("--quick", report_quick, "a reduced sweep (about 2 minutes for all scenes)")
-      ->capture_default_str();
+  report->add_flag("--quick", report_quick, "a reduced sweep (about 2 minutes for all scenes)");
   report->add_flag("--list-runs", report_list,
-                   "print one self-contained command per run, to spread the sweep over machines")
-      ->capture_default_str();
+                   "print one self-contained command per run, to spread the sweep over machines");
   report->add_option("--merge", report_merge,
                      "combine the CSV files below these folders into one report in --out");
   report->add_option("--run", report_run, "execute one run by its id (see --list-runs)");
@@ -275,8 +283,7 @@ int run(int argc, char** argv) {
   bool bench_quick = false;
   CLI::App* bench = app.add_subcommand(
       "bench", "microseconds per step (explicit and matrix-free), cost growth, ms per frame");
-  bench->add_flag("--quick", bench_quick, "smaller scenes and fewer steps (results in us/step, ms/frame)")
-      ->capture_default_str();
+  bench->add_flag("--quick", bench_quick, "smaller scenes and fewer steps (results in us/step, ms/frame)");
 
 #ifdef CPS_HAVE_RENDERER
   std::string render_scene;

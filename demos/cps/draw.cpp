@@ -50,7 +50,7 @@ void add_contacts(const World& world, render::DrawList& list) {
     for (int k = 0; k < m.count; ++k) {
       const Contact& c = m.contacts[static_cast<std::size_t>(k)];
       list.spheres.push_back({to_glm(c.point), glm::quat(1.0f, 0.0f, 0.0f, 0.0f),
-                              static_cast<float>(0.12 * size), red});
+                              static_cast<float>(0.25 * size), red});
       list.lines.push_back({to_glm(c.point), to_glm(c.point + size * c.normal), red, 3.0f});
     }
   }

@@ -197,6 +197,7 @@ nlohmann::json figure_json(const FigureSpec& spec, const std::string& command_li
           {"scene", spec.scene->name},
           {"compare", spec.compare},
           {"caption", spec.caption},
+          {"shows", spec.what},
           {"times_s", spec.times},
           {"layout", "rows = variants, columns = times"},
           {"panel_size_px", {spec.panel_width, spec.panel_height}},

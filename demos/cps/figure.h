@@ -42,6 +42,8 @@ struct FigureSpec {
   std::vector<std::vector<std::string>> tags;
   /// The --compare option the rows come from ("" for one row); recorded in the sidecar.
   std::string compare;
+  /// What the figure shows, in one sentence (recorded in the sidecar as "shows"); may be empty.
+  std::string what;
 };
 
 /// Parses "t1,t2,..." (s). Throws UsageError naming the bad entry and what is allowed if an

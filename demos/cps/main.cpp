@@ -189,6 +189,7 @@ int run_figure(int argc, char** argv, const std::string& scene_name, const std::
       spec.caption = f.caption + " counterpart";
       spec.tags = f.tags;
       spec.preset = f.preset;
+      spec.what = f.what;
       plan.push_back({spec, folder / f.file});
     }
   } else {

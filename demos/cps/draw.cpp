@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace cps::cli {
 namespace {
@@ -25,11 +28,57 @@ constexpr std::array<glm::vec3, 6> kPalette = {{{0.85f, 0.33f, 0.20f},
 
 glm::vec3 colour_of(std::size_t body) { return kPalette[body % kPalette.size()]; }
 
+// A length (m) that says how big a movable body is: its largest half extent or its radius;
+// 0 for planes and static bodies.
+double body_size(const Body& b) {
+  if (b.is_static()) return 0.0;
+  if (b.shape.kind == ShapeKind::box) return b.shape.half_extents.maxCoeff();
+  if (b.shape.kind == ShapeKind::sphere) return b.shape.radius;
+  return 0.0;
+}
+
+// Contact overlay: for each contact point of the last step, a small sphere at the point and a
+// segment of length about one body size along the normal (from a towards b).
+void add_contacts(const World& world, render::DrawList& list) {
+  const glm::vec3 red(0.85f, 0.05f, 0.05f);
+  const auto& bodies = world.bodies();
+  for (const Manifold& m : world.manifolds()) {
+    const double sa = body_size(bodies[static_cast<std::size_t>(m.body_a)]);
+    const double sb = body_size(bodies[static_cast<std::size_t>(m.body_b)]);
+    double size = sa > 0.0 && sb > 0.0 ? std::min(sa, sb) : std::max(sa, sb);
+    if (!(size > 0.0)) size = 0.5;
+    for (int k = 0; k < m.count; ++k) {
+      const Contact& c = m.contacts[static_cast<std::size_t>(k)];
+      list.spheres.push_back({to_glm(c.point), glm::quat(1.0f, 0.0f, 0.0f, 0.0f),
+                              static_cast<float>(0.25 * size), red});
+      list.lines.push_back({to_glm(c.point), to_glm(c.point + size * c.normal), red, 3.0f});
+    }
+  }
+}
+
+// `camera` turned about the vertical axis through its target by `deg` degrees.
+render::Camera orbit(render::Camera camera, double deg) {
+  const float a = static_cast<float>(deg * 3.14159265358979323846 / 180.0);
+  const glm::vec3 r = camera.eye - camera.target;
+  const float c = std::cos(a);
+  const float s = std::sin(a);
+  camera.eye = camera.target + glm::vec3(c * r.x + s * r.z, r.y, -s * r.x + c * r.z);
+  return camera;
+}
+
+
 }  // namespace
+
+Overlays& default_overlays() {
+  static Overlays overlays;
+  return overlays;
+}
 
 render::DrawList draw_list(const World& world, const DrawStyle& style) {
   render::DrawList list;
-  list.camera = style.camera;
+  list.camera = style.overlays.orbit_deg_per_s == 0.0
+                    ? style.camera
+                    : orbit(style.camera, style.overlays.orbit_deg_per_s * world.time());
   const auto& bodies = world.bodies();
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
@@ -41,6 +90,7 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
     }
   }
   for (const DistanceConstraint& d : world.distances()) {
+    if (!style.overlays.rods) break;
     Vec3 p_a;
     Vec3 p_b;
     distance_endpoints(d, bodies, p_a, p_b);
@@ -48,7 +98,8 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
   }
   glm::vec3 lo(-5.0f);
   glm::vec3 hi(5.0f);
-  render::bounds(list, lo, hi);
+  render::bounds(list, lo, hi);  // the bodies only: contact markers do not move the planes
+  if (style.overlays.contacts) add_contacts(world, list);
   const glm::vec3 centre = 0.5f * (lo + hi);
   const float extent = glm::length(hi - lo);
   for (const Body& b : bodies) {
@@ -67,7 +118,9 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
 }
 
 render::Camera frame_world(const World& world, float aspect) {
-  const render::DrawList list = draw_list(world, {});
+  DrawStyle all;
+  all.overlays = Overlays{};  // rods on, no contacts, no orbit: framing ignores the flags
+  const render::DrawList list = draw_list(world, all);
   glm::vec3 lo(-5.0f);
   glm::vec3 hi(5.0f);
   render::bounds(list, lo, hi);
@@ -88,6 +141,45 @@ render::Camera camera_from_preset(const scenes::CameraPreset& preset) {
   camera.near_m = distance / 50.0f;
   camera.far_m = distance * 50.0f;
   return camera;
+}
+
+namespace {
+
+constexpr std::array<std::string_view, 5> kCameraNames = {"preset", "auto", "front", "side",
+                                                          "top"};
+
+}  // namespace
+
+std::span<const std::string_view> camera_names() { return kCameraNames; }
+
+std::optional<scenes::CameraPreset> camera_preset(const scenes::Scene& scene, const World& world,
+                                                  std::string_view name, float aspect) {
+  if (name == "preset") return scene.camera;
+  if (name == "auto") return std::nullopt;
+  scenes::CameraPreset base;
+  if (scene.camera) {
+    base = *scene.camera;
+  } else {
+    const render::Camera framed = frame_world(world, aspect);
+    base.eye = Vec3(framed.eye.x, framed.eye.y, framed.eye.z);
+    base.target = Vec3(framed.target.x, framed.target.y, framed.target.z);
+    base.fov_y_deg = framed.fov_y_deg;
+  }
+  const double distance = (base.eye - base.target).norm();
+  scenes::CameraPreset view = base;
+  if (name == "front") {
+    view.eye = base.target + Vec3(0.0, 0.15 * distance, distance);
+  } else if (name == "side") {
+    view.eye = base.target + Vec3(distance, 0.15 * distance, 0.0);
+  } else if (name == "top") {
+    // Straight down would make the up vector (0, 1, 0) degenerate: tilt a little towards +z.
+    view.eye = base.target + Vec3(0.0, distance, 0.05 * distance);
+  } else {
+    std::string known;
+    for (std::string_view n : kCameraNames) known += (known.empty() ? "" : ", ") + std::string(n);
+    throw std::invalid_argument("--camera " + std::string(name) + ": allowed are " + known);
+  }
+  return view;
 }
 
 }  // namespace cps::cli

@@ -6,6 +6,8 @@
 #include "report.h"
 
 #ifdef CPS_HAVE_RENDERER
+#include "draw.h"
+#include "figure.h"
 #include "render.h"
 #include "video.h"
 #endif
@@ -13,7 +15,9 @@
 #include <chrono>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <iostream>
 #include <regex>
 
@@ -38,6 +42,60 @@ SizeWxH parse_size(const std::string& text) {
   }
   return s;
 }
+
+// The command line as typed (arguments quoted where needed), for the records next to outputs.
+std::string command_line(int argc, char** argv) {
+  std::string text;
+  for (int i = 0; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const bool plain = !arg.empty() && arg.find_first_of(" \t'\"\\$*?;&|<>()") == std::string::npos;
+    text += (i == 0 ? "" : " ") + (plain ? arg : "'" + arg + "'");
+  }
+  return text;
+}
+
+#ifdef CPS_HAVE_RENDERER
+// The overlay and camera flags shared by render and figure.
+struct ViewFlags {
+  cli::Overlays overlays;
+  bool label = false;
+  std::string camera = "preset";
+};
+
+void add_view_options(CLI::App& cmd, ViewFlags& v, bool label_default) {
+  v.label = label_default;
+  cmd.add_flag("--contacts", v.overlays.contacts,
+               "draw the last step's contact points (red spheres) and normals (red segments, about "
+               "one body size long (m), from body a towards body b); default: off");
+  cmd.add_flag("--rods,!--no-rods", v.overlays.rods,
+               "draw distance constraints as rods; default: on (--no-rods hides them)");
+  cmd.add_flag("--label,!--no-label", v.label,
+               std::string("write scene, variant and time (s) on each picture; default: ") +
+                   (label_default ? "on (--no-label leaves the pictures bare)" : "off (variants of --compare are always labelled)"));
+  std::string names;
+  for (std::string_view n : cli::camera_names()) names += (names.empty() ? "" : ", ") + std::string(n);
+  cmd.add_option("--camera", v.camera,
+                 "view: preset (the scene's own), auto (framed on the bodies as built), front, side "
+                 "or top (the preset's target from the same distance)")
+      ->capture_default_str()
+      ->check(CLI::IsMember(std::vector<std::string>(cli::camera_names().begin(),
+                                                     cli::camera_names().end())));
+  cmd.add_option("--orbit", v.overlays.orbit_deg_per_s,
+                 "turn the camera about the vertical axis through its target (degrees per "
+                 "simulated second; 0 = fixed, typical 10)")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& input) -> std::string {
+            double value = 0.0;
+            std::istringstream in(input);
+            if (!(in >> value) || !in.eof() || !std::isfinite(value) || std::abs(value) > 36000.0) {
+              return "--orbit " + input + ": give a finite rate in degrees per second, |rate| <= 36000";
+            }
+            return {};
+          },
+          "DEG/S"));
+}
+#endif
 
 // The absolute path of this executable, for commands that must run anywhere.
 std::string self_path() {
@@ -93,21 +151,117 @@ int run_report(const std::string& scene_name, const std::string& out, bool quick
   return 0;
 }
 
+#ifdef CPS_HAVE_RENDERER
+// `cps figure`: everything is checked (scene, times, size, variants, output ownership) before
+// anything is rendered or written.
+int run_figure(int argc, char** argv, const std::string& scene_name, const std::string& times_text,
+               const std::string& compare, const std::string& size_text, const std::string& out,
+               bool force, const scenes::Overrides& overrides, const ViewFlags& view) {
+  namespace fs = std::filesystem;
+  const SizeWxH size = parse_size(size_text);
+  const std::string line = command_line(argc, argv);
+  struct Planned {
+    cli::FigureSpec spec;
+    fs::path png;
+  };
+  std::vector<Planned> plan;
+  const auto base_spec = [&](const scenes::Scene* scene) {
+    cli::FigureSpec spec;
+    spec.scene = scene;
+    spec.panel_width = size.width;
+    spec.panel_height = size.height;
+    spec.camera = view.camera;
+    spec.overlays = view.overlays;
+    spec.label = view.label;
+    return spec;
+  };
+  if (scene_name == "paper") {
+    if (!times_text.empty() || !compare.empty()) {
+      throw cli::UsageError("cps figure paper chooses its own --times and --compare for each "
+                            "figure; drop them, or name a scene (e.g. cps figure "
+                            "intersecting_stack --times 0,0.5 --compare push)");
+    }
+    const fs::path folder = out.empty() ? fs::path("out/figures") : fs::path(out);
+    for (const cli::PaperFigure& f : cli::paper_figures()) {
+      cli::FigureSpec spec = base_spec(cli::select_scenes(f.scene).front());
+      spec.times = f.times;
+      spec.compare = f.compare;
+      spec.variants = cli::compare_variants(f.compare, overrides);
+      spec.caption = f.caption + " counterpart";
+      spec.tags = f.tags;
+      spec.preset = f.preset;
+      spec.what = f.what;
+      plan.push_back({spec, folder / f.file});
+    }
+  } else {
+    const std::vector<const scenes::Scene*> chosen = cli::select_scenes(scene_name);
+    if (scene_name == "all" || scene_name == "stress") {
+      throw cli::UsageError("figure takes one scene or 'paper', not '" + scene_name + "'");
+    }
+    if (times_text.empty()) {
+      throw cli::UsageError("--times is required: the simulated times (s) of the columns, e.g. "
+                            "--times 0,0.5,2");
+    }
+    cli::FigureSpec spec = base_spec(chosen.front());
+    spec.times = cli::parse_times(times_text);
+    spec.compare = compare;
+    spec.variants = cli::compare_variants(compare, overrides);
+    const fs::path png = out.empty() ? fs::path("out/figures") /
+                                           (scene_name + (compare.empty() ? "" : "-compare-" + compare) + ".png")
+                                     : fs::path(out);
+    if (png.extension() != ".png") {
+      throw cli::UsageError("--out " + png.string() + ": the figure is a PNG; give a name ending in .png");
+    }
+    plan.push_back({spec, png});
+  }
+  for (Planned& p : plan) {
+    for (const cli::Variant& v : p.spec.variants) cli::make_run_or_usage_error(*p.spec.scene, v.overrides);
+    const long long w = static_cast<long long>(p.spec.times.size()) * size.width;
+    const long long h = static_cast<long long>(p.spec.variants.size()) * size.height;
+    if (w > 16384 || h > 16384) {
+      throw cli::UsageError("the figure would be " + std::to_string(w) + "x" + std::to_string(h) +
+                            " pixels (more than 16384 on a side); give fewer --times or a "
+                            "smaller --size");
+    }
+    cli::check_output_is_ours(p.png, force);
+  }
+  render::Renderer renderer(size.width, size.height);
+  for (Planned& p : plan) {
+    const render::Image image = cli::render_figure(p.spec, renderer);
+    cli::write_figure(p.png, image, cli::figure_json(p.spec, line));
+    std::printf("%s: %dx%d pixels, %zu times x %zu variants (%s)\n", p.png.c_str(), image.width,
+                image.height, p.spec.times.size(), p.spec.variants.size(),
+                cli::sidecar_path(p.png).filename().c_str());
+  }
+  return 0;
+}
+#endif
+
 int run(int argc, char** argv) {
   CLI::App app{"cps: the constraint based physics solver of Tamis & Maggiore (2015)"};
   app.require_subcommand(1);
 
-  CLI::App* list = app.add_subcommand("list", "print the scenes");
+  CLI::App* list = app.add_subcommand(
+      "list", "print the scenes with their default duration (s) and a summary");
 
   std::string sim_scene;
   std::optional<double> sim_seconds;
   bool sim_json = false;
+  std::string sim_trace;
+  bool sim_force = false;
   scenes::Overrides sim_overrides;
   CLI::App* simulate = app.add_subcommand("simulate", "run a scene headless and report metrics");
   simulate->add_option("scene", sim_scene, "scene name (see 'cps list')")->required();
   simulate->add_option("--seconds", sim_seconds, "simulated time (s), > 0; default: the scene's")
       ->check(cli::kFinitePositive);
-  simulate->add_flag("--json", sim_json, "print one JSON object");
+  simulate->add_flag("--json", sim_json, "print one JSON object (keys carry their unit: _s, _m, ...)");
+  simulate->add_option("--trace", sim_trace,
+                       "write every body's state per step to this CSV: step, t (s), body index, "
+                       "position (m), orientation quaternion w x y z, velocity (m/s), angular "
+                       "velocity (rad/s); one row per body per step, step 0 = as built");
+  simulate->add_flag("--force", sim_force,
+                     "let --trace replace an existing file that is not a cps trace (a file whose "
+                     "first line is the cps trace header is replaced without it)");
   cli::add_world_options(*simulate, sim_overrides);
 
   std::string report_scene = "all";
@@ -131,7 +285,7 @@ int run(int argc, char** argv) {
   bool bench_quick = false;
   CLI::App* bench = app.add_subcommand(
       "bench", "microseconds per step (explicit and matrix-free), cost growth, ms per frame");
-  bench->add_flag("--quick", bench_quick, "smaller scenes and fewer steps");
+  bench->add_flag("--quick", bench_quick, "smaller scenes and fewer steps (results in us/step, ms/frame)");
 
 #ifdef CPS_HAVE_RENDERER
   std::string render_scene;
@@ -165,6 +319,37 @@ int run(int argc, char** argv) {
                      "after the frames, assemble them with ffmpeg into OUT/SCENE.mp4 (H.264) or "
                      "OUT/SCENE.gif")
       ->check(CLI::IsMember({"mp4", "gif"}));
+  ViewFlags render_view;
+  add_view_options(*render, render_view, /*label_default=*/false);
+
+  std::string fig_scene;
+  std::string fig_times_text;
+  std::string fig_compare;
+  std::string fig_size_text = "640x360";
+  std::string fig_out;
+  bool fig_force = false;
+  scenes::Overrides fig_overrides;
+  ViewFlags fig_view;
+  CLI::App* figure = app.add_subcommand(
+      "figure",
+      "one labelled PNG of a scene: a panel per time (columns) and per variant (rows); "
+      "'cps figure paper' writes the counterparts of the paper's Figs. 6-10");
+  figure->add_option("scene", fig_scene, "scene name (see 'cps list') or 'paper'")->required();
+  figure->add_option("--times", fig_times_text,
+                     "simulated times of the columns (s), comma separated, finite, >= 0, "
+                     "increasing, e.g. 0,0.5,2; required except for 'paper'");
+  figure->add_option("--compare", fig_compare,
+                     "one row per value of this option (default: one row, the scene's settings)")
+      ->check(CLI::IsMember({"push", "solver", "friction-model", "rotation"}));
+  figure->add_option("--size", fig_size_text, "size of ONE panel, WxH in pixels, each in [16, 8192]")
+      ->capture_default_str();
+  figure->add_option("--out", fig_out,
+                     "output PNG (default out/figures/SCENE[-compare-OPTION].png); for 'paper', "
+                     "the folder (default out/figures); a FILE.json sidecar records the run");
+  figure->add_flag("--force", fig_force,
+                   "replace an output file that cps figure did not write (one without its sidecar)");
+  cli::add_world_options(*figure, fig_overrides);
+  add_view_options(*figure, fig_view, /*label_default=*/true);
 #endif
 
   std::string names;
@@ -209,8 +394,15 @@ int run(int argc, char** argv) {
       }
       const scenes::Scene* scene = chosen.front();
       scenes::Run r = cli::make_run_or_usage_error(*scene, sim_overrides);
-      const nlohmann::json summary =
-          cli::simulate(*scene, r, sim_seconds.value_or(scene->default_seconds));
+      std::optional<cli::TraceWriter> trace;
+      if (!sim_trace.empty()) trace.emplace(sim_trace, sim_force);
+      const nlohmann::json summary = cli::simulate(
+          *scene, r, sim_seconds.value_or(scene->default_seconds), trace ? &*trace : nullptr);
+      if (trace) {
+        const long rows = trace->finish();
+        std::cerr << "trace: " << rows << " rows (" << r.world.bodies().size()
+                  << " bodies per step) in " << sim_trace << "\n";
+      }
       if (sim_json) {
         std::cout << summary.dump(2) << "\n";
       } else {
@@ -261,13 +453,32 @@ int run(int argc, char** argv) {
         }
       }
       const int panel_width = size.width / static_cast<int>(variants.size());
+      const float aspect = static_cast<float>(panel_width) / static_cast<float>(size.height);
+      // The view flags reach render.cpp through the DrawStyle defaults and the scene's camera.
+      cli::default_overlays() = render_view.overlays;
+      std::vector<scenes::Scene> viewed;  // the scenes with the chosen camera as their preset
+      viewed.reserve(jobs.size());
+      for (Job& job : jobs) {
+        viewed.push_back(*job.scene);
+        try {
+          viewed.back().camera = cli::camera_preset(*job.scene, job.runs.front().world,
+                                                    render_view.camera, aspect);
+        } catch (const std::invalid_argument& e) {
+          throw cli::UsageError(e.what());
+        }
+        job.scene = &viewed.back();
+      }
       render::Renderer renderer(panel_width, size.height,
                                 *render::parse_backend(render_backend));
       std::fprintf(stderr, "render: %s\n", renderer.context_description().c_str());
       for (Job& job : jobs) {
         std::vector<cli::Panel> panels;
         for (std::size_t v = 0; v < variants.size(); ++v) {
-          panels.push_back({&job.runs[v], variants[v].label});
+          std::string label = variants[v].label;
+          if (render_view.label) {
+            label = std::string(job.scene->name) + (label.empty() ? "" : "\n" + label);
+          }
+          panels.push_back({&job.runs[v], label});
         }
         cli::RenderJob spec;
         spec.seconds = render_seconds.value_or(job.scene->default_seconds);
@@ -307,6 +518,8 @@ int run(int argc, char** argv) {
       }
       return 0;
     }
+    if (*figure) return run_figure(argc, argv, fig_scene, fig_times_text, fig_compare,
+                                   fig_size_text, fig_out, fig_force, fig_overrides, fig_view);
 #endif
   } catch (const cli::UsageError& e) {
     std::cerr << "cps: " << e.what() << "\n";

@@ -1,0 +1,273 @@
+#include "figure.h"
+
+#include "simulate.h"
+
+#include "cps/render/image_ops.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <stdexcept>
+#include <system_error>
+
+namespace cps::cli {
+namespace fs = std::filesystem;
+
+std::vector<double> parse_times(const std::string& text) {
+  constexpr std::size_t kMaxTimes = 64;
+  constexpr double kMaxTime = 36000.0;  // s: ten hours of simulated time, far beyond any scene
+  std::vector<double> times;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    std::string entry = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    entry.erase(0, entry.find_first_not_of(" \t"));
+    entry.erase(entry.find_last_not_of(" \t") + 1);
+    const std::string quoted = "'" + entry + "'";
+    if (entry.empty()) {
+      throw UsageError("--times " + text + ": an empty entry; give times in seconds separated by "
+                       "commas, e.g. --times 0,0.5,2");
+    }
+    char* end = nullptr;
+    errno = 0;
+    const double t = std::strtod(entry.c_str(), &end);
+    if (end != entry.c_str() + entry.size()) {
+      throw UsageError("--times: " + quoted + " is not a number; give times in seconds, e.g. "
+                       "--times 0,0.5,2");
+    }
+    if (!std::isfinite(t) || errno == ERANGE) {
+      throw UsageError("--times: " + quoted + " is not finite; times are finite seconds >= 0");
+    }
+    if (t < 0.0) throw UsageError("--times: " + quoted + " is negative; times are seconds >= 0");
+    if (t > kMaxTime) {
+      throw UsageError("--times: " + quoted + " is beyond " + std::to_string(static_cast<int>(kMaxTime)) +
+                       " s of simulated time; give shorter times");
+    }
+    if (!times.empty() && !(t > times.back())) {
+      char before[64];
+      std::snprintf(before, sizeof before, "%g", times.back());
+      throw UsageError("--times: " + quoted + " is not greater than the time before it (" +
+                       before + " s); list the times in increasing order");
+    }
+    times.push_back(t);
+    if (times.size() > kMaxTimes) {
+      throw UsageError("--times: more than " + std::to_string(kMaxTimes) + " times; give fewer");
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return times;
+}
+
+render::Image stack_vertically(const std::vector<render::Image>& images) {
+  if (images.empty()) throw std::invalid_argument("stack_vertically: no images");
+  render::Image out;
+  out.width = images.front().width;
+  for (const render::Image& im : images) {
+    if (im.width != out.width) {
+      throw std::invalid_argument("stack_vertically: widths differ (" + std::to_string(im.width) +
+                                  " and " + std::to_string(out.width) + ")");
+    }
+    out.height += im.height;
+    out.pixels.insert(out.pixels.end(), im.pixels.begin(), im.pixels.end());
+  }
+  return out;
+}
+
+namespace {
+
+// A 1-pixel dark frame along the edges of the image, so neighbouring panels stay apart.
+void draw_border(render::Image& image) {
+  const auto set = [&image](int x, int y) {
+    const std::size_t i = 3u * (static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) +
+                                static_cast<std::size_t>(x));
+    image.pixels[i] = image.pixels[i + 1] = image.pixels[i + 2] = 40;
+  };
+  for (int x = 0; x < image.width; ++x) {
+    set(x, 0);
+    set(x, image.height - 1);
+  }
+  for (int y = 0; y < image.height; ++y) {
+    set(0, y);
+    set(image.width - 1, y);
+  }
+}
+
+std::string format_time(double t) {
+  char text[48];
+  std::snprintf(text, sizeof text, "t = %.2f s", t);
+  return text;
+}
+
+}  // namespace
+
+render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer) {
+  scenes::Scene scene = *spec.scene;
+  if (spec.preset) scene.camera = spec.preset;
+  std::vector<scenes::Run> runs;
+  for (const Variant& v : spec.variants) runs.push_back(make_run_or_usage_error(scene, v.overrides));
+
+  const float aspect = static_cast<float>(renderer.width()) / static_cast<float>(renderer.height());
+  std::optional<scenes::CameraPreset> preset;
+  try {
+    preset = camera_preset(scene, runs.front().world, spec.camera, aspect);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  DrawStyle style{preset ? camera_from_preset(*preset) : frame_world(runs.front().world, aspect),
+                  static_cast<float>(scene.plane_opacity), spec.overlays};
+  const int label_scale = std::max(1, renderer.height() / 360);
+
+  std::vector<render::Image> rows;
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    std::vector<render::Image> row;
+    for (std::size_t c = 0; c < spec.times.size(); ++c) {
+      runs[r].advance_to(spec.times[c]);
+      render::Image panel = renderer.draw(draw_list(runs[r].world, style));
+      draw_border(panel);
+      if (spec.label) {
+        std::string text;
+        if (!spec.caption.empty()) text += spec.caption + "\n";
+        const std::string tag =
+            r < spec.tags.size() && c < spec.tags[r].size() ? spec.tags[r][c] : std::string();
+        text += (tag.empty() ? "" : tag + " ") + std::string(scene.name) + "\n";
+        if (!spec.variants[r].label.empty()) text += spec.variants[r].label + "\n";
+        text += format_time(runs[r].world.time());
+        render::draw_label(panel, 4 * label_scale, 4 * label_scale, text, label_scale);
+      }
+      row.push_back(std::move(panel));
+    }
+    rows.push_back(row.size() == 1 ? std::move(row.front()) : render::side_by_side(row));
+  }
+  return stack_vertically(rows);
+}
+
+fs::path sidecar_path(const fs::path& png) {
+  fs::path p = png;
+  p += ".json";
+  return p;
+}
+
+namespace {
+
+bool sidecar_is_ours(const fs::path& sidecar) {
+  std::ifstream in(sidecar);
+  if (!in) return false;
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return j.is_object() && j.value("written_by", std::string()) == "cps figure";
+}
+
+}  // namespace
+
+void check_output_is_ours(const fs::path& png, bool force) {
+  if (force) return;
+  const fs::path side = sidecar_path(png);
+  std::error_code ec;
+  const bool png_exists = fs::exists(png, ec);
+  const bool side_exists = fs::exists(side, ec);
+  if (!png_exists && !side_exists) return;
+  if (side_exists && sidecar_is_ours(side)) return;
+  throw UsageError((png_exists ? png : side).string() +
+                   " exists and was not written by cps figure (no " + side.filename().string() +
+                   " sidecar saying so); choose another --out, or pass --force to replace it");
+}
+
+std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return text;
+}
+
+nlohmann::json figure_json(const FigureSpec& spec, const std::string& command_line) {
+  nlohmann::json variants = nlohmann::json::array();
+  for (const Variant& v : spec.variants) {
+    variants.push_back({{"label", v.label},
+                        {"parameters", parameters_json(scenes::world_def_with(*spec.scene, v.overrides))}});
+  }
+  const int columns = static_cast<int>(spec.times.size());
+  const int rows = static_cast<int>(spec.variants.size());
+  return {{"written_by", "cps figure"},
+          {"scene", spec.scene->name},
+          {"compare", spec.compare},
+          {"caption", spec.caption},
+          {"shows", spec.what},
+          {"times_s", spec.times},
+          {"layout", "rows = variants, columns = times"},
+          {"panel_size_px", {spec.panel_width, spec.panel_height}},
+          {"image_size_px", {columns * spec.panel_width, rows * spec.panel_height}},
+          {"camera", spec.camera},
+          {"camera_preset",
+           spec.preset ? nlohmann::json{{"eye_m", {spec.preset->eye.x(), spec.preset->eye.y(), spec.preset->eye.z()}},
+                                        {"target_m", {spec.preset->target.x(), spec.preset->target.y(), spec.preset->target.z()}},
+                                        {"fov_y_deg", spec.preset->fov_y_deg}}
+                       : nlohmann::json("the scene's")},
+          {"overlays",
+           {{"contacts", spec.overlays.contacts},
+            {"rods", spec.overlays.rods},
+            {"orbit_deg_per_s", spec.overlays.orbit_deg_per_s},
+            {"label", spec.label}}},
+          {"variants", variants},
+          {"command_line", command_line},
+          {"date_utc", utc_now()}};
+}
+
+void write_figure(const fs::path& png, const render::Image& image, const nlohmann::json& sidecar) {
+  if (png.has_parent_path()) fs::create_directories(png.parent_path());
+  const fs::path side = sidecar_path(png);
+  fs::path tmp = side;
+  tmp += ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << sidecar.dump(2) << "\n";
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      fs::remove(tmp, ignored);
+      throw std::runtime_error("cannot write " + side.string());
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, side, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw std::runtime_error("cannot rename " + tmp.string() + " to " + side.string() + ": " +
+                             ec.message());
+  }
+  render::write_png(png, image);
+}
+
+const std::vector<PaperFigure>& paper_figures() {
+  static const std::vector<PaperFigure> figures = {
+      {"fig6_stack.png", "paper Fig. 6", "stack", "", {0.0, 1.0, 10.0, 85.0}, {}, std::nullopt,
+       "the stack test: five cubes dropped 0.6 m apart land and stand; the paper's stack falls "
+       "after about 85 s, so the last column is t = 85 s"},
+      {"fig7_intersecting_stack.png", "paper Fig. 7", "intersecting_stack", "push",
+       {0.0, 0.5, 1.0},
+       {{"(a)", "(b)", ""}, {"(a)", "(c)", ""}},
+       // Far enough back that the cubes of the original push factor stay in view at 0.5 s.
+       scenes::CameraPreset{Vec3(15.0, 17.0, 36.0), Vec3(0.0, 11.5, 0.0), 45.0},
+       "(a) the intersecting start; (b) the original push factor at 0.5 s: the cubes fly apart; "
+       "(c) the single frame push factor at 0.5 s: the cubes stop once the overlap is gone"},
+      {"fig8_funnel.png", "paper Fig. 8", "funnel", "", {0.0, 0.6, 1.5, 10.0}, {}, std::nullopt,
+       "20 balls poured into a funnel of 4 planes come to rest"},
+      {"fig9_pendulum_grid.png", "paper Fig. 9", "pendulum_grid", "", {0.0, 2.0, 10.0}, {},
+       std::nullopt, "a 5 x 5 grid of pendulums holds the shapes resting on top"},
+      {"fig10_pendulum_wave.png", "paper Fig. 10", "pendulum_wave", "",
+       {0.0, 5.0, 15.0, 30.0, 60.0}, {},
+       // From above (tilted 3 degrees): the pendulums swing in the y-z plane, so the wave shows as the
+       // line of balls snaking across the picture.
+       scenes::CameraPreset{Vec3(1.225, 3.2, 0.13), Vec3(1.225, 0.6, 0.0), 45.0},
+       "50 pendulums of varied length: the wave-like procession, realigned after the 60 s cycle"},
+  };
+  return figures;
+}
+
+}  // namespace cps::cli

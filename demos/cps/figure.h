@@ -1,0 +1,100 @@
+#pragma once
+// `cps figure`: one labelled PNG of a scene at chosen times (columns) for each variant of an
+// option (rows), like the paper's Fig. 7 (a)-(c); and the counterparts of the paper's
+// Figs. 6-10 (`cps figure paper`).
+
+#include "draw.h"
+#include "options.h"
+#include "scene.h"
+
+#include "cps/render/renderer.h"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cps::cli {
+
+/// What one figure shows.
+struct FigureSpec {
+  const scenes::Scene* scene = nullptr;
+  /// Simulated times of the columns (s): finite, >= 0, strictly increasing (see parse_times).
+  std::vector<double> times;
+  /// The rows: one run of the scene per variant (compare_variants gives them).
+  std::vector<Variant> variants;
+  /// Size of one panel in pixels (each in [16, 8192]); the figure is
+  /// (times.size() * panel_width) x (variants.size() * panel_height).
+  int panel_width = 640;
+  int panel_height = 360;
+  /// A name from camera_names(); the same camera for every panel (turned by overlays.orbit).
+  std::string camera = "preset";
+  /// Replaces the scene's own preset (for "preset", "front", "side", "top") if set.
+  std::optional<scenes::CameraPreset> preset;
+  Overlays overlays;
+  /// Write a label on each panel: caption, tag, scene, variant, time.
+  bool label = true;
+  /// First line of every label (e.g. "paper Fig. 7"); none if empty.
+  std::string caption;
+  /// Optional tag per panel, tags[row][column] (e.g. "(a)"); empty or missing: none.
+  std::vector<std::vector<std::string>> tags;
+  /// The --compare option the rows come from ("" for one row); recorded in the sidecar.
+  std::string compare;
+  /// What the figure shows, in one sentence (recorded in the sidecar as "shows"); may be empty.
+  std::string what;
+};
+
+/// Parses "t1,t2,..." (s). Throws UsageError naming the bad entry and what is allowed if an
+/// entry is not a number, not finite, negative, beyond 36000 s, or not greater than the one
+/// before it, or if an entry is empty or there are more than 64.
+std::vector<double> parse_times(const std::string& text);
+
+/// Steps one run per variant through the times and draws every panel. Returns the composed
+/// figure: row r, column c is the variant r at times[c]; labelled if spec.label. The panels
+/// have a 1-pixel dark border (inside the panel, so the size is exact). Throws UsageError for
+/// a bad parameter or camera name, std::runtime_error from the renderer.
+/// `renderer` must be spec.panel_width x spec.panel_height.
+render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer);
+
+/// The images one below the other, top to bottom, all of the same width. Returns
+/// width x sum(heights). Throws std::invalid_argument if the list is empty or the widths differ.
+render::Image stack_vertically(const std::vector<render::Image>& images);
+
+/// The sidecar that marks `png` as written by cps figure: png with ".json" appended.
+std::filesystem::path sidecar_path(const std::filesystem::path& png);
+
+/// Refuses to replace a file cps figure did not write: throws UsageError if `png` or its sidecar
+/// exists and the sidecar is missing or lacks "written_by": "cps figure", unless `force`.
+void check_output_is_ours(const std::filesystem::path& png, bool force);
+
+/// The sidecar's content: written_by, scene, compare, times_s, panel_size_px, image_size_px,
+/// camera, overlays, caption, variants (label and world parameters with units), command line
+/// and the date (UTC, ISO 8601).
+nlohmann::json figure_json(const FigureSpec& spec, const std::string& command_line);
+
+/// Writes the sidecar (temp + rename) and then the PNG (temp + rename, render::write_png),
+/// creating the folder. Throws std::runtime_error naming the path on failure.
+void write_figure(const std::filesystem::path& png, const render::Image& image,
+                  const nlohmann::json& sidecar);
+
+/// A counterpart of one of the paper's result figures (Sec. 10, Figs. 6-10).
+struct PaperFigure {
+  std::string file;     ///< e.g. "fig7_intersecting_stack.png"
+  std::string caption;  ///< e.g. "paper Fig. 7"
+  std::string scene;
+  std::string compare;  ///< "" or a compare_variants option
+  std::vector<double> times;  ///< s
+  std::vector<std::vector<std::string>> tags;
+  std::optional<scenes::CameraPreset> preset;  ///< replaces the scene's camera preset if set
+  std::string what;     ///< one sentence: what the paper's figure shows and what to look for
+};
+
+/// The five figures `cps figure paper` writes, in the paper's order.
+const std::vector<PaperFigure>& paper_figures();
+
+/// The current date and time in UTC, ISO 8601 ("2026-11-21T18:30:00Z").
+std::string utc_now();
+
+}  // namespace cps::cli

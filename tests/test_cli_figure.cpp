@@ -1,0 +1,305 @@
+// cps figure, cps simulate --trace and every command's --help, run as a user runs them:
+// picture sizes, refusals that keep foreign files intact, and a trace that obeys free fall.
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs `cps ARGS` in `dir` and captures its exit code, stdout and stderr.
+Result cps(const std::string& args, const fs::path& dir) {
+  const fs::path out = dir / "stdout.txt";
+  const fs::path err = dir / "stderr.txt";
+  const std::string command = "cd '" + dir.string() + "' && '" CPS_EXE "' " + args + " > '" +
+                              out.string() + "' 2> '" + err.string() + "'";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  fs::remove(out);
+  fs::remove(err);
+  return r;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("cps_cli_figure_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+#ifdef CPS_HAVE_RENDERER
+// Width and height of a PNG from its IHDR chunk (bytes 16..23, big endian); {0, 0} if the file
+// is not a PNG.
+std::pair<int, int> png_size(const fs::path& p) {
+  const std::string bytes = slurp(p);
+  if (bytes.size() < 24 || bytes.compare(1, 3, "PNG") != 0 || bytes.compare(12, 4, "IHDR") != 0) {
+    return {0, 0};
+  }
+  const auto be32 = [&bytes](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(bytes[at + i]);
+    return static_cast<int>(v);
+  };
+  return {be32(16), be32(20)};
+}
+#endif
+
+// The rows of a CSV file, each split at commas.
+std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::vector<std::string>> rows;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream s(line);
+    std::string cell;
+    while (std::getline(s, cell, ',')) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+}  // namespace
+
+#ifdef CPS_HAVE_RENDERER
+TEST_CASE("cps figure writes one PNG of times x variants panels with a sidecar", "[cli][figure]") {
+  const fs::path dir = fresh_dir("size");
+  const Result r = cps("figure intersecting_stack --times 0,0.25,0.5 --compare push --size 48x32 "
+                       "--out f.png",
+                       dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto [w, h] = png_size(dir / "f.png");
+  CHECK(w == 3 * 48);  // one column per time
+  CHECK(h == 2 * 32);  // one row per variant of --push
+  const nlohmann::json side = nlohmann::json::parse(slurp(dir / "f.png.json"));
+  CHECK(side["written_by"] == "cps figure");
+  CHECK(side["times_s"].size() == 3);
+  CHECK(side["variants"].size() == 2);
+  CHECK(side["variants"][1]["parameters"]["push"] == "split");
+  CHECK(side["command_line"].get<std::string>().find("--times 0,0.25,0.5") != std::string::npos);
+
+  // Its own file is replaced without --force; the default name is out/figures/SCENE.png.
+  CHECK(cps("figure intersecting_stack --times 0,0.25 --size 48x32 --out f.png", dir).exit_code == 0);
+  CHECK(png_size(dir / "f.png") == std::make_pair(2 * 48, 32));
+  CHECK(cps("figure stack --times 0 --size 40x24", dir).exit_code == 0);
+  CHECK(png_size(dir / "out/figures/stack.png") == std::make_pair(40, 24));
+  CHECK(fs::exists(dir / "out/figures/stack.png.json"));
+}
+
+TEST_CASE("cps figure rejects bad --times with exit 2, naming the value, and writes nothing",
+          "[cli][figure]") {
+  const fs::path dir = fresh_dir("times");
+  struct Case {
+    std::string times;
+    std::string says;
+  };
+  const Case cases[] = {{"0,abc", "'abc'"},     {"0,-1", "'-1'"},   {"0,1,0.5", "'0.5'"},
+                        {"nan", "'nan'"},       {"0,inf", "'inf'"}, {"1,1", "'1'"},
+                        {"1e999", "'1e999'"},   {"1,,2", "empty"},  {"0,1e6", "'1e6'"}};
+  for (const Case& c : cases) {
+    INFO("--times " << c.times);
+    const Result r = cps("figure stack --size 32x32 --times '" + c.times + "'", dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find(c.says) != std::string::npos);
+  }
+  CHECK(cps("figure stack --size 32x32", dir).exit_code == 2);  // --times is required
+  CHECK(cps("figure nosuchscene --times 0", dir).err.find("cps list") != std::string::npos);
+  CHECK(!fs::exists(dir / "out"));
+}
+
+TEST_CASE("cps figure keeps a file it did not write unless --force", "[cli][figure]") {
+  const fs::path dir = fresh_dir("foreign");
+  const std::string foreign = "a figure someone made by hand\n";
+  write_text(dir / "mine.png", foreign);
+  const Result r = cps("figure stack --times 0 --size 32x32 --out mine.png", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("--force") != std::string::npos);
+  CHECK(slurp(dir / "mine.png") == foreign);
+  CHECK(!fs::exists(dir / "mine.png.json"));
+
+  // A sidecar that is not ours does not make the file ours either.
+  write_text(dir / "mine.png.json", "{\"written_by\": \"someone else\"}");
+  CHECK(cps("figure stack --times 0 --size 32x32 --out mine.png", dir).exit_code == 2);
+  CHECK(slurp(dir / "mine.png") == foreign);
+
+  CHECK(cps("figure stack --times 0 --size 32x32 --out mine.png --force", dir).exit_code == 0);
+  CHECK(png_size(dir / "mine.png") == std::make_pair(32, 32));
+}
+
+TEST_CASE("cps figure paper writes the counterparts of Figs. 6 to 10", "[cli][figure]") {
+  const fs::path dir = fresh_dir("paper");
+  const Result r = cps("figure paper --size 32x24 --out figs", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const std::pair<std::string, int> figures[] = {{"fig6_stack", 6},
+                                                 {"fig7_intersecting_stack", 7},
+                                                 {"fig8_funnel", 8},
+                                                 {"fig9_pendulum_grid", 9},
+                                                 {"fig10_pendulum_wave", 10}};
+  for (const auto& [name, number] : figures) {
+    INFO(name);
+    const fs::path png = dir / "figs" / (name + ".png");
+    const auto [w, h] = png_size(png);
+    const nlohmann::json side = nlohmann::json::parse(slurp(fs::path(png.string() + ".json")));
+    CHECK(side["caption"].get<std::string>().find("Fig. " + std::to_string(number)) !=
+          std::string::npos);
+    CHECK(w == 32 * static_cast<int>(side["times_s"].size()));
+    CHECK(h == 24 * static_cast<int>(side["variants"].size()));
+  }
+  // Fig. 7 compares the original push factor with the single frame push factor at 0.5 s.
+  const nlohmann::json fig7 =
+      nlohmann::json::parse(slurp(dir / "figs/fig7_intersecting_stack.png.json"));
+  CHECK(fig7["compare"] == "push");
+  CHECK(std::find(fig7["times_s"].begin(), fig7["times_s"].end(), 0.5) != fig7["times_s"].end());
+  CHECK(cps("figure paper --times 0,1", dir).exit_code == 2);
+}
+
+TEST_CASE("cps render takes the overlay and camera flags", "[cli][figure]") {
+  const fs::path dir = fresh_dir("render_flags");
+  const Result r = cps("render pendulum_grid --seconds 0.1 --fps 10 --size 32x32 --contacts "
+                       "--no-rods --label --camera top --orbit 10 --out o",
+                       dir);
+  INFO(r.err);
+  CHECK(r.exit_code == 0);
+  CHECK(png_size(dir / "o/pendulum_grid/frame_000001.png") == std::make_pair(32, 32));
+  const std::string quick = "render stack --seconds 0.1 --fps 10 --size 32x32 --out o ";
+  CHECK(cps(quick + "--camera sideways", dir).exit_code == 2);
+  const Result nan = cps(quick + "--orbit nan", dir);
+  CHECK(nan.exit_code == 2);
+  CHECK(nan.err.find("--orbit") != std::string::npos);
+  CHECK(!fs::exists(dir / "o/stack"));
+}
+#endif
+
+TEST_CASE("cps simulate --trace writes every body per step and obeys free fall", "[cli][trace]") {
+  const fs::path dir = fresh_dir("trace");
+  const Result r = cps("simulate stack --seconds 0.5 --trace t.csv", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto rows = read_csv(dir / "t.csv");
+  REQUIRE(rows.size() > 1);
+  const std::vector<std::string> header = {"step", "t_s", "body", "x_m", "y_m", "z_m",
+                                           "qw", "qx", "qy", "qz", "vx_mps", "vy_mps",
+                                           "vz_mps", "wx_radps", "wy_radps", "wz_radps"};
+  CHECK(rows.front() == header);
+  // The stack: the ground plane and 5 cubes; 0.5 s at 60 Hz is 30 steps, plus the state as built.
+  const int bodies = 6;
+  const int steps = 30;
+  REQUIRE(rows.size() == 1u + static_cast<std::size_t>((steps + 1) * bodies));
+  const double dt = std::stod(rows[1 + bodies][1]);  // t of step 1
+  CHECK(dt == Approx(1.0 / 60.0).margin(1e-9));
+  const double g = 10.0;  // m/s^2, the paper's gravity
+  for (int n = 0; n <= steps; ++n) {
+    for (int b = 0; b < bodies; ++b) {
+      const auto& row = rows[static_cast<std::size_t>(1 + n * bodies + b)];
+      REQUIRE(row.size() == header.size());
+      CHECK(std::stoi(row[0]) == n);
+      CHECK(std::stoi(row[2]) == b);
+    }
+  }
+  // Step 0 is the scene as built: cube i at (0, 2 + 3 i, 0) m (Sec. 10.1), at rest.
+  for (int i = 0; i < 5; ++i) {
+    const auto& row = rows[static_cast<std::size_t>(1 + 1 + i)];
+    CHECK(std::stod(row[4]) == Approx(2.0 + 3.0 * i).margin(1e-9));
+    CHECK(std::stod(row[11]) == Approx(0.0).margin(1e-12));
+  }
+  // The bottom cube (body 1, half edge 1.2 m, centre 2 m up) falls freely until it reaches the
+  // ground after about sqrt(2 * 0.8 / g) = 0.4 s: semi-implicit Euler (Eq. 3.2.1-3.2.3) gives
+  // v_n = -g n dt and y_n = 2 - g dt^2 n (n + 1) / 2 while nothing touches (n <= 20 here).
+  for (int n = 1; n <= 20; ++n) {
+    const auto& row = rows[static_cast<std::size_t>(1 + n * bodies + 1)];
+    INFO("step " << n);
+    CHECK(std::stod(row[4]) == Approx(2.0 - g * dt * dt * n * (n + 1) / 2.0).margin(1e-7));
+    CHECK(std::stod(row[11]) == Approx(-g * dt * n).margin(1e-7));
+  }
+  // Afterwards it rests on the ground: y ends near the half edge 1.2 m, not below the ground.
+  const auto& last = rows[static_cast<std::size_t>(1 + steps * bodies + 1)];
+  CHECK(std::stod(last[4]) > 1.2 - 0.1);
+  CHECK(std::stod(last[4]) < 1.2 + 0.1);
+}
+
+TEST_CASE("cps simulate --trace keeps a file that is not a trace unless --force", "[cli][trace]") {
+  const fs::path dir = fresh_dir("trace_foreign");
+  const std::string foreign = "measurements,from,the,lab\n1,2,3,4\n";
+  write_text(dir / "lab.csv", foreign);
+  const Result r = cps("simulate stack --seconds 0.1 --trace lab.csv", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("--force") != std::string::npos);
+  CHECK(slurp(dir / "lab.csv") == foreign);
+  CHECK(!fs::exists(dir / "lab.csv.tmp"));
+  // A trace written by cps is replaced without --force; --force replaces the foreign file.
+  CHECK(cps("simulate stack --seconds 0.1 --trace t.csv", dir).exit_code == 0);
+  CHECK(cps("simulate stack --seconds 0.2 --trace t.csv", dir).exit_code == 0);
+  CHECK(read_csv(dir / "t.csv").size() == 1u + 13u * 6u);
+  CHECK(cps("simulate stack --seconds 0.1 --trace lab.csv --force", dir).exit_code == 0);
+  CHECK(slurp(dir / "lab.csv").rfind("step,t_s,", 0) == 0);
+  // A folder that does not exist: exit 1 with the path named, nothing left behind.
+  const Result missing = cps("simulate stack --seconds 0.1 --trace no/such/dir/t.csv", dir);
+  CHECK(missing.exit_code != 0);
+  CHECK(missing.err.find("no/such/dir") != std::string::npos);
+}
+
+TEST_CASE("every command's --help states the units of its options", "[cli][help]") {
+  const fs::path dir = fresh_dir("help");
+  struct Case {
+    std::string command;
+    std::vector<std::string> says;
+  };
+  std::vector<Case> cases = {
+      {"list", {"(s)"}},
+      {"simulate", {"(s)", "(m)", "(m/s)", "(rad/s)", "--trace", "--force"}},
+      {"report", {"minutes", "--out TEXT=out/report"}},
+      {"bench", {"us/step"}},
+  };
+#ifdef CPS_HAVE_RENDERER
+  for (const std::string c : {"render", "figure"}) {
+    cases.push_back({c,
+                     {"(s)", "pixels", "degrees per", "--contacts", "--no-rods", "--label",
+                      "--camera TEXT:{preset,auto,front,side,top}=preset", "--orbit", "=0"}});
+  }
+  cases.back().says.push_back("--size TEXT=640x360");
+  cases.back().says.push_back("--times");
+#endif
+  for (const Case& c : cases) {
+    const Result r = cps(c.command + " --help", dir);
+    INFO("cps " << c.command << " --help");
+    CHECK(r.exit_code == 0);
+    for (const std::string& s : c.says) {
+      INFO(s);
+      CHECK(r.out.find(s) != std::string::npos);
+    }
+  }
+}

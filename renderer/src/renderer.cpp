@@ -479,7 +479,63 @@ struct Renderer::Impl {
     p.set("u_shadow_texel", 1.0f / static_cast<float>(k_shadow_size));
   }
 
-  void draw_plane(const PlaneDraw& d) const {
+  /// The pixel rectangle {x, y, w, h} (GL window coordinates) holding every fragment of plane d
+  /// that plane.frag.glsl keeps: its square clipped (Sutherland-Hodgman) by the solid sides of
+  /// the other planes it is clipped by and by the near plane, projected, widened by 1 pixel. The
+  /// shader's discard stays exact; the scissor only spares llvmpipe the fragments it would
+  /// discard (and the sky beyond a ground plane's far edge). Returns false if nothing is left.
+  bool plane_scissor(const PlaneDraw& d, const glm::mat4& view_proj, const glm::vec3& eye,
+                     const glm::vec3& forward, float near_m, int width, int height,
+                     std::array<GLint, 4>& rect) const {
+    std::vector<glm::vec3> poly = {d.origin + d.half_size * (-d.t1 - d.t2),
+                                   d.origin + d.half_size * (d.t1 - d.t2),
+                                   d.origin + d.half_size * (d.t1 + d.t2),
+                                   d.origin + d.half_size * (-d.t1 + d.t2)};
+    std::vector<glm::vec3> next;
+    // Keeps the part of poly where dot(n, x) >= m.
+    const auto clip = [&](const glm::vec3& n, float m) {
+      next.clear();
+      for (std::size_t i = 0; i < poly.size(); ++i) {
+        const glm::vec3& a = poly[i];
+        const glm::vec3& b = poly[(i + 1) % poly.size()];
+        const float da = glm::dot(n, a) - m;
+        const float db = glm::dot(n, b) - m;
+        if (da >= 0.0f) next.push_back(a);
+        if ((da >= 0.0f) != (db >= 0.0f)) next.push_back(a + (da / (da - db)) * (b - a));
+      }
+      poly.swap(next);
+    };
+    int n_clip = 0;
+    for (const PlaneDraw& other : planes) {
+      if (other.index == d.index || n_clip == k_max_clip_planes) continue;
+      ++n_clip;
+      clip(other.normal, other.offset - 1e-3f);  // a little wider than the shader's 1e-4 m
+      if (poly.empty()) return false;
+    }
+    clip(forward, glm::dot(forward, eye) + near_m);
+    if (poly.empty()) return false;
+    glm::vec2 lo(std::numeric_limits<float>::max());
+    glm::vec2 hi(std::numeric_limits<float>::lowest());
+    for (const glm::vec3& p : poly) {
+      const glm::vec4 c = view_proj * glm::vec4(p, 1.0f);
+      if (!(c.w > 0.0f)) return true;  // numerically on the eye plane: keep the whole viewport
+      const glm::vec2 px((0.5f * c.x / c.w + 0.5f) * static_cast<float>(width),
+                         (0.5f * c.y / c.w + 0.5f) * static_cast<float>(height));
+      lo = glm::min(lo, px);
+      hi = glm::max(hi, px);
+    }
+    const float x0 = std::clamp(std::floor(lo.x) - 1.0f, 0.0f, static_cast<float>(width));
+    const float y0 = std::clamp(std::floor(lo.y) - 1.0f, 0.0f, static_cast<float>(height));
+    const float x1 = std::clamp(std::ceil(hi.x) + 1.0f, 0.0f, static_cast<float>(width));
+    const float y1 = std::clamp(std::ceil(hi.y) + 1.0f, 0.0f, static_cast<float>(height));
+    if (!(x1 > x0) || !(y1 > y0)) return false;
+    rect = {static_cast<GLint>(x0), static_cast<GLint>(y0), static_cast<GLint>(x1 - x0),
+            static_cast<GLint>(y1 - y0)};
+    return true;
+  }
+
+  void draw_plane(const PlaneDraw& d, const std::array<GLint, 4>& scissor) const {
+    glScissor(scissor[0], scissor[1], scissor[2], scissor[3]);
     // Every other plane clips this one (see plane.frag.glsl).
     std::array<glm::vec4, k_max_clip_planes> clip{};
     int n_clip = 0;
@@ -606,7 +662,16 @@ struct Renderer::Impl {
     glBindVertexArray(empty_vao.id());
     auto first_translucent = std::find_if(planes.begin(), planes.end(),
                                           [](const PlaneDraw& d) { return d.alpha < 1.0f; });
-    for (auto it = planes.begin(); it != first_translucent; ++it) draw_plane(*it);
+    // Each plane drawn only inside the screen rectangle of its visible part.
+    const auto draw_clipped = [&](const PlaneDraw& d) {
+      std::array<GLint, 4> rect = {0, 0, width, height};
+      if (plane_scissor(d, view_proj, cam.eye, forward, near_m, width, height, rect)) {
+        draw_plane(d, rect);
+      }
+    };
+    glEnable(GL_SCISSOR_TEST);
+    for (auto it = planes.begin(); it != first_translucent; ++it) draw_clipped(*it);
+    glDisable(GL_SCISSOR_TEST);
 
     if (!line_data.empty()) {
       line_program.use();
@@ -624,9 +689,11 @@ struct Renderer::Impl {
       glDepthMask(GL_FALSE);
       plane_program.use();
       glBindVertexArray(empty_vao.id());
+      glEnable(GL_SCISSOR_TEST);
       for (auto it = first_translucent; it != planes.end(); ++it) {
-        if (it->alpha > 0.0f) draw_plane(*it);
+        if (it->alpha > 0.0f) draw_clipped(*it);
       }
+      glDisable(GL_SCISSOR_TEST);
       glDepthMask(GL_TRUE);
       glDisable(GL_BLEND);
     }

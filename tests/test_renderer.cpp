@@ -302,3 +302,70 @@ TEST_CASE("frame_bounds keeps the whole box in view", "[renderer]") {
   CHECK_THROWS_AS(frame_bounds(lo, hi, 0.0f), std::invalid_argument);
   CHECK_THROWS_AS(frame_bounds(lo, hi, -1.0f), std::invalid_argument);
 }
+
+TEST_CASE("PngWriter writes every queued image and reports a failed write by its path",
+          "[renderer]") {
+  TempDir dir;
+  Image img;
+  img.width = 40;
+  img.height = 30;
+  img.pixels.resize(40 * 30 * 3);
+  for (std::size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = static_cast<std::uint8_t>(i * 7);
+
+  SECTION("all images arrive, byte for byte, with no temporary file left") {
+    PngWriter writer(2, 3);
+    for (int k = 0; k < 12; ++k) writer.write(dir.path / (std::to_string(k) + ".png"), img);
+    writer.finish();
+    CHECK(writer.written() == 12);
+    for (int k = 0; k < 12; ++k) {
+      const Image back = read_png(dir.path / (std::to_string(k) + ".png"));
+      CHECK(back.width == 40);
+      CHECK(back.height == 30);
+      CHECK(back.pixels == img.pixels);  // PNG is lossless
+    }
+    for (const fs::directory_entry& e : fs::directory_iterator(dir.path)) {
+      CHECK(e.path().extension() == ".png");
+    }
+  }
+  SECTION("a failed write stops the queue and is thrown with its path") {
+    PngWriter writer(1, 2);
+    writer.write(dir.path / "missing_folder" / "a.png", img);
+    CHECK_THROWS_WITH(writer.finish(), Catch::Contains("missing_folder"));
+    CHECK_THROWS_AS(writer.write(dir.path / "b.png", img), std::runtime_error);
+    CHECK_FALSE(fs::exists(dir.path / "b.png"));
+  }
+  CHECK_THROWS_AS(PngWriter(0, 3), std::invalid_argument);
+  CHECK_THROWS_AS(PngWriter(2, 1), std::invalid_argument);
+}
+
+TEST_CASE("spheres stay round at every level of detail", "[renderer]") {
+  // A sphere of radius r seen from distance D covers about pi * (r * f / D)^2 pixels, f the
+  // focal length in pixels. From far (a few pixels across, the coarsest mesh) to near (the
+  // finest), the covered area stays within 8 % of the disc (the coarsest mesh allowed at a
+  // radius deviates by at most 0.5 px; an icosahedron, the level below, would lose about 17 %).
+  constexpr int w = 320;
+  constexpr int h = 240;
+  Renderer renderer(w, h);
+  const float f = 0.5f * static_cast<float>(h) / std::tan(glm::radians(22.5f));
+  for (const float radius_px : {6.0f, 12.0f, 30.0f, 60.0f, 100.0f}) {
+    DrawList list;
+    list.camera.eye = glm::vec3(0.0f, 0.0f, 20.0f);
+    list.camera.target = glm::vec3(0.0f);
+    list.camera.fov_y_deg = 45.0f;
+    SphereItem ball;
+    // The projected radius of a sphere is r f / sqrt(D^2 - r^2); solve for r at D = 20 m.
+    const float t = radius_px / f;
+    ball.radius = 20.0f * t / std::sqrt(1.0f + t * t);
+    ball.color = glm::vec3(0.9f, 0.1f, 0.1f);
+    list.spheres.push_back(ball);
+    const Image img = renderer.draw(list);
+    const Rgb bg = to_bytes(list.background);
+    double covered = 0.0;  // pixels clearly not background: edge pixels about half covered count
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) covered += max_channel_diff(pixel(img, x, y), bg) > 60 ? 1.0 : 0.0;
+    }
+    const double disc = 3.14159265 * static_cast<double>(radius_px) * radius_px;
+    INFO("radius " << radius_px << " px: " << covered << " px covered, disc " << disc);
+    CHECK(covered == Approx(disc).epsilon(0.08));
+  }
+}

@@ -4,6 +4,7 @@
 
 #ifdef CPS_HAVE_RENDERER
 #include "draw.h"
+#include "render.h"
 
 #include "cps/render/renderer.h"
 #endif
@@ -16,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 namespace cps::cli {
 namespace {
 
@@ -23,6 +26,12 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+double mean(const std::vector<double>& v) {
+  double sum = 0.0;
+  for (const double x : v) sum += x;
+  return sum / static_cast<double>(v.size());
 }
 
 double median(std::vector<double> v) {
@@ -61,9 +70,88 @@ double log_log_slope(const std::vector<std::pair<double, double>>& points) {
   return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
+#ifdef CPS_HAVE_RENDERER
+// The rendering table: per paper scene at 1280x720 over its first second at 30 fps, the
+// milliseconds per frame of each stage alone (median over the frames) and of the real pipeline
+// (render_frames: physics and drawing on this thread, PNG encoding on the writer's thread),
+// whose total time / frames is taken in `repeats` runs, median.
+void render_table(bool quick) {
+  constexpr int k_width = 1280;
+  constexpr int k_height = 720;
+  constexpr double k_fps = 30.0;
+  constexpr double k_seconds = 1.0;
+  const int repeats = quick ? 1 : 3;
+  std::printf("\n## Rendering at %dx%d: milliseconds per frame (first %.0f s at %.0f fps; stages: "
+              "median over the frames; end to end: %d run%s of the real pipeline, median)\n\n"
+              "| scene | physics | draw | PNG encode + write | PNG KiB | physics + draw (mean) | "
+              "end to end | end to end / (physics + draw) |\n|---|---|---|---|---|---|---|---|\n",
+              k_width, k_height, k_seconds, k_fps, repeats, repeats > 1 ? "s" : "");
+  render::Renderer renderer(k_width, k_height);
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("cps_bench_frames_" + std::to_string(getpid()));
+  std::filesystem::create_directories(folder);
+  RenderJob job;
+  job.seconds = k_seconds;
+  job.fps = k_fps;
+  job.folder = folder;
+  const int frames = frame_count(job);
+  for (const scenes::Scene& scene : scenes::paper_scenes()) {
+    std::fprintf(stderr, "bench: rendering %s\n", std::string(scene.name).c_str());
+    // Stages, one at a time.
+    std::vector<double> physics, draw, encode;
+    double bytes = 0.0;
+    {
+      scenes::Run run = scenes::make_run(scene);
+      DrawStyle style{frame_world(run.world, static_cast<float>(k_width) / k_height),
+                      static_cast<float>(scene.plane_opacity)};
+      if (scene.camera) style.camera = camera_from_preset(*scene.camera);
+      for (int k = 0; k < frames; ++k) {
+        auto start = Clock::now();
+        run.advance_to(static_cast<double>(k) / k_fps);
+        physics.push_back(1e3 * seconds_since(start));
+        start = Clock::now();
+        const render::Image image = renderer.draw(draw_list(run.world, style));
+        draw.push_back(1e3 * seconds_since(start));
+        start = Clock::now();
+        render::write_png(folder / "frame.png", image);
+        encode.push_back(1e3 * seconds_since(start));
+        bytes += static_cast<double>(std::filesystem::file_size(folder / "frame.png"));
+      }
+    }
+    // The real pipeline.
+    std::vector<double> end_to_end;
+    for (int r = 0; r < repeats; ++r) {
+      scenes::Run run = scenes::make_run(scene);
+      std::vector<Panel> panels{{&run, ""}};
+      render::PngWriter writer(1, 3);
+      const auto start = Clock::now();
+      render_frames(scene, panels, job, renderer, writer, nullptr);
+      end_to_end.push_back(1e3 * seconds_since(start) / frames);
+    }
+    const double alone = mean(physics) + mean(draw);
+    const double e = median(end_to_end);
+    std::printf("| %s | %.1f | %.1f | %.1f | %.0f | %.1f | %.1f | %.2f |\n",
+                std::string(scene.name).c_str(), median(physics), median(draw), median(encode),
+                bytes / frames / 1024.0, alone, e, e / alone);
+  }
+  std::filesystem::remove_all(folder);
+}
+#endif
+
 }  // namespace
 
-int run_bench(bool quick) {
+int run_bench(bool quick, bool rendering_only) {
+#ifdef CPS_HAVE_RENDERER
+  if (rendering_only) {
+    render_table(quick);
+    return 0;
+  }
+#else
+  if (rendering_only) {
+    std::fprintf(stderr, "cps bench: built without the renderer (CPS_BUILD_RENDERER=OFF)\n");
+    return 2;
+  }
+#endif
   std::printf("## Physics: microseconds per step (one thread)\n\n"
               "| scene | bodies | explicit (us/step) | matrix-free (us/step) | speed-up |\n"
               "|---|---|---|---|---|\n");
@@ -108,32 +196,7 @@ int run_bench(bool quick) {
   }
 
 #ifdef CPS_HAVE_RENDERER
-  std::printf("\n## Rendering at 1280x720: milliseconds per frame (median of 10)\n\n"
-              "| scene | draw | PNG encode and write | end to end |\n|---|---|---|---|\n");
-  render::Renderer renderer(1280, 720);
-  const std::filesystem::path folder = std::filesystem::temp_directory_path() / "cps_bench_frames";
-  std::filesystem::create_directories(folder);
-  for (const scenes::Scene& scene : scenes::paper_scenes()) {
-    std::fprintf(stderr, "bench: rendering %s\n", std::string(scene.name).c_str());
-    scenes::Run run = scenes::make_run(scene);
-    DrawStyle style{frame_world(run.world, 1280.0f / 720.0f), static_cast<float>(scene.plane_opacity)};
-    if (scene.camera) style.camera = camera_from_preset(*scene.camera);
-    run.advance_to(1.0);
-    std::vector<double> draw, encode, total;
-    for (int k = 0; k < 10; ++k) {
-      const auto start = Clock::now();
-      const render::Image image = renderer.draw(draw_list(run.world, style));
-      const double d = seconds_since(start);
-      const auto start_png = Clock::now();
-      render::write_png(folder / "frame.png", image);
-      encode.push_back(1e3 * seconds_since(start_png));
-      draw.push_back(1e3 * d);
-      total.push_back(1e3 * seconds_since(start));
-    }
-    std::printf("| %s | %.1f | %.1f | %.1f |\n", std::string(scene.name).c_str(), median(draw),
-                median(encode), median(total));
-  }
-  std::filesystem::remove_all(folder);
+  render_table(quick);
 #endif
   return 0;
 }

@@ -3,6 +3,8 @@
 #include "simulate.h"
 
 #include "bench.h"
+#include "output.h"
+#include "progress.h"
 #include "report.h"
 
 #ifdef CPS_HAVE_RENDERER
@@ -19,6 +21,7 @@
 #include <cstdio>
 #include <sstream>
 #include <iostream>
+#include <memory>
 #include <regex>
 
 namespace {
@@ -97,6 +100,24 @@ void add_view_options(CLI::App& cmd, ViewFlags& v, bool label_default) {
 }
 #endif
 
+// Metrics that also report steps done to a Progress: the hook called after every step, so a long
+// `cps simulate` shows progress without changing how it runs.
+class ProgressMetrics final : public scenes::Metrics {
+ public:
+  ProgressMetrics(std::unique_ptr<scenes::Metrics> inner, cli::Progress& progress)
+      : inner_(std::move(inner)), progress_(progress) {}
+  void observe(const World& world) override {
+    inner_->observe(world);
+    progress_.update(++steps_);
+  }
+  nlohmann::json report() const override { return inner_->report(); }
+
+ private:
+  std::unique_ptr<scenes::Metrics> inner_;
+  cli::Progress& progress_;
+  long long steps_ = 0;
+};
+
 // The absolute path of this executable, for commands that must run anywhere.
 std::string self_path() {
   char path[4096];
@@ -107,14 +128,27 @@ std::string self_path() {
 }
 
 int run_report(const std::string& scene_name, const std::string& out, bool quick, bool list,
-               const std::vector<std::string>& merge, const std::string& one_run) {
+               const std::vector<std::string>& merge, const std::string& one_run, int argc,
+               char** argv) {
   namespace fs = std::filesystem;
+  // run.json in the report folder: what produced it (written after the report, atomically).
+  const auto write_run_json = [&] {
+    nlohmann::json merged = nlohmann::json::array();
+    for (const std::string& m : merge) merged.push_back(m);
+    const nlohmann::json info = cli::run_info(
+        "report", argc, argv,
+        {{"scene", scene_name}, {"quick", quick}, {"repeats", quick ? 1 : 3}, {"merge", merged}});
+    nlohmann::json j = info;
+    j["tool"] = "cps";
+    cli::write_json_atomic(fs::path(out) / cli::k_manifest_name, j);
+  };
   const int repeats = quick ? 1 : 3;
   if (!merge.empty()) {
     std::vector<fs::path> dirs(merge.begin(), merge.end());
     const std::vector<cli::Row> rows = cli::read_rows(dirs);
     if (rows.empty()) throw cli::UsageError("--merge: no report CSV found below the given folders");
     cli::write_report(out, rows);
+    write_run_json();
     std::printf("merged %zu runs into %s/report.md\n", rows.size(), out.c_str());
     return 0;
   }
@@ -137,16 +171,14 @@ int run_report(const std::string& scene_name, const std::string& out, bool quick
     return 0;
   }
   std::vector<cli::Row> rows;
-  const auto start = std::chrono::steady_clock::now();
+  cli::Progress progress("report " + scene_name, static_cast<long long>(runs.size()), "runs");
   for (std::size_t i = 0; i < runs.size(); ++i) {
     rows.push_back(cli::execute_run(runs[i], repeats));
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const double left = elapsed / static_cast<double>(i + 1) * static_cast<double>(runs.size() - i - 1);
-    std::fprintf(stderr, "report: %zu/%zu %s (%.0f s elapsed, about %.0f s left)\n", i + 1,
-                 runs.size(), runs[i].id().c_str(), elapsed, left);
+    progress.update(static_cast<long long>(i + 1));
   }
+  progress.finish();
   cli::write_report(out, rows);
+  write_run_json();
   std::printf("%zu runs: %s/report.md\n", rows.size(), out.c_str());
   return 0;
 }
@@ -286,6 +318,9 @@ int run(int argc, char** argv) {
   CLI::App* bench = app.add_subcommand(
       "bench", "microseconds per step (explicit and matrix-free), cost growth, ms per frame");
   bench->add_flag("--quick", bench_quick, "smaller scenes and fewer steps (results in us/step, ms/frame)");
+  bool bench_rendering = false;
+  bench->add_flag("--rendering", bench_rendering,
+                  "only the rendering table (ms per frame at 1280x720: draw, PNG, end to end)");
 
 #ifdef CPS_HAVE_RENDERER
   std::string render_scene;
@@ -307,6 +342,10 @@ int run(int argc, char** argv) {
                      "render the two variants of this option side by side, labelled, into "
                      "OUT/SCENE-compare-OPTION/")
       ->check(CLI::IsMember({"push", "solver", "friction-model", "rotation"}));
+  bool render_force = false;
+  render->add_flag("--force", render_force,
+                   "write into an output folder that holds files no earlier cps run wrote there "
+                   "(they are kept; same-named files are replaced)");
   cli::add_world_options(*render, render_overrides);
   std::string render_backend = "osmesa";
   render->add_option("--backend", render_backend,
@@ -394,10 +433,16 @@ int run(int argc, char** argv) {
       }
       const scenes::Scene* scene = chosen.front();
       scenes::Run r = cli::make_run_or_usage_error(*scene, sim_overrides);
+      const double seconds = sim_seconds.value_or(scene->default_seconds);
       std::optional<cli::TraceWriter> trace;
       if (!sim_trace.empty()) trace.emplace(sim_trace, sim_force);
-      const nlohmann::json summary = cli::simulate(
-          *scene, r, sim_seconds.value_or(scene->default_seconds), trace ? &*trace : nullptr);
+      // Steps on stderr, only once the run has taken 2 s (short runs and --json stay clean).
+      cli::Progress progress("simulate " + sim_scene,
+                             std::llround(seconds / r.world.def().dt), "steps", 2.0);
+      r.metrics = std::make_unique<ProgressMetrics>(std::move(r.metrics), progress);
+      const nlohmann::json summary =
+          cli::simulate(*scene, r, seconds, trace ? &*trace : nullptr);
+      progress.finish();
       if (trace) {
         const long rows = trace->finish();
         std::cerr << "trace: " << rows << " rows (" << r.world.bodies().size()
@@ -413,10 +458,10 @@ int run(int argc, char** argv) {
       }
       return 0;
     }
-    if (*bench) return cli::run_bench(bench_quick);
+    if (*bench) return cli::run_bench(bench_quick, bench_rendering);
     if (*report) {
       return run_report(report_scene, report_out, report_quick, report_list, report_merge,
-                        report_run);
+                        report_run, argc, argv);
     }
 #ifdef CPS_HAVE_RENDERER
     if (*render) {
@@ -468,25 +513,62 @@ int run(int argc, char** argv) {
         }
         job.scene = &viewed.back();
       }
+      // Every output folder is checked (foreign files, see output.h) before any is written.
+      std::vector<cli::RenderJob> specs;
+      std::vector<cli::OutputPlan> plans;
+      for (Job& job : jobs) {
+        cli::RenderJob spec;
+        spec.seconds = render_seconds.value_or(job.scene->default_seconds);
+        spec.fps = fps;
+        spec.folder = std::filesystem::path(out_dir) /
+                      (std::string(job.scene->name) + (compare.empty() ? "" : "-compare-" + compare));
+        std::vector<std::string> files;
+        for (int k = 0; k < cli::frame_count(spec); ++k) files.push_back(cli::frame_name(k));
+        plans.push_back(cli::plan_output(spec.folder, std::move(files), render_force));
+        specs.push_back(spec);
+      }
       render::Renderer renderer(panel_width, size.height,
                                 *render::parse_backend(render_backend));
       std::fprintf(stderr, "render: %s\n", renderer.context_description().c_str());
-      for (Job& job : jobs) {
+      // Encoding overlaps drawing: one encoder thread keeps up with llvmpipe (see cps bench).
+      render::PngWriter writer(1, 3);
+      for (std::size_t j = 0; j < jobs.size(); ++j) {
+        Job& job = jobs[j];
+        const cli::RenderJob& spec = specs[j];
         std::vector<cli::Panel> panels;
+        nlohmann::json world = nlohmann::json::array();
         for (std::size_t v = 0; v < variants.size(); ++v) {
           std::string label = variants[v].label;
           if (render_view.label) {
             label = std::string(job.scene->name) + (label.empty() ? "" : "\n" + label);
           }
           panels.push_back({&job.runs[v], label});
+          world.push_back({{"label", variants[v].label},
+                           {"overrides", cli::overrides_json(variants[v].overrides)},
+                           {"parameters", cli::parameters_json(job.runs[v].world.def())}});
         }
-        cli::RenderJob spec;
-        spec.seconds = render_seconds.value_or(job.scene->default_seconds);
-        spec.fps = fps;
-        const std::string folder = std::string(job.scene->name) +
-                                   (compare.empty() ? "" : "-compare-" + compare);
-        spec.folder = std::filesystem::path(out_dir) / folder;
-        const int frames = cli::render_frames(*job.scene, panels, spec, renderer);
+        const nlohmann::json info = cli::run_info(
+            "render", argc, argv,
+            {{"scene", job.scene->name},
+             {"seconds", spec.seconds},
+             {"fps", spec.fps},
+             {"frames", cli::frame_count(spec)},
+             {"size", {{"width", size.width}, {"height", size.height}}},
+             {"compare", compare.empty() ? nlohmann::json(nullptr) : nlohmann::json(compare)},
+             {"backend", render_backend},
+             {"camera", render_view.camera},
+             {"orbit_deg_per_s", render_view.overlays.orbit_deg_per_s},
+             {"contacts", render_view.overlays.contacts},
+             {"rods", render_view.overlays.rods},
+             {"label", render_view.label},
+             {"overrides", cli::overrides_json(render_overrides)},
+             {"world", world}});
+        cli::begin_output(plans[j], info);
+        cli::Progress progress("render " + spec.folder.filename().string(), cli::frame_count(spec),
+                               "frames");
+        const int frames = cli::render_frames(*job.scene, panels, spec, renderer, writer, &progress);
+        cli::end_output(plans[j], info);
+        const std::string folder = spec.folder.filename().string();
         std::printf("%s: %d frames in %s\n", folder.c_str(), frames, spec.folder.c_str());
         if (!render_video.empty()) {
           cli::VideoJob video;

@@ -10,9 +10,18 @@
 
 namespace cps::cli {
 
+int frame_count(const RenderJob& job) {
+  return static_cast<int>(std::floor(job.seconds * job.fps + 1e-9)) + 1;
+}
+
+std::string frame_name(int k) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d.png", k);
+  return name;
+}
+
 int render_frames(const scenes::Scene& scene, std::vector<Panel>& panels, const RenderJob& job,
-                  render::Renderer& renderer) {
-  std::filesystem::create_directories(job.folder);
+                  render::Renderer& renderer, render::PngWriter& writer, Progress* progress) {
   const float aspect = static_cast<float>(renderer.width()) / static_cast<float>(renderer.height());
   // The camera is fixed for the whole sequence.
   DrawStyle style{frame_world(panels.front().run->world, aspect),
@@ -20,8 +29,7 @@ int render_frames(const scenes::Scene& scene, std::vector<Panel>& panels, const 
   if (scene.camera) style.camera = camera_from_preset(*scene.camera);
   const int label_scale = std::max(1, renderer.height() / 360);
 
-  const int frames = static_cast<int>(std::floor(job.seconds * job.fps + 1e-9)) + 1;
-  const int report_every = std::max(1, frames / 10);
+  const int frames = frame_count(job);
   std::vector<render::Image> pictures(panels.size());
   for (int k = 0; k < frames; ++k) {
     const double t = static_cast<double>(k) / job.fps;
@@ -35,15 +43,13 @@ int render_frames(const scenes::Scene& scene, std::vector<Panel>& panels, const 
                            label_scale);
       }
     }
-    char name[32];
-    std::snprintf(name, sizeof name, "frame_%06d.png", k);
-    render::write_png(job.folder / name,
-                      pictures.size() == 1 ? pictures.front() : render::side_by_side(pictures));
-    if ((k + 1) % report_every == 0 || k + 1 == frames) {
-      std::fprintf(stderr, "render %s: frame %d/%d (t = %.2f s)\n", std::string(scene.name).c_str(),
-                   k + 1, frames, t);
-    }
+    writer.write(job.folder / frame_name(k), pictures.size() == 1
+                                                 ? std::move(pictures.front())
+                                                 : render::side_by_side(pictures));
+    if (progress != nullptr) progress->update(k + 1);
   }
+  writer.finish();
+  if (progress != nullptr) progress->finish();
   return frames;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // `cps render`: steps a scene and writes its frames as PNG files.
 
+#include "progress.h"
 #include "scene.h"
 
 #include "cps/render/renderer.h"
@@ -19,19 +20,28 @@ struct RenderJob {
   std::filesystem::path folder;
 };
 
+/// Number of frames of a job: floor(seconds * fps) + 1 (frame 0 at t = 0).
+int frame_count(const RenderJob& job);
+
+/// The file name of frame k (>= 0): "frame_%06d.png".
+std::string frame_name(int k);
+
 /// One picture in a frame: a run of the scene and the label written on it (none if empty).
 struct Panel {
   scenes::Run* run = nullptr;
   std::string label;
 };
 
-/// Renders frame k at simulated time k / fps for k = 0 .. floor(seconds * fps); every panel's
-/// physics steps at its world's own dt in between. The panels are drawn side by side, each at
-/// the renderer's size, so a frame is (panels x renderer width) by renderer height pixels.
-/// The camera is the scene's preset, or frames the first panel's world as built. Returns the
-/// number of frames written. Progress goes to stderr. Throws std::runtime_error if a frame
-/// cannot be written.
+/// Renders frame k at simulated time k / fps for k = 0 .. frame_count(job) - 1 into job.folder
+/// (which must exist); every panel's physics steps at its world's own dt in between. The panels
+/// are drawn side by side, each at the renderer's size, so a frame is (panels x renderer width)
+/// by renderer height pixels. The camera is the scene's preset, or frames the first panel's world
+/// as built. Drawing stays on the calling thread (it owns the GL context); each finished frame
+/// goes to `writer`, which encodes it on its threads while the next frame is drawn; this returns
+/// after every frame is written. `progress` (may be null) is updated once per frame. Returns the
+/// number of frames. Throws std::runtime_error if a frame cannot be drawn or written (frames
+/// already written stay, each complete; none is left half-written under its final name).
 int render_frames(const scenes::Scene& scene, std::vector<Panel>& panels, const RenderJob& job,
-                  render::Renderer& renderer);
+                  render::Renderer& renderer, render::PngWriter& writer, Progress* progress);
 
 }  // namespace cps::cli

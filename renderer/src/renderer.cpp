@@ -38,7 +38,14 @@ constexpr int k_shadow_size = 2048;
 constexpr int k_msaa_samples = 4;
 // Above this many pixels a 4x RGBA8 + depth multisampled buffer would exceed ~512 MB.
 constexpr long long k_msaa_max_pixels = 4096LL * 4096LL;
-constexpr int k_sphere_subdivisions = 3;  // 1280 triangles
+// Sphere level of detail: icospheres subdivided 1..4 times (80, 320, 1280, 5120 triangles). Each
+// sphere is drawn with the coarsest mesh whose silhouette stays within k_sphere_max_error_px of
+// the true circle: an icosphere of level L deviates from the sphere by at most r * (1 - cos(a/2)),
+// a = the longest edge's angle (63.4 deg for the icosahedron, about halved by each subdivision),
+// so the allowed projected radius of level L is k_sphere_max_error_px / (1 - cos(a_L / 2)).
+constexpr int k_sphere_min_subdivisions = 1;
+constexpr int k_sphere_lods = 4;
+constexpr float k_sphere_max_error_px = 0.5f;  // pixels; typical 0.5
 constexpr int k_max_clip_planes = 16;     // size of u_clip in plane.frag.glsl
 
 struct BodyInstance {
@@ -196,6 +203,19 @@ glm::quat safe_normalize(const glm::quat& q) {
   return glm::quat(q.w / n, q.x / n, q.y / n, q.z / n);
 }
 
+/// Projected radius (pixels) up to which icosphere level k_sphere_min_subdivisions + i keeps its
+/// silhouette error within k_sphere_max_error_px; the finest level takes every larger sphere.
+std::array<float, k_sphere_lods> sphere_lod_limits_px() {
+  std::array<float, k_sphere_lods> limits{};
+  const float edge0 = std::atan(2.0f);  // icosahedron edge angle: 63.43 deg, in radians
+  for (int i = 0; i < k_sphere_lods; ++i) {
+    const float edge = edge0 / static_cast<float>(1 << (k_sphere_min_subdivisions + i));
+    limits[static_cast<std::size_t>(i)] = k_sphere_max_error_px / (1.0f - std::cos(0.5f * edge));
+  }
+  limits.back() = std::numeric_limits<float>::max();
+  return limits;
+}
+
 /// The world axis least aligned with unit vector n.
 glm::vec3 least_aligned_axis(const glm::vec3& n) {
   const glm::vec3 a = glm::abs(n);
@@ -213,7 +233,8 @@ struct Renderer::Impl {
   ShaderProgram plane_program;
   ShaderProgram line_program;
   InstancedMesh cube;
-  InstancedMesh sphere;
+  std::array<InstancedMesh, k_sphere_lods> spheres;  // coarse to fine
+  std::array<float, k_sphere_lods> sphere_limits_px;
   gl::VertexArray line_vao;
   gl::Buffer line_corners;
   gl::Buffer line_instances;
@@ -228,7 +249,7 @@ struct Renderer::Impl {
 
   // CPU staging reused across frames.
   std::vector<BodyInstance> box_data;
-  std::vector<BodyInstance> sphere_data;
+  std::array<std::vector<BodyInstance>, k_sphere_lods> sphere_data;  // per level of detail
   std::vector<LineInstance> line_data;
   std::vector<PlaneDraw> planes;
 
@@ -240,7 +261,11 @@ struct Renderer::Impl {
         plane_program("plane", {shaders::plane_vert}, {shaders::lighting, shaders::plane_frag}),
         line_program("line", {shaders::line_vert}, {shaders::line_frag}),
         cube(make_unit_cube()),
-        sphere(make_unit_icosphere(k_sphere_subdivisions)),
+        spheres{InstancedMesh(make_unit_icosphere(k_sphere_min_subdivisions)),
+                InstancedMesh(make_unit_icosphere(k_sphere_min_subdivisions + 1)),
+                InstancedMesh(make_unit_icosphere(k_sphere_min_subdivisions + 2)),
+                InstancedMesh(make_unit_icosphere(k_sphere_min_subdivisions + 3))},
+        sphere_limits_px(sphere_lod_limits_px()),
         line_vao(gl::VertexArray::create()),
         line_corners(gl::Buffer::create()),
         line_instances(gl::Buffer::create()),
@@ -329,18 +354,27 @@ struct Renderer::Impl {
     }
   }
 
-  void gather(const DrawList& list, const glm::vec3& eye) {
+  /// Copies the valid items into the staging buffers. Spheres are sorted by level of detail from
+  /// their projected radius r * focal_px / depth (pixels; depth along the unit view direction
+  /// `forward`, m; spheres reaching behind the eye count as large).
+  void gather(const DrawList& list, const glm::vec3& eye, const glm::vec3& forward,
+              float focal_px) {
     box_data.clear();
     for (const BoxItem& b : list.boxes) {
       const glm::vec3 h = glm::abs(b.half_extents);
       if (!finite(b.center) || !finite(h) || !finite(b.color) || !(std::min({h.x, h.y, h.z}) > 0.0f)) continue;
       box_data.push_back(make_instance(b.center, safe_normalize(b.orientation), h, b.color));
     }
-    sphere_data.clear();
+    for (std::vector<BodyInstance>& v : sphere_data) v.clear();
     for (const SphereItem& s : list.spheres) {
       const float r = std::abs(s.radius);
       if (!finite(s.center) || !finite(r) || !finite(s.color) || !(r > 0.0f)) continue;
-      sphere_data.push_back(make_instance(s.center, safe_normalize(s.orientation), glm::vec3(r), s.color));
+      const float depth = glm::dot(s.center - eye, forward);
+      const float radius_px = depth > r ? r * focal_px / depth : std::numeric_limits<float>::max();
+      std::size_t lod = 0;
+      while (lod + 1 < sphere_limits_px.size() && radius_px > sphere_limits_px[lod]) ++lod;
+      sphere_data[lod].push_back(
+          make_instance(s.center, safe_normalize(s.orientation), glm::vec3(r), s.color));
     }
     line_data.clear();
     for (const LineItem& l : list.lines) {
@@ -446,7 +480,63 @@ struct Renderer::Impl {
     p.set("u_shadow_texel", 1.0f / static_cast<float>(k_shadow_size));
   }
 
-  void draw_plane(const PlaneDraw& d) const {
+  /// The pixel rectangle {x, y, w, h} (GL window coordinates) holding every fragment of plane d
+  /// that plane.frag.glsl keeps: its square clipped (Sutherland-Hodgman) by the solid sides of
+  /// the other planes it is clipped by and by the near plane, projected, widened by 1 pixel. The
+  /// shader's discard stays exact; the scissor only spares llvmpipe the fragments it would
+  /// discard (and the sky beyond a ground plane's far edge). Returns false if nothing is left.
+  bool plane_scissor(const PlaneDraw& d, const glm::mat4& view_proj, const glm::vec3& eye,
+                     const glm::vec3& forward, float near_m, int width, int height,
+                     std::array<GLint, 4>& rect) const {
+    std::vector<glm::vec3> poly = {d.origin + d.half_size * (-d.t1 - d.t2),
+                                   d.origin + d.half_size * (d.t1 - d.t2),
+                                   d.origin + d.half_size * (d.t1 + d.t2),
+                                   d.origin + d.half_size * (-d.t1 + d.t2)};
+    std::vector<glm::vec3> next;
+    // Keeps the part of poly where dot(n, x) >= m.
+    const auto clip = [&](const glm::vec3& n, float m) {
+      next.clear();
+      for (std::size_t i = 0; i < poly.size(); ++i) {
+        const glm::vec3& a = poly[i];
+        const glm::vec3& b = poly[(i + 1) % poly.size()];
+        const float da = glm::dot(n, a) - m;
+        const float db = glm::dot(n, b) - m;
+        if (da >= 0.0f) next.push_back(a);
+        if ((da >= 0.0f) != (db >= 0.0f)) next.push_back(a + (da / (da - db)) * (b - a));
+      }
+      poly.swap(next);
+    };
+    int n_clip = 0;
+    for (const PlaneDraw& other : planes) {
+      if (other.index == d.index || n_clip == k_max_clip_planes) continue;
+      ++n_clip;
+      clip(other.normal, other.offset - 1e-3f);  // a little wider than the shader's 1e-4 m
+      if (poly.empty()) return false;
+    }
+    clip(forward, glm::dot(forward, eye) + near_m);
+    if (poly.empty()) return false;
+    glm::vec2 lo(std::numeric_limits<float>::max());
+    glm::vec2 hi(std::numeric_limits<float>::lowest());
+    for (const glm::vec3& p : poly) {
+      const glm::vec4 c = view_proj * glm::vec4(p, 1.0f);
+      if (!(c.w > 0.0f)) return true;  // numerically on the eye plane: keep the whole viewport
+      const glm::vec2 px((0.5f * c.x / c.w + 0.5f) * static_cast<float>(width),
+                         (0.5f * c.y / c.w + 0.5f) * static_cast<float>(height));
+      lo = glm::min(lo, px);
+      hi = glm::max(hi, px);
+    }
+    const float x0 = std::clamp(std::floor(lo.x) - 1.0f, 0.0f, static_cast<float>(width));
+    const float y0 = std::clamp(std::floor(lo.y) - 1.0f, 0.0f, static_cast<float>(height));
+    const float x1 = std::clamp(std::ceil(hi.x) + 1.0f, 0.0f, static_cast<float>(width));
+    const float y1 = std::clamp(std::ceil(hi.y) + 1.0f, 0.0f, static_cast<float>(height));
+    if (!(x1 > x0) || !(y1 > y0)) return false;
+    rect = {static_cast<GLint>(x0), static_cast<GLint>(y0), static_cast<GLint>(x1 - x0),
+            static_cast<GLint>(y1 - y0)};
+    return true;
+  }
+
+  void draw_plane(const PlaneDraw& d, const std::array<GLint, 4>& scissor) const {
+    glScissor(scissor[0], scissor[1], scissor[2], scissor[3]);
     // Every other plane clips this one (see plane.frag.glsl).
     std::array<glm::vec4, k_max_clip_planes> clip{};
     int n_clip = 0;
@@ -494,15 +584,23 @@ struct Renderer::Impl {
     const glm::mat4 view = glm::lookAt(cam.eye, target, up);
     const glm::mat4 view_proj = proj * view;
 
-    gather(list, cam.eye);
+    const float focal_px =
+        0.5f * static_cast<float>(height) / std::tan(0.5f * glm::radians(fov));
+    gather(list, cam.eye, forward, focal_px);
     const ShadowSetup shadow = fit_shadow(list, light_dir);
 
     upload(cube.instances, cube.capacity, box_data.data(), box_data.size() * sizeof(BodyInstance));
-    upload(sphere.instances, sphere.capacity, sphere_data.data(),
-           sphere_data.size() * sizeof(BodyInstance));
+    for (std::size_t i = 0; i < spheres.size(); ++i) {
+      upload(spheres[i].instances, spheres[i].capacity, sphere_data[i].data(),
+             sphere_data[i].size() * sizeof(BodyInstance));
+    }
     upload(line_instances, line_capacity, line_data.data(), line_data.size() * sizeof(LineInstance));
     const auto n_boxes = static_cast<GLsizei>(box_data.size());
-    const auto n_spheres = static_cast<GLsizei>(sphere_data.size());
+    const auto draw_spheres = [&] {
+      for (std::size_t i = 0; i < spheres.size(); ++i) {
+        spheres[i].draw(static_cast<GLsizei>(sphere_data[i].size()));
+      }
+    };
 
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
@@ -523,7 +621,7 @@ struct Renderer::Impl {
       shadow_program.use();
       shadow_program.set("u_light_view_proj", shadow.view_proj);
       cube.draw(n_boxes);
-      sphere.draw(n_spheres);
+      draw_spheres();
       glDisable(GL_POLYGON_OFFSET_FILL);
       glCullFace(GL_BACK);
     }
@@ -556,7 +654,7 @@ struct Renderer::Impl {
     body_program.set("u_kind", 0);
     cube.draw(n_boxes);
     body_program.set("u_kind", 1);
-    sphere.draw(n_spheres);
+    draw_spheres();
 
     glDisable(GL_CULL_FACE);
     plane_program.use();
@@ -565,7 +663,16 @@ struct Renderer::Impl {
     glBindVertexArray(empty_vao.id());
     auto first_translucent = std::find_if(planes.begin(), planes.end(),
                                           [](const PlaneDraw& d) { return d.alpha < 1.0f; });
-    for (auto it = planes.begin(); it != first_translucent; ++it) draw_plane(*it);
+    // Each plane drawn only inside the screen rectangle of its visible part.
+    const auto draw_clipped = [&](const PlaneDraw& d) {
+      std::array<GLint, 4> rect = {0, 0, width, height};
+      if (plane_scissor(d, view_proj, cam.eye, forward, near_m, width, height, rect)) {
+        draw_plane(d, rect);
+      }
+    };
+    glEnable(GL_SCISSOR_TEST);
+    for (auto it = planes.begin(); it != first_translucent; ++it) draw_clipped(*it);
+    glDisable(GL_SCISSOR_TEST);
 
     if (!line_data.empty()) {
       line_program.use();
@@ -583,9 +690,11 @@ struct Renderer::Impl {
       glDepthMask(GL_FALSE);
       plane_program.use();
       glBindVertexArray(empty_vao.id());
+      glEnable(GL_SCISSOR_TEST);
       for (auto it = first_translucent; it != planes.end(); ++it) {
-        if (it->alpha > 0.0f) draw_plane(*it);
+        if (it->alpha > 0.0f) draw_clipped(*it);
       }
+      glDisable(GL_SCISSOR_TEST);
       glDepthMask(GL_TRUE);
       glDisable(GL_BLEND);
     }
@@ -609,7 +718,7 @@ struct Renderer::Impl {
 // Renderer(width, height, backend): width and height in pixels, each in [1, 8192], else
 // std::invalid_argument naming the value. Creates the backend's context (OpenGL 3.3 core or
 // newer, RGBA8, 24-bit depth; see gl_context.h), compiles the embedded shaders
-// (std::runtime_error with the info log on failure), builds the unit cube and icosphere, the 2048x2048 shadow map and, when llvmpipe allows
+// (std::runtime_error with the info log on failure), builds the unit cube and the icospheres (levels of detail), the 2048x2048 shadow map and, when llvmpipe allows
 // it and the frame has at most 4096x4096 pixels, a 4x multisampled framebuffer (GL_MAX_SAMPLES is
 // queried; otherwise the frame is rendered without MSAA).
 Renderer::Renderer(int width, int height, Backend backend) {

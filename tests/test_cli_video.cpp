@@ -2,6 +2,8 @@
 // frames and checked with ffprobe (codec, frame count, even size). Without ffmpeg on this machine
 // the video tests WARN and skip; the missing-ffmpeg test always runs (it hides ffmpeg itself).
 
+#include "cli_support.h"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -19,42 +21,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
+using cli_test::Result;
+using cli_test::run_cps;
+using cli_test::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// Runs `ENV cps ARGS` in `dir` (ENV: variable assignments, may be empty) and captures its exit
-// code, stdout and stderr.
+// Runs `ENV cps ARGS` in `dir` (ENV: variable assignments, may be empty).
 Result cps(const std::string& env, const std::string& args, const fs::path& dir) {
-  const fs::path out = dir / "stdout.txt";
-  const fs::path err = dir / "stderr.txt";
-  const std::string command = "cd '" + dir.string() + "' && " + env + " '" CPS_EXE "' " + args +
-                              " > '" + out.string() + "' 2> '" + err.string() + "'";
-  const int status = std::system(command.c_str());
-  Result r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  fs::remove(out);
-  fs::remove(err);
-  return r;
+  return run_cps(args, dir, env);
 }
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("cps_cli_video_test_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir(const std::string& name) { return cli_test::fresh_dir("cps_cli_video_test_" + name); }
 
 bool have_ffmpeg() {
   return std::system("command -v ffmpeg > /dev/null 2>&1 && command -v ffprobe > /dev/null 2>&1") == 0;

@@ -80,10 +80,10 @@ TEST_CASE("cps figure writes one PNG of times x variants panels with a sidecar",
   CHECK(h == 2 * 32);  // one row per variant of --push
   const nlohmann::json side = nlohmann::json::parse(slurp(dir / "f.png.json"));
   CHECK(side["written_by"] == "cps figure");
-  CHECK(side["times_s"].size() == 3);
-  CHECK(side["variants"].size() == 2);
-  CHECK(side["variants"][1]["parameters"]["push"] == "split");
-  CHECK(side["command_line"].get<std::string>().find("--times 0,0.25,0.5") != std::string::npos);
+  CHECK(side["parameters"]["times_s"].size() == 3);
+  CHECK(side["parameters"]["variants"].size() == 2);
+  CHECK(side["parameters"]["variants"][1]["parameters"]["push"] == "split");
+  CHECK(side["command_line"].dump().find("\"--times\",\"0,0.25,0.5\"") != std::string::npos);
 
   // Its own file is replaced without --force; the default name is out/figures/SCENE.png.
   CHECK(cps("figure intersecting_stack --times 0,0.25 --size 48x32 --out f.png", dir).exit_code == 0);
@@ -148,14 +148,14 @@ TEST_CASE("cps figure paper writes the counterparts of Figs. 6 to 10", "[cli][fi
     const fs::path png = dir / "figs" / (name + ".png");
     const auto [w, h] = png_size(png);
     const nlohmann::json side = nlohmann::json::parse(slurp(fs::path(png.string() + ".json")));
-    CHECK(side["caption"].get<std::string>().find("Fig. " + std::to_string(number)) !=
+    CHECK(side["parameters"]["caption"].get<std::string>().find("Fig. " + std::to_string(number)) !=
           std::string::npos);
-    CHECK(w == 32 * static_cast<int>(side["times_s"].size()));
-    CHECK(h == 24 * static_cast<int>(side["variants"].size()));
+    CHECK(w == 32 * static_cast<int>(side["parameters"]["times_s"].size()));
+    CHECK(h == 24 * static_cast<int>(side["parameters"]["variants"].size()));
   }
   // Fig. 7 compares the original push factor with the single frame push factor at 0.5 s.
   const nlohmann::json fig7 =
-      nlohmann::json::parse(slurp(dir / "figs/fig7_intersecting_stack.png.json"));
+      nlohmann::json::parse(slurp(dir / "figs/fig7_intersecting_stack.png.json"))["parameters"];
   CHECK(fig7["compare"] == "push");
   CHECK(std::find(fig7["times_s"].begin(), fig7["times_s"].end(), 0.5) != fig7["times_s"].end());
   CHECK(cps("figure paper --times 0,1", dir).exit_code == 2);

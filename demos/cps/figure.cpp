@@ -1,5 +1,7 @@
 #include "figure.h"
 
+#include "output.h"
+
 #include "simulate.h"
 
 #include "cps/render/image_ops.h"
@@ -9,7 +11,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
@@ -176,16 +177,7 @@ void check_output_is_ours(const fs::path& png, bool force) {
                    " sidecar saying so); choose another --out, or pass --force to replace it");
 }
 
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return text;
-}
-
-nlohmann::json figure_json(const FigureSpec& spec, const std::string& command_line) {
+nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
   nlohmann::json variants = nlohmann::json::array();
   for (const Variant& v : spec.variants) {
     variants.push_back({{"label", v.label},
@@ -193,7 +185,7 @@ nlohmann::json figure_json(const FigureSpec& spec, const std::string& command_li
   }
   const int columns = static_cast<int>(spec.times.size());
   const int rows = static_cast<int>(spec.variants.size());
-  return {{"written_by", "cps figure"},
+  const nlohmann::json parameters = {
           {"scene", spec.scene->name},
           {"compare", spec.compare},
           {"caption", spec.caption},
@@ -213,34 +205,15 @@ nlohmann::json figure_json(const FigureSpec& spec, const std::string& command_li
             {"rods", spec.overlays.rods},
             {"orbit_deg_per_s", spec.overlays.orbit_deg_per_s},
             {"label", spec.label}}},
-          {"variants", variants},
-          {"command_line", command_line},
-          {"date_utc", utc_now()}};
+          {"variants", variants}};
+  nlohmann::json sidecar = run_info("figure", argc, argv, parameters);
+  sidecar["written_by"] = "cps figure";
+  return sidecar;
 }
 
 void write_figure(const fs::path& png, const render::Image& image, const nlohmann::json& sidecar) {
   if (png.has_parent_path()) fs::create_directories(png.parent_path());
-  const fs::path side = sidecar_path(png);
-  fs::path tmp = side;
-  tmp += ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << sidecar.dump(2) << "\n";
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(tmp, ignored);
-      throw std::runtime_error("cannot write " + side.string());
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, side, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw std::runtime_error("cannot rename " + tmp.string() + " to " + side.string() + ": " +
-                             ec.message());
-  }
+  write_json_atomic(sidecar_path(png), sidecar);
   render::write_png(png, image);
 }
 

@@ -69,10 +69,11 @@ std::filesystem::path sidecar_path(const std::filesystem::path& png);
 /// exists and the sidecar is missing or lacks "written_by": "cps figure", unless `force`.
 void check_output_is_ours(const std::filesystem::path& png, bool force);
 
-/// The sidecar's content: written_by, scene, compare, times_s, panel_size_px, image_size_px,
-/// camera, overlays, caption, variants (label and world parameters with units), command line
-/// and the date (UTC, ISO 8601).
-nlohmann::json figure_json(const FigureSpec& spec, const std::string& command_line);
+/// The sidecar's content: run_info("figure", argc, argv, parameters) (command line, engine
+/// version, UTC date; see output.h) with "written_by": "cps figure", where the parameters are
+/// scene, compare, caption, times_s, panel_size_px, image_size_px, camera, overlays and the
+/// variants (label and world parameters with units).
+nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv);
 
 /// Writes the sidecar (temp + rename) and then the PNG (temp + rename, render::write_png),
 /// creating the folder. Throws std::runtime_error naming the path on failure.
@@ -93,8 +94,5 @@ struct PaperFigure {
 
 /// The five figures `cps figure paper` writes, in the paper's order.
 const std::vector<PaperFigure>& paper_figures();
-
-/// The current date and time in UTC, ISO 8601 ("2026-11-21T18:30:00Z").
-std::string utc_now();
 
 }  // namespace cps::cli

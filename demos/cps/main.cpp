@@ -46,17 +46,6 @@ SizeWxH parse_size(const std::string& text) {
   return s;
 }
 
-// The command line as typed (arguments quoted where needed), for the records next to outputs.
-std::string command_line(int argc, char** argv) {
-  std::string text;
-  for (int i = 0; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const bool plain = !arg.empty() && arg.find_first_of(" \t'\"\\$*?;&|<>()") == std::string::npos;
-    text += (i == 0 ? "" : " ") + (plain ? arg : "'" + arg + "'");
-  }
-  return text;
-}
-
 #ifdef CPS_HAVE_RENDERER
 // The overlay and camera flags shared by render and figure.
 struct ViewFlags {
@@ -191,7 +180,6 @@ int run_figure(int argc, char** argv, const std::string& scene_name, const std::
                bool force, const scenes::Overrides& overrides, const ViewFlags& view) {
   namespace fs = std::filesystem;
   const SizeWxH size = parse_size(size_text);
-  const std::string line = command_line(argc, argv);
   struct Planned {
     cli::FigureSpec spec;
     fs::path png;
@@ -260,7 +248,7 @@ int run_figure(int argc, char** argv, const std::string& scene_name, const std::
   render::Renderer renderer(size.width, size.height);
   for (Planned& p : plan) {
     const render::Image image = cli::render_figure(p.spec, renderer);
-    cli::write_figure(p.png, image, cli::figure_json(p.spec, line));
+    cli::write_figure(p.png, image, cli::figure_json(p.spec, argc, argv));
     std::printf("%s: %dx%d pixels, %zu times x %zu variants (%s)\n", p.png.c_str(), image.width,
                 image.height, p.spec.times.size(), p.spec.variants.size(),
                 cli::sidecar_path(p.png).filename().c_str());

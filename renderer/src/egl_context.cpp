@@ -211,28 +211,13 @@ class EglContext final : public OffscreenContext {
       throw std::runtime_error("cps::render: egl backend: glReadPixels failed (GL error " +
                                std::to_string(e) + ")");
     }
-    out.width = width_;
-    out.height = height_;
-    out.pixels.resize(w * h * 3u);
-    for (std::size_t row = 0; row < h; ++row) {
-      const std::uint8_t* src = rgba_.data() + (h - 1u - row) * w * 4u;  // GL: bottom row first
-      std::uint8_t* dst = out.pixels.data() + row * w * 3u;
-      for (std::size_t x = 0; x < w; ++x) {
-        dst[3 * x + 0] = src[4 * x + 0];
-        dst[3 * x + 1] = src[4 * x + 1];
-        dst[3 * x + 2] = src[4 * x + 2];
-      }
-    }
+    rgba_bottom_up_to_rgb(rgba_.data(), width_, height_, out);
   }
 
   const GlFunctions& functions() const override { return fn_; }
 
   std::string description() const override {
-    const auto str = [&](GLenum name) {
-      const GLubyte* s = fn_.GetString(name);
-      return s != nullptr ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
-    };
-    return "egl (" + source_ + "): OpenGL " + str(GL_VERSION) + ", " + str(GL_RENDERER);
+    return "egl (" + source_ + "): " + gl_version_and_renderer(fn_);
   }
 
   int width() const override { return width_; }

@@ -63,4 +63,29 @@ void GlContext::make_current() {
   t_current_gl = &impl_->functions();
 }
 
+void rgba_bottom_up_to_rgb(const std::uint8_t* rgba, int width, int height, Image& out) {
+  const auto w = static_cast<std::size_t>(width);
+  const auto h = static_cast<std::size_t>(height);
+  out.width = width;
+  out.height = height;
+  out.pixels.resize(w * h * 3u);
+  for (std::size_t row = 0; row < h; ++row) {
+    const std::uint8_t* src = rgba + (h - 1u - row) * w * 4u;
+    std::uint8_t* dst = out.pixels.data() + row * w * 3u;
+    for (std::size_t x = 0; x < w; ++x) {
+      dst[3 * x + 0] = src[4 * x + 0];
+      dst[3 * x + 1] = src[4 * x + 1];
+      dst[3 * x + 2] = src[4 * x + 2];
+    }
+  }
+}
+
+std::string gl_version_and_renderer(const GlFunctions& fn) {
+  const auto str = [&](GLenum name) {
+    const GLubyte* s = fn.GetString(name);
+    return s != nullptr ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
+  };
+  return "OpenGL " + str(GL_VERSION) + ", " + str(GL_RENDERER);
+}
+
 }  // namespace cps::render

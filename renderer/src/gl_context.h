@@ -8,6 +8,7 @@
 
 #include "gl_functions.h"
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -35,6 +36,14 @@ class OffscreenContext {
   virtual int width() const = 0;
   virtual int height() const = 0;
 };
+
+/// Converts a width x height RGBA8 buffer stored bottom row first (as glReadPixels and OSMesa's
+/// default Y-up buffer give it) into `out` as RGB8, rows top to bottom (width, height >= 1).
+void rgba_bottom_up_to_rgb(const std::uint8_t* rgba, int width, int height, Image& out);
+
+/// "OpenGL <GL_VERSION>, <GL_RENDERER>" of the context whose entry points are `fn` ("?" for a
+/// string GL does not give). The context must be current.
+std::string gl_version_and_renderer(const GlFunctions& fn);
 
 /// Owner of one backend context. At most one cps context is current per thread: make_current
 /// releases the previous one (whatever its backend) before binding this one and points

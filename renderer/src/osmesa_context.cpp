@@ -135,31 +135,14 @@ class OsMesaContext final : public OffscreenContext {
 
   void read_rgb(Image& out) override {
     fn_.Finish();  // OSMesa copies the rendering into rgba_ when the context flushes
-    const auto w = static_cast<std::size_t>(width_);
-    const auto h = static_cast<std::size_t>(height_);
-    out.width = width_;
-    out.height = height_;
-    out.pixels.resize(w * h * 3u);
-    for (std::size_t row = 0; row < h; ++row) {
-      // OSMesa's default (OSMESA_Y_UP = true) stores the bottom row first.
-      const std::uint8_t* src = rgba_.data() + (h - 1u - row) * w * 4u;
-      std::uint8_t* dst = out.pixels.data() + row * w * 3u;
-      for (std::size_t x = 0; x < w; ++x) {
-        dst[3 * x + 0] = src[4 * x + 0];
-        dst[3 * x + 1] = src[4 * x + 1];
-        dst[3 * x + 2] = src[4 * x + 2];
-      }
-    }
+    // OSMesa's default (OSMESA_Y_UP = true) stores the bottom row first.
+    rgba_bottom_up_to_rgb(rgba_.data(), width_, height_, out);
   }
 
   const GlFunctions& functions() const override { return fn_; }
 
   std::string description() const override {
-    const auto str = [&](GLenum name) {
-      const GLubyte* s = fn_.GetString(name);
-      return s != nullptr ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
-    };
-    return "osmesa: OpenGL " + str(GL_VERSION) + ", " + str(GL_RENDERER);
+    return "osmesa: " + gl_version_and_renderer(fn_);
   }
 
   int width() const override { return width_; }

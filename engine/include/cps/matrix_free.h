@@ -19,13 +19,19 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;  ///< per body: linear then angular pa
 /// Buffers of the matrix-free solve, sized by prepare() and reused from step to step, so a step
 /// allocates nothing once they have reached their largest size.
 struct MatrixFreeSystem {
-  /// One row packed for the sweep: its bodies (a fixed world point is the extra slot n, whose w
-  /// stays 0), j (12) and M^-1 j^T (12) side by side.
-  struct Row {
-    int a = 0;
-    int b = 0;
-    std::array<double, 12> j{};
+  /// One row packed for the sweep, everything the sweep reads in one contiguous block (as the
+  /// constraint parts of Box2D v3 and Jolt): its bodies (a fixed world point is the extra slot
+  /// n, whose w stays 0), j (12) and M^-1 j^T (12), 1 / A_jj, and its bounds.
+  struct alignas(16) Row {
+    std::array<double, 12> j{};        ///< [j_a (6), j_b (6)]: the row of J
     std::array<double, 12> minv_jt{};  ///< [M_a^-1 j_a (6), M_b^-1 j_b (6)]
+    double inv_diagonal = 0.0;         ///< 1 / A_jj (kg); 0 for a row that touches no movable body
+    double c_min = 0.0;                ///< lower force limit (N)
+    double c_max = 0.0;                ///< upper force limit (N)
+    double mu = 0.0;                   ///< friction coefficient of a friction row (dimensionless)
+    int normal_row = -1;               ///< a friction row's contact row, for the coupled limit
+    int a = 0;                         ///< body slot of body_a
+    int b = 0;                         ///< body slot of body_b
   };
   std::vector<Row> rows;
   std::vector<double> diagonal;  ///< per row: A_jj = j M^-1 j^T (1/kg)
@@ -35,7 +41,8 @@ struct MatrixFreeSystem {
   std::vector<Mat3> inv_inertia; ///< per body: world inverse inertia this step (1/(kg m^2))
 };
 
-/// Fills minv_jt and diagonal for the rows (c) and bodies (n), resizing the buffers.
+/// Packs the rows (c) for bodies (n): j, minv_jt, diagonal, 1 / A_jj and the bounds, and the
+/// world inverse inertia per body, resizing the buffers (no allocation once they are big enough).
 /// Rows refer to bodies by index or kWorldBody. Source: Eq. 6.2.9, A_jj = j M^-1 j^T.
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
              const std::vector<Body>& bodies);

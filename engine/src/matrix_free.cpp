@@ -13,11 +13,13 @@ namespace {
 using PackedRow = MatrixFreeSystem::Row;
 using ConstMap6 = Eigen::Map<const Vec6, Eigen::Aligned16>;
 
-// j_j . w over the row's bodies: sum_i A_ji lambda_i. Two 6-vector dot products (Eigen sums each
-// in pairs, so the additions do not form one long chain).
-inline double row_times_w(const PackedRow& r, const std::vector<Vec6>& w) {
-  return ConstMap6(r.j.data()).dot(w[static_cast<std::size_t>(r.a)]) +
-         ConstMap6(r.j.data() + 6).dot(w[static_cast<std::size_t>(r.b)]);
+// j_j . w over the row's bodies: sum_i A_ji lambda_i. 6-vector dot products (Eigen sums each in
+// pairs, so the additions do not form one long chain); a row on one movable body (its other
+// half, in slot b, is the fixed slot whose w is 0) takes one.
+inline double row_times_w(const PackedRow& r, const std::vector<Vec6>& w, int fixed_slot) {
+  const double d = ConstMap6(r.j.data()).dot(w[static_cast<std::size_t>(r.a)]);
+  if (r.b == fixed_slot) return d;
+  return d + ConstMap6(r.j.data() + 6).dot(w[static_cast<std::size_t>(r.b)]);
 }
 
 // w += M^-1 j^T delta for the row's movable bodies. The fixed slot (static bodies and the world)
@@ -39,11 +41,105 @@ inline void bounds(const PackedRow& r, const std::vector<double>& lambda, double
   }
 }
 
-// The sweeps of solve(), with the solver kind and friction model fixed at compile time so the
-// inner loop has no branches on them. Row j's new value (Eq. 7.1.1):
-//   (b_j - sum_{i != j} A_ji lambda_i) / A_jj = lambda_j + (b_j - j_j . w) / A_jj
-template <bool kJacobi, bool kCoupled>
-void sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
+// A short run row by row through w (Eq. 7.1.1): rows r[0..m) all on w_a and, when kTwoBodies, w_b.
+template <bool kCoupled, bool kTwoBodies>
+inline void sweep_short_run(const PackedRow* r, const double* b, double* l, int m,
+                            const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
+  for (int i = 0; i < m; ++i) {
+    const PackedRow& row = r[i];
+    if (row.inv_diagonal == 0.0) continue;  // the row touches no movable body: lambda stays 0
+    double lo;
+    double hi;
+    bounds<kCoupled>(row, lambda, lo, hi);
+    double jw = ConstMap6(row.j.data()).dot(w_a);
+    if constexpr (kTwoBodies) jw += ConstMap6(row.j.data() + 6).dot(w_b);
+    const double value = std::clamp(l[i] + (b[i] - jw) * row.inv_diagonal, lo, hi);
+    const double delta = value - l[i];
+    w_a += delta * ConstMap6(row.minv_jt.data());
+    if constexpr (kTwoBodies) w_b += delta * ConstMap6(row.minv_jt.data() + 6);
+    l[i] = value;
+  }
+}
+
+// A run of m rows on w_a and (kTwoBodies) w_b as a block; kM = m when known at compile time (the
+// loops then unroll), 0 otherwise. g: the run's m x m coupling block (column i: A_ki / A_kk).
+template <bool kCoupled, bool kTwoBodies, int kM>
+inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_runtime,
+                        const double* g, const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
+  const int m = kM > 0 ? kM : m_runtime;
+  // Unclamped new values against w at the start of the run: independent of each other.
+  double t[MatrixFreeSystem::kMaxRun];
+  for (int i = 0; i < m; ++i) {
+    double jw = ConstMap6(r[i].j.data()).dot(w_a);
+    if constexpr (kTwoBodies) jw += ConstMap6(r[i].j.data() + 6).dot(w_b);
+    t[i] = l[i] + (b[i] - jw) * r[i].inv_diagonal;
+  }
+  Vec6 dw_a = Vec6::Zero();
+  Vec6 dw_b = Vec6::Zero();
+  for (int i = 0; i < m; ++i, g += m) {
+    if (r[i].inv_diagonal == 0.0) continue;  // lambda_i stays 0
+    double lo;
+    double hi;
+    bounds<kCoupled>(r[i], lambda, lo, hi);
+    const double value = std::clamp(t[i], lo, hi);
+    const double delta = value - l[i];
+    l[i] = value;
+    for (int k = i + 1; k < m; ++k) t[k] -= g[k] * delta;
+    dw_a += delta * ConstMap6(r[i].minv_jt.data());
+    if constexpr (kTwoBodies) dw_b += delta * ConstMap6(r[i].minv_jt.data() + 6);
+  }
+  w_a += dw_a;
+  if constexpr (kTwoBodies) w_b += dw_b;
+}
+
+// PGS over the runs (see MatrixFreeSystem::Run). In a run of m rows on bodies a and b, row k's
+// value after rows i < k have changed by delta_i is
+//   lambda_k + (b_k - j_k . w_start) / A_kk - sum_{i < k} (A_ki / A_kk) delta_i,
+// the same number Eq. 7.1.1 gives through w, in the same order; w_a and w_b take the run's
+// sum of M^-1 j_i^T delta_i at its end.
+template <bool kCoupled>
+void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
+  const PackedRow* rows = s.rows.data();
+  const double* b = s.b.data();
+  double* l = lambda.data();
+  const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+  for (int it = 0; it < iterations; ++it) {
+    for (const MatrixFreeSystem::Run& run : s.runs) {
+      const auto first = static_cast<std::size_t>(run.begin);
+      if (run.offset < 0) {  // a short run: row by row, through w
+        const PackedRow& r0 = rows[first];
+        Vec6& w_a = s.w[static_cast<std::size_t>(r0.a)];
+        if (r0.a == fixed_slot) continue;  // no movable body: every lambda stays 0
+        if (r0.b == fixed_slot) {
+          Vec6 unused;
+          sweep_short_run<kCoupled, false>(rows + first, b + first, l + first, run.count, lambda, w_a, unused);
+        } else {
+          sweep_short_run<kCoupled, true>(rows + first, b + first, l + first, run.count, lambda, w_a,
+                                          s.w[static_cast<std::size_t>(r0.b)]);
+        }
+        continue;
+      }
+      const PackedRow& r0 = rows[first];
+      Vec6& w_a = s.w[static_cast<std::size_t>(r0.a)];
+      Vec6& w_b = s.w[static_cast<std::size_t>(r0.b)];
+      const double* g = s.coupling.data() + run.offset;
+      const bool two = r0.b != fixed_slot;
+      if (r0.a == fixed_slot) continue;  // no movable body: every lambda stays 0
+      // Two contact points (a contact and two friction rows each), or any other size.
+      if (run.count == 6) {
+        two ? sweep_block<kCoupled, true, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b)
+            : sweep_block<kCoupled, false, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b);
+      } else {
+        two ? sweep_block<kCoupled, true, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b)
+            : sweep_block<kCoupled, false, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b);
+      }
+    }
+  }
+}
+
+// Projected Jacobi: every row against the w of the previous sweep, then all of them applied.
+template <bool kCoupled>
+void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
   const std::size_t c = s.rows.size();
   const PackedRow* rows = s.rows.data();
   const double* b = s.b.data();
@@ -56,20 +152,12 @@ void sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
       double lo;
       double hi;
       bounds<kCoupled>(row, lambda, lo, hi);
-      const double value = std::clamp(l[j] + (b[j] - row_times_w(row, s.w)) * row.inv_diagonal, lo, hi);
-      if constexpr (kJacobi) {
-        s.next[j] = value;
-      } else {
-        add_to_w(row, value - l[j], s.w, fixed_slot);
-        l[j] = value;
-      }
+      s.next[j] = std::clamp(l[j] + (b[j] - row_times_w(row, s.w, fixed_slot)) * row.inv_diagonal, lo, hi);
     }
-    if constexpr (kJacobi) {
-      for (std::size_t j = 0; j < c; ++j) {
-        if (rows[j].inv_diagonal == 0.0) continue;
-        add_to_w(rows[j], s.next[j] - l[j], s.w, fixed_slot);
-        l[j] = s.next[j];
-      }
+    for (std::size_t j = 0; j < c; ++j) {
+      if (rows[j].inv_diagonal == 0.0) continue;
+      add_to_w(rows[j], s.next[j] - l[j], s.w, fixed_slot);
+      l[j] = s.next[j];
     }
   }
 }
@@ -116,9 +204,17 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
         diagonal += row.j[o + k] * p.minv_jt[static_cast<std::size_t>(o + k)];
       }
     }
+    if (p.a == n && p.b != n) {
+      // One movable body, in half b: move it to half a, so the sweep reads one half only
+      // (row_times_w). The dot products lose only exact zero terms, so nothing changes.
+      std::swap_ranges(p.j.begin(), p.j.begin() + 6, p.j.begin() + 6);
+      std::swap_ranges(p.minv_jt.begin(), p.minv_jt.begin() + 6, p.minv_jt.begin() + 6);
+      std::swap(p.a, p.b);
+    }
     s.diagonal[r] = diagonal;
     p.inv_diagonal = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
   }
+  s.runs_ready = false;  // built by the first PGS solve (Jacobi does not use them)
 }
 
 void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
@@ -136,9 +232,48 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   s.w.back().setZero();
   for (std::size_t r = 0; r < rows.size(); ++r) {
     const double v = rows[r].bias + (terms == TargetTerms::push_and_bias ? rows[r].push : 0.0);
-    s.b[r] = v / dt - row_times_w(s.rows[r], s.w);
+    s.b[r] = v / dt - row_times_w(s.rows[r], s.w, static_cast<int>(bodies.size()));
   }
 }
+
+namespace {
+
+// Runs of consecutive rows on the same two slots, and their coupling blocks (PGS only).
+void build_runs(MatrixFreeSystem& s) {
+  const std::size_t c = s.rows.size();
+  s.runs.clear();
+  detail::reserve_with_headroom(s.runs, c);
+  std::size_t coupling_size = 0;
+  for (std::size_t r = 0; r < c;) {
+    std::size_t end = r + 1;
+    while (end < c && end - r < static_cast<std::size_t>(MatrixFreeSystem::kMaxRun) &&
+           s.rows[end].a == s.rows[r].a && s.rows[end].b == s.rows[r].b) {
+      ++end;
+    }
+    const int m = static_cast<int>(end - r);
+    const bool block = m >= MatrixFreeSystem::kMinBlock;
+    s.runs.push_back({static_cast<int>(r), m, block ? static_cast<int>(coupling_size) : -1});
+    if (block) coupling_size += static_cast<std::size_t>(m * m);
+    r = end;
+  }
+  detail::resize_with_headroom(s.coupling, coupling_size);
+  for (const MatrixFreeSystem::Run& run : s.runs) {
+    if (run.offset < 0) continue;
+    const PackedRow* r = s.rows.data() + run.begin;
+    double* g = s.coupling.data() + run.offset;
+    for (int i = 0; i < run.count; ++i) {
+      // Column i: A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
+      for (int k = i + 1; k < run.count; ++k) {
+        const double a_ki = ConstMap6(r[k].j.data()).dot(ConstMap6(r[i].minv_jt.data())) +
+                            ConstMap6(r[k].j.data() + 6).dot(ConstMap6(r[i].minv_jt.data() + 6));
+        g[run.count * i + k] = a_ki * r[k].inv_diagonal;
+      }
+    }
+  }
+  s.runs_ready = true;
+}
+
+}  // namespace
 
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
            SolverKind kind, int iterations, std::vector<double>& lambda) {
@@ -147,9 +282,10 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
   const bool coupled = friction == FrictionModel::coupled;
   if (kind == SolverKind::jacobi) {
     detail::assign_with_headroom(s.next, rows.size(), 0.0);
-    coupled ? sweeps<true, true>(s, iterations, lambda) : sweeps<true, false>(s, iterations, lambda);
+    coupled ? jacobi_sweeps<true>(s, iterations, lambda) : jacobi_sweeps<false>(s, iterations, lambda);
   } else {
-    coupled ? sweeps<false, true>(s, iterations, lambda) : sweeps<false, false>(s, iterations, lambda);
+    if (!s.runs_ready) build_runs(s);
+    coupled ? pgs_sweeps<true>(s, iterations, lambda) : pgs_sweeps<false>(s, iterations, lambda);
   }
 }
 
@@ -168,7 +304,7 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     } else {
       bounds<false>(s.rows[j], lambda, lo, hi);
     }
-    const double Ax = row_times_w(s.rows[j], s.w);
+    const double Ax = row_times_w(s.rows[j], s.w, static_cast<int>(s.w.size()) - 1);
     const double r = std::abs(lambda[j] - std::clamp(lambda[j] - (Ax - s.b[j]) / diagonal, lo, hi));
     max = std::max(max, r);
     sum_squares += r * r;

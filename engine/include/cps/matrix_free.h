@@ -20,8 +20,10 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;  ///< per body: linear then angular pa
 /// allocates nothing once they have reached their largest size.
 struct MatrixFreeSystem {
   /// One row packed for the sweep, everything the sweep reads in one contiguous block (as the
-  /// constraint parts of Box2D v3 and Jolt): its bodies (a fixed world point is the extra slot
-  /// n, whose w stays 0), j (12) and M^-1 j^T (12), 1 / A_jj, and its bounds.
+  /// constraint parts of Box2D v3 and Jolt): its bodies (static bodies and a fixed world point
+  /// share the extra slot n, whose w stays 0 and is never written), j (12) and M^-1 j^T (12),
+  /// 1 / A_jj, and its bounds. A row with one movable body keeps it in half a (its halves are
+  /// swapped if needed), so b == n marks a one-body row.
   struct alignas(16) Row {
     std::array<double, 12> j{};        ///< [j_a (6), j_b (6)]: the row of J
     std::array<double, 12> minv_jt{};  ///< [M_a^-1 j_a (6), M_b^-1 j_b (6)]
@@ -30,8 +32,8 @@ struct MatrixFreeSystem {
     double c_max = 0.0;                ///< upper force limit (N)
     double mu = 0.0;                   ///< friction coefficient of a friction row (dimensionless)
     int normal_row = -1;               ///< a friction row's contact row, for the coupled limit
-    int a = 0;                         ///< body slot of body_a
-    int b = 0;                         ///< body slot of body_b
+    int a = 0;                         ///< body slot of half a
+    int b = 0;                         ///< body slot of half b
   };
   /// Consecutive rows on the same two body slots (the rows of one manifold): PGS sweeps them as
   /// a block. Each sees the others' updates through coupling[offset + m i + k] =
@@ -49,8 +51,8 @@ struct MatrixFreeSystem {
   static constexpr int kMaxRun = 3 * kMaxManifoldPoints;
   std::vector<Row> rows;
   std::vector<Run> runs;
-  bool runs_ready = false;        ///< runs and coupling built for these rows (by the first PGS solve)
-  std::vector<double> coupling;  ///< per run of m > 1 rows: m x m, column i = A_ki / A_kk, k > i
+  bool runs_ready = false;       ///< runs and coupling built for these rows (first PGS solve)
+  std::vector<double> coupling;  ///< per block run of m rows: m x m, column i = A_ki / A_kk, k > i
   std::vector<double> diagonal;  ///< per row: A_jj = j M^-1 j^T (1/kg)
   std::vector<double> b;         ///< per row: right-hand side of Eq. 6.2.9 (N)
   std::vector<double> next;      ///< Jacobi: the sweep's new values (N)

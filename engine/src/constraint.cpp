@@ -27,10 +27,11 @@ void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
 
 namespace {
 
-// j . v_ab for the current body velocities (m/s).
-double relative_velocity(const Vec12& j, const Body& a, const Body& b) {
-  return j.segment<3>(0).dot(a.velocity()) + j.segment<3>(3).dot(a.angular_velocity()) +
-         j.segment<3>(6).dot(b.velocity()) + j.segment<3>(9).dot(b.angular_velocity());
+// j . v_ab (m/s) for body velocities v_a, w_a, v_b, w_b (m/s, rad/s).
+double relative_velocity(const Vec12& j, const Vec3& v_a, const Vec3& w_a, const Vec3& v_b,
+                         const Vec3& w_b) {
+  return j.segment<3>(0).dot(v_a) + j.segment<3>(3).dot(w_a) + j.segment<3>(6).dot(v_b) +
+         j.segment<3>(9).dot(w_b);
 }
 
 }  // namespace
@@ -43,6 +44,11 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
   // Sec. 5.4: m is the combined mass of both bodies divided over the contact points (a static
   // body has mass 0 here, so the movable body's mass remains).
   const double mass_per_point = (a.mass + b.mass) / static_cast<double>(m.count);
+  // Body velocities, once per manifold (the angular ones need I^-1 in world space).
+  const Vec3 v_a = a.velocity();
+  const Vec3 w_a = a.angular_velocity();
+  const Vec3 v_b = b.velocity();
+  const Vec3 w_b = b.angular_velocity();
   for (int i = 0; i < m.count; ++i) {
     const Contact& c = m.contacts[static_cast<std::size_t>(i)];
     const Vec3 r_a = c.point - a.x;
@@ -53,7 +59,7 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
     contact.body_a = m.body_a;
     contact.body_b = m.body_b;
     contact.j = axis_row(c.normal, r_a, r_b);
-    const double approach = relative_velocity(contact.j, a, b);  // j . v1 (m/s)
+    const double approach = relative_velocity(contact.j, v_a, w_a, v_b, w_b);  // j . v1 (m/s)
     if (c.depth >= 0.0) {
       // Eq. 5.3.1 with the sign of NOTES.md: C = -d, v = -beta C / dt = beta d / dt > 0 opens it.
       contact.push = params.beta * c.depth / params.dt;

@@ -2,6 +2,8 @@
 // per body in place of A = J M^-1 J^T.
 #include "cps/matrix_free.h"
 
+#include "buffers.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -9,27 +11,28 @@ namespace cps {
 namespace {
 
 using PackedRow = MatrixFreeSystem::Row;
+using ConstMap6 = Eigen::Map<const Vec6, Eigen::Aligned16>;
 
-// j_j . w over the row's bodies: sum_i A_ji lambda_i.
-inline double row_times_w(const PackedRow& r, const std::vector<Vec6>& w) {
-  const Vec6& wa = w[static_cast<std::size_t>(r.a)];
-  const Vec6& wb = w[static_cast<std::size_t>(r.b)];
-  double d = 0.0;
-  for (int k = 0; k < 6; ++k) d += r.j[static_cast<std::size_t>(k)] * wa[k];
-  for (int k = 0; k < 6; ++k) d += r.j[static_cast<std::size_t>(k + 6)] * wb[k];
-  return d;
+// j_j . w over the row's bodies: sum_i A_ji lambda_i. 6-vector dot products (Eigen sums each in
+// pairs, so the additions do not form one long chain); a row on one movable body (its other
+// half, in slot b, is the fixed slot whose w is 0) takes one.
+inline double row_times_w(const PackedRow& r, const std::vector<Vec6>& w, int fixed_slot) {
+  const double d = ConstMap6(r.j.data()).dot(w[static_cast<std::size_t>(r.a)]);
+  if (r.b == fixed_slot) return d;
+  return d + ConstMap6(r.j.data() + 6).dot(w[static_cast<std::size_t>(r.b)]);
 }
 
-inline void add_to_w(const PackedRow& r, double delta, std::vector<Vec6>& w) {
-  Vec6& wa = w[static_cast<std::size_t>(r.a)];
-  Vec6& wb = w[static_cast<std::size_t>(r.b)];
-  for (int k = 0; k < 6; ++k) wa[k] += delta * r.minv_jt[static_cast<std::size_t>(k)];
-  for (int k = 0; k < 6; ++k) wb[k] += delta * r.minv_jt[static_cast<std::size_t>(k + 6)];
+// w += M^-1 j^T delta for the row's movable bodies. The fixed slot (static bodies and the world)
+// is never written: M^-1 is 0 there, and rows that share only a static body then do not wait on
+// each other's stores.
+inline void add_to_w(const PackedRow& r, double delta, std::vector<Vec6>& w, int fixed_slot) {
+  if (r.a != fixed_slot) w[static_cast<std::size_t>(r.a)] += delta * ConstMap6(r.minv_jt.data());
+  if (r.b != fixed_slot) w[static_cast<std::size_t>(r.b)] += delta * ConstMap6(r.minv_jt.data() + 6);
 }
 
-inline void bounds(const ConstraintRow& r, FrictionModel friction,
-                   const std::vector<double>& lambda, double& lo, double& hi) {
-  if (friction == FrictionModel::coupled && r.normal_row >= 0) {
+template <bool kCoupled>
+inline void bounds(const PackedRow& r, const std::vector<double>& lambda, double& lo, double& hi) {
+  if (kCoupled && r.normal_row >= 0) {
     hi = r.mu * lambda[static_cast<std::size_t>(r.normal_row)];
     lo = -hi;
   } else {
@@ -38,21 +41,150 @@ inline void bounds(const ConstraintRow& r, FrictionModel friction,
   }
 }
 
+// A short run row by row through w (Eq. 7.1.1): rows r[0..m) all on w_a and, when kTwoBodies, w_b.
+template <bool kCoupled, bool kTwoBodies>
+inline void sweep_short_run(const PackedRow* r, const double* b, double* l, int m,
+                            const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
+  for (int i = 0; i < m; ++i) {
+    const PackedRow& row = r[i];
+    if (row.inv_diagonal == 0.0) continue;  // the row touches no movable body: lambda stays 0
+    double lo;
+    double hi;
+    bounds<kCoupled>(row, lambda, lo, hi);
+    double jw = ConstMap6(row.j.data()).dot(w_a);
+    if constexpr (kTwoBodies) jw += ConstMap6(row.j.data() + 6).dot(w_b);
+    const double value = std::clamp(l[i] + (b[i] - jw) * row.inv_diagonal, lo, hi);
+    const double delta = value - l[i];
+    w_a += delta * ConstMap6(row.minv_jt.data());
+    if constexpr (kTwoBodies) w_b += delta * ConstMap6(row.minv_jt.data() + 6);
+    l[i] = value;
+  }
+}
+
+// A run of m rows on w_a and (kTwoBodies) w_b as a block; kM = m when known at compile time (the
+// loops then unroll), 0 otherwise. g: the run's m x m coupling block (column i: A_ki / A_kk).
+template <bool kCoupled, bool kTwoBodies, int kM>
+inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_runtime,
+                        const double* g, const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
+  const int m = kM > 0 ? kM : m_runtime;
+  // Unclamped new values against w at the start of the run: independent of each other.
+  double t[MatrixFreeSystem::kMaxRun];
+  for (int i = 0; i < m; ++i) {
+    double jw = ConstMap6(r[i].j.data()).dot(w_a);
+    if constexpr (kTwoBodies) jw += ConstMap6(r[i].j.data() + 6).dot(w_b);
+    t[i] = l[i] + (b[i] - jw) * r[i].inv_diagonal;
+  }
+  Vec6 dw_a = Vec6::Zero();
+  Vec6 dw_b = Vec6::Zero();
+  for (int i = 0; i < m; ++i, g += m) {
+    if (r[i].inv_diagonal == 0.0) continue;  // lambda_i stays 0
+    double lo;
+    double hi;
+    bounds<kCoupled>(r[i], lambda, lo, hi);
+    const double value = std::clamp(t[i], lo, hi);
+    const double delta = value - l[i];
+    l[i] = value;
+    for (int k = i + 1; k < m; ++k) t[k] -= g[k] * delta;
+    dw_a += delta * ConstMap6(r[i].minv_jt.data());
+    if constexpr (kTwoBodies) dw_b += delta * ConstMap6(r[i].minv_jt.data() + 6);
+  }
+  w_a += dw_a;
+  if constexpr (kTwoBodies) w_b += dw_b;
+}
+
+// PGS over the runs (see MatrixFreeSystem::Run). In a run of m rows on bodies a and b, row k's
+// value after rows i < k have changed by delta_i is
+//   lambda_k + (b_k - j_k . w_start) / A_kk - sum_{i < k} (A_ki / A_kk) delta_i,
+// the same number Eq. 7.1.1 gives through w, in the same order; w_a and w_b take the run's
+// sum of M^-1 j_i^T delta_i at its end.
+template <bool kCoupled>
+void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
+  const PackedRow* rows = s.rows.data();
+  const double* b = s.b.data();
+  double* l = lambda.data();
+  const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+  for (int it = 0; it < iterations; ++it) {
+    for (const MatrixFreeSystem::Run& run : s.runs) {
+      const auto first = static_cast<std::size_t>(run.begin);
+      if (run.offset < 0) {  // a short run: row by row, through w
+        const PackedRow& r0 = rows[first];
+        Vec6& w_a = s.w[static_cast<std::size_t>(r0.a)];
+        if (r0.a == fixed_slot) continue;  // no movable body: every lambda stays 0
+        if (r0.b == fixed_slot) {
+          Vec6 unused;
+          sweep_short_run<kCoupled, false>(rows + first, b + first, l + first, run.count, lambda, w_a, unused);
+        } else {
+          sweep_short_run<kCoupled, true>(rows + first, b + first, l + first, run.count, lambda, w_a,
+                                          s.w[static_cast<std::size_t>(r0.b)]);
+        }
+        continue;
+      }
+      const PackedRow& r0 = rows[first];
+      Vec6& w_a = s.w[static_cast<std::size_t>(r0.a)];
+      Vec6& w_b = s.w[static_cast<std::size_t>(r0.b)];
+      const double* g = s.coupling.data() + run.offset;
+      const bool two = r0.b != fixed_slot;
+      if (r0.a == fixed_slot) continue;  // no movable body: every lambda stays 0
+      // Two contact points (a contact and two friction rows each), or any other size.
+      if (run.count == 6) {
+        two ? sweep_block<kCoupled, true, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b)
+            : sweep_block<kCoupled, false, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b);
+      } else {
+        two ? sweep_block<kCoupled, true, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b)
+            : sweep_block<kCoupled, false, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b);
+      }
+    }
+  }
+}
+
+// Projected Jacobi: every row against the w of the previous sweep, then all of them applied.
+template <bool kCoupled>
+void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
+  const std::size_t c = s.rows.size();
+  const PackedRow* rows = s.rows.data();
+  const double* b = s.b.data();
+  double* l = lambda.data();
+  const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+  for (int k = 0; k < iterations; ++k) {
+    for (std::size_t j = 0; j < c; ++j) {
+      const PackedRow& row = rows[j];
+      if (row.inv_diagonal == 0.0) continue;  // the row touches no movable body: lambda_j stays 0
+      double lo;
+      double hi;
+      bounds<kCoupled>(row, lambda, lo, hi);
+      s.next[j] = std::clamp(l[j] + (b[j] - row_times_w(row, s.w, fixed_slot)) * row.inv_diagonal, lo, hi);
+    }
+    for (std::size_t j = 0; j < c; ++j) {
+      if (rows[j].inv_diagonal == 0.0) continue;
+      add_to_w(rows[j], s.next[j] - l[j], s.w, fixed_slot);
+      l[j] = s.next[j];
+    }
+  }
+}
+
 }  // namespace
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
              const std::vector<Body>& bodies) {
   const int n = static_cast<int>(bodies.size());
-  s.inv_inertia.resize(bodies.size());
+  detail::resize_with_headroom(s.inv_inertia, bodies.size());
   for (std::size_t i = 0; i < bodies.size(); ++i) s.inv_inertia[i] = bodies[i].inv_inertia_world();
-  s.rows.resize(rows.size());
-  s.diagonal.resize(rows.size());
-  s.w.resize(bodies.size() + 1);  // slot n: the fixed world, always 0
+  detail::resize_with_headroom(s.rows, rows.size());
+  detail::resize_with_headroom(s.diagonal, rows.size());
+  detail::resize_with_headroom(s.w, bodies.size() + 1);  // slot n: static bodies and the fixed world, always 0
   for (std::size_t r = 0; r < rows.size(); ++r) {
     const ConstraintRow& row = rows[r];
     PackedRow& p = s.rows[r];
-    p.a = row.body_a == kWorldBody ? n : row.body_a;
-    p.b = row.body_b == kWorldBody ? n : row.body_b;
+    // Static bodies and the fixed world share slot n, whose w stays 0 (M^-1 = 0 there).
+    const auto slot = [&](int body) {
+      return body == kWorldBody || bodies[static_cast<std::size_t>(body)].is_static() ? n : body;
+    };
+    p.a = slot(row.body_a);
+    p.b = slot(row.body_b);
+    p.c_min = row.c_min;
+    p.c_max = row.c_max;
+    p.mu = row.mu;
+    p.normal_row = row.normal_row;
     p.minv_jt.fill(0.0);
     double diagonal = 0.0;
     for (int half = 0; half < 2; ++half) {
@@ -61,6 +193,7 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
       for (int k = 0; k < 6; ++k) p.j[static_cast<std::size_t>(o + k)] = row.j[o + k];
       if (body == kWorldBody) continue;
       const Body& bd = bodies[static_cast<std::size_t>(body)];
+      if (bd.is_static()) continue;  // M^-1 = 0: nothing to add
       const Vec3 lin = bd.inv_mass * row.j.segment<3>(o);
       const Vec3 ang = s.inv_inertia[static_cast<std::size_t>(body)] * row.j.segment<3>(o + 3);
       for (int k = 0; k < 3; ++k) {
@@ -71,15 +204,24 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
         diagonal += row.j[o + k] * p.minv_jt[static_cast<std::size_t>(o + k)];
       }
     }
+    if (p.a == n && p.b != n) {
+      // One movable body, in half b: move it to half a, so the sweep reads one half only
+      // (row_times_w). The dot products lose only exact zero terms, so nothing changes.
+      std::swap_ranges(p.j.begin(), p.j.begin() + 6, p.j.begin() + 6);
+      std::swap_ranges(p.minv_jt.begin(), p.minv_jt.begin() + 6, p.minv_jt.begin() + 6);
+      std::swap(p.a, p.b);
+    }
     s.diagonal[r] = diagonal;
+    p.inv_diagonal = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
   }
+  s.runs_ready = false;  // built by the first PGS solve (Jacobi does not use them)
 }
 
 void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
          const std::vector<Body>& bodies, const Vec3& gravity, double dt, TargetTerms terms) {
-  s.b.resize(rows.size());
+  detail::resize_with_headroom(s.b, rows.size());
   // a = v1 / dt + M^-1 f_ext per body, in w's storage (solve() overwrites it).
-  s.w.resize(bodies.size() + 1);
+  detail::resize_with_headroom(s.w, bodies.size() + 1);
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Body& body = bodies[i];
     Vec6& a = s.w[i];
@@ -90,42 +232,60 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   s.w.back().setZero();
   for (std::size_t r = 0; r < rows.size(); ++r) {
     const double v = rows[r].bias + (terms == TargetTerms::push_and_bias ? rows[r].push : 0.0);
-    s.b[r] = v / dt - row_times_w(s.rows[r], s.w);
+    s.b[r] = v / dt - row_times_w(s.rows[r], s.w, static_cast<int>(bodies.size()));
   }
 }
 
+namespace {
+
+// Runs of consecutive rows on the same two slots, and their coupling blocks (PGS only).
+void build_runs(MatrixFreeSystem& s) {
+  const std::size_t c = s.rows.size();
+  s.runs.clear();
+  detail::reserve_with_headroom(s.runs, c);
+  std::size_t coupling_size = 0;
+  for (std::size_t r = 0; r < c;) {
+    std::size_t end = r + 1;
+    while (end < c && end - r < static_cast<std::size_t>(MatrixFreeSystem::kMaxRun) &&
+           s.rows[end].a == s.rows[r].a && s.rows[end].b == s.rows[r].b) {
+      ++end;
+    }
+    const int m = static_cast<int>(end - r);
+    const bool block = m >= MatrixFreeSystem::kMinBlock;
+    s.runs.push_back({static_cast<int>(r), m, block ? static_cast<int>(coupling_size) : -1});
+    if (block) coupling_size += static_cast<std::size_t>(m * m);
+    r = end;
+  }
+  detail::resize_with_headroom(s.coupling, coupling_size);
+  for (const MatrixFreeSystem::Run& run : s.runs) {
+    if (run.offset < 0) continue;
+    const PackedRow* r = s.rows.data() + run.begin;
+    double* g = s.coupling.data() + run.offset;
+    for (int i = 0; i < run.count; ++i) {
+      // Column i: A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
+      for (int k = i + 1; k < run.count; ++k) {
+        const double a_ki = ConstMap6(r[k].j.data()).dot(ConstMap6(r[i].minv_jt.data())) +
+                            ConstMap6(r[k].j.data() + 6).dot(ConstMap6(r[i].minv_jt.data() + 6));
+        g[run.count * i + k] = a_ki * r[k].inv_diagonal;
+      }
+    }
+  }
+  s.runs_ready = true;
+}
+
+}  // namespace
+
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
            SolverKind kind, int iterations, std::vector<double>& lambda) {
-  const std::size_t c = rows.size();
-  lambda.assign(c, 0.0);  // initial guess 0
+  detail::assign_with_headroom(lambda, rows.size(), 0.0);  // initial guess 0
   for (Vec6& w : s.w) w.setZero();
-  const bool jacobi = kind == SolverKind::jacobi;
-  if (jacobi) s.next.assign(c, 0.0);
-  for (int k = 0; k < iterations; ++k) {
-    for (std::size_t j = 0; j < c; ++j) {
-      const double diagonal = s.diagonal[j];
-      if (!(diagonal > 0.0)) continue;  // the row touches no movable body: lambda_j stays 0
-      const PackedRow& row = s.rows[j];
-      // b_j - sum_{i != j} A_ji lambda_i = b_j - (j_j . w - A_jj lambda_j)   (Eq. 7.1.1)
-      const double sum = s.b[j] - (row_times_w(row, s.w) - diagonal * lambda[j]);
-      double lo;
-      double hi;
-      bounds(rows[j], friction, lambda, lo, hi);
-      const double value = std::clamp(sum / diagonal, lo, hi);
-      if (jacobi) {
-        s.next[j] = value;
-      } else {
-        add_to_w(row, value - lambda[j], s.w);
-        lambda[j] = value;
-      }
-    }
-    if (jacobi) {
-      for (std::size_t j = 0; j < c; ++j) {
-        if (!(s.diagonal[j] > 0.0)) continue;
-        add_to_w(s.rows[j], s.next[j] - lambda[j], s.w);
-        lambda[j] = s.next[j];
-      }
-    }
+  const bool coupled = friction == FrictionModel::coupled;
+  if (kind == SolverKind::jacobi) {
+    detail::assign_with_headroom(s.next, rows.size(), 0.0);
+    coupled ? jacobi_sweeps<true>(s, iterations, lambda) : jacobi_sweeps<false>(s, iterations, lambda);
+  } else {
+    if (!s.runs_ready) build_runs(s);
+    coupled ? pgs_sweeps<true>(s, iterations, lambda) : pgs_sweeps<false>(s, iterations, lambda);
   }
 }
 
@@ -139,8 +299,12 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     if (!(diagonal > 0.0)) continue;
     double lo;
     double hi;
-    bounds(rows[j], friction, lambda, lo, hi);
-    const double Ax = row_times_w(s.rows[j], s.w);
+    if (friction == FrictionModel::coupled) {
+      bounds<true>(s.rows[j], lambda, lo, hi);
+    } else {
+      bounds<false>(s.rows[j], lambda, lo, hi);
+    }
+    const double Ax = row_times_w(s.rows[j], s.w, static_cast<int>(s.w.size()) - 1);
     const double r = std::abs(lambda[j] - std::clamp(lambda[j] - (Ax - s.b[j]) / diagonal, lo, hi));
     max = std::max(max, r);
     sum_squares += r * r;

@@ -1,6 +1,8 @@
 // The step: collide, build rows, assemble, solve, integrate (see world.h).
 #include "cps/world.h"
 
+#include "buffers.h"
+
 #include "cps/integrator.h"
 #include "cps/solver.h"
 #include "cps/system.h"
@@ -137,6 +139,7 @@ void World::collide() {
     }
   }
   std::sort(pairs_.begin(), pairs_.end());
+  detail::reserve_with_headroom(manifolds_, pairs_.size());
   for (const auto& [a, b] : pairs_) {
     ++counters_.pairs_tested;
     Manifold m;
@@ -153,6 +156,12 @@ void World::collide() {
 // Stage 2, Sec. 5: contact and friction rows, then distance rows.
 void World::build_rows() {
   rows_.clear();
+  // The row count is known from the manifolds: make room once, with headroom (no allocation in
+  // steady state).
+  std::size_t contact_points = 0;
+  for (const Manifold& m : manifolds_) contact_points += static_cast<std::size_t>(m.count);
+  detail::reserve_with_headroom(
+      rows_, contact_points * (def_.friction > 0.0 ? 3 : 1) + distances_.size());
   const RowParams params{def_.beta,    def_.dt,          def_.friction,
                          def_.gravity, def_.restitution, def_.restitution_threshold};
   for (const Manifold& m : manifolds_) append_contact_rows(m, bodies_, params, rows_);

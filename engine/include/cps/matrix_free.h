@@ -19,15 +19,40 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;  ///< per body: linear then angular pa
 /// Buffers of the matrix-free solve, sized by prepare() and reused from step to step, so a step
 /// allocates nothing once they have reached their largest size.
 struct MatrixFreeSystem {
-  /// One row packed for the sweep: its bodies (a fixed world point is the extra slot n, whose w
-  /// stays 0), j (12) and M^-1 j^T (12) side by side.
-  struct Row {
-    int a = 0;
-    int b = 0;
-    std::array<double, 12> j{};
+  /// One row packed for the sweep, everything the sweep reads in one contiguous block (as the
+  /// constraint parts of Box2D v3 and Jolt): its bodies (static bodies and a fixed world point
+  /// share the extra slot n, whose w stays 0 and is never written), j (12) and M^-1 j^T (12),
+  /// 1 / A_jj, and its bounds. A row with one movable body keeps it in half a (its halves are
+  /// swapped if needed), so b == n marks a one-body row.
+  struct alignas(16) Row {
+    std::array<double, 12> j{};        ///< [j_a (6), j_b (6)]: the row of J
     std::array<double, 12> minv_jt{};  ///< [M_a^-1 j_a (6), M_b^-1 j_b (6)]
+    double inv_diagonal = 0.0;         ///< 1 / A_jj (kg); 0 for a row that touches no movable body
+    double c_min = 0.0;                ///< lower force limit (N)
+    double c_max = 0.0;                ///< upper force limit (N)
+    double mu = 0.0;                   ///< friction coefficient of a friction row (dimensionless)
+    int normal_row = -1;               ///< a friction row's contact row, for the coupled limit
+    int a = 0;                         ///< body slot of half a
+    int b = 0;                         ///< body slot of half b
   };
+  /// Consecutive rows on the same two body slots (the rows of one manifold): PGS sweeps them as
+  /// a block. Each sees the others' updates through coupling[offset + m i + k] =
+  /// A_ki / A_kk (k > i) instead of through w, so the rows of a run do not wait on each other's
+  /// w stores and the first products j . w of a run are independent.
+  struct Run {
+    int begin = 0;   ///< first row
+    int count = 0;   ///< rows, 1..kMaxRun
+    int offset = 0;  ///< start of its count x count block in coupling; -1: swept row by row
+  };
+  /// Runs shorter than this (a single contact point: 3 rows) are swept row by row through w: for
+  /// them the block measured no faster (funnel scene).
+  static constexpr int kMinBlock = 4;
+  /// Most rows in a run: the rows of a full manifold (a contact and two friction rows a point).
+  static constexpr int kMaxRun = 3 * kMaxManifoldPoints;
   std::vector<Row> rows;
+  std::vector<Run> runs;
+  bool runs_ready = false;       ///< runs and coupling built for these rows (first PGS solve)
+  std::vector<double> coupling;  ///< per block run of m rows: m x m, column i = A_ki / A_kk, k > i
   std::vector<double> diagonal;  ///< per row: A_jj = j M^-1 j^T (1/kg)
   std::vector<double> b;         ///< per row: right-hand side of Eq. 6.2.9 (N)
   std::vector<double> next;      ///< Jacobi: the sweep's new values (N)
@@ -35,7 +60,8 @@ struct MatrixFreeSystem {
   std::vector<Mat3> inv_inertia; ///< per body: world inverse inertia this step (1/(kg m^2))
 };
 
-/// Fills minv_jt and diagonal for the rows (c) and bodies (n), resizing the buffers.
+/// Packs the rows (c) for bodies (n): j, minv_jt, diagonal, 1 / A_jj and the bounds, and the
+/// world inverse inertia per body, resizing the buffers (no allocation once they are big enough).
 /// Rows refer to bodies by index or kWorldBody. Source: Eq. 6.2.9, A_jj = j M^-1 j^T.
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
              const std::vector<Body>& bodies);

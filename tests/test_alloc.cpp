@@ -1,0 +1,104 @@
+// The step allocates nothing once its buffers have reached their working size: after a few
+// simulated seconds of warm-up, N more steps of every paper scene make no heap allocation (a hard
+// bound, counted, not a timing). This is its own executable: the global operator new below
+// counts every allocation of the process and must not replace the allocator of the other tests.
+#include "scene.h"
+
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+#include <string>
+#include <vector>
+
+namespace {
+
+std::atomic<long> g_allocations{0};
+
+void* counted_allocation(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+
+void* counted_aligned_allocation(std::size_t size, std::align_val_t alignment) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  const auto a = static_cast<std::size_t>(alignment);
+  const std::size_t rounded = (size + a - 1) / a * a;  // aligned_alloc wants a multiple
+  if (void* p = std::aligned_alloc(a, rounded == 0 ? a : rounded)) return p;
+  throw std::bad_alloc();
+}
+
+long allocations() { return g_allocations.load(std::memory_order_relaxed); }
+
+}  // namespace
+
+void* operator new(std::size_t size) { return counted_allocation(size); }
+void* operator new[](std::size_t size) { return counted_allocation(size); }
+void* operator new(std::size_t size, std::align_val_t a) { return counted_aligned_allocation(size, a); }
+void* operator new[](std::size_t size, std::align_val_t a) { return counted_aligned_allocation(size, a); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+
+using namespace cps;
+
+namespace {
+
+constexpr double kWarmUp = 3.0;  // s of simulated time before counting
+constexpr int kCountedSteps = 300;  // 5 s at 60 Hz
+
+// Allocations made by `steps` steps of the world (only World::step is counted, not metrics).
+long allocations_in_steps(World& world, int steps) {
+  const long before = allocations();
+  for (int k = 0; k < steps; ++k) world.step();
+  return allocations() - before;
+}
+
+}  // namespace
+
+TEST_CASE("the allocation counter sees an allocation", "[alloc]") {
+  const long before = allocations();
+  auto* v = new std::vector<double>(100, 1.0);  // two allocations: the vector and its storage
+  const long counted = allocations() - before;
+  delete v;
+  CHECK(counted >= 2);
+}
+
+TEST_CASE("after warm-up a step of every paper scene allocates nothing", "[alloc]") {
+  struct Variant {
+    const char* name;
+    SolverKind solver;
+    PushMode push;
+  };
+  for (const scenes::Scene& scene : scenes::paper_scenes()) {
+    for (const Variant& v : {Variant{"pgs baumgarte", SolverKind::pgs, PushMode::baumgarte},
+                             Variant{"pgs split", SolverKind::pgs, PushMode::split},
+                             Variant{"jacobi baumgarte", SolverKind::jacobi, PushMode::baumgarte}}) {
+      scenes::Overrides o;
+      o.solver = v.solver;
+      o.push = v.push;
+      o.assembly = Assembly::matrix_free;
+      scenes::Run run = scenes::make_run(scene, o);
+      while (run.world.time() < kWarmUp) run.world.step();
+      const long counted = allocations_in_steps(run.world, kCountedSteps);
+      INFO(std::string(scene.name) << ", " << v.name << ": " << counted << " allocations in "
+                                   << kCountedSteps << " steps after " << kWarmUp << " s");
+      CHECK(counted == 0);
+    }
+  }
+}
+
+TEST_CASE("after warm-up a step with the residual measured allocates nothing", "[alloc]") {
+  scenes::Overrides o;
+  o.measure_residual = true;
+  scenes::Run run = scenes::make_run(*scenes::find_scene("funnel"), o);
+  while (run.world.time() < kWarmUp) run.world.step();
+  CHECK(allocations_in_steps(run.world, kCountedSteps) == 0);
+}

@@ -79,6 +79,14 @@ class BulletEngine final : public Engine {
 
   void step() override { world_.stepSimulation(btScalar(dt_), 0); }
 
+  int contacts() const override {
+    int n = 0;
+    for (int i = 0; i < dispatcher_.getNumManifolds(); ++i) {
+      n += dispatcher_.getManifoldByIndexInternal(i)->getNumContacts();
+    }
+    return n;
+  }
+
   std::vector<BodyState> states() const override {
     std::vector<BodyState> out;
     for (const auto& b : bodies_) {

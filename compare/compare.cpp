@@ -152,6 +152,7 @@ struct Column {
   std::string label;
   std::vector<double> us;
   Check check;
+  int contacts = 0;  ///< contact points of the last step
 };
 
 int run(int argc, char** argv) {
@@ -212,7 +213,10 @@ int run(int argc, char** argv) {
       for (int e = 0; e < 2; ++e) {
         std::unique_ptr<Engine> engine = e == 0 ? make_bullet(initial) : make_ode(initial);
         cols[static_cast<std::size_t>(e)].us.push_back(us_per_step([&] { engine->step(); }, dt, steps));
-        if (r == 0) cols[static_cast<std::size_t>(e)].check = sanity(name, initial, engine->states());
+        if (r == 0) {
+          cols[static_cast<std::size_t>(e)].check = sanity(name, initial, engine->states());
+          cols[static_cast<std::size_t>(e)].contacts = engine->contacts();
+        }
       }
       // cps: exactly as bench.cpp's us_per_step (make_run, assembly set on the def, world.step()).
       for (int e = 0; e < 2; ++e) {
@@ -221,7 +225,12 @@ int run(int argc, char** argv) {
         def.assembly = e == 0 ? Assembly::matrix_free : Assembly::explicit_matrices;
         run.world.set_def(def);
         cols[static_cast<std::size_t>(2 + e)].us.push_back(us_per_step([&] { run.world.step(); }, dt, steps));
-        if (r == 0) cols[static_cast<std::size_t>(2 + e)].check = sanity(name, initial, cps_states(run.world));
+        if (r == 0) {
+          cols[static_cast<std::size_t>(2 + e)].check = sanity(name, initial, cps_states(run.world));
+          int n = 0;
+          for (const Manifold& m : run.world.manifolds()) n += m.count;
+          cols[static_cast<std::size_t>(2 + e)].contacts = n;
+        }
       }
     }
     std::size_t dynamic = 0;
@@ -235,13 +244,13 @@ int run(int argc, char** argv) {
     const double end_time = std::ceil(1.0 / dt - 1e-9) * dt + 3.0 * steps * dt;
     for (const Column& c : cols) {
       char line[512];
-      std::snprintf(line, sizeof line, "| %s | %s | t = %.2f s: %s | %s |\n", name.c_str(),
-                    c.label.c_str(), end_time, c.check.text.c_str(), c.check.ok ? "ok" : "FAILED");
+      std::snprintf(line, sizeof line, "| %s | %s | t = %.2f s: %s | %d | %s |\n", name.c_str(),
+                    c.label.c_str(), end_time, c.check.text.c_str(), c.contacts, c.check.ok ? "ok" : "FAILED");
       checks += line;
     }
   }
   std::printf("\n## Sanity at the end of the first repeat's last timed block\n\n"
-              "| scene | engine | state | check |\n|---|---|---|---|\n%s",
+              "| scene | engine | state | contact points (last step) | check |\n|---|---|---|---|---|\n%s",
               checks.c_str());
   std::printf("\nLoad average (1, 5, 15 min) before: %s, after: %s (2 cores, shared).\n",
               load_before.c_str(), load_average().c_str());

@@ -28,6 +28,9 @@ class Engine {
   virtual void step() = 0;
   /// The bodies' states, indexed as the cps world's bodies.
   virtual std::vector<BodyState> states() const = 0;
+  /// Contact points the last step used (Bullet: points in the dispatcher's persistent
+  /// manifolds; ODE: contact joints made).
+  virtual int contacts() const = 0;
 };
 
 /// Bullet 3.24: btDiscreteDynamicsWorld with btSequentialImpulseConstraintSolver, DBVT

@@ -87,10 +87,13 @@ class OdeEngine final : public Engine {
   }
 
   void step() override {
+    contacts_made_ = 0;
     if (collide_) dSpaceCollide(space_, this, &OdeEngine::near_callback);
     dWorldQuickStep(world_, dt_);
     dJointGroupEmpty(contacts_);
   }
+
+  int contacts() const override { return contacts_made_; }
 
   std::vector<BodyState> states() const override {
     std::vector<BodyState> out;
@@ -123,6 +126,7 @@ class OdeEngine final : public Engine {
     constexpr int kMaxContacts = 8;
     std::array<dContactGeom, kMaxContacts> found{};
     const int n = dCollide(g1, g2, kMaxContacts, found.data(), sizeof(dContactGeom));
+    self->contacts_made_ += n;
     for (int i = 0; i < n; ++i) {
       dContact c{};
       c.surface.mode = dContactApprox1 | (self->restitution_ > 0.0 ? dContactBounce : 0);
@@ -138,6 +142,7 @@ class OdeEngine final : public Engine {
   double friction_;
   double restitution_;
   bool collide_;
+  int contacts_made_ = 0;
   dWorldID world_ = nullptr;
   dSpaceID space_ = nullptr;
   dJointGroupID contacts_ = nullptr;

@@ -201,6 +201,7 @@ int run(int argc, char** argv) {
   std::printf("| scene | dt (s) | bodies | rods | Bullet | ODE | cps matrix-free | cps explicit |\n"
               "|---|---|---|---|---|---|---|---|\n");
   std::string checks;
+  std::string ratios;
   for (const std::string& name : names) {
     const scenes::Scene& scene = *scenes::find_scene(name);
     const scenes::Run built = scenes::make_run(scene);
@@ -241,6 +242,17 @@ int run(int argc, char** argv) {
                   *std::max_element(c.us.begin(), c.us.end()));
     }
     std::printf("\n");
+    // Each engine's time over cps matrix-free's in the same repeat (so a load change between
+    // repeats cancels), median over the repeats.
+    ratios += "| " + name + " |";
+    for (const std::size_t e : {std::size_t{0}, std::size_t{1}, std::size_t{3}}) {
+      std::vector<double> q;
+      for (std::size_t r = 0; r < cols[e].us.size(); ++r) q.push_back(cols[e].us[r] / cols[2].us[r]);
+      char cell[32];
+      std::snprintf(cell, sizeof cell, " %.2f |", median(q));
+      ratios += cell;
+    }
+    ratios += "\n";
     const double end_time = std::ceil(1.0 / dt - 1e-9) * dt + 3.0 * steps * dt;
     for (const Column& c : cols) {
       char line[512];
@@ -249,6 +261,9 @@ int run(int argc, char** argv) {
       checks += line;
     }
   }
+  std::printf("\n## Time over cps matrix-free's in the same repeat, median over the repeats\n\n"
+              "| scene | Bullet | ODE | cps explicit |\n|---|---|---|---|\n%s",
+              ratios.c_str());
   std::printf("\n## Sanity at the end of the first repeat's last timed block\n\n"
               "| scene | engine | state | contact points (last step) | check |\n|---|---|---|---|---|\n%s",
               checks.c_str());

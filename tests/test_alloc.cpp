@@ -52,7 +52,7 @@ using namespace cps;
 namespace {
 
 constexpr double kWarmUp = 3.0;  // s of simulated time before counting
-constexpr int kCountedSteps = 300;  // 5 s at 60 Hz
+constexpr int kCountedSteps = 3000;  // 50 s at 60 Hz
 
 // Allocations made by `steps` steps of the world (only World::step is counted, not metrics).
 long allocations_in_steps(World& world, int steps) {

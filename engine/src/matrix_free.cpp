@@ -238,6 +238,11 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
 
 namespace {
 
+// Coupling entries reserved per row: sum over runs of m^2 <= kMaxRun * (sum of m) = kMaxRun *
+// rows, so this bound holds for any mix of manifolds (8 bytes x 24 = 192 bytes a row, about
+// the size of the packed row itself).
+constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun;
+
 // Runs of consecutive rows on the same two slots, and their coupling blocks (PGS only).
 void build_runs(MatrixFreeSystem& s) {
   const std::size_t c = s.rows.size();
@@ -256,6 +261,10 @@ void build_runs(MatrixFreeSystem& s) {
     if (block) coupling_size += static_cast<std::size_t>(m * m);
     r = end;
   }
+  // Room for the largest coupling these many rows can need (kCouplingPerRow): it then grows only
+  // when the row count does, not whenever more rows happen to sit in blocks than in any earlier
+  // step (which a long run meets after warm-up).
+  detail::reserve_with_headroom(s.coupling, std::max(coupling_size, kCouplingPerRow * c));
   detail::resize_with_headroom(s.coupling, coupling_size);
   for (const MatrixFreeSystem::Run& run : s.runs) {
     if (run.offset < 0) continue;

@@ -103,7 +103,7 @@ void render_table(bool quick) {
     {
       scenes::Run run = scenes::make_run(scene);
       DrawStyle style{frame_world(run.world, static_cast<float>(k_width) / k_height),
-                      static_cast<float>(scene.plane_opacity)};
+                      static_cast<float>(scene.plane_opacity), Overlays{}};
       if (scene.camera) style.camera = camera_from_preset(*scene.camera);
       for (int k = 0; k < frames; ++k) {
         auto start = Clock::now();

@@ -69,11 +69,6 @@ render::Camera orbit(render::Camera camera, double deg) {
 
 }  // namespace
 
-Overlays& default_overlays() {
-  static Overlays overlays;
-  return overlays;
-}
-
 render::DrawList draw_list(const World& world, const DrawStyle& style) {
   render::DrawList list;
   list.camera = style.overlays.orbit_deg_per_s == 0.0

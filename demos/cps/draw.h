@@ -30,16 +30,11 @@ struct Overlays {
   double orbit_deg_per_s = 0.0;
 };
 
-/// The overlays that a DrawStyle built without naming them gets. `cps render` builds its
-/// DrawStyle inside render.cpp from the camera and the plane opacity only; main.cpp sets this
-/// process-wide default once, before rendering, so the flags reach those frames unchanged.
-Overlays& default_overlays();
-
 /// How to draw a world: the camera, the opacity of its planes ([0, 1]) and the overlays.
 struct DrawStyle {
   render::Camera camera;
   float plane_opacity = 1.0f;
-  Overlays overlays = default_overlays();
+  Overlays overlays;
 };
 
 /// A snapshot of `world` for the renderer: every box and sphere, every distance constraint as a

@@ -487,8 +487,7 @@ int run(int argc, char** argv) {
       }
       const int panel_width = size.width / static_cast<int>(variants.size());
       const float aspect = static_cast<float>(panel_width) / static_cast<float>(size.height);
-      // The view flags reach render.cpp through the DrawStyle defaults and the scene's camera.
-      cli::default_overlays() = render_view.overlays;
+      // The camera flag reaches render.cpp as the scene's preset, the overlays in the RenderJob.
       std::vector<scenes::Scene> viewed;  // the scenes with the chosen camera as their preset
       viewed.reserve(jobs.size());
       for (Job& job : jobs) {
@@ -508,6 +507,7 @@ int run(int argc, char** argv) {
         cli::RenderJob spec;
         spec.seconds = render_seconds.value_or(job.scene->default_seconds);
         spec.fps = fps;
+        spec.overlays = render_view.overlays;
         spec.folder = std::filesystem::path(out_dir) /
                       (std::string(job.scene->name) + (compare.empty() ? "" : "-compare-" + compare));
         std::vector<std::string> files;

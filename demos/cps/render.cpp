@@ -25,7 +25,7 @@ int render_frames(const scenes::Scene& scene, std::vector<Panel>& panels, const 
   const float aspect = static_cast<float>(renderer.width()) / static_cast<float>(renderer.height());
   // The camera is fixed for the whole sequence.
   DrawStyle style{frame_world(panels.front().run->world, aspect),
-                  static_cast<float>(scene.plane_opacity)};
+                  static_cast<float>(scene.plane_opacity), job.overlays};
   if (scene.camera) style.camera = camera_from_preset(*scene.camera);
   const int label_scale = std::max(1, renderer.height() / 360);
 

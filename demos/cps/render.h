@@ -1,6 +1,7 @@
 #pragma once
 // `cps render`: steps a scene and writes its frames as PNG files.
 
+#include "draw.h"
 #include "progress.h"
 #include "scene.h"
 
@@ -18,6 +19,7 @@ struct RenderJob {
   double seconds = 10.0;
   double fps = 30.0;
   std::filesystem::path folder;
+  Overlays overlays;  ///< contacts, rods, camera orbit (see draw.h)
 };
 
 /// Number of frames of a job: floor(seconds * fps) + 1 (frame 0 at t = 0).

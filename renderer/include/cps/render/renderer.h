@@ -70,7 +70,8 @@ class Renderer {
 /// or by zlib at level 1 in a build without ISA-L: the fastest of the encoders measured for these
 /// renders, see png_io.cpp). The file is first written as
 /// "<path>.tmp" in the same folder and then renamed, so an interrupted run never leaves a
-/// half-written frame under its final name. Thread-safe (each call has its own encoder state).
+/// half-written frame under its final name. Thread-safe: each thread has its own encoder, whose
+/// buffers (about 6 bytes per pixel of the largest image) stay for its next call.
 /// Throws std::runtime_error naming the path if it cannot be written; the temporary file is then
 /// removed.
 void write_png(const std::filesystem::path& path, const Image& image);

@@ -15,6 +15,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 namespace fs = std::filesystem;
 using namespace cps::render;
@@ -301,6 +302,45 @@ TEST_CASE("frame_bounds keeps the whole box in view", "[renderer]") {
   CHECK_THROWS_AS(frame_bounds(glm::vec3(1.0f), glm::vec3(0.0f), 1.0f), std::invalid_argument);
   CHECK_THROWS_AS(frame_bounds(lo, hi, 0.0f), std::invalid_argument);
   CHECK_THROWS_AS(frame_bounds(lo, hi, -1.0f), std::invalid_argument);
+}
+
+TEST_CASE("write_png keeps every pixel of noise, flat and tiny images", "[renderer]") {
+  // Noise does not compress: the encoder must fall back to stored blocks within its output room.
+  // read_png (libpng) checks every chunk's CRC and the zlib stream's Adler-32.
+  TempDir dir;
+  std::mt19937 rng(12345);
+  const auto image = [&](int w, int h, bool noise) {
+    Image img;
+    img.width = w;
+    img.height = h;
+    img.pixels.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3u);
+    for (std::size_t i = 0; i < img.pixels.size(); ++i) {
+      img.pixels[i] = noise ? static_cast<std::uint8_t>(rng() >> 24) : static_cast<std::uint8_t>(60 + i % 3);
+    }
+    return img;
+  };
+  for (const auto& [w, h, noise] : {std::tuple{1, 1, true}, std::tuple{333, 257, true},
+                                    std::tuple{640, 360, false}, std::tuple{7, 300, true}}) {
+    INFO(w << "x" << h << (noise ? " noise" : " flat"));
+    const Image img = image(w, h, noise);
+    const fs::path png = dir.path / "img.png";
+    write_png(png, img);
+    const Image back = read_png(png);
+    CHECK(back.width == w);
+    CHECK(back.height == h);
+    CHECK(back.pixels == img.pixels);
+    // Noise takes about its raw size (the rows with their filter bytes, plus up to 1 % for block
+    // headers and the chunks); a flat image compresses at least 100:1.
+    const auto bytes = static_cast<double>(fs::file_size(png));
+    const double raw = static_cast<double>((3 * w + 1) * h);
+    if (noise) CHECK(bytes < 1.01 * raw + 200.0);
+    if (!noise) CHECK(bytes < static_cast<double>(img.pixels.size()) / 100.0);
+  }
+  // A file cut short is refused, naming the file.
+  const Image img = image(64, 48, true);
+  write_png(dir.path / "cut.png", img);
+  fs::resize_file(dir.path / "cut.png", fs::file_size(dir.path / "cut.png") - 20);
+  CHECK_THROWS_WITH(read_png(dir.path / "cut.png"), Catch::Contains("cut.png"));
 }
 
 TEST_CASE("PngWriter writes every queued image and reports a failed write by its path",

@@ -1,13 +1,18 @@
-// write_png through libpng (Debian's libpng16 + zlib), PngWriter (encoding on worker threads) and
-// read_png through stb_image (Debian's libstb).
+// write_png (a PNG file assembled here around a zlib stream from Intel's ISA-L, or from zlib when
+// the build has no ISA-L), PngWriter (encoding on worker threads) and read_png through libpng.
 
 #include "cps/render/renderer.h"
 
 #include <png.h>
-#include <stb_image.h>
+#include <zlib.h>
+#if CPS_PNG_ISAL
+#include <isa-l/igzip_lib.h>
+#endif
 
+#include <array>
+#include <cerrno>
 #include <condition_variable>
-#include <csetjmp>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <deque>
@@ -18,68 +23,152 @@
 #include <system_error>
 #include <thread>
 #include <utility>
+#include <vector>
 
 namespace cps::render {
 namespace {
 
-// Speed over size. Measured on 15 real 1280x720 frames of the five paper scenes (llvmpipe host,
-// Debian 12, median ms per frame, encoding to memory; mean KiB per frame):
-//   stb_image_write default (adaptive filter, level 8)   72 ms  263 KiB
-//   stb_image_write, filter none, level 1                 29 ms  236 KiB
-//   libpng, zlib level 1, filter none                     11 ms  218 KiB
-//   libpng, zlib level 6, all filters (libpng default)    52 ms  189 KiB
-// The renders are mostly flat colour, which deflate compresses well without row prediction.
-constexpr int k_zlib_level = 1;
-constexpr int k_png_filters = PNG_FILTER_NONE;
+// Speed over size: a frame is drawn in 15-300 ms and its encoding runs beside the drawing of the
+// next frame on the same two cores, so every millisecond of encoder CPU slows the pipeline down.
+// Measured on 8-16 real 1280x720 frames of each of the five paper scenes (Debian 12 on the
+// 2-core host, median thread CPU ms per frame, encoding to memory; mean KiB per frame;
+// pendulum_wave / the four others; an earlier note found stb_image_write slower still):
+//   libpng 1.6, zlib 1.2.13 level 1, filter none          5.7 / 11-14   55 / 251-269 KiB
+//   libpng, zlib level 1, Z_RLE + filter up or sub        6.6 / 12-18   47 / 236-482 KiB
+//   libpng, zlib level 1, Z_FILTERED + filter up or sub   6.9 / 13-16   52 / 256-359 KiB
+//   libdeflate 1.14 level 1, filter none                  3.7 / 6.3-7   43 / 212-232 KiB
+//   ISA-L 2.30 igzip level 1, filter none                 0.8 / 2.4-2.7 55 / 243-262 KiB
+//   ISA-L igzip level 2, filter none (chosen)             0.8 / 2.5-2.8 55 / 240-259 KiB
+//   ISA-L igzip level 1, filter up or sub                 1.5 / 3.4-4.9 52 / 235-369 KiB
+// The renders are mostly flat colour, which deflate compresses well without row prediction, and
+// a row filter costs more than it saves here. Every row therefore uses PNG filter type 0 (none),
+// and the zlib stream of the whole image is made in one call (ISA-L's stateless mode).
+#if CPS_PNG_ISAL
+constexpr int k_isal_level = 2;                            // igzip level, 0..3; typical 1-2
+constexpr std::uint32_t k_isal_level_buf = ISAL_DEF_LVL2_DEFAULT;  // bytes of work space
+#else
+constexpr int k_zlib_level = 1;  // zlib level, 0..9 (fallback without ISA-L); typical 1
+#endif
 
-struct ErrorSink {
-  char message[256] = {};
+void put_be32(std::uint8_t* p, std::uint32_t v) {
+  p[0] = static_cast<std::uint8_t>(v >> 24);
+  p[1] = static_cast<std::uint8_t>(v >> 16);
+  p[2] = static_cast<std::uint8_t>(v >> 8);
+  p[3] = static_cast<std::uint8_t>(v);
+}
+
+/// Writes a chunk's CRC-32 of its type and data (4 + length bytes from `type`) at `type` + 4 +
+/// length (PNG specification, 3rd ed., 5.3: CRC-32 of ISO 3309, as in zlib's crc32).
+void put_crc(std::uint8_t* type, std::size_t length) {
+  put_be32(type + 4 + length,
+           static_cast<std::uint32_t>(crc32(0L, type, static_cast<uInt>(length + 4))));
+}
+
+/// One PNG encoder's buffers, kept between images so that a stream of frames allocates (and
+/// clears) nothing after the first. Not thread-safe: one encoder per thread.
+struct PngEncoder {
+  std::vector<std::uint8_t> scanlines;  // height rows of (filter byte 0, 3 * width bytes RGB)
+  std::vector<std::uint8_t> file;       // the PNG file in its first `size` bytes
+  std::size_t size = 0;
+#if CPS_PNG_ISAL
+  std::vector<std::uint8_t> level_buf;  // ISA-L's work space for k_isal_level
+#endif
+
+  /// Encodes `image` (checked by the caller: sizes > 0, 3 * width * height bytes) into
+  /// file[0, size): an 8-bit RGB, non-interlaced PNG with chunks IHDR, one IDAT and IEND.
+  /// Throws std::runtime_error if the compressor fails.
+  void encode(const Image& image) {
+    const std::size_t row = 3u * static_cast<std::size_t>(image.width);
+    const auto height = static_cast<std::size_t>(image.height);
+    if (scanlines.size() != (row + 1u) * height) scanlines.resize((row + 1u) * height);
+    for (std::size_t y = 0; y < height; ++y) {
+      std::uint8_t* line = scanlines.data() + (row + 1u) * y;
+      line[0] = 0;  // filter type: none
+      std::memcpy(line + 1, image.pixels.data() + row * y, row);
+    }
+
+    // Layout: signature (8), IHDR (12 + 13), IDAT (12 + n), IEND (12). The IDAT data, the zlib
+    // stream, is compressed straight into place, with room for the worst case: incompressible
+    // data sent in stored blocks, 5 bytes per block of at most 65535 bytes (RFC 1951) plus the
+    // zlib header and Adler-32 (RFC 1950); 1/1024 + 1 KiB covers both.
+    constexpr std::size_t k_ihdr = 8;
+    constexpr std::size_t k_idat = k_ihdr + 12 + 13;
+    const std::size_t room = scanlines.size() + scanlines.size() / 1024u + 1024u;
+    if (file.size() < k_idat + 12 + room + 12) file.resize(k_idat + 12 + room + 12);
+    std::uint8_t* out = file.data();
+
+    static constexpr std::array<std::uint8_t, 8> k_signature = {0x89, 'P', 'N', 'G',
+                                                                 0x0D, 0x0A, 0x1A, 0x0A};
+    std::memcpy(out, k_signature.data(), k_signature.size());
+    put_be32(out + k_ihdr, 13);
+    std::memcpy(out + k_ihdr + 4, "IHDR", 4);
+    put_be32(out + k_ihdr + 8, static_cast<std::uint32_t>(image.width));
+    put_be32(out + k_ihdr + 12, static_cast<std::uint32_t>(image.height));
+    out[k_ihdr + 16] = 8;  // bits per sample
+    out[k_ihdr + 17] = 2;  // colour type: RGB
+    out[k_ihdr + 18] = 0;  // compression method: zlib deflate
+    out[k_ihdr + 19] = 0;  // filter method 0 (five filter types; every row uses type 0, none)
+    out[k_ihdr + 20] = 0;  // no interlace
+    put_crc(out + k_ihdr + 4, 13);
+
+    std::memcpy(out + k_idat + 4, "IDAT", 4);
+    const std::size_t length = deflate_into(out + k_idat + 8, room);
+    put_be32(out + k_idat, static_cast<std::uint32_t>(length));
+    put_crc(out + k_idat + 4, length);
+
+    const std::size_t iend = k_idat + 12 + length;
+    put_be32(out + iend, 0);
+    std::memcpy(out + iend + 4, "IEND", 4);
+    put_crc(out + iend + 4, 0);
+    size = iend + 12;
+  }
+
+ private:
+  /// Compresses `scanlines` into out[0, room) as one zlib stream; returns its length in bytes.
+  std::size_t deflate_into(std::uint8_t* out, std::size_t room) {
+#if CPS_PNG_ISAL
+    if (level_buf.size() != k_isal_level_buf) level_buf.assign(k_isal_level_buf, 0);
+    isal_zstream z;
+    isal_deflate_stateless_init(&z);
+    z.gzip_flag = IGZIP_ZLIB;
+    z.level = k_isal_level;
+    z.level_buf = level_buf.data();
+    z.level_buf_size = static_cast<std::uint32_t>(level_buf.size());
+    z.flush = NO_FLUSH;
+    z.end_of_stream = 1;
+    z.next_in = scanlines.data();
+    z.avail_in = static_cast<std::uint32_t>(scanlines.size());
+    z.next_out = out;
+    z.avail_out = static_cast<std::uint32_t>(room);
+    const int status = isal_deflate_stateless(&z);
+    if (status != COMP_OK) {
+      throw std::runtime_error("ISA-L deflate failed (status " + std::to_string(status) + ")");
+    }
+    return z.total_out;
+#else
+    z_stream z{};
+    if (deflateInit(&z, k_zlib_level) != Z_OK) throw std::runtime_error("zlib: deflateInit failed");
+    z.next_in = scanlines.data();
+    z.avail_in = static_cast<uInt>(scanlines.size());
+    z.next_out = out;
+    z.avail_out = static_cast<uInt>(room);
+    const int status = deflate(&z, Z_FINISH);
+    const std::size_t length = z.total_out;
+    deflateEnd(&z);
+    if (status != Z_STREAM_END) {
+      throw std::runtime_error("zlib deflate failed (status " + std::to_string(status) + ")");
+    }
+    return length;
+#endif
+  }
 };
-
-void on_png_error(png_structp png, png_const_charp message) {
-  auto* sink = static_cast<ErrorSink*>(png_get_error_ptr(png));
-  std::snprintf(sink->message, sizeof sink->message, "%s", message != nullptr ? message : "?");
-  png_longjmp(png, 1);
-}
-
-void on_png_warning(png_structp, png_const_charp) {}
-
-// Encodes `image` into the open file. Only trivially destructible locals live in this frame, as
-// libpng reports errors by longjmp. Returns false with sink.message set on failure.
-bool encode(std::FILE* file, const Image& image, ErrorSink& sink) {
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &sink, on_png_error,
-                                            on_png_warning);
-  if (png == nullptr) {
-    std::snprintf(sink.message, sizeof sink.message, "libpng: out of memory");
-    return false;
-  }
-  png_infop info = png_create_info_struct(png);
-  if (info == nullptr || setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    if (sink.message[0] == '\0') std::snprintf(sink.message, sizeof sink.message, "libpng failed");
-    return false;
-  }
-  png_init_io(png, file);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(image.width),
-               static_cast<png_uint_32>(image.height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_set_compression_level(png, k_zlib_level);
-  png_set_filter(png, PNG_FILTER_TYPE_BASE, k_png_filters);
-  png_write_info(png, info);
-  const std::size_t stride = 3u * static_cast<std::size_t>(image.width);
-  for (int y = 0; y < image.height; ++y) {
-    png_write_row(png, const_cast<png_bytep>(image.pixels.data() + stride * static_cast<std::size_t>(y)));
-  }
-  png_write_end(png, info);
-  png_destroy_write_struct(&png, &info);
-  return true;
-}
 
 }  // namespace
 
 // write_png: image of width x height > 0 with 3 * width * height bytes (RGB8, rows top to bottom),
-// else std::runtime_error naming the path. Encodes into "<path>.tmp" in the same folder and renames
-// it over `path` (atomic on POSIX within one file system); on any failure the temporary file is
+// else std::runtime_error naming the path. Encodes into this thread's buffers (kept for the next
+// call: about 2 x 3 x width x height bytes), writes "<path>.tmp" in the same folder and renames it
+// over `path` (atomic on POSIX within one file system); on any failure the temporary file is
 // removed and std::runtime_error names the path and the reason.
 void write_png(const std::filesystem::path& path, const Image& image) {
   const auto expected = static_cast<std::size_t>(image.width > 0 ? image.width : 0) *
@@ -96,15 +185,20 @@ void write_png(const std::filesystem::path& path, const Image& image) {
     std::filesystem::remove(tmp, ignored);
     throw std::runtime_error("write_png: cannot write " + path.string() + ": " + why);
   };
+  thread_local PngEncoder encoder;
+  try {
+    encoder.encode(image);
+  } catch (const std::exception& e) {
+    fail(e.what());
+  }
   std::FILE* file = std::fopen(tmp.c_str(), "wb");
   if (file == nullptr) fail(std::strerror(errno));
-  ErrorSink sink;
-  const bool encoded = encode(file, image, sink);
-  const bool flushed = std::fflush(file) == 0;
-  const int flush_errno = errno;
+  const bool written = std::fwrite(encoder.file.data(), 1, encoder.size, file) == encoder.size;
+  const int write_errno = errno;
   const bool closed = std::fclose(file) == 0;
-  if (!encoded) fail(sink.message);
-  if (!flushed || !closed) fail(std::strerror(flush_errno));
+  const int close_errno = errno;
+  if (!written) fail(std::strerror(write_errno));
+  if (!closed) fail(std::strerror(close_errno));
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) fail("cannot rename " + tmp.string() + ": " + ec.message());
@@ -195,23 +289,24 @@ long long PngWriter::written() const {
   return impl_->written;
 }
 
-// read_png: decodes any PNG stb_image reads, converted to 3 channels (RGB8, rows top to bottom).
-// std::runtime_error naming the path and stb's failure reason if it cannot.
+// read_png: decodes any PNG libpng reads (its simplified API, which checks every chunk's CRC and
+// the zlib stream's Adler-32), converted to RGB8, rows top to bottom; an alpha channel is
+// composited onto black. std::runtime_error naming the path and libpng's message if it cannot.
 Image read_png(const std::filesystem::path& path) {
-  int w = 0;
-  int h = 0;
-  int channels_in_file = 0;
-  stbi_uc* data = stbi_load(path.c_str(), &w, &h, &channels_in_file, 3);
-  if (data == nullptr) {
-    const char* reason = stbi_failure_reason();
-    throw std::runtime_error("read_png: cannot read " + path.string() + ": " +
-                             (reason != nullptr ? reason : "unknown error"));
-  }
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  const auto fail = [&]() -> Image {
+    const std::string why = png.message[0] != '\0' ? png.message : "unknown error";
+    png_image_free(&png);
+    throw std::runtime_error("read_png: cannot read " + path.string() + ": " + why);
+  };
+  if (png_image_begin_read_from_file(&png, path.c_str()) == 0) return fail();
+  png.format = PNG_FORMAT_RGB;
   Image image;
-  image.width = w;
-  image.height = h;
-  image.pixels.assign(data, data + static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3u);
-  stbi_image_free(data);
+  image.width = static_cast<int>(png.width);
+  image.height = static_cast<int>(png.height);
+  image.pixels.resize(PNG_IMAGE_SIZE(png));
+  if (png_image_finish_read(&png, nullptr, image.pixels.data(), 0, nullptr) == 0) return fail();
   return image;
 }
 

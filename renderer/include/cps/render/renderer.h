@@ -66,10 +66,12 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Writes `image` as a PNG at `path` (libpng, zlib level 1, no row filter: the fastest of the
-/// encoders measured for these renders, see png_io.cpp). The file is first written as
+/// Writes `image` as an 8-bit RGB PNG at `path` (no row filter, deflate by Intel's ISA-L at level 2,
+/// or by zlib at level 1 in a build without ISA-L: the fastest of the encoders measured for these
+/// renders, see png_io.cpp). The file is first written as
 /// "<path>.tmp" in the same folder and then renamed, so an interrupted run never leaves a
-/// half-written frame under its final name. Thread-safe (each call has its own encoder state).
+/// half-written frame under its final name. Thread-safe: each thread has its own encoder, whose
+/// buffers (about 6 bytes per pixel of the largest image) stay for its next call.
 /// Throws std::runtime_error naming the path if it cannot be written; the temporary file is then
 /// removed.
 void write_png(const std::filesystem::path& path, const Image& image);
@@ -108,7 +110,9 @@ class PngWriter {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Reads a PNG back (for tests and tools). Throws std::runtime_error naming the path on failure.
+/// Reads a PNG back as RGB8 (for tests and tools) through libpng, which checks every chunk's CRC
+/// and the zlib checksum; alpha, if any, is composited onto black. Throws std::runtime_error
+/// naming the path and the reason on failure.
 Image read_png(const std::filesystem::path& path);
 
 }  // namespace cps::render

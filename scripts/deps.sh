@@ -3,6 +3,8 @@
 cps_packages=(
   cmake g++ make pkg-config
   libeigen3-dev libglm-dev libstb-dev libpng-dev catch2 libcli11-dev nlohmann-json3-dev
+  # PNG frames: deflate by Intel ISA-L, CRCs by zlib.
+  libisal-dev zlib1g-dev
   # The two GL backends (both loaded at run time): OSMesa, and EGL with Mesa's driver.
   libosmesa6-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri
   # Plots of `cps report`, videos of `cps render --video`.

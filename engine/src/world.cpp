@@ -7,7 +7,9 @@
 #include "cps/solver.h"
 #include "cps/system.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <stdexcept>
 
@@ -82,25 +84,95 @@ void World::step() {
   ++counters_.steps;
 }
 
-// Stage 1, Sec. 4. Broad phase: sort and sweep along x over axis-aligned bounds (grown by the
-// contact margin), every plane against every movable body; the candidate pairs are then sorted
-// by index, so the narrow phase, the manifolds and the rows come in the same order as testing
-// every pair would give (Baraff 1992; Ericson 2005, Sec. 7.5).
+namespace {
+
+// Broad phase grid. Bodies wider than this many times the median width (dimensionless) are not
+// put in the grid but tested against every body, so that one large body (a static slab, say)
+// does not make every cell large. Typical: 8.
+constexpr double kOversizeFactor = 8.0;
+// Cell edge = widest gridded body times this (dimensionless, > 1): the margin keeps two
+// overlapping bounds in neighbouring cells despite the rounding of lo / edge.
+constexpr double kCellGrowth = 1.001;
+// Cell coordinates are clamped to +-2^30 (about 1e9 cells): far out, or not finite, bodies
+// share the edge cells, which can only add candidates, never lose one.
+constexpr double kMaxCell = 1073741824.0;
+
+// Bucket of grid cell (x, y, z) before masking (Teschner et al. 2003, "Optimized spatial hashing
+// for collision detection of deformable objects"); unsigned, so it wraps instead of overflowing.
+std::uint32_t hash_cell(std::int32_t x, std::int32_t y, std::int32_t z) {
+  return (static_cast<std::uint32_t>(x) * 73856093u) ^ (static_cast<std::uint32_t>(y) * 19349663u) ^
+         (static_cast<std::uint32_t>(z) * 83492791u);
+}
+
+// Closed intervals overlap on all three axes.
+template <class B>
+bool bounds_overlap(const B& a, const B& b) {
+  return !(b.lo.x() > a.hi.x() || a.lo.x() > b.hi.x() || b.lo.y() > a.hi.y() ||
+           a.lo.y() > b.hi.y() || b.lo.z() > a.hi.z() || a.lo.z() > b.hi.z());
+}
+
+// Sorts a short list in place (the candidates of one body: a handful).
+void insertion_sort(std::vector<int>& v) {
+  for (std::size_t i = 1; i < v.size(); ++i) {
+    const int x = v[i];
+    std::size_t k = i;
+    for (; k > 0 && v[k - 1] > x; --k) v[k] = v[k - 1];
+    v[k] = x;
+  }
+}
+
+}  // namespace
+
+// Stage 1, Sec. 4: the broad phase lists the pairs that may touch, in index order, then the
+// narrow phase builds their manifolds. The order is that of testing every pair (a, b), a < b,
+// so manifolds and rows do not depend on how the candidates were found.
 void World::collide() {
   manifolds_.clear();
   if (!def_.collision) return;
-  const int n = static_cast<int>(bodies_.size());
-  bounds_.resize(bodies_.size());
-  sweep_order_.clear();
+  broad_phase();
+  detail::reserve_with_headroom(manifolds_, pairs_.size());
+  for (const auto& [a, b] : pairs_) {
+    ++counters_.pairs_tested;
+    // Built in place (no copy of the 8 contact slots); dropped again if the pair does not touch.
+    Manifold& m = manifolds_.emplace_back();
+    m.body_a = a;
+    m.body_b = b;
+    if (cps::collide(bodies_[static_cast<std::size_t>(a)], bodies_[static_cast<std::size_t>(b)], m,
+                     def_.contact_margin) > 0) {
+      counters_.contacts += m.count;
+    } else {
+      manifolds_.pop_back();
+    }
+  }
+}
+
+// Broad phase: axis-aligned bounds grown by the contact margin; a pair is a candidate when its
+// bounds overlap (closed intervals on x, y and z) and not both bodies are static; every plane is
+// a candidate with every movable body. Bounds go into a uniform grid of cubic cells as wide as
+// the widest body (Ericson 2005, Sec. 7.1), hashed into twice as many buckets as bodies and
+// sorted into them by a counting sort, so the cost grows with the body count and the pairs, not
+// with their square or a sort. Two overlapping bounds have lower corners at most one cell
+// apart, so each body looks in the 27 cells around its own for bodies of higher index; the few
+// candidates of one body are sorted, so the pairs come out in index order without a global sort.
+void World::broad_phase() {
+  const std::size_t n = bodies_.size();
+  bounds_.resize(n);
+  broad_class_.resize(n);
+  bucket_of_.resize(n);
   planes_.clear();
+  oversize_.clear();
+  widths_.clear();
   pairs_.clear();
+  detail::reserve_with_headroom(widths_, n);
+  detail::reserve_with_headroom(candidates_, n);
   const double grow = 0.5 * def_.contact_margin;
-  for (int i = 0; i < n; ++i) {
-    const Body& b = bodies_[static_cast<std::size_t>(i)];
+  for (std::size_t i = 0; i < n; ++i) {
+    const Body& b = bodies_[i];
     Vec3 half = Vec3::Zero();
     switch (b.shape.kind) {
       case ShapeKind::plane:
-        planes_.push_back(i);
+        broad_class_[i] = BroadClass::plane;
+        planes_.push_back(static_cast<int>(i));
         continue;
       case ShapeKind::box:
         half = b.rotation().cwiseAbs() * b.shape.half_extents;
@@ -109,47 +181,121 @@ void World::collide() {
         half = Vec3::Constant(b.shape.radius);
         break;
     }
-    bounds_[static_cast<std::size_t>(i)] = {b.x - half - Vec3::Constant(grow),
-                                            b.x + half + Vec3::Constant(grow)};
-    sweep_order_.push_back(i);
+    bounds_[i] = {b.x - half - Vec3::Constant(grow), b.x + half + Vec3::Constant(grow)};
+    broad_class_[i] = BroadClass::gridded;
+    const double width = (bounds_[i].hi - bounds_[i].lo).maxCoeff();
+    widths_.push_back(std::isfinite(width) ? width : 0.0);
   }
-  std::sort(sweep_order_.begin(), sweep_order_.end(), [this](int a, int b) {
-    const double xa = bounds_[static_cast<std::size_t>(a)].lo.x();
-    const double xb = bounds_[static_cast<std::size_t>(b)].lo.x();
-    return xa < xb || (xa == xb && a < b);
-  });
-  for (std::size_t k = 0; k < sweep_order_.size(); ++k) {
-    const int a = sweep_order_[k];
-    const Bounds& ba = bounds_[static_cast<std::size_t>(a)];
-    for (std::size_t m = k + 1; m < sweep_order_.size(); ++m) {
-      const int b = sweep_order_[m];
-      const Bounds& bb = bounds_[static_cast<std::size_t>(b)];
-      if (bb.lo.x() > ba.hi.x()) break;
-      if (bb.lo.y() > ba.hi.y() || ba.lo.y() > bb.hi.y() || bb.lo.z() > ba.hi.z() ||
-          ba.lo.z() > bb.hi.z()) {
+  // Bodies much wider than the median go to the oversize list; the rest set the cell edge.
+  double limit = kInfinity;
+  if (!widths_.empty()) {
+    const auto middle = widths_.begin() + static_cast<std::ptrdiff_t>(widths_.size() / 2);
+    std::nth_element(widths_.begin(), middle, widths_.end());
+    limit = kOversizeFactor * *middle;
+  }
+  double widest = 0.0;
+  std::size_t gridded = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (broad_class_[i] == BroadClass::plane) continue;
+    const double width = (bounds_[i].hi - bounds_[i].lo).maxCoeff();
+    if (width > limit) {
+      broad_class_[i] = BroadClass::oversize;
+      oversize_.push_back(static_cast<int>(i));
+    } else {
+      widest = std::max(widest, width);
+      ++gridded;
+    }
+  }
+  const double edge = widest > 0.0 && std::isfinite(widest) ? kCellGrowth * widest : 1.0;
+  const double inv_edge = 1.0 / edge;
+  std::size_t buckets = 1;
+  while (buckets < 2 * gridded) buckets *= 2;
+  const auto mask = static_cast<std::uint32_t>(buckets - 1);
+  const auto cell_coordinate = [inv_edge](double x) {
+    double q = std::floor(x * inv_edge);
+    if (!(q >= -kMaxCell)) q = -kMaxCell;  // also NaN
+    if (q > kMaxCell) q = kMaxCell;
+    return static_cast<std::int32_t>(q);
+  };
+  // Counting sort of the gridded bodies by bucket (index order within a bucket).
+  detail::assign_with_headroom(bucket_start_, buckets + 2, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (broad_class_[i] != BroadClass::gridded) continue;
+    const Vec3& lo = bounds_[i].lo;
+    bucket_of_[i] = hash_cell(cell_coordinate(lo.x()), cell_coordinate(lo.y()),
+                              cell_coordinate(lo.z())) & mask;
+    ++bucket_start_[bucket_of_[i] + 2];
+  }
+  for (std::size_t k = 2; k < buckets + 2; ++k) bucket_start_[k] += bucket_start_[k - 1];
+  detail::resize_with_headroom(grid_, gridded);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (broad_class_[i] != BroadClass::gridded) continue;
+    const Vec3& lo = bounds_[i].lo;
+    grid_[static_cast<std::size_t>(bucket_start_[bucket_of_[i] + 1]++)] = {
+        static_cast<int>(i), bodies_[i].is_static(),
+        {cell_coordinate(lo.x()), cell_coordinate(lo.y()), cell_coordinate(lo.z())}, bounds_[i]};
+  }
+
+  for (std::size_t ia = 0; ia < n; ++ia) {
+    const int a = static_cast<int>(ia);
+    const bool a_static = bodies_[ia].is_static();
+    switch (broad_class_[ia]) {
+      case BroadClass::plane:
+        // Every movable body of higher index, in order.
+        for (std::size_t ib = ia + 1; ib < n; ++ib) {
+          if (broad_class_[ib] != BroadClass::plane && !bodies_[ib].is_static()) {
+            pairs_.emplace_back(a, static_cast<int>(ib));
+          }
+        }
         continue;
+      case BroadClass::oversize:
+        // Every body of higher index, in order.
+        for (std::size_t ib = ia + 1; ib < n; ++ib) {
+          if (broad_class_[ib] == BroadClass::plane) {
+            if (!a_static) pairs_.emplace_back(a, static_cast<int>(ib));
+          } else if (!(a_static && bodies_[ib].is_static()) && bounds_overlap(bounds_[ia], bounds_[ib])) {
+            pairs_.emplace_back(a, static_cast<int>(ib));
+          }
+        }
+        continue;
+      case BroadClass::gridded:
+        break;
+    }
+    candidates_.clear();
+    const Bounds& ba = bounds_[ia];
+    const Vec3& lo = ba.lo;
+    const std::int32_t cx = cell_coordinate(lo.x());
+    const std::int32_t cy = cell_coordinate(lo.y());
+    const std::int32_t cz = cell_coordinate(lo.z());
+    for (std::int32_t x = cx - 1; x <= cx + 1; ++x) {
+      for (std::int32_t y = cy - 1; y <= cy + 1; ++y) {
+        for (std::int32_t z = cz - 1; z <= cz + 1; ++z) {
+          const std::uint32_t bucket = hash_cell(x, y, z) & mask;
+          const int begin = bucket_start_[bucket];
+          // The bucket is in index order: walk down while the index is above a.
+          for (int k = bucket_start_[bucket + 1] - 1; k >= begin; --k) {
+            const GridEntry& e = grid_[static_cast<std::size_t>(k)];
+            if (e.body <= a) break;
+            if (e.cell[0] != x || e.cell[1] != y || e.cell[2] != z) continue;  // another cell
+            if (a_static && e.is_static) continue;
+            if (bounds_overlap(ba, e.bounds)) candidates_.push_back(e.body);
+          }
+        }
       }
-      if (bodies_[static_cast<std::size_t>(a)].is_static() && bodies_[static_cast<std::size_t>(b)].is_static()) continue;
-      pairs_.emplace_back(std::min(a, b), std::max(a, b));
     }
-  }
-  for (const int p : planes_) {
-    for (const int i : sweep_order_) {
-      if (!bodies_[static_cast<std::size_t>(i)].is_static()) pairs_.emplace_back(std::min(p, i), std::max(p, i));
+    for (const int b : oversize_) {
+      const auto ib = static_cast<std::size_t>(b);
+      if (b > a && !(a_static && bodies_[ib].is_static()) && bounds_overlap(ba, bounds_[ib])) {
+        candidates_.push_back(b);
+      }
     }
-  }
-  std::sort(pairs_.begin(), pairs_.end());
-  detail::reserve_with_headroom(manifolds_, pairs_.size());
-  for (const auto& [a, b] : pairs_) {
-    ++counters_.pairs_tested;
-    Manifold m;
-    m.body_a = a;
-    m.body_b = b;
-    if (cps::collide(bodies_[static_cast<std::size_t>(a)], bodies_[static_cast<std::size_t>(b)], m,
-                     def_.contact_margin) > 0) {
-      counters_.contacts += m.count;
-      manifolds_.push_back(m);
+    if (!a_static) {
+      for (const int p : planes_) {
+        if (p > a) candidates_.push_back(p);
+      }
     }
+    insertion_sort(candidates_);
+    for (const int b : candidates_) pairs_.emplace_back(a, b);
   }
 }
 
@@ -164,7 +310,21 @@ void World::build_rows() {
       rows_, contact_points * (def_.friction > 0.0 ? 3 : 1) + distances_.size());
   const RowParams params{def_.beta,    def_.dt,          def_.friction,
                          def_.gravity, def_.restitution, def_.restitution_threshold};
-  for (const Manifold& m : manifolds_) append_contact_rows(m, bodies_, params, rows_);
+  // Each body's v and w (w needs I^-1 = R I_body^-1 R^T) once, for the bodies in a manifold;
+  // a body typically sits in several.
+  velocity_known_.assign(bodies_.size(), 0);  // n bytes: no allocation once grown
+  velocities_.resize(bodies_.size());
+  const auto velocity = [this](int i) -> const BodyVelocity& {
+    const auto k = static_cast<std::size_t>(i);
+    if (!velocity_known_[k]) {
+      velocities_[k] = body_velocity(bodies_[k]);
+      velocity_known_[k] = 1;
+    }
+    return velocities_[k];
+  };
+  for (const Manifold& m : manifolds_) {
+    append_contact_rows(m, bodies_, velocity(m.body_a), velocity(m.body_b), params, rows_);
+  }
   for (const DistanceConstraint& d : distances_) append_distance_row(d, bodies_, params, rows_);
   counters_.rows += static_cast<std::int64_t>(rows_.size());
 }

@@ -97,13 +97,6 @@ constexpr double kCellGrowth = 1.001;
 // share the edge cells, which can only add candidates, never lose one.
 constexpr double kMaxCell = 1073741824.0;
 
-// Bucket of grid cell (x, y, z) before masking (Teschner et al. 2003, "Optimized spatial hashing
-// for collision detection of deformable objects"); unsigned, so it wraps instead of overflowing.
-std::uint32_t hash_cell(std::int32_t x, std::int32_t y, std::int32_t z) {
-  return (static_cast<std::uint32_t>(x) * 73856093u) ^ (static_cast<std::uint32_t>(y) * 19349663u) ^
-         (static_cast<std::uint32_t>(z) * 83492791u);
-}
-
 // Closed intervals overlap on all three axes.
 template <class B>
 bool bounds_overlap(const B& a, const B& b) {
@@ -112,8 +105,8 @@ bool bounds_overlap(const B& a, const B& b) {
 }
 
 // Sorts a short list in place (the candidates of one body: a handful).
-void insertion_sort(std::vector<int>& v) {
-  for (std::size_t i = 1; i < v.size(); ++i) {
+void insertion_sort(int* v, std::size_t size) {
+  for (std::size_t i = 1; i < size; ++i) {
     const int x = v[i];
     std::size_t k = i;
     for (; k > 0 && v[k - 1] > x; --k) v[k] = v[k - 1];
@@ -158,13 +151,13 @@ void World::broad_phase() {
   const std::size_t n = bodies_.size();
   bounds_.resize(n);
   broad_class_.resize(n);
+  cell_.resize(n);
   bucket_of_.resize(n);
   planes_.clear();
   oversize_.clear();
   widths_.clear();
   pairs_.clear();
   detail::reserve_with_headroom(widths_, n);
-  detail::reserve_with_headroom(candidates_, n);
   const double grow = 0.5 * def_.contact_margin;
   for (std::size_t i = 0; i < n; ++i) {
     const Body& b = bodies_[i];
@@ -208,33 +201,65 @@ void World::broad_phase() {
   }
   const double edge = widest > 0.0 && std::isfinite(widest) ? kCellGrowth * widest : 1.0;
   const double inv_edge = 1.0 / edge;
-  std::size_t buckets = 1;
-  while (buckets < 2 * gridded) buckets *= 2;
-  const auto mask = static_cast<std::uint32_t>(buckets - 1);
   const auto cell_coordinate = [inv_edge](double x) {
     double q = std::floor(x * inv_edge);
     if (!(q >= -kMaxCell)) q = -kMaxCell;  // also NaN
     if (q > kMaxCell) q = kMaxCell;
     return static_cast<std::int32_t>(q);
   };
-  // Counting sort of the gridded bodies by bucket (index order within a bucket).
-  detail::assign_with_headroom(bucket_start_, buckets + 2, 0);
+  // Cells of the gridded bodies and the box of cells they span.
+  std::array<std::int32_t, 3> low{0, 0, 0};
+  std::array<std::int32_t, 3> high{0, 0, 0};
+  bool first = true;
   for (std::size_t i = 0; i < n; ++i) {
     if (broad_class_[i] != BroadClass::gridded) continue;
     const Vec3& lo = bounds_[i].lo;
-    bucket_of_[i] = hash_cell(cell_coordinate(lo.x()), cell_coordinate(lo.y()),
-                              cell_coordinate(lo.z())) & mask;
+    cell_[i] = {cell_coordinate(lo.x()), cell_coordinate(lo.y()), cell_coordinate(lo.z())};
+    for (int k = 0; k < 3; ++k) {
+      low[k] = first ? cell_[i][k] : std::min(low[k], cell_[i][k]);
+      high[k] = first ? cell_[i][k] : std::max(high[k], cell_[i][k]);
+    }
+    first = false;
+  }
+  // Bucket of a cell: x + row(y, z), so that the cells x - 1, x, x + 1 of a row are three
+  // consecutive buckets (one range of the sorted bodies). When the box of cells is at most 16
+  // times the body count, row(y, z) numbers the rows of the box densely and no two cells share
+  // a bucket; otherwise it is a hash of (y, z) (Teschner et al. 2003) and a bucket may also hold
+  // other cells, which the cell test below skips.
+  const std::uint64_t size_x = static_cast<std::uint64_t>(high[0] - low[0]) + 3;
+  const std::uint64_t size_y = static_cast<std::uint64_t>(high[1] - low[1]) + 3;
+  const std::uint64_t size_z = static_cast<std::uint64_t>(high[2] - low[2]) + 3;
+  const double box_cells = static_cast<double>(size_x) * static_cast<double>(size_y) *
+                           static_cast<double>(size_z);
+  const bool dense = box_cells <= 16.0 * static_cast<double>(gridded);
+  std::uint64_t buckets = 4;  // >= 4: the three buckets of a row range are distinct
+  while (buckets < (dense ? static_cast<std::uint64_t>(box_cells) : 2 * gridded)) buckets *= 2;
+  const std::uint64_t mask = buckets - 1;
+  const auto row_key = [&](std::int32_t y, std::int32_t z) -> std::uint64_t {
+    // y - low + 1 and z - low + 1 are in [0, size) for the rows a body looks at.
+    const auto ry = static_cast<std::uint64_t>(static_cast<std::int64_t>(y) - low[1] + 1);
+    const auto rz = static_cast<std::uint64_t>(static_cast<std::int64_t>(z) - low[2] + 1);
+    if (dense) return size_x * (ry + size_y * rz);
+    return (ry * 19349663u) ^ (rz * 83492791u);
+  };
+  const auto key = [&](std::int32_t x, std::int32_t y, std::int32_t z) {
+    return (static_cast<std::uint64_t>(static_cast<std::int64_t>(x) - low[0] + 1) + row_key(y, z)) & mask;
+  };
+  // Counting sort of the gridded bodies by bucket (index order within a bucket).
+  detail::assign_with_headroom(bucket_start_, static_cast<std::size_t>(buckets) + 2, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (broad_class_[i] != BroadClass::gridded) continue;
+    bucket_of_[i] = static_cast<std::uint32_t>(key(cell_[i][0], cell_[i][1], cell_[i][2]));
     ++bucket_start_[bucket_of_[i] + 2];
   }
-  for (std::size_t k = 2; k < buckets + 2; ++k) bucket_start_[k] += bucket_start_[k - 1];
+  for (std::size_t k = 2; k < bucket_start_.size(); ++k) bucket_start_[k] += bucket_start_[k - 1];
   detail::resize_with_headroom(grid_, gridded);
   for (std::size_t i = 0; i < n; ++i) {
     if (broad_class_[i] != BroadClass::gridded) continue;
-    const Vec3& lo = bounds_[i].lo;
     grid_[static_cast<std::size_t>(bucket_start_[bucket_of_[i] + 1]++)] = {
-        static_cast<int>(i), bodies_[i].is_static(),
-        {cell_coordinate(lo.x()), cell_coordinate(lo.y()), cell_coordinate(lo.z())}, bounds_[i]};
+        static_cast<int>(i), bodies_[i].is_static(), cell_[i], bounds_[i]};
   }
+  detail::resize_with_headroom(candidates_, n + planes_.size());
 
   for (std::size_t ia = 0; ia < n; ++ia) {
     const int a = static_cast<int>(ia);
@@ -261,24 +286,32 @@ void World::broad_phase() {
       case BroadClass::gridded:
         break;
     }
-    candidates_.clear();
+    // Bodies of higher index in the 27 cells around a's: per neighbour row one range of
+    // buckets. The test is without branches; a hit is kept by advancing the count.
+    std::size_t count = 0;
     const Bounds& ba = bounds_[ia];
-    const Vec3& lo = ba.lo;
-    const std::int32_t cx = cell_coordinate(lo.x());
-    const std::int32_t cy = cell_coordinate(lo.y());
-    const std::int32_t cz = cell_coordinate(lo.z());
-    for (std::int32_t x = cx - 1; x <= cx + 1; ++x) {
-      for (std::int32_t y = cy - 1; y <= cy + 1; ++y) {
-        for (std::int32_t z = cz - 1; z <= cz + 1; ++z) {
-          const std::uint32_t bucket = hash_cell(x, y, z) & mask;
-          const int begin = bucket_start_[bucket];
-          // The bucket is in index order: walk down while the index is above a.
-          for (int k = bucket_start_[bucket + 1] - 1; k >= begin; --k) {
-            const GridEntry& e = grid_[static_cast<std::size_t>(k)];
-            if (e.body <= a) break;
-            if (e.cell[0] != x || e.cell[1] != y || e.cell[2] != z) continue;  // another cell
-            if (a_static && e.is_static) continue;
-            if (bounds_overlap(ba, e.bounds)) candidates_.push_back(e.body);
+    const std::array<std::int32_t, 3> c = cell_[ia];
+    const auto scan = [&](int begin, int end, std::int32_t y, std::int32_t z) {
+      for (int k = begin; k < end; ++k) {
+        const GridEntry& e = grid_[static_cast<std::size_t>(k)];
+        // The row test keeps a body that shares its bucket with another row from being taken
+        // twice; cells of this row beyond x +- 1 can only be there by wrapping (hashed rows)
+        // and fail the bounds test.
+        const bool hit = (e.body > a) & (e.cell[1] == y) & (e.cell[2] == z) &
+                         !(a_static & e.is_static) & bounds_overlap(ba, e.bounds);
+        candidates_[count] = e.body;
+        count += hit ? 1 : 0;
+      }
+    };
+    for (std::int32_t y = c[1] - 1; y <= c[1] + 1; ++y) {
+      for (std::int32_t z = c[2] - 1; z <= c[2] + 1; ++z) {
+        const auto first_bucket = static_cast<std::size_t>(key(c[0] - 1, y, z));
+        if (first_bucket + 3 <= buckets) {
+          scan(bucket_start_[first_bucket], bucket_start_[first_bucket + 3], y, z);
+        } else {  // the three buckets wrap around the end of the table
+          for (std::int32_t x = c[0] - 1; x <= c[0] + 1; ++x) {
+            const auto bucket = static_cast<std::size_t>(key(x, y, z));
+            scan(bucket_start_[bucket], bucket_start_[bucket + 1], y, z);
           }
         }
       }
@@ -286,16 +319,16 @@ void World::broad_phase() {
     for (const int b : oversize_) {
       const auto ib = static_cast<std::size_t>(b);
       if (b > a && !(a_static && bodies_[ib].is_static()) && bounds_overlap(ba, bounds_[ib])) {
-        candidates_.push_back(b);
+        candidates_[count++] = b;
       }
     }
     if (!a_static) {
       for (const int p : planes_) {
-        if (p > a) candidates_.push_back(p);
+        if (p > a) candidates_[count++] = p;
       }
     }
-    insertion_sort(candidates_);
-    for (const int b : candidates_) pairs_.emplace_back(a, b);
+    insertion_sort(candidates_.data(), count);
+    for (std::size_t k = 0; k < count; ++k) pairs_.emplace_back(a, candidates_[k]);
   }
 }
 

@@ -150,7 +150,7 @@ class World {
   Eigen::VectorXd f_cv_;
   Eigen::VectorXd f_c0_;
   MatrixFreeSystem mf_;
-  // Broad phase (collide()): a uniform grid of cubic cells hashed into buckets, rebuilt every
+  // Broad phase (collide()): a uniform grid of cubic cells numbered into buckets, rebuilt every
   // step by a counting sort, so its cost grows linearly with the body count.
   struct Bounds {
     Vec3 lo;
@@ -166,13 +166,14 @@ class World {
   };
   std::vector<Bounds> bounds_;                       // per body, grown by the contact margin (m)
   std::vector<BroadClass> broad_class_;              // per body
+  std::vector<std::array<std::int32_t, 3>> cell_;    // per body: grid cell (gridded only)
   std::vector<std::uint32_t> bucket_of_;             // per body: its cell's bucket (gridded only)
   std::vector<int> bucket_start_;                    // buckets + 2: bucket k is [start[k], start[k+1])
   std::vector<GridEntry> grid_;                      // gridded bodies by bucket, then index
   std::vector<double> widths_;                       // scratch: widths (m) for the median
   std::vector<int> planes_;                          // plane bodies, by index
   std::vector<int> oversize_;                        // bodies too wide for the grid, by index
-  std::vector<int> candidates_;                      // scratch: bodies b > a that may touch a
+  std::vector<int> candidates_;                      // scratch (n + planes): bodies b > a that may touch a
   std::vector<std::pair<int, int>> pairs_;           // candidate pairs (a < b), in index order
   // build_rows(): body velocities of this step (n), and which of them are computed.
   std::vector<BodyVelocity> velocities_;

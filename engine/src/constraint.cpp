@@ -64,7 +64,9 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
     const Vec3 r_a = c.point - a.x;
     const Vec3 r_b = c.point - b.x;
 
-    ConstraintRow contact;
+    // Rows are built in place (no copy of the 12-vector j per row).
+    const int normal_row = static_cast<int>(rows.size());
+    ConstraintRow& contact = rows.emplace_back();
     contact.kind = RowKind::contact;
     contact.body_a = m.body_a;
     contact.body_b = m.body_b;
@@ -87,15 +89,13 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
     }
     contact.c_min = 0.0;
     contact.c_max = kInfinity;
-    const int normal_row = static_cast<int>(rows.size());
-    rows.push_back(contact);
 
     if (params.friction <= 0.0) continue;
     const double limit = params.friction * mass_per_point * std::abs(params.gravity.dot(c.normal));
     Vec3 t[2];
     tangent_basis(c.normal, t[0], t[1]);
     for (const Vec3& tangent : t) {
-      ConstraintRow friction;
+      ConstraintRow& friction = rows.emplace_back();
       friction.kind = RowKind::friction;
       friction.body_a = m.body_a;
       friction.body_b = m.body_b;
@@ -104,7 +104,6 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
       friction.c_max = limit;
       friction.normal_row = normal_row;
       friction.mu = params.friction;
-      rows.push_back(friction);
     }
   }
 }

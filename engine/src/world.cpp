@@ -93,15 +93,19 @@ constexpr double kOversizeFactor = 8.0;
 // Cell edge = widest gridded body times this (dimensionless, > 1): the margin keeps two
 // overlapping bounds in neighbouring cells despite the rounding of lo / edge.
 constexpr double kCellGrowth = 1.001;
+// The grid numbers its cells densely when their box holds at most this many cells per gridded
+// body (dimensionless; memory: 4 bytes a cell), else it hashes its rows. Typical: 16.
+constexpr double kDenseCells = 16.0;
 // Cell coordinates are clamped to +-2^30 (about 1e9 cells): far out, or not finite, bodies
 // share the edge cells, which can only add candidates, never lose one.
 constexpr double kMaxCell = 1073741824.0;
 
-// Closed intervals overlap on all three axes.
+// Closed intervals overlap on all three axes: no axis separates them (evaluated without
+// branches: | not ||).
 template <class B>
 bool bounds_overlap(const B& a, const B& b) {
-  return !(b.lo.x() > a.hi.x() || a.lo.x() > b.hi.x() || b.lo.y() > a.hi.y() ||
-           a.lo.y() > b.hi.y() || b.lo.z() > a.hi.z() || a.lo.z() > b.hi.z());
+  return !((b.lo.x() > a.hi.x()) | (a.lo.x() > b.hi.x()) | (b.lo.y() > a.hi.y()) |
+           (a.lo.y() > b.hi.y()) | (b.lo.z() > a.hi.z()) | (a.lo.z() > b.hi.z()));
 }
 
 // Sorts a short list in place (the candidates of one body: a handful).
@@ -130,7 +134,9 @@ void World::collide() {
     Manifold& m = manifolds_.emplace_back();
     m.body_a = a;
     m.body_b = b;
-    if (cps::collide(bodies_[static_cast<std::size_t>(a)], bodies_[static_cast<std::size_t>(b)], m,
+    const auto ia = static_cast<std::size_t>(a);
+    const auto ib = static_cast<std::size_t>(b);
+    if (cps::collide(bodies_[ia], rotations_[ia], bodies_[ib], rotations_[ib], m,
                      def_.contact_margin) > 0) {
       counters_.contacts += m.count;
     } else {
@@ -151,6 +157,7 @@ void World::broad_phase() {
   const std::size_t n = bodies_.size();
   bounds_.resize(n);
   broad_class_.resize(n);
+  rotations_.resize(n);
   cell_.resize(n);
   bucket_of_.resize(n);
   planes_.clear();
@@ -164,11 +171,13 @@ void World::broad_phase() {
     Vec3 half = Vec3::Zero();
     switch (b.shape.kind) {
       case ShapeKind::plane:
+        rotations_[i] = b.rotation();
         broad_class_[i] = BroadClass::plane;
         planes_.push_back(static_cast<int>(i));
         continue;
       case ShapeKind::box:
-        half = b.rotation().cwiseAbs() * b.shape.half_extents;
+        rotations_[i] = b.rotation();
+        half = rotations_[i].cwiseAbs() * b.shape.half_extents;
         break;
       case ShapeKind::sphere:
         half = Vec3::Constant(b.shape.radius);
@@ -222,19 +231,29 @@ void World::broad_phase() {
     first = false;
   }
   // Bucket of a cell: x + row(y, z), so that the cells x - 1, x, x + 1 of a row are three
-  // consecutive buckets (one range of the sorted bodies). When the box of cells is at most 16
-  // times the body count, row(y, z) numbers the rows of the box densely and no two cells share
-  // a bucket; otherwise it is a hash of (y, z) (Teschner et al. 2003) and a bucket may also hold
-  // other cells, which the cell test below skips.
+  // consecutive buckets (one range of the sorted bodies). When the box of cells is at most
+  // kDenseCells times the body count, row(y, z) numbers the rows of the box densely and no two
+  // cells share a bucket; otherwise it is a hash of (y, z) (Teschner et al. 2003) and a bucket
+  // may also hold other cells, which the row test below skips.
   const std::uint64_t size_x = static_cast<std::uint64_t>(high[0] - low[0]) + 3;
   const std::uint64_t size_y = static_cast<std::uint64_t>(high[1] - low[1]) + 3;
   const std::uint64_t size_z = static_cast<std::uint64_t>(high[2] - low[2]) + 3;
   const double box_cells = static_cast<double>(size_x) * static_cast<double>(size_y) *
                            static_cast<double>(size_z);
-  const bool dense = box_cells <= 16.0 * static_cast<double>(gridded);
-  std::uint64_t buckets = 4;  // >= 4: the three buckets of a row range are distinct
-  while (buckets < (dense ? static_cast<std::uint64_t>(box_cells) : 2 * gridded)) buckets *= 2;
+  const bool dense = box_cells <= kDenseCells * static_cast<double>(gridded);
+  const auto power_of_two_from = [](std::uint64_t count) {
+    std::uint64_t p = 4;  // >= 4: the three buckets of a row range are distinct
+    while (p < count) p *= 2;
+    return p;
+  };
+  const std::uint64_t buckets =
+      power_of_two_from(dense ? static_cast<std::uint64_t>(box_cells) : 2 * gridded);
   const std::uint64_t mask = buckets - 1;
+  // Room for the most buckets this body count can ask for, so that bodies spreading out (a
+  // larger box of cells) do not make a step allocate.
+  detail::reserve_with_headroom(
+      bucket_start_, static_cast<std::size_t>(power_of_two_from(
+                         static_cast<std::uint64_t>(kDenseCells) * gridded)) + 2);
   const auto row_key = [&](std::int32_t y, std::int32_t z) -> std::uint64_t {
     // y - low + 1 and z - low + 1 are in [0, size) for the rows a body looks at.
     const auto ry = static_cast<std::uint64_t>(static_cast<std::int64_t>(y) - low[1] + 1);
@@ -243,7 +262,8 @@ void World::broad_phase() {
     return (ry * 19349663u) ^ (rz * 83492791u);
   };
   const auto key = [&](std::int32_t x, std::int32_t y, std::int32_t z) {
-    return (static_cast<std::uint64_t>(static_cast<std::int64_t>(x) - low[0] + 1) + row_key(y, z)) & mask;
+    const auto rx = static_cast<std::uint64_t>(static_cast<std::int64_t>(x) - low[0] + 1);
+    return (rx + row_key(y, z)) & mask;
   };
   // Counting sort of the gridded bodies by bucket (index order within a bucket).
   detail::assign_with_headroom(bucket_start_, static_cast<std::size_t>(buckets) + 2, 0);
@@ -278,7 +298,8 @@ void World::broad_phase() {
         for (std::size_t ib = ia + 1; ib < n; ++ib) {
           if (broad_class_[ib] == BroadClass::plane) {
             if (!a_static) pairs_.emplace_back(a, static_cast<int>(ib));
-          } else if (!(a_static && bodies_[ib].is_static()) && bounds_overlap(bounds_[ia], bounds_[ib])) {
+          } else if (!(a_static && bodies_[ib].is_static()) &&
+                     bounds_overlap(bounds_[ia], bounds_[ib])) {
             pairs_.emplace_back(a, static_cast<int>(ib));
           }
         }

@@ -165,15 +165,16 @@ class World {
     Bounds bounds;
   };
   std::vector<Bounds> bounds_;                       // per body, grown by the contact margin (m)
+  std::vector<Mat3> rotations_;                      // per box or plane: R, for the narrow phase
   std::vector<BroadClass> broad_class_;              // per body
   std::vector<std::array<std::int32_t, 3>> cell_;    // per body: grid cell (gridded only)
   std::vector<std::uint32_t> bucket_of_;             // per body: its cell's bucket (gridded only)
-  std::vector<int> bucket_start_;                    // buckets + 2: bucket k is [start[k], start[k+1])
+  std::vector<int> bucket_start_;                    // buckets + 2: k is [start[k], start[k+1])
   std::vector<GridEntry> grid_;                      // gridded bodies by bucket, then index
   std::vector<double> widths_;                       // scratch: widths (m) for the median
   std::vector<int> planes_;                          // plane bodies, by index
   std::vector<int> oversize_;                        // bodies too wide for the grid, by index
-  std::vector<int> candidates_;                      // scratch (n + planes): bodies b > a that may touch a
+  std::vector<int> candidates_;                      // scratch (n + planes): b > a near a
   std::vector<std::pair<int, int>> pairs_;           // candidate pairs (a < b), in index order
   // build_rows(): body velocities of this step (n), and which of them are computed.
   std::vector<BodyVelocity> velocities_;

@@ -147,12 +147,14 @@ void World::collide() {
 
 // Broad phase: axis-aligned bounds grown by the contact margin; a pair is a candidate when its
 // bounds overlap (closed intervals on x, y and z) and not both bodies are static; every plane is
-// a candidate with every movable body. Bounds go into a uniform grid of cubic cells as wide as
-// the widest body (Ericson 2005, Sec. 7.1), hashed into twice as many buckets as bodies and
-// sorted into them by a counting sort, so the cost grows with the body count and the pairs, not
-// with their square or a sort. Two overlapping bounds have lower corners at most one cell
-// apart, so each body looks in the 27 cells around its own for bodies of higher index; the few
-// candidates of one body are sorted, so the pairs come out in index order without a global sort.
+// a candidate with every movable body. Bounds go into a uniform grid of cubic cells a little
+// wider than the widest body (Ericson 2005, Sec. 7.1), put in order of their cell's bucket by a
+// counting sort, so the cost grows with the body count and the pairs, not with their square or
+// a sort. Two overlapping bounds have lower corners at most one cell apart, so each body looks
+// in the 27 cells around its own (9 rows of 3) for bodies of higher index; the few candidates
+// of one body are sorted, so the pairs come out in index order without a global sort. Bodies
+// more than kOversizeFactor times wider than the median are kept out of the grid and tested
+// against every body, so that one large body does not make every cell large.
 void World::broad_phase() {
   const std::size_t n = bodies_.size();
   bounds_.resize(n);
@@ -165,6 +167,8 @@ void World::broad_phase() {
   widths_.clear();
   pairs_.clear();
   detail::reserve_with_headroom(widths_, n);
+  detail::reserve_with_headroom(planes_, n);
+  detail::reserve_with_headroom(oversize_, n);
   const double grow = 0.5 * def_.contact_margin;
   for (std::size_t i = 0; i < n; ++i) {
     const Body& b = bodies_[i];

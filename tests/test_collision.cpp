@@ -1,10 +1,13 @@
 // Collision detection (paper Sec. 4): box-plane and box-box manifolds against geometry worked
 // out by hand.
 #include "cps/collision.h"
+#include "cps/world.h"
 
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <random>
+#include <vector>
 
 using namespace cps;
 
@@ -227,4 +230,101 @@ TEST_CASE("a speculative margin reports near features with a negative depth", "[
                         m, 0.005) == 0);
   REQUIRE(collide_sphere_sphere(Vec3::Zero(), 0.5, Vec3(1.003, 0, 0), 0.5, m, 0.005) == 1);
   CHECK(m.contacts[0].depth == Approx(-0.003).margin(1e-12));
+}
+
+// The broad phase (a hashed grid, World::collide) must hand the narrow phase exactly the pairs
+// of the plain definition, in index order: every pair a < b, not both static, that is a plane
+// with a movable body or whose axis-aligned bounds (grown by half the margin each) overlap. A
+// crowded random world with bodies of 0.05 to 2 m, a 60 m static slab (wider than the grid's
+// cells) and planes between the other bodies is checked against that definition evaluated
+// over all pairs; once as it is (the grid numbers its cells densely) and once with one more body
+// 1e7 m away (the grid's box is then too large and it hashes its rows).
+TEST_CASE("the broad phase finds the manifolds of the all-pairs test, in index order",
+          "[collision][broad]") {
+  const double margin = GENERATE(0.0, 0.02);
+  // 0: the mixed world (dense grid); 1: the same with one body 1e7 m away (hashed rows);
+  // 2: 600 small balls in two clusters 400 m apart (hashed rows that share buckets).
+  const int layout = GENERATE(0, 1, 2);
+  WorldDef def;
+  def.contact_margin = margin;
+  World world(def);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto add = [&](const Shape& shape, bool is_static, const Vec3& at) {
+    BodyDef b;
+    b.shape = shape;
+    b.is_static = is_static;
+    b.position = at;
+    b.orientation = Quat(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5,
+                         unit(random) - 0.5).normalized();
+    if (shape.kind == ShapeKind::plane) b.orientation = Quat::Identity();
+    world.add_body(b);
+  };
+  add(Shape::plane(Vec3::UnitY(), 0.0), true, Vec3::Zero());
+  if (layout == 2) {
+    for (int i = 0; i < 600; ++i) {
+      const Vec3 at = Vec3(2.0 * unit(random), 2.0 * unit(random), 2.0 * unit(random)) +
+                      (i % 2 == 0 ? Vec3::Zero() : Vec3(400.0, 0.0, 300.0));
+      add(Shape::sphere(0.1 + 0.05 * unit(random)), false, at);
+    }
+  }
+  for (int i = 0; i < 400 && layout != 2; ++i) {
+    const Vec3 at(8.0 * unit(random) - 4.0, 6.0 * unit(random), 8.0 * unit(random) - 4.0);
+    const double size = 0.05 + (i % 7 == 0 ? 1.95 : 0.6) * unit(random);
+    if (i == 100) add(Shape::box(Vec3(30.0, 0.2, 30.0)), true, Vec3(0.0, 1.0, 0.0));
+    if (i == 200) add(Shape::plane(Vec3(1.0, 1.0, 0.0), -1.0), true, Vec3::Zero());
+    if (i == 300 && layout == 1) add(Shape::box(Vec3::Constant(0.5)), false, Vec3(1e7, 3.0, -1e7));
+    if (i % 50 == 0) {
+      add(Shape::box(Vec3::Constant(size)), true, at);  // static boxes among the others
+    } else if (i % 2 == 0) {
+      add(Shape::box(Vec3(size, 0.5 * size + 0.05, 0.8 * size)), false, at);
+    } else {
+      add(Shape::sphere(size), false, at);
+    }
+  }
+  const std::vector<Body> before = world.bodies();  // the step collides this state
+  world.step();
+
+  const auto bounds = [&](const Body& b, Vec3& lo, Vec3& hi) {
+    const Vec3 half = b.shape.kind == ShapeKind::box
+                          ? Vec3(b.rotation().cwiseAbs() * b.shape.half_extents)
+                          : Vec3(Vec3::Constant(b.shape.radius));
+    lo = b.x - half - Vec3::Constant(0.5 * margin);
+    hi = b.x + half + Vec3::Constant(0.5 * margin);
+  };
+  std::vector<Manifold> expected;
+  const int n = static_cast<int>(before.size());
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) {
+      const Body& A = before[static_cast<std::size_t>(a)];
+      const Body& B = before[static_cast<std::size_t>(b)];
+      if (A.is_static() && B.is_static()) continue;
+      const bool a_plane = A.shape.kind == ShapeKind::plane;
+      const bool b_plane = B.shape.kind == ShapeKind::plane;
+      if (!a_plane && !b_plane) {
+        Vec3 lo_a, hi_a, lo_b, hi_b;
+        bounds(A, lo_a, hi_a);
+        bounds(B, lo_b, hi_b);
+        if ((lo_b.array() > hi_a.array()).any() || (lo_a.array() > hi_b.array()).any()) continue;
+      }
+      Manifold m;
+      m.body_a = a;
+      m.body_b = b;
+      if (collide(A, B, m, margin) > 0) expected.push_back(m);
+    }
+  }
+  const std::vector<Manifold>& found = world.manifolds();
+  REQUIRE(expected.size() > 200);  // a crowded world: the test has pairs to find
+  REQUIRE(found.size() == expected.size());
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    INFO("manifold " << k);
+    REQUIRE(found[k].body_a == expected[k].body_a);
+    REQUIRE(found[k].body_b == expected[k].body_b);
+    REQUIRE(found[k].count == expected[k].count);
+    for (int i = 0; i < found[k].count; ++i) {
+      const auto c = static_cast<std::size_t>(i);
+      CHECK(found[k].contacts[c].point == expected[k].contacts[c].point);
+      CHECK(found[k].contacts[c].depth == expected[k].contacts[c].depth);
+    }
+  }
 }

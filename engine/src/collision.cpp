@@ -6,11 +6,11 @@
 namespace cps {
 namespace {
 
-OrientedBox oriented_box(const Body& b) { return {b.x, b.rotation(), b.shape.half_extents}; }
+OrientedBox oriented_box(const Body& b, const Mat3& R) { return {b.x, R, b.shape.half_extents}; }
 
-// World-space plane of a plane body: {x : dot(n, x) = offset}.
-void world_plane(const Body& b, Vec3& n, double& offset) {
-  n = b.rotation() * b.shape.normal;
+// World-space plane of a plane body with rotation R: {x : dot(n, x) = offset}.
+void world_plane(const Body& b, const Mat3& R, Vec3& n, double& offset) {
+  n = R * b.shape.normal;
   offset = b.shape.offset + n.dot(b.x);
 }
 
@@ -94,7 +94,11 @@ int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold
   return 1;
 }
 
-int collide(const Body& a, const Body& b, Manifold& out, double margin) {
+namespace {
+
+// collide() with the rotations given (R_a, R_b), or computed here when needed (nullptr).
+int collide_bodies(const Body& a, const Mat3* R_a, const Body& b, const Mat3* R_b, Manifold& out,
+                   double margin) {
   out.count = 0;
   if (a.is_static() && b.is_static()) return 0;
   // Order the pair as (box, sphere, plane) by kind; flip the normals back if it was swapped.
@@ -102,16 +106,20 @@ int collide(const Body& a, const Body& b, Manifold& out, double margin) {
   const bool swapped = rank(a.shape.kind) > rank(b.shape.kind);
   const Body& first = swapped ? b : a;
   const Body& second = swapped ? a : b;
+  const Mat3* given_1 = swapped ? R_b : R_a;
+  const Mat3* given_2 = swapped ? R_a : R_b;
+  const auto R1 = [&] { return given_1 != nullptr ? *given_1 : first.rotation(); };
+  const auto R2 = [&] { return given_2 != nullptr ? *given_2 : second.rotation(); };
   const ShapeKind k1 = first.shape.kind;
   const ShapeKind k2 = second.shape.kind;
   Vec3 n;
   double offset;
   if (k2 == ShapeKind::plane) {
     if (k1 == ShapeKind::plane) return 0;
-    world_plane(second, n, offset);
+    world_plane(second, R2(), n, offset);
     // Contacts come from the plane to the shape: from `second` to `first`.
     if (k1 == ShapeKind::box) {
-      collide_box_plane(oriented_box(first), n, offset, out, margin);
+      collide_box_plane(oriented_box(first, R1()), n, offset, out, margin);
     } else {
       collide_sphere_plane(first.x, first.shape.radius, n, offset, out, margin);
     }
@@ -119,15 +127,26 @@ int collide(const Body& a, const Body& b, Manifold& out, double margin) {
     return out.count;
   }
   if (k1 == ShapeKind::box && k2 == ShapeKind::box) {
-    collide_box_box(oriented_box(first), oriented_box(second), out, margin);
+    collide_box_box(oriented_box(first, R1()), oriented_box(second, R2()), out, margin);
   } else if (k1 == ShapeKind::box) {
-    collide_box_sphere(oriented_box(first), second.x, second.shape.radius, out, margin);
+    collide_box_sphere(oriented_box(first, R1()), second.x, second.shape.radius, out, margin);
   } else {
     collide_sphere_sphere(first.x, first.shape.radius, second.x, second.shape.radius, out,
                           margin);
   }
   if (swapped) flip_normals(out);
   return out.count;
+}
+
+}  // namespace
+
+int collide(const Body& a, const Body& b, Manifold& out, double margin) {
+  return collide_bodies(a, nullptr, b, nullptr, out, margin);
+}
+
+int collide(const Body& a, const Mat3& R_a, const Body& b, const Mat3& R_b, Manifold& out,
+            double margin) {
+  return collide_bodies(a, &R_a, b, &R_b, out, margin);
 }
 
 }  // namespace cps

@@ -36,7 +36,18 @@ double relative_velocity(const Vec12& j, const Vec3& v_a, const Vec3& w_a, const
 
 }  // namespace
 
+BodyVelocity body_velocity(const Body& b) { return {b.velocity(), b.angular_velocity()}; }
+
 void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
+                         const RowParams& params, std::vector<ConstraintRow>& rows) {
+  if (m.count == 0) return;
+  // Body velocities, once per manifold (the angular ones need I^-1 in world space).
+  append_contact_rows(m, bodies, body_velocity(bodies[static_cast<std::size_t>(m.body_a)]),
+                      body_velocity(bodies[static_cast<std::size_t>(m.body_b)]), params, rows);
+}
+
+void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
+                         const BodyVelocity& vel_a, const BodyVelocity& vel_b,
                          const RowParams& params, std::vector<ConstraintRow>& rows) {
   if (m.count == 0) return;
   const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
@@ -44,17 +55,18 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
   // Sec. 5.4: m is the combined mass of both bodies divided over the contact points (a static
   // body has mass 0 here, so the movable body's mass remains).
   const double mass_per_point = (a.mass + b.mass) / static_cast<double>(m.count);
-  // Body velocities, once per manifold (the angular ones need I^-1 in world space).
-  const Vec3 v_a = a.velocity();
-  const Vec3 w_a = a.angular_velocity();
-  const Vec3 v_b = b.velocity();
-  const Vec3 w_b = b.angular_velocity();
+  const Vec3& v_a = vel_a.v;
+  const Vec3& w_a = vel_a.w;
+  const Vec3& v_b = vel_b.v;
+  const Vec3& w_b = vel_b.w;
   for (int i = 0; i < m.count; ++i) {
     const Contact& c = m.contacts[static_cast<std::size_t>(i)];
     const Vec3 r_a = c.point - a.x;
     const Vec3 r_b = c.point - b.x;
 
-    ConstraintRow contact;
+    // Rows are built in place (no copy of the 12-vector j per row).
+    const int normal_row = static_cast<int>(rows.size());
+    ConstraintRow& contact = rows.emplace_back();
     contact.kind = RowKind::contact;
     contact.body_a = m.body_a;
     contact.body_b = m.body_b;
@@ -77,15 +89,13 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
     }
     contact.c_min = 0.0;
     contact.c_max = kInfinity;
-    const int normal_row = static_cast<int>(rows.size());
-    rows.push_back(contact);
 
     if (params.friction <= 0.0) continue;
     const double limit = params.friction * mass_per_point * std::abs(params.gravity.dot(c.normal));
     Vec3 t[2];
     tangent_basis(c.normal, t[0], t[1]);
     for (const Vec3& tangent : t) {
-      ConstraintRow friction;
+      ConstraintRow& friction = rows.emplace_back();
       friction.kind = RowKind::friction;
       friction.body_a = m.body_a;
       friction.body_b = m.body_b;
@@ -94,7 +104,6 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
       friction.c_max = limit;
       friction.normal_row = normal_row;
       friction.mu = params.friction;
-      rows.push_back(friction);
     }
   }
 }

@@ -44,6 +44,12 @@ struct Manifold {
 /// no contact. No errors are raised. Every collide_* function below takes the same margin.
 int collide(const Body& a, const Body& b, Manifold& out, double margin = 0.0);
 
+/// collide() with the rotation matrices of the bodies given: R_a = a.rotation(), R_b =
+/// b.rotation() (3 x 3, body to world), for a caller that has them already (the world computes
+/// them once per step for its bounds). Same result as collide(a, b, out, margin).
+int collide(const Body& a, const Mat3& R_a, const Body& b, const Mat3& R_b, Manifold& out,
+            double margin = 0.0);
+
 /// A box in world space: centre c (m), rotation R (3 x 3, columns are the box axes in world
 /// space), half extents e (m).
 struct OrientedBox {

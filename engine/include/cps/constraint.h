@@ -78,6 +78,23 @@ struct RowParams {
 void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
                          const RowParams& params, std::vector<ConstraintRow>& rows);
 
+/// A body's velocities in world space: linear v = m^-1 p (m/s) and angular w = I^-1 l (rad/s)
+/// with I^-1 = R I_body^-1 R^T (Sec. 3.1), as Body::velocity and Body::angular_velocity give.
+struct BodyVelocity {
+  Vec3 v = Vec3::Zero();
+  Vec3 w = Vec3::Zero();
+};
+
+/// BodyVelocity of one body (the same numbers as b.velocity(), b.angular_velocity()).
+BodyVelocity body_velocity(const Body& b);
+
+/// The same rows as append_contact_rows above, with the two bodies' velocities given (v_a of
+/// body m.body_a, v_b of body m.body_b), so that a step that builds many manifolds per body
+/// computes each body's I^-1 once instead of once per manifold.
+void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
+                         const BodyVelocity& v_a, const BodyVelocity& v_b,
+                         const RowParams& params, std::vector<ConstraintRow>& rows);
+
 /// A distance constraint (Sec. 5.2): point local_a of body_a and point local_b of body_b stay
 /// `length` apart (m, >= 0). local_a, local_b are in body space (m); when body_b is kWorldBody,
 /// local_b is a fixed world point (m). The row is unbounded (c_min = -inf, c_max = +inf).

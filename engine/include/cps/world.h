@@ -1,6 +1,6 @@
 #pragma once
 // The world and its step. One step reads as the paper's stages, in order:
-//   1. collide          Sec. 4    sort-and-sweep broad phase, then manifolds for every pair
+//   1. collide          Sec. 4    uniform grid broad phase, then manifolds for every pair
 //                                 that can touch (skipped when the world has collision off)
 //   2. build rows       Sec. 5    contact, friction (only with mu > 0) and distance rows
 //   3. assemble         Sec. 6    J, M^-1, A and b of Eq. 6.2.9 (explicit), or per-row
@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -128,6 +129,7 @@ class World {
 
  private:
   void collide();
+  void broad_phase();
   void build_rows();
   void solve_and_integrate();
   void solve_explicit();
@@ -148,15 +150,35 @@ class World {
   Eigen::VectorXd f_cv_;
   Eigen::VectorXd f_c0_;
   MatrixFreeSystem mf_;
-  // Broad phase buffers: per body bounds, the sweep order, candidate pairs.
+  // Broad phase (collide()): a uniform grid of cubic cells numbered into buckets, rebuilt every
+  // step by a counting sort, so its cost grows linearly with the body count.
   struct Bounds {
     Vec3 lo;
     Vec3 hi;
   };
-  std::vector<Bounds> bounds_;
-  std::vector<int> sweep_order_;
-  std::vector<int> planes_;
-  std::vector<std::pair<int, int>> pairs_;
+  enum class BroadClass : unsigned char { plane, gridded, oversize };
+  // A gridded body as the grid stores it, by bucket: what the pair test needs, side by side.
+  struct GridEntry {
+    int body;                          // index
+    bool is_static;
+    std::array<std::int32_t, 3> cell;  // grid cell of the lower corner
+    Bounds bounds;
+  };
+  std::vector<Bounds> bounds_;                       // per body, grown by the contact margin (m)
+  std::vector<Mat3> rotations_;                      // per box or plane: R, for the narrow phase
+  std::vector<BroadClass> broad_class_;              // per body
+  std::vector<std::array<std::int32_t, 3>> cell_;    // per body: grid cell (gridded only)
+  std::vector<std::uint32_t> bucket_of_;             // per body: its cell's bucket (gridded only)
+  std::vector<int> bucket_start_;                    // buckets + 2: k is [start[k], start[k+1])
+  std::vector<GridEntry> grid_;                      // gridded bodies by bucket, then index
+  std::vector<double> widths_;                       // scratch: widths (m) for the median
+  std::vector<int> planes_;                          // plane bodies, by index
+  std::vector<int> oversize_;                        // bodies too wide for the grid, by index
+  std::vector<int> candidates_;                      // scratch (n + planes): b > a near a
+  std::vector<std::pair<int, int>> pairs_;           // candidate pairs (a < b), in index order
+  // build_rows(): body velocities of this step (n), and which of them are computed.
+  std::vector<BodyVelocity> velocities_;
+  std::vector<unsigned char> velocity_known_;
   StepCounters counters_;
   ResidualStats residual_;
 };

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -42,22 +43,34 @@ double thread_cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-// Microseconds per step of `scene` with this assembly: the world is first advanced 1 s into
-// the scene (untimed, so contacts have formed), then stepped in 5 timed blocks of `steps`; the
-// median block's thread CPU time per step counts.
-double us_per_step(const scenes::Scene& scene, Assembly assembly, int steps) {
+// Time and work per step of a scene: microseconds (thread CPU time) and constraint rows.
+struct StepCost {
+  double us = 0.0;    ///< median block's microseconds per step
+  double rows = 0.0;  ///< rows per step over the timed blocks (contact, friction, distance)
+};
+
+// The cost of `scene` with this assembly: the world is first advanced 1 s into the scene
+// (untimed, so contacts have formed), then stepped in 5 timed blocks of `steps`; the median
+// block's thread CPU time per step counts.
+StepCost step_cost(const scenes::Scene& scene, Assembly assembly, int steps) {
   scenes::Run run = scenes::make_run(scene);
   WorldDef def = run.world.def();
   def.assembly = assembly;
   run.world.set_def(def);
   while (run.world.time() < 1.0) run.world.step();
   std::vector<double> blocks;
+  const std::int64_t rows_before = run.world.counters().rows;
   for (int b = 0; b < 5; ++b) {
     const double start = thread_cpu_seconds();
     for (int k = 0; k < steps; ++k) run.world.step();
     blocks.push_back(1e6 * (thread_cpu_seconds() - start) / steps);
   }
-  return median(blocks);
+  return {median(blocks),
+          static_cast<double>(run.world.counters().rows - rows_before) / (5.0 * steps)};
+}
+
+double us_per_step(const scenes::Scene& scene, Assembly assembly, int steps) {
+  return step_cost(scene, assembly, steps).us;
 }
 
 // Least-squares slope of log(time) against log(bodies).
@@ -201,7 +214,7 @@ int run_bench(bool quick, bool rendering_only) {
   }
   for (const std::string& name : names) {
     const scenes::Scene& scene = *scenes::find_scene(name);
-    const int steps = quick ? 20 : 60;
+    const int steps = quick ? 12 : 36;  // 5 blocks: 3 s of a 60 Hz scene (1 s quick)
     std::fprintf(stderr, "bench: %s\n", name.c_str());
     const double e = us_per_step(scene, Assembly::explicit_matrices, steps);
     const double m = us_per_step(scene, Assembly::matrix_free, steps);
@@ -210,24 +223,31 @@ int run_bench(bool quick, bool rendering_only) {
   }
 
   std::printf("\n## Cost growth (matrix-free): log-log slope of time per step against bodies\n\n"
-              "| family | bodies: us/step | slope |\n|---|---|---|\n");
+              "Also against the rows per step: a larger pile has more contacts per body (fewer "
+              "bodies on its edges), so part of the growth is more work per body.\n\n"
+              "| family | bodies: us/step (rows/step) | slope against bodies | slope against rows |\n"
+              "|---|---|---|---|\n");
   const std::vector<int> sizes = quick ? std::vector<int>{100, 300, 1000}
                                        : std::vector<int>{100, 300, 1000, 3000, 5000};
   for (const char* family : {"pyramid", "funnel"}) {
-    std::vector<std::pair<double, double>> points;
+    std::vector<std::pair<double, double>> by_bodies;
+    std::vector<std::pair<double, double>> by_rows;
     std::string cells;
     for (const int n : sizes) {
       const std::string name = std::string(family) + "_" + std::to_string(n);
       std::fprintf(stderr, "bench: %s\n", name.c_str());
       const scenes::Scene& scene = *scenes::find_scene(name);
       const double bodies = static_cast<double>(scenes::make_run(scene).world.bodies().size());
-      const double t = us_per_step(scene, Assembly::matrix_free, quick ? 5 : 10);
-      points.emplace_back(bodies, t);
-      char cell[64];
-      std::snprintf(cell, sizeof cell, "%s%.0f: %.0f", cells.empty() ? "" : ", ", bodies, t);
+      const StepCost cost = step_cost(scene, Assembly::matrix_free, quick ? 3 : 6);
+      by_bodies.emplace_back(bodies, cost.us);
+      by_rows.emplace_back(std::max(cost.rows, 1.0), cost.us);
+      char cell[96];
+      std::snprintf(cell, sizeof cell, "%s%.0f: %.0f (%.0f)", cells.empty() ? "" : ", ", bodies,
+                    cost.us, cost.rows);
       cells += cell;
     }
-    std::printf("| %s_N | %s | %.2f |\n", family, cells.c_str(), log_log_slope(points));
+    std::printf("| %s_N | %s | %.2f | %.2f |\n", family, cells.c_str(), log_log_slope(by_bodies),
+                log_log_slope(by_rows));
   }
 
 #ifdef CPS_HAVE_RENDERER

@@ -197,13 +197,12 @@ void World::broad_phase() {
     widths_.push_back(std::isfinite(width) ? width : 0.0);
   }
   if (widths_.size() <= kAllPairsMax) {
-    // A small world: every body is tested against every other, as the oversize ones are (the
-    // grid below is then empty).
+    // A small world: every body is tested against every other, as the oversize ones are.
     for (std::size_t i = 0; i < n; ++i) {
-      if (broad_class_[i] == BroadClass::plane) continue;
-      broad_class_[i] = BroadClass::oversize;
-      oversize_.push_back(static_cast<int>(i));
+      if (broad_class_[i] != BroadClass::plane) broad_class_[i] = BroadClass::oversize;
     }
+    for (std::size_t i = 0; i < n; ++i) pairs_of_ungridded(i);
+    return;
   }
   // Bodies much wider than the median go to the oversize list; the rest set the cell edge.
   double limit = kInfinity;
@@ -301,28 +300,9 @@ void World::broad_phase() {
   for (std::size_t ia = 0; ia < n; ++ia) {
     const int a = static_cast<int>(ia);
     const bool a_static = bodies_[ia].is_static();
-    switch (broad_class_[ia]) {
-      case BroadClass::plane:
-        // Every movable body of higher index, in order.
-        for (std::size_t ib = ia + 1; ib < n; ++ib) {
-          if (broad_class_[ib] != BroadClass::plane && !bodies_[ib].is_static()) {
-            pairs_.emplace_back(a, static_cast<int>(ib));
-          }
-        }
-        continue;
-      case BroadClass::oversize:
-        // Every body of higher index, in order.
-        for (std::size_t ib = ia + 1; ib < n; ++ib) {
-          if (broad_class_[ib] == BroadClass::plane) {
-            if (!a_static) pairs_.emplace_back(a, static_cast<int>(ib));
-          } else if (!(a_static && bodies_[ib].is_static()) &&
-                     bounds_overlap(bounds_[ia], bounds_[ib])) {
-            pairs_.emplace_back(a, static_cast<int>(ib));
-          }
-        }
-        continue;
-      case BroadClass::gridded:
-        break;
+    if (broad_class_[ia] != BroadClass::gridded) {
+      pairs_of_ungridded(ia);
+      continue;
     }
     // Bodies of higher index in the 27 cells around a's: per neighbour row one range of
     // buckets. The test is without branches; a hit is kept by advancing the count.
@@ -367,6 +347,30 @@ void World::broad_phase() {
     }
     insertion_sort(candidates_.data(), count);
     for (std::size_t k = 0; k < count; ++k) pairs_.emplace_back(a, candidates_[k]);
+  }
+}
+
+// The pairs (ia, b), b > ia, in order, of a body kept out of the grid: a plane pairs with every
+// movable body; an oversize body with every plane (when it is movable) and every body whose
+// bounds overlap its own, not both static.
+void World::pairs_of_ungridded(std::size_t ia) {
+  const std::size_t n = bodies_.size();
+  const int a = static_cast<int>(ia);
+  const bool a_static = bodies_[ia].is_static();
+  if (broad_class_[ia] == BroadClass::plane) {
+    for (std::size_t ib = ia + 1; ib < n; ++ib) {
+      if (broad_class_[ib] != BroadClass::plane && !bodies_[ib].is_static()) {
+        pairs_.emplace_back(a, static_cast<int>(ib));
+      }
+    }
+    return;
+  }
+  for (std::size_t ib = ia + 1; ib < n; ++ib) {
+    if (broad_class_[ib] == BroadClass::plane) {
+      if (!a_static) pairs_.emplace_back(a, static_cast<int>(ib));
+    } else if (!(a_static && bodies_[ib].is_static()) && bounds_overlap(bounds_[ia], bounds_[ib])) {
+      pairs_.emplace_back(a, static_cast<int>(ib));
+    }
   }
 }
 

@@ -130,6 +130,7 @@ class World {
  private:
   void collide();
   void broad_phase();
+  void pairs_of_ungridded(std::size_t body);
   void build_rows();
   void solve_and_integrate();
   void solve_explicit();

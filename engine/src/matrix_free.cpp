@@ -62,7 +62,8 @@ inline void sweep_short_run(const PackedRow* r, const double* b, double* l, int 
 }
 
 // A run of m rows on w_a and (kTwoBodies) w_b as a block; kM = m when known at compile time (the
-// loops then unroll), 0 otherwise. g: the run's m x m coupling block (column i: A_ki / A_kk).
+// loops then unroll), 0 otherwise. g: the run's coupling, the strict lower triangle of its m x m
+// block column by column (column i: A_ki / A_kk for k = i+1..m-1).
 template <bool kCoupled, bool kTwoBodies, int kM>
 inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_runtime,
                         const double* g, const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
@@ -76,7 +77,7 @@ inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_ru
   }
   Vec6 dw_a = Vec6::Zero();
   Vec6 dw_b = Vec6::Zero();
-  for (int i = 0; i < m; ++i, g += m) {
+  for (int i = 0; i < m; g += m - 1 - i, ++i) {
     if (r[i].inv_diagonal == 0.0) continue;  // lambda_i stays 0
     double lo;
     double hi;
@@ -84,7 +85,7 @@ inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_ru
     const double value = std::clamp(t[i], lo, hi);
     const double delta = value - l[i];
     l[i] = value;
-    for (int k = i + 1; k < m; ++k) t[k] -= g[k] * delta;
+    for (int k = i + 1; k < m; ++k) t[k] -= g[k - i - 1] * delta;
     dw_a += delta * ConstMap6(r[i].minv_jt.data());
     if constexpr (kTwoBodies) dw_b += delta * ConstMap6(r[i].minv_jt.data() + 6);
   }
@@ -238,10 +239,9 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
 
 namespace {
 
-// Coupling entries reserved per row: sum over runs of m^2 <= kMaxRun * (sum of m) = kMaxRun *
-// rows, so this bound holds for any mix of manifolds (8 bytes x 24 = 192 bytes a row, about
-// the size of the packed row itself).
-constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun;
+// Coupling entries reserved per row: sum over runs of m (m - 1) / 2 <= (kMaxRun - 1) / 2 *
+// (sum of m), so this bound holds for any mix of manifolds (8 bytes x 12 = 96 bytes a row).
+constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun / 2;
 
 // Runs of consecutive rows on the same two slots, and their coupling blocks (PGS only).
 void build_runs(MatrixFreeSystem& s) {
@@ -258,7 +258,7 @@ void build_runs(MatrixFreeSystem& s) {
     const int m = static_cast<int>(end - r);
     const bool block = m >= MatrixFreeSystem::kMinBlock;
     s.runs.push_back({static_cast<int>(r), m, block ? static_cast<int>(coupling_size) : -1});
-    if (block) coupling_size += static_cast<std::size_t>(m * m);
+    if (block) coupling_size += static_cast<std::size_t>(m * (m - 1) / 2);
     r = end;
   }
   // Room for the largest coupling these many rows can need (kCouplingPerRow): it then grows only
@@ -270,12 +270,12 @@ void build_runs(MatrixFreeSystem& s) {
     if (run.offset < 0) continue;
     const PackedRow* r = s.rows.data() + run.begin;
     double* g = s.coupling.data() + run.offset;
-    for (int i = 0; i < run.count; ++i) {
+    for (int i = 0; i < run.count; g += run.count - 1 - i, ++i) {
       // Column i: A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
       for (int k = i + 1; k < run.count; ++k) {
         const double a_ki = ConstMap6(r[k].j.data()).dot(ConstMap6(r[i].minv_jt.data())) +
                             ConstMap6(r[k].j.data() + 6).dot(ConstMap6(r[i].minv_jt.data() + 6));
-        g[run.count * i + k] = a_ki * r[k].inv_diagonal;
+        g[k - i - 1] = a_ki * r[k].inv_diagonal;
       }
     }
   }

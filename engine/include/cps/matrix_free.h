@@ -36,13 +36,13 @@ struct MatrixFreeSystem {
     int b = 0;                         ///< body slot of half b
   };
   /// Consecutive rows on the same two body slots (the rows of one manifold): PGS sweeps them as
-  /// a block. Each sees the others' updates through coupling[offset + m i + k] =
-  /// A_ki / A_kk (k > i) instead of through w, so the rows of a run do not wait on each other's
-  /// w stores and the first products j . w of a run are independent.
+  /// a block. Each sees the others' updates through the coupling A_ki / A_kk (k > i) instead of
+  /// through w, so the rows of a run do not wait on each other's w stores and the first products
+  /// j . w of a run are independent.
   struct Run {
     int begin = 0;   ///< first row
     int count = 0;   ///< rows, 1..kMaxRun
-    int offset = 0;  ///< start of its count x count block in coupling; -1: swept row by row
+    int offset = 0;  ///< start of its coupling (m (m - 1) / 2 entries); -1: swept row by row
   };
   /// Runs shorter than this (a single contact point: 3 rows) are swept row by row through w: for
   /// them the block measured no faster (funnel scene).
@@ -52,7 +52,9 @@ struct MatrixFreeSystem {
   std::vector<Row> rows;
   std::vector<Run> runs;
   bool runs_ready = false;       ///< runs and coupling built for these rows (first PGS solve)
-  std::vector<double> coupling;  ///< per block run of m rows: m x m, column i = A_ki / A_kk, k > i
+  /// Per block run of m rows: the strict lower triangle of its m x m coupling, column by column
+  /// (column i: A_ki / A_kk for k = i+1..m-1; dimensionless).
+  std::vector<double> coupling;
   std::vector<double> diagonal;  ///< per row: A_jj = j M^-1 j^T (1/kg)
   std::vector<double> b;         ///< per row: right-hand side of Eq. 6.2.9 (N)
   std::vector<double> next;      ///< Jacobi: the sweep's new values (N)

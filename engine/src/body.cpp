@@ -67,6 +67,7 @@ Shape Shape::plane(const Vec3& n, double offset) {
 
 Mat3 Body::inv_inertia_world() const {
   if (is_static()) return Mat3::Zero();
+  if (shape.kind == ShapeKind::sphere) return inv_inertia_body;  // isotropic: R c R^T = c
   const Mat3 R = rotation();
   return R * inv_inertia_body * R.transpose();
 }

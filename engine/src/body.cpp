@@ -67,7 +67,13 @@ Shape Shape::plane(const Vec3& n, double offset) {
 
 Mat3 Body::inv_inertia_world() const {
   if (is_static()) return Mat3::Zero();
-  if (shape.kind == ShapeKind::sphere) return inv_inertia_body;  // isotropic: R c R^T = c
+  // An isotropic tensor (c times the identity: a sphere, a cube) is the same in every frame,
+  // R c R^T = c: returned as it is, without the rounding of the two products.
+  const Mat3& t = inv_inertia_body;
+  if (t(0, 0) == t(1, 1) && t(1, 1) == t(2, 2) && t(0, 1) == 0.0 && t(0, 2) == 0.0 &&
+      t(1, 0) == 0.0 && t(1, 2) == 0.0 && t(2, 0) == 0.0 && t(2, 1) == 0.0) {
+    return t;
+  }
   const Mat3 R = rotation();
   return R * inv_inertia_body * R.transpose();
 }

@@ -66,9 +66,8 @@ struct Body {
   bool is_static() const { return inv_mass == 0.0; }
   /// Rotation matrix R of o (3 x 3, body to world).
   Mat3 rotation() const { return o.toRotationMatrix(); }
-  /// World-space inverse inertia I^-1 = R I_body^-1 R^T (1/(kg m^2), 3 x 3). A sphere's tensor
-  /// is isotropic (c times the identity, from shape_inertia), so R c R^T = c and it is returned
-  /// as it is, without the rounding of the two products.
+  /// World-space inverse inertia I^-1 = R I_body^-1 R^T (1/(kg m^2), 3 x 3). An isotropic
+  /// I_body^-1 (c times the identity: a sphere, a cube) is returned as it is, since R c R^T = c.
   Mat3 inv_inertia_world() const;
   /// Linear velocity v = m^-1 p (m/s).
   Vec3 velocity() const { return inv_mass * p; }

@@ -112,16 +112,6 @@ bool bounds_overlap(const B& a, const B& b) {
            (a.lo.y() > b.hi.y()) | (b.lo.z() > a.hi.z()) | (a.lo.z() > b.hi.z()));
 }
 
-// Sorts a short list in place (the candidates of one body: a handful).
-void insertion_sort(int* v, std::size_t size) {
-  for (std::size_t i = 1; i < size; ++i) {
-    const int x = v[i];
-    std::size_t k = i;
-    for (; k > 0 && v[k - 1] > x; --k) v[k] = v[k - 1];
-    v[k] = x;
-  }
-}
-
 }  // namespace
 
 // Stage 1, Sec. 4: the broad phase lists the pairs that may touch, in index order, then the
@@ -345,7 +335,7 @@ void World::broad_phase() {
         if (p > a) candidates_[count++] = p;
       }
     }
-    insertion_sort(candidates_.data(), count);
+    std::sort(candidates_.begin(), candidates_.begin() + static_cast<std::ptrdiff_t>(count));
     for (std::size_t k = 0; k < count; ++k) pairs_.emplace_back(a, candidates_[k]);
   }
 }

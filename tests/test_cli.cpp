@@ -96,6 +96,33 @@ TEST_CASE("cps simulate --json reports parameters, metrics and the final bodies"
   fs::remove_all(dir);
 }
 
+TEST_CASE("cps simulate --expect-hash exits 1 on another state, 0 on the same", "[cli][state_hash]") {
+  const fs::path dir = fresh_dir("hash");
+  const Result first = cps("simulate funnel --seconds 0.5 --json", dir);
+  REQUIRE(first.exit_code == 0);
+  const nlohmann::json j = nlohmann::json::parse(first.out);
+  const std::string hash = j["state_hash"];
+  CHECK(hash.size() == 16);
+  CHECK(hash.find_first_not_of("0123456789abcdef") == std::string::npos);
+  CHECK(!j["engine_version"].get<std::string>().empty());
+  // The same run again ends in the same state.
+  CHECK(cps("simulate funnel --seconds 0.5 --expect-hash " + hash, dir).exit_code == 0);
+  // Any other hash: exit 1, both hashes printed.
+  std::string wrong = hash;
+  wrong[15] = wrong[15] == '0' ? '1' : '0';
+  const Result differs = cps("simulate funnel --seconds 0.5 --expect-hash " + wrong, dir);
+  CHECK(differs.exit_code == 1);
+  CHECK(differs.err.find(hash) != std::string::npos);
+  CHECK(differs.err.find(wrong) != std::string::npos);
+  // One more step is another state.
+  CHECK(cps("simulate funnel --seconds 0.52 --expect-hash " + hash, dir).exit_code == 1);
+  // Not a hash: a usage error.
+  const Result bad = cps("simulate funnel --seconds 0.5 --expect-hash 12345", dir);
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.err.find("--expect-hash 12345") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 #ifdef CPS_HAVE_RENDERER
 TEST_CASE("cps render writes numbered frames of the requested size", "[cli][renderer]") {
   const fs::path dir = fresh_dir("render");

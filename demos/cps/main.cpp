@@ -1,6 +1,7 @@
 // The cps command: list the scenes, simulate them headless, render them to PNG frames.
 #include "options.h"
 #include "simulate.h"
+#include "state_hash.h"
 
 #include "bench.h"
 #include "output.h"
@@ -269,6 +270,7 @@ int run(int argc, char** argv) {
   bool sim_json = false;
   std::string sim_trace;
   bool sim_force = false;
+  std::string sim_expect_hash;
   scenes::Overrides sim_overrides;
   CLI::App* simulate = app.add_subcommand("simulate", "run a scene headless and report metrics");
   simulate->add_option("scene", sim_scene, "scene name (see 'cps list')")->required();
@@ -282,6 +284,10 @@ int run(int argc, char** argv) {
   simulate->add_flag("--force", sim_force,
                      "let --trace replace an existing file that is not a cps trace (a file whose "
                      "first line is the cps trace header is replaced without it)");
+  simulate->add_option("--expect-hash", sim_expect_hash,
+                       "the state_hash (16 hex digits) the run must end with: if the run ends in "
+                       "another state, print both hashes and exit 1 (a CI check that the physics "
+                       "did not change)");
   cli::add_world_options(*simulate, sim_overrides);
 
   std::string report_scene = "all";
@@ -420,6 +426,15 @@ int run(int argc, char** argv) {
         throw cli::UsageError("simulate takes one scene, not '" + sim_scene + "'");
       }
       const scenes::Scene* scene = chosen.front();
+      std::optional<std::uint64_t> expected_hash;
+      if (!sim_expect_hash.empty()) {
+        expected_hash = scenes::parse_hash(sim_expect_hash);
+        if (!expected_hash) {
+          throw cli::UsageError("--expect-hash " + sim_expect_hash +
+                                ": give the 16 hex digits of a state_hash, as simulate --json "
+                                "prints it (e.g. 0123456789abcdef)");
+        }
+      }
       scenes::Run r = cli::make_run_or_usage_error(*scene, sim_overrides);
       const double seconds = sim_seconds.value_or(scene->default_seconds);
       std::optional<cli::TraceWriter> trace;
@@ -442,7 +457,16 @@ int run(int argc, char** argv) {
         std::cout << scene->name << ": " << summary["steps"] << " steps, "
                   << summary["simulated_s"] << " s simulated in " << summary["wall_s"] << " s ("
                   << summary["us_per_step"] << " us/step)\nmetrics: " << summary["metrics"].dump()
-                  << "\n";
+                  << "\nstate hash: " << std::string(summary["state_hash"]) << "\n";
+      }
+      if (expected_hash) {
+        const std::string got = summary["state_hash"];
+        if (got != scenes::format_hash(*expected_hash)) {
+          std::cerr << "cps: state hash " << got << " differs from the expected "
+                    << scenes::format_hash(*expected_hash) << " (--expect-hash): the run ended in "
+                    << "another state\n";
+          return 1;
+        }
       }
       return 0;
     }

@@ -1,6 +1,8 @@
 #include "simulate.h"
 
 #include "options.h"
+#include "output.h"
+#include "state_hash.h"
 
 #include <chrono>
 #include <fstream>
@@ -122,6 +124,7 @@ nlohmann::json simulate(const scenes::Scene& scene, scenes::Run& run, double sec
                       {"angular_velocity", vec(b.angular_velocity())}});
   }
   return {{"scene", scene.name},
+          {"engine_version", engine_version()},
           {"parameters", parameters_json(run.world.def())},
           {"steps", c.steps},
           {"simulated_s", run.world.time()},
@@ -133,6 +136,7 @@ nlohmann::json simulate(const scenes::Scene& scene, scenes::Run& run, double sec
             {"contacts", c.contacts},
             {"rows", c.rows},
             {"solves", c.solves}}},
+          {"state_hash", scenes::format_hash(scenes::state_hash(run.world))},
           {"bodies", bodies}};
 }
 

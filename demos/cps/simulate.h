@@ -44,7 +44,8 @@ class TraceWriter {
 };
 
 /// Runs `run` until `seconds` (s) of simulated time and returns the report documented in
-/// README.md: scene, parameters, steps, simulated_s, wall_s, us_per_step, metrics, counters and
+/// README.md: scene, engine_version, parameters, steps, simulated_s, wall_s, us_per_step,
+/// metrics, counters, state_hash (scenes::state_hash of every body at the end, 16 hex digits) and
 /// the final state of the movable bodies in creation order. With a `trace`, the state as built
 /// and after every step is written to it (the wall time then includes the writing).
 nlohmann::json simulate(const scenes::Scene& scene, scenes::Run& run, double seconds,

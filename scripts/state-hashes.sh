@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# The state hash at the end of every paper and stress scene (each at its own duration) for every
+# combination of --push, --solver and --assembly, one line each:
+#   SCENE PUSH SOLVER ASSEMBLY HASH
+# Usage: scripts/state-hashes.sh [CPS]               print the table (CPS: default build/demos/cps)
+#        scripts/state-hashes.sh --check FILE [CPS]  rerun every line of FILE with --expect-hash;
+#                                                    exit 1 listing the lines whose state differs
+# A refactoring that must not change the physics keeps every hash (docs/state_hashes.txt holds
+# the table of the last change that was meant to keep them). Hashes are of IEEE-754 bytes: a
+# different compiler, flags or libm (glibc picks sin/cos variants by CPU) may change them.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [ "${1:-}" = "--check" ]; then
+  table=${2:?--check needs the table file}
+  cps=${3:-build/demos/cps}
+  failed=0
+  checked=0
+  while read -r scene push solver assembly hash; do
+    case "$scene" in ''|'#'*) continue ;; esac
+    checked=$((checked + 1))
+    if ! "$cps" simulate "$scene" --push "$push" --solver "$solver" --assembly "$assembly" \
+        --expect-hash "$hash" > /dev/null 2> /tmp/cps-state-hash.$$; then
+      echo "DIFFERS: $scene $push $solver $assembly: $(tail -1 /tmp/cps-state-hash.$$)"
+      failed=$((failed + 1))
+    fi
+  done < "$table"
+  rm -f /tmp/cps-state-hash.$$
+  echo "$((checked - failed)) passed, $failed failed"
+  [ "$failed" -eq 0 ]
+  exit
+fi
+cps=${1:-build/demos/cps}
+scenes=$("$cps" list | awk '/^  /{print $1}')
+echo "# scene push solver assembly state_hash   ($("$cps" simulate stack --seconds 0.02 --json | sed -n 's/.*"engine_version": "\(.*\)".*/\1/p'))"
+for scene in $scenes; do
+  for push in baumgarte split; do
+    for solver in pgs jacobi; do
+      for assembly in explicit matrix-free; do
+        hash=$("$cps" simulate "$scene" --push "$push" --solver "$solver" --assembly "$assembly" \
+          --json 2>/dev/null | sed -n 's/.*"state_hash": "\([0-9a-f]*\)".*/\1/p')
+        echo "$scene $push $solver $assembly $hash"
+      done
+    done
+  done
+done

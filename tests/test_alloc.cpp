@@ -82,9 +82,9 @@ TEST_CASE("after warm-up a step of every paper scene allocates nothing", "[alloc
                              Variant{"pgs split", SolverKind::pgs, PushMode::split},
                              Variant{"jacobi baumgarte", SolverKind::jacobi, PushMode::baumgarte}}) {
       scenes::Overrides o;
-      o.solver = v.solver;
-      o.push = v.push;
-      o.assembly = Assembly::matrix_free;
+      o.set("solver", v.solver);
+      o.set("push", v.push);
+      o.set("assembly", Assembly::matrix_free);
       scenes::Run run = scenes::make_run(scene, o);
       while (run.world.time() < kWarmUp) run.world.step();
       const long counted = allocations_in_steps(run.world, kCountedSteps);
@@ -97,7 +97,7 @@ TEST_CASE("after warm-up a step of every paper scene allocates nothing", "[alloc
 
 TEST_CASE("after warm-up a step with the residual measured allocates nothing", "[alloc]") {
   scenes::Overrides o;
-  o.measure_residual = true;
+  o.set("measure_residual", true);
   scenes::Run run = scenes::make_run(*scenes::find_scene("funnel"), o);
   while (run.world.time() < kWarmUp) run.world.step();
   CHECK(allocations_in_steps(run.world, kCountedSteps) == 0);

@@ -32,7 +32,7 @@ TEST_CASE("matrix-free lambda equals the explicit path's to round-off", "[solver
     for (const SolverKind solver : {SolverKind::pgs, SolverKind::jacobi}) {
       for (const PushMode push : {PushMode::baumgarte, PushMode::split}) {
         scenes::Overrides o;
-        o.solver = SolverKind::pgs;  // reach a state with contacts the same way every time
+        o.set("solver", SolverKind::pgs);  // reach a state with contacts the same way every time
         scenes::Run run = scenes::make_run(scene, o);
         // Into the scene, where it has contacts or rods (the intersecting stack flies apart).
         run.advance_to(scene.name == "intersecting_stack" ? 0.1 : std::min(1.5, scene.default_seconds / 2.0));

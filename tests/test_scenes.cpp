@@ -106,7 +106,7 @@ TEST_CASE("intersecting stack at 0.5 s: split comes to rest, baumgarte flies apa
           "[scene][intersecting_stack]") {
   // The paper's Fig. 7 (b) and (c).
   scenes::Overrides split;
-  split.push = PushMode::split;
+  split.set("push", PushMode::split);
   scenes::Run rest = run_scene("intersecting_stack", split);
   rest.advance_to(0.5);
   int i = 0;
@@ -118,7 +118,7 @@ TEST_CASE("intersecting stack at 0.5 s: split comes to rest, baumgarte flies apa
     ++i;
   }
   scenes::Overrides baumgarte;
-  baumgarte.push = PushMode::baumgarte;
+  baumgarte.set("push", PushMode::baumgarte);
   scenes::Run fly = run_scene("intersecting_stack", baumgarte);
   fly.advance_to(0.5);
   CHECK(fly.world.bodies().back().velocity().norm() > 5.0);
@@ -187,7 +187,7 @@ TEST_CASE("each scene runs only the stages it needs", "[scene][counters]") {
   SECTION("the stack solves once per step with baumgarte, twice with split") {
     for (const PushMode push : {PushMode::baumgarte, PushMode::split}) {
       scenes::Overrides o;
-      o.push = push;
+      o.set("push", push);
       scenes::Run run = run_scene("stack", o);
       run.advance_to(3.0);  // the cubes are resting on each other: every step has contacts
       const std::int64_t before = run.world.counters().solves;
@@ -197,7 +197,7 @@ TEST_CASE("each scene runs only the stages it needs", "[scene][counters]") {
   }
   SECTION("mu = 0 builds no friction rows") {
     scenes::Overrides o;
-    o.friction = 0.0;
+    o.set("friction", 0.0);
     scenes::Run run = run_scene("stack", o);
     run.advance_to(3.0);
     REQUIRE(!run.world.rows().empty());

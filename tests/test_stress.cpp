@@ -265,7 +265,7 @@ TEST_CASE("a free spinning box keeps |o| = 1 and l exactly and its energy within
   for (const char* name : {"spin_100", "spin_1000"}) {
     for (const RotationUpdate rotation : {RotationUpdate::linear, RotationUpdate::exact}) {
       scenes::Overrides o;
-      o.rotation = rotation;
+      o.set("rotation", rotation);
       scenes::Run run = scenes::make_run(scene(name), o);
       // The first step from o0 = 1 turns by w0 = I^-1 l0 (l does not change): Eq. 3.2.4 then
       // normalise, or the axis-angle step of Eq. 12.4.1, even at |w0| dt = 17 rad.
@@ -318,7 +318,7 @@ TEST_CASE("a ball started inside a box is pushed out without being thrown", "[st
     // no body is faster than beta d0 / dt plus one step of gravity (8.57 m/s; measured 7.47 m/s:
     // the 10 kg box takes 1/11 of it). It flies up and lands back on the box.
     scenes::Overrides o;
-    o.push = PushMode::baumgarte;
+    o.set("push", PushMode::baumgarte);
     const CheckedRun c = run_checked("sphere_in_box", s.default_seconds, o);
     const nlohmann::json& m = c.metrics;
     INFO(m.dump());
@@ -335,7 +335,7 @@ TEST_CASE("the intersecting stack with the single frame push factor never moves 
   // in the box with split: 3 g dt = 0.5 m/s over the whole 4 s (measured 0.28 m/s, the column
   // rocking while it rises; with baumgarte the top cube leaves at 30.8 m/s).
   scenes::Overrides o;
-  o.push = PushMode::split;
+  o.set("push", PushMode::split);
   scenes::Run run = scenes::make_run(scene("intersecting_stack"), o);
   double max_speed = 0.0;
   while (run.world.time() < 4.0 - 1e-9) {

@@ -335,7 +335,7 @@ int run(int argc, char** argv) {
   render->add_option("--compare", compare,
                      "render the two variants of this option side by side, labelled, into "
                      "OUT/SCENE-compare-OPTION/")
-      ->check(CLI::IsMember({"push", "solver", "friction-model", "rotation"}));
+      ->check(CLI::IsMember(cli::comparable_options()));
   bool render_force = false;
   render->add_flag("--force", render_force,
                    "write into an output folder that holds files no earlier cps run wrote there "
@@ -373,7 +373,7 @@ int run(int argc, char** argv) {
                      "increasing, e.g. 0,0.5,2; required except for 'paper'");
   figure->add_option("--compare", fig_compare,
                      "one row per value of this option (default: one row, the scene's settings)")
-      ->check(CLI::IsMember({"push", "solver", "friction-model", "rotation"}));
+      ->check(CLI::IsMember(cli::comparable_options()));
   figure->add_option("--size", fig_size_text, "size of ONE panel, WxH in pixels, each in [16, 8192]")
       ->capture_default_str();
   figure->add_option("--out", fig_out,

@@ -18,65 +18,39 @@ const CLI::Validator kFinitePositive(
     },
     "POSITIVE");
 
-namespace {
-
-// A validator that accepts one of the names and hands CLI11 the enum's integer value; an unknown
-// name gets "'x' is not one of: a, b".
-template <class Enum>
-CLI::Validator one_of(const std::vector<std::pair<std::string, Enum>>& names) {
-  std::string joined;
-  for (const auto& [name, value] : names) joined += (joined.empty() ? "" : ", ") + name;
-  return CLI::Validator(
-      [names, joined](std::string& input) -> std::string {
-        for (const auto& [name, value] : names) {
-          if (input == name) {
-            input = std::to_string(static_cast<int>(value));
-            return {};
-          }
-        }
-        return "'" + input + "' is not one of: " + joined;
-      },
-      "{" + joined + "}");
+std::string option_help(const Parameter& p) {
+  std::string help(p.help);
+  help += "; " + p.allowed() + "; default: the scene's";
+  return help;
 }
 
-}  // namespace
-
 void add_world_options(CLI::App& cmd, scenes::Overrides& o) {
-  cmd.add_option("--dt", o.dt, "time step (s), > 0; paper: 1/60")->check(kFinitePositive);
-  cmd.add_option("--iterations", o.iterations, "PGS iterations per solve, >= 1; paper: 25")
-      ->check(CLI::Range(1, 1000000));
-  cmd.add_option("--beta", o.beta, "push factor constant beta (dimensionless) in [0, 1]; paper: 0.2")
-      ->check(CLI::Range(0.0, 1.0));
-  cmd.add_option("--friction", o.friction,
-                 "friction coefficient mu (dimensionless), >= 0; scenes use 0.5")
-      ->check(CLI::Range(0.0, 1e6));
-  cmd.add_option("--restitution", o.restitution,
-                 "coefficient of restitution eps (dimensionless) in [0, 1]; scenes use 0")
-      ->check(CLI::Range(0.0, 1.0));
-  cmd.add_option("--contact-margin", o.contact_margin,
-                 "speculative contact distance (m), >= 0; 0 = contacts only on overlap, as in the "
-                 "paper")
-      ->check(CLI::Range(0.0, 1e6));
-  cmd.add_option("--push", o.push,
-                 "baumgarte: push factor kept in the velocity (Sec. 5); split: single frame push "
-                 "factor, two solves (Sec. 8.1)")
-      ->transform(one_of<PushMode>({{"baumgarte", PushMode::baumgarte}, {"split", PushMode::split}}));
-  cmd.add_option("--solver", o.solver, "pgs (Sec. 7.2) or jacobi")
-      ->transform(one_of<SolverKind>({{"pgs", SolverKind::pgs}, {"jacobi", SolverKind::jacobi}}));
-  cmd.add_option("--friction-model", o.friction_model,
-                 "fixed: the paper's limit mu m |g.n| (Sec. 5.4); coupled: mu times the contact "
-                 "row's lambda")
-      ->transform(one_of<FrictionModel>({
-          {"fixed", FrictionModel::fixed}, {"coupled", FrictionModel::coupled}}));
-  cmd.add_option("--assembly", o.assembly,
-                 "explicit: sparse J, M^-1 and A = J M^-1 J^T as in the paper; matrix-free: w = "
-                 "M^-1 J^T lambda per body (default; the same lambda to round-off)")
-      ->transform(one_of<Assembly>({{"explicit", Assembly::explicit_matrices},
-                                    {"matrix-free", Assembly::matrix_free}}));
-  cmd.add_option("--rotation", o.rotation,
-                 "linear: Eq. 3.2.4 then normalise; exact: the axis-angle step of Eq. 12.4.1")
-      ->transform(one_of<RotationUpdate>({
-          {"linear", RotationUpdate::linear}, {"exact", RotationUpdate::exact}}));
+  for (const Parameter& p : world_parameters()) {
+    if (p.flag.empty()) continue;
+    const Parameter* param = &p;
+    // The table parses and checks the text (its message names the flag, the value and what is
+    // allowed); the callback runs only on text the check accepted.
+    cmd.add_option_function<std::string>(
+           "--" + std::string(p.flag),
+           [param, &o](const std::string& text) { o.set(*param, param->parse(text)); },
+           option_help(p))
+        ->type_name(p.type == ParameterType::choice ? "{" + p.allowed().substr(8) + "}"
+                    : p.type == ParameterType::integer ? "INT"
+                                                       : "NUMBER")
+        ->check(CLI::Validator(
+            [param](std::string& text) -> std::string {
+              try {
+                param->parse(text);
+              } catch (const std::invalid_argument& e) {
+                // CLI11 puts the flag in front of the message already.
+                const std::string why = e.what();
+                const std::string prefix = "--" + std::string(param->flag) + " ";
+                return why.rfind(prefix, 0) == 0 ? why.substr(prefix.size()) : why;
+              }
+              return {};
+            },
+            ""));
+  }
 }
 
 std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
@@ -95,40 +69,35 @@ std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
                    "describes them");
 }
 
+std::vector<std::string> comparable_options() {
+  std::vector<std::string> names;
+  for (const Parameter& p : world_parameters()) {
+    if (p.type == ParameterType::choice && !p.flag.empty()) names.emplace_back(p.flag);
+  }
+  return names;
+}
+
 std::vector<Variant> compare_variants(const std::string& option, const scenes::Overrides& base) {
   if (option.empty()) return {{base, ""}};
-  std::vector<Variant> v(2, Variant{base, ""});
-  bool already_set = false;
-  if (option == "push") {
-    already_set = base.push.has_value();
-    v[0].overrides.push = PushMode::baumgarte;
-    v[1].overrides.push = PushMode::split;
-    v[0].label = "push = baumgarte (Sec. 5.3)";
-    v[1].label = "push = split (Sec. 8.1)";
-  } else if (option == "solver") {
-    already_set = base.solver.has_value();
-    v[0].overrides.solver = SolverKind::pgs;
-    v[1].overrides.solver = SolverKind::jacobi;
-    v[0].label = "solver = pgs";
-    v[1].label = "solver = jacobi";
-  } else if (option == "friction-model") {
-    already_set = base.friction_model.has_value();
-    v[0].overrides.friction_model = FrictionModel::fixed;
-    v[1].overrides.friction_model = FrictionModel::coupled;
-    v[0].label = "friction model = fixed";
-    v[1].label = "friction model = coupled";
-  } else if (option == "rotation") {
-    already_set = base.rotation.has_value();
-    v[0].overrides.rotation = RotationUpdate::linear;
-    v[1].overrides.rotation = RotationUpdate::exact;
-    v[0].label = "rotation = linear (Eq. 3.2.4)";
-    v[1].label = "rotation = exact (Eq. 12.4.1)";
-  } else {
-    throw UsageError("--compare " + option + ": allowed are push, solver, friction-model, rotation");
+  const Parameter* p = find_parameter(option);
+  if (p == nullptr || p->type != ParameterType::choice || p->flag != option) {
+    std::string allowed;
+    for (const std::string& n : comparable_options()) allowed += (allowed.empty() ? "" : ", ") + n;
+    throw UsageError("--compare " + option + ": allowed are " + allowed);
   }
-  if (already_set) {
-    throw UsageError("--compare " + option + " renders both values of --" + option +
+  if (base.find(p->name) != nullptr) {
+    throw UsageError("--compare " + option + " renders every value of --" + option +
                      "; do not set --" + option + " as well");
+  }
+  std::vector<Variant> v;
+  for (const Choice& c : p->choices) {
+    Variant variant{base, std::string(p->name) + " = " + std::string(c.name)};
+    for (char& ch : variant.label) {
+      if (ch == '_') ch = ' ';
+    }
+    if (!c.source.empty()) variant.label += " (" + std::string(c.source) + ")";
+    variant.overrides.set(*p, c.value);
+    v.push_back(std::move(variant));
   }
   return v;
 }

@@ -16,8 +16,8 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The world parameter overrides every stepping command takes (--dt, --iterations, --beta,
-/// --friction), with their units in the help text.
+/// The world parameter overrides every stepping command takes: one option per parameter of the
+/// table (cps/parameters.h) that has a flag, its help, unit and allowed values from the table.
 void add_world_options(CLI::App& cmd, scenes::Overrides& overrides);
 
 /// CLI11 validator: a finite number > 0 (rejects nan and inf, which CLI::PositiveNumber lets by).
@@ -33,9 +33,13 @@ struct Variant {
   std::string label;
 };
 
-/// The variants of `option` ("push", "solver", "friction-model", "rotation"), each on top of
-/// `base`; with an empty option, the single variant `base` with no label. Throws UsageError if
-/// base already sets the compared option.
+/// The flags of the parameters --compare takes: every choice parameter of the table.
+std::vector<std::string> comparable_options();
+
+/// The variants of `option` (a flag of comparable_options()), one per value in the table's
+/// order, each on top of `base` and labelled "push = split (Sec. 8.1)"; with an empty option,
+/// the single variant `base` with no label. Throws UsageError for another option, or if base
+/// already sets the compared option.
 std::vector<Variant> compare_variants(const std::string& option, const scenes::Overrides& base);
 
 /// Builds a run and turns a bad parameter (std::invalid_argument) into a UsageError.

@@ -169,22 +169,33 @@ nlohmann::json run_info(const std::string& command, int argc, char** argv,
           {"parameters", parameters}};
 }
 
+nlohmann::json parameter_json(const Parameter& p, const ParameterValue& v) {
+  switch (p.type) {
+    case ParameterType::choice:
+      return p.format(v);
+    case ParameterType::vector3: {
+      const Vec3& x = std::get<Vec3>(v);
+      return {x.x(), x.y(), x.z()};
+    }
+    case ParameterType::real:
+      return std::holds_alternative<int>(v) ? static_cast<double>(std::get<int>(v)) : std::get<double>(v);
+    case ParameterType::integer:
+      return std::get<int>(v);
+    case ParameterType::boolean:
+      return std::get<bool>(v);
+  }
+  return nullptr;
+}
+
 nlohmann::json overrides_json(const scenes::Overrides& o) {
   nlohmann::json j = nlohmann::json::object();
-  if (o.dt) j["dt_s"] = *o.dt;
-  if (o.iterations) j["iterations"] = *o.iterations;
-  if (o.beta) j["beta"] = *o.beta;
-  if (o.friction) j["friction"] = *o.friction;
-  if (o.restitution) j["restitution"] = *o.restitution;
-  if (o.contact_margin) j["contact_margin_m"] = *o.contact_margin;
-  if (o.push) j["push"] = *o.push == PushMode::split ? "split" : "baumgarte";
-  if (o.solver) j["solver"] = *o.solver == SolverKind::jacobi ? "jacobi" : "pgs";
-  if (o.friction_model) {
-    j["friction_model"] = *o.friction_model == FrictionModel::coupled ? "coupled" : "fixed";
-  }
-  if (o.rotation) j["rotation"] = *o.rotation == RotationUpdate::exact ? "exact" : "linear";
-  if (o.assembly) j["assembly"] = *o.assembly == Assembly::matrix_free ? "matrix-free" : "explicit";
-  if (o.measure_residual) j["measure_residual"] = true;
+  for (const auto& [p, value] : o.values) j[std::string(p->json_key)] = parameter_json(*p, value);
+  return j;
+}
+
+nlohmann::json parameters_json(const WorldDef& def) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const Parameter& p : world_parameters()) j[std::string(p.json_key)] = parameter_json(p, p.get(def));
   return j;
 }
 

@@ -56,9 +56,15 @@ void write_json_atomic(const std::filesystem::path& path, const nlohmann::json& 
 nlohmann::json run_info(const std::string& command, int argc, char** argv,
                         const nlohmann::json& parameters);
 
-/// The overrides given on the command line, by option name ("dt_s", "iterations", "push", ...),
-/// units as in WorldDef; an empty object when none.
+/// One parameter's value as JSON: a number, a bool, [x, y, z], or a choice's name.
+nlohmann::json parameter_json(const Parameter& p, const ParameterValue& v);
+
+/// The overrides given on the command line, by the table's JSON key ("dt_s", "iterations",
+/// "push", ...; units as the key's suffix); an empty object when none.
 nlohmann::json overrides_json(const scenes::Overrides& overrides);
+
+/// Every world parameter with its value, by the table's JSON key.
+nlohmann::json parameters_json(const WorldDef& def);
 
 /// `git describe --always --dirty` of the sources at build time, or "unknown".
 const char* engine_version();

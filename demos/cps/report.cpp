@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -35,9 +36,17 @@ double trajectory_time_of(const scenes::Scene& scene) {
   return std::min(1.0, horizon_of(scene));
 }
 
-const char* name_of(SolverKind s) { return s == SolverKind::pgs ? "pgs" : "jacobi"; }
-const char* name_of(PushMode p) { return p == PushMode::baumgarte ? "baumgarte" : "split"; }
-const char* name_of(FrictionModel f) { return f == FrictionModel::fixed ? "fixed" : "coupled"; }
+std::string name(SolverKind v) { return std::string(name_of(v)); }
+std::string name(PushMode v) { return std::string(name_of(v)); }
+std::string name(FrictionModel v) { return std::string(name_of(v)); }
+
+// The value of a choice parameter called `text` in a run id, or std::nullopt.
+template <class Enum>
+std::optional<Enum> choice_of(const char* parameter_name, const std::string& text) {
+  const Choice* c = parameter(parameter_name).find_choice(text);
+  if (c == nullptr) return std::nullopt;
+  return static_cast<Enum>(c->value);
+}
 
 std::string number(double v) {
   if (!std::isfinite(v)) return "";
@@ -59,12 +68,13 @@ bool is_paper_scene(const std::string& name) {
 // scene's own dt / substeps for the others (stress scenes choose their dt on purpose).
 scenes::Overrides overrides_of(const RunSpec& spec) {
   scenes::Overrides o;
-  o.solver = spec.solver;
-  o.push = spec.push;
-  o.friction_model = spec.friction_model;
-  o.iterations = spec.iterations;
-  o.dt = is_paper_scene(spec.scene) ? 1.0 / (60.0 * spec.substeps)
-                                     : scenes::find_scene(spec.scene)->world_def().dt / spec.substeps;
+  o.set("solver", spec.solver);
+  o.set("push", spec.push);
+  o.set("friction_model", spec.friction_model);
+  o.set("iterations", spec.iterations);
+  o.set("dt", is_paper_scene(spec.scene)
+                  ? 1.0 / (60.0 * spec.substeps)
+                  : scenes::find_scene(spec.scene)->world_def().dt / spec.substeps);
   return o;
 }
 
@@ -281,7 +291,7 @@ bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& 
 }  // namespace
 
 std::string RunSpec::id() const {
-  return scene + "." + name_of(solver) + "." + name_of(push) + "." + name_of(friction_model) +
+  return scene + "." + name(solver) + "." + name(push) + "." + name(friction_model) +
          ".it" + std::to_string(iterations) + ".ss" + std::to_string(substeps);
 }
 
@@ -297,12 +307,15 @@ RunSpec RunSpec::parse(const std::string& id) {
   RunSpec r;
   r.scene = parts[0];
   if (!scenes::find_scene(r.scene)) throw bad("unknown scene");
-  if (parts[1] != "pgs" && parts[1] != "jacobi") throw bad("unknown solver '" + parts[1] + "'");
-  r.solver = parts[1] == "pgs" ? SolverKind::pgs : SolverKind::jacobi;
-  if (parts[2] != "baumgarte" && parts[2] != "split") throw bad("unknown push '" + parts[2] + "'");
-  r.push = parts[2] == "baumgarte" ? PushMode::baumgarte : PushMode::split;
-  if (parts[3] != "fixed" && parts[3] != "coupled") throw bad("unknown friction model");
-  r.friction_model = parts[3] == "fixed" ? FrictionModel::fixed : FrictionModel::coupled;
+  const auto solver = choice_of<SolverKind>("solver", parts[1]);
+  if (!solver) throw bad("unknown solver '" + parts[1] + "'");
+  const auto push = choice_of<PushMode>("push", parts[2]);
+  if (!push) throw bad("unknown push '" + parts[2] + "'");
+  const auto friction_model = choice_of<FrictionModel>("friction_model", parts[3]);
+  if (!friction_model) throw bad("unknown friction model '" + parts[3] + "'");
+  r.solver = *solver;
+  r.push = *push;
+  r.friction_model = *friction_model;
   const auto count = [&](const std::string& p, const char* prefix) {
     if (p.rfind(prefix, 0) != 0) throw bad("'" + p + "' does not start with " + prefix);
     const int n = std::atoi(p.c_str() + 2);
@@ -341,16 +354,17 @@ Row execute_run(const RunSpec& spec, int repeats) {
   scenes::Overrides o = overrides_of(spec);
   Row row;
   row["scene"] = spec.scene;
-  row["solver"] = name_of(spec.solver);
-  row["push"] = name_of(spec.push);
-  row["friction_model"] = name_of(spec.friction_model);
-  row["iterations"] = std::to_string(spec.iterations);
+  // The columns of the settings are the table's JSON keys.
+  row[std::string(parameter("solver").json_key)] = name(spec.solver);
+  row[std::string(parameter("push").json_key)] = name(spec.push);
+  row[std::string(parameter("friction_model").json_key)] = name(spec.friction_model);
+  row[std::string(parameter("iterations").json_key)] = std::to_string(spec.iterations);
   row["substeps"] = std::to_string(spec.substeps);
-  row["dt_s"] = number(*o.dt);
+  row[std::string(parameter("dt").json_key)] = number(std::get<double>(*o.find("dt")));
   row["horizon_s"] = number(horizon);
 
   // The error run: residuals on, every step observed.
-  o.measure_residual = true;
+  o.set("measure_residual", true);
   const auto error_start = std::chrono::steady_clock::now();
   scenes::Run run = scenes::make_run(scene, o);
   double pen_max = 0.0, pen_sq = 0.0, rod_max = 0.0, rod_sq = 0.0;
@@ -421,7 +435,7 @@ Row execute_run(const RunSpec& spec, int repeats) {
   if (std::chrono::duration<double>(std::chrono::steady_clock::now() - error_start).count() > 2.0) {
     repeats = std::min(repeats, 1);
   }
-  o.measure_residual = false;
+  o.set("measure_residual", false);
   std::vector<double> seconds;
   std::int64_t steps = 0;
   for (int r = 0; r < (diverged ? 0 : repeats); ++r) {

@@ -16,24 +16,6 @@ nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
-nlohmann::json parameters_json(const WorldDef& def) {
-  return {{"gravity_mps2", vec(def.gravity)},
-          {"dt_s", def.dt},
-          {"iterations", def.iterations},
-          {"beta", def.beta},
-          {"friction", def.friction},
-          {"restitution", def.restitution},
-          {"restitution_threshold_mps", def.restitution_threshold},
-          {"push", def.push == PushMode::split ? "split" : "baumgarte"},
-          {"solver", def.solver == SolverKind::jacobi ? "jacobi" : "pgs"},
-          {"friction_model", def.friction_model == FrictionModel::coupled ? "coupled" : "fixed"},
-          {"rotation", def.rotation == RotationUpdate::exact ? "exact" : "linear"},
-          {"assembly", def.assembly == Assembly::matrix_free ? "matrix-free" : "explicit"},
-          {"contact_margin_m", def.contact_margin},
-          {"collision", def.collision},
-          {"contact_caching", false}};
-}
-
 TraceWriter::TraceWriter(std::filesystem::path path, bool force) : path_(std::move(path)) {
   std::error_code ec;
   if (!force && std::filesystem::exists(path_, ec)) {

@@ -51,7 +51,4 @@ class TraceWriter {
 nlohmann::json simulate(const scenes::Scene& scene, scenes::Run& run, double seconds,
                         TraceWriter* trace = nullptr);
 
-/// Every world parameter with its value, keys suffixed with their unit.
-nlohmann::json parameters_json(const WorldDef& def);
-
 }  // namespace cps::cli

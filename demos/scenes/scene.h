@@ -12,6 +12,8 @@
 #include <span>
 #include <utility>
 #include <string_view>
+#include <type_traits>
+#include <vector>
 
 namespace cps::scenes {
 
@@ -74,20 +76,23 @@ std::span<const std::string_view> scaled_families();
 /// the allowed range, or an unknown family.
 Scene scaled_scene(std::string_view family, int n);
 
-/// Values that replace a scene's own world parameters (units as in WorldDef).
+/// Values that replace a scene's own world parameters, by parameter of the table in
+/// cps/parameters.h (units as there), in the order they were set.
 struct Overrides {
-  std::optional<double> dt;
-  std::optional<int> iterations;
-  std::optional<double> beta;
-  std::optional<double> friction;
-  std::optional<double> restitution;
-  std::optional<double> contact_margin;
-  std::optional<PushMode> push;
-  std::optional<SolverKind> solver;
-  std::optional<FrictionModel> friction_model;
-  std::optional<RotationUpdate> rotation;
-  std::optional<Assembly> assembly;
-  bool measure_residual = false;  ///< sets WorldDef::measure_residual
+  std::vector<std::pair<const Parameter*, ParameterValue>> values;
+
+  /// Sets the parameter (WorldDef member name, flag or JSON key) to v, replacing an earlier
+  /// value of it. Throws std::invalid_argument for an unknown name or a value the table refuses.
+  Overrides& set(std::string_view name, const ParameterValue& v);
+  Overrides& set(const Parameter& p, const ParameterValue& v);
+  /// The same for a method, by its enum (PushMode::split, SolverKind::jacobi, ...).
+  template <class Enum>
+    requires std::is_enum_v<Enum>
+  Overrides& set(std::string_view name, Enum v) {
+    return set(name, ParameterValue(static_cast<int>(v)));
+  }
+  /// The value set for the parameter, or nullptr.
+  const ParameterValue* find(std::string_view name) const;
 };
 
 /// The scene's WorldDef with the overrides applied. Not validated here: World's constructor does.

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <deque>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace cps::scenes {
@@ -93,20 +95,41 @@ const Scene* find_scene(std::string_view name) {
   return &made.back();
 }
 
+Overrides& Overrides::set(const Parameter& p, const ParameterValue& v) {
+  ParameterValue value = v;
+  // An integer given for a real parameter (1 for 1.0) is taken as its value.
+  if (p.type == ParameterType::real && std::holds_alternative<int>(v)) value = double(std::get<int>(v));
+  if (const std::optional<std::string> why = p.check(value)) {
+    throw std::invalid_argument("world parameter " + std::string(p.name) + " = " + p.format(value) +
+                                " is not allowed: " + *why);
+  }
+  for (auto& [q, old] : values) {
+    if (q == &p) {
+      old = value;
+      return *this;
+    }
+  }
+  values.emplace_back(&p, value);
+  return *this;
+}
+
+Overrides& Overrides::set(std::string_view name, const ParameterValue& v) {
+  const Parameter* p = find_parameter(name);
+  if (p == nullptr) throw std::invalid_argument("no world parameter is called '" + std::string(name) + "'");
+  return set(*p, v);
+}
+
+const ParameterValue* Overrides::find(std::string_view name) const {
+  const Parameter* p = find_parameter(name);
+  for (const auto& [q, value] : values) {
+    if (q == p) return &value;
+  }
+  return nullptr;
+}
+
 WorldDef world_def_with(const Scene& scene, const Overrides& o) {
   WorldDef def = scene.world_def();
-  if (o.dt) def.dt = *o.dt;
-  if (o.iterations) def.iterations = *o.iterations;
-  if (o.beta) def.beta = *o.beta;
-  if (o.friction) def.friction = *o.friction;
-  if (o.restitution) def.restitution = *o.restitution;
-  if (o.contact_margin) def.contact_margin = *o.contact_margin;
-  if (o.push) def.push = *o.push;
-  if (o.solver) def.solver = *o.solver;
-  if (o.friction_model) def.friction_model = *o.friction_model;
-  if (o.rotation) def.rotation = *o.rotation;
-  if (o.assembly) def.assembly = *o.assembly;
-  if (o.measure_residual) def.measure_residual = true;
+  for (const auto& [p, value] : o.values) p->set(def, value);
   return def;
 }
 

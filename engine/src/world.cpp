@@ -14,35 +14,6 @@
 #include <stdexcept>
 
 namespace cps {
-namespace {
-
-[[noreturn]] void bad_parameter(const char* name, double value, const char* allowed) {
-  std::ostringstream s;
-  s << "world parameter " << name << " = " << value << " is not allowed: " << allowed;
-  throw std::invalid_argument(s.str());
-}
-
-}  // namespace
-
-void WorldDef::validate() const {
-  if (!all_finite(gravity)) bad_parameter("gravity", gravity.norm(), "it must be finite (m/s^2)");
-  if (!(std::isfinite(dt) && dt > 0.0)) bad_parameter("dt", dt, "it must be finite and > 0 s");
-  if (iterations < 1) bad_parameter("iterations", iterations, "it must be >= 1");
-  if (!(beta >= 0.0 && beta <= 1.0)) bad_parameter("beta", beta, "it must be in [0, 1]");
-  if (!(std::isfinite(friction) && friction >= 0.0)) {
-    bad_parameter("friction", friction, "it must be finite and >= 0");
-  }
-  if (!(restitution >= 0.0 && restitution <= 1.0)) {
-    bad_parameter("restitution", restitution, "it must be in [0, 1]");
-  }
-  if (!(std::isfinite(contact_margin) && contact_margin >= 0.0)) {
-    bad_parameter("contact_margin", contact_margin, "it must be finite and >= 0 m");
-  }
-  if (!(std::isfinite(restitution_threshold) && restitution_threshold >= 0.0)) {
-    bad_parameter("restitution_threshold", restitution_threshold, "it must be finite and >= 0 m/s");
-  }
-}
-
 World::World(const WorldDef& def) : def_(def) { def_.validate(); }
 
 void World::set_def(const WorldDef& def) {

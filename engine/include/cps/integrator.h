@@ -2,18 +2,13 @@
 // Semi-implicit Euler integration (paper Sec. 3.2, Eqs. 3.2.1-3.2.4).
 
 #include "cps/body.h"
+#include "cps/parameters.h"
 
 #include <Eigen/Core>
 
 #include <vector>
 
 namespace cps {
-
-/// How the orientation follows the angular velocity w = I^-1 l over a step.
-enum class RotationUpdate {
-  linear,  ///< o += 1/2 [0, w] o dt, then normalise (Eq. 3.2.4)
-  exact,   ///< o = [cos(|w| dt / 2), sin(|w| dt / 2) w / |w|] o (Eq. 12.4.1)
-};
 
 /// Advances every movable body by dt (s, > 0).
 /// f_position and f_momentum (6n each): force and torque per body (N, N m), external plus

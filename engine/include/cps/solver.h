@@ -2,22 +2,10 @@
 // Iterative solution of A lambda = b with bounds on lambda (paper Sec. 6.2.3 and 7):
 // projected Gauss-Seidel, and Jacobi for comparison.
 
+#include "cps/parameters.h"
 #include "cps/system.h"
 
 namespace cps {
-
-/// The iteration used for A lambda = b.
-enum class SolverKind {
-  pgs,     ///< projected Gauss-Seidel: new values used at once (Sec. 7.2)
-  jacobi,  ///< projected Jacobi: new values used after the sweep (Sec. 7.1)
-};
-
-/// How friction rows are bounded.
-enum class FrictionModel {
-  fixed,    ///< the paper's limit +-mu m |g . n| set when the row is built (Sec. 5.4)
-  coupled,  ///< +-mu lambda_n with lambda_n the current value of the row's contact row, as
-            ///< sequential impulse solvers do (Catto, "Iterative Dynamics", GDC 2005)
-};
 
 /// Solves A lambda = b subject to the bounds of each row (Eq. 7.1.1 with clamping):
 ///   lambda_j = clamp((b_j - sum_{i != j} A_ji lambda_i) / A_jj, lo_j, hi_j)

@@ -14,6 +14,7 @@
 #include "cps/constraint.h"
 #include "cps/integrator.h"
 #include "cps/matrix_free.h"
+#include "cps/parameters.h"
 #include "cps/solver.h"
 
 #include <Eigen/Core>
@@ -25,48 +26,6 @@
 #include <vector>
 
 namespace cps {
-
-/// How violated constraints are corrected.
-enum class PushMode {
-  baumgarte,  ///< the push factor stays in the velocity (Eq. 5.2.3, 5.3.1): one solve a step
-  split,      ///< the single frame push factor (Sec. 8.1): positions move with f_cv, the stored
-              ///< momenta with f_c0 from a second solve without the push
-};
-
-/// How A lambda = b is represented while it is solved.
-enum class Assembly {
-  explicit_matrices,  ///< sparse J, M^-1 and A = J M^-1 J^T built every step (Sec. 6), as the
-                      ///< paper states it
-  matrix_free,        ///< per body w = M^-1 J^T lambda, O(12) a row update (matrix_free.h)
-};
-
-/// World parameters, each with its unit and a typical value. Validate with validate().
-struct WorldDef {
-  Vec3 gravity = Vec3(0.0, -10.0, 0.0);  ///< m/s^2; the paper uses (0, -10, 0)
-  double dt = 1.0 / 60.0;                ///< time step (s), > 0; the paper uses 1/60
-  int iterations = 25;                   ///< solver sweeps per solve, >= 1; the paper uses 25
-  double beta = 0.2;                     ///< push factor constant (dimensionless) in [0, 1]; 0.2
-  double friction = 0.5;                 ///< friction coefficient mu (dimensionless) >= 0; 0.5
-  double restitution = 0.0;              ///< coefficient of restitution eps in [0, 1]; 0
-  double restitution_threshold = 1.0;    ///< approach speed (m/s) >= 0 below which no bounce; 1
-  PushMode push = PushMode::baumgarte;   ///< Sec. 5 (baumgarte) or Sec. 8.1 (split)
-  SolverKind solver = SolverKind::pgs;   ///< Sec. 7.2 PGS, or Jacobi
-  FrictionModel friction_model = FrictionModel::fixed;  ///< Sec. 5.4 fixed, or coupled
-  RotationUpdate rotation = RotationUpdate::linear;     ///< Eq. 3.2.4, or Eq. 12.4.1
-  Assembly assembly = Assembly::matrix_free;  ///< same lambda to round-off; matrix-free is faster
-  /// Speculative contact distance (m) >= 0: features closer than this already get a contact row
-  /// that lets them close the gap within a step and no further, so resting contacts do not
-  /// break and re-form each step. 0 gives the paper's contacts, made only on overlap. Typical:
-  /// 1e-3 m for bodies of 0.5 to 3 m.
-  double contact_margin = 0.0;
-  bool collision = true;  ///< false: the bodies never collide and stage 1 is skipped
-  /// true: after every solve, measure the LCP residual (lcp_residual) into World::residual();
-  /// it costs one pass over A per solve, so it is off unless a report asks for it.
-  bool measure_residual = false;
-
-  /// Throws std::invalid_argument naming the parameter, its value and what is allowed.
-  void validate() const;
-};
 
 /// Work done by the steps so far, summed over the run.
 struct StepCounters {

@@ -1,0 +1,152 @@
+#pragma once
+// The world's parameters: the methods to choose from, WorldDef (one value of each), and the
+// parameter table that defines each parameter once: its name, command-line flag, JSON key (with
+// its unit as a suffix), unit, allowed range or names, and help. Validation, the command-line
+// options, run.json, `cps simulate --json` and the report all read the table, so a new world
+// parameter is one WorldDef member plus one table entry (engine/src/parameters.cpp) plus its
+// physics.
+
+#include "cps/math.h"
+
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <variant>
+
+namespace cps {
+
+/// How violated constraints are corrected.
+enum class PushMode {
+  baumgarte,  ///< the push factor stays in the velocity (Eq. 5.2.3, 5.3.1): one solve a step
+  split,      ///< the single frame push factor (Sec. 8.1): positions move with f_cv, the stored
+              ///< momenta with f_c0 from a second solve without the push
+};
+
+/// The iteration used for A lambda = b.
+enum class SolverKind {
+  pgs,     ///< projected Gauss-Seidel: new values used at once (Sec. 7.2)
+  jacobi,  ///< projected Jacobi: new values used after the sweep (Sec. 7.1)
+};
+
+/// How friction rows are bounded.
+enum class FrictionModel {
+  fixed,    ///< the paper's limit +-mu m |g . n| set when the row is built (Sec. 5.4)
+  coupled,  ///< +-mu lambda_n with lambda_n the current value of the row's contact row, as
+            ///< sequential impulse solvers do (Catto, "Iterative Dynamics", GDC 2005)
+};
+
+/// How the orientation follows the angular velocity w = I^-1 l over a step.
+enum class RotationUpdate {
+  linear,  ///< o += 1/2 [0, w] o dt, then normalise (Eq. 3.2.4)
+  exact,   ///< o = [cos(|w| dt / 2), sin(|w| dt / 2) w / |w|] o (Eq. 12.4.1)
+};
+
+/// How A lambda = b is represented while it is solved.
+enum class Assembly {
+  explicit_matrices,  ///< sparse J, M^-1 and A = J M^-1 J^T built every step (Sec. 6), as the
+                      ///< paper states it
+  matrix_free,        ///< per body w = M^-1 J^T lambda, O(12) a row update (matrix_free.h)
+};
+
+/// World parameters, each with its unit and a typical value; the table below gives each one's
+/// allowed values. Validate with validate().
+struct WorldDef {
+  Vec3 gravity = Vec3(0.0, -10.0, 0.0);  ///< m/s^2; the paper uses (0, -10, 0)
+  double dt = 1.0 / 60.0;                ///< time step (s), > 0; the paper uses 1/60
+  int iterations = 25;                   ///< solver sweeps per solve, >= 1; the paper uses 25
+  double beta = 0.2;                     ///< push factor constant (dimensionless) in [0, 1]; 0.2
+  double friction = 0.5;                 ///< friction coefficient mu (dimensionless) >= 0; 0.5
+  double restitution = 0.0;              ///< coefficient of restitution eps in [0, 1]; 0
+  double restitution_threshold = 1.0;    ///< approach speed (m/s) >= 0 below which no bounce; 1
+  PushMode push = PushMode::baumgarte;   ///< Sec. 5 (baumgarte) or Sec. 8.1 (split)
+  SolverKind solver = SolverKind::pgs;   ///< Sec. 7.2 PGS, or Jacobi
+  FrictionModel friction_model = FrictionModel::fixed;  ///< Sec. 5.4 fixed, or coupled
+  RotationUpdate rotation = RotationUpdate::linear;     ///< Eq. 3.2.4, or Eq. 12.4.1
+  Assembly assembly = Assembly::matrix_free;  ///< same lambda to round-off; matrix-free is faster
+  /// Speculative contact distance (m) >= 0: features closer than this already get a contact row
+  /// that lets them close the gap within a step and no further, so resting contacts do not
+  /// break and re-form each step. 0 gives the paper's contacts, made only on overlap. Typical:
+  /// 1e-3 m for bodies of 0.5 to 3 m.
+  double contact_margin = 0.0;
+  bool collision = true;  ///< false: the bodies never collide and the collide stage is skipped
+  /// true: after every solve, measure the LCP residual into World::residual(); it costs one pass
+  /// over the rows per solve, so it is off unless a report asks for it.
+  bool measure_residual = false;
+
+  /// Checks every parameter against the table. Throws std::invalid_argument naming the
+  /// parameter, its value and what is allowed ("world parameter dt = 0 is not allowed: it must
+  /// be finite and > 0 (s)").
+  void validate() const;
+};
+
+/// The kind of value a parameter holds.
+enum class ParameterType {
+  real,     ///< a finite double in [min, max] (or (min, max] when min_exclusive)
+  integer,  ///< an int in [min, max]
+  boolean,  ///< true or false
+  vector3,  ///< three finite doubles
+  choice,   ///< one of the named values of an enum (stored as the enum's int value)
+};
+
+/// One named value of a choice parameter.
+struct Choice {
+  std::string_view name;    ///< as typed and written: "baumgarte"
+  int value;                ///< the enum's value, static_cast<int>(PushMode::baumgarte)
+  std::string_view source;  ///< where it is defined, for labels ("Sec. 5.3"); may be empty
+};
+
+/// A parameter's value: double (real), int (integer, and choice: the enum's value), bool
+/// (boolean) or Vec3 (vector3, in the parameter's unit).
+using ParameterValue = std::variant<double, int, bool, Vec3>;
+
+/// One world parameter, defined once.
+struct Parameter {
+  std::string_view name{};    ///< WorldDef member: "contact_margin"
+  std::string_view flag{};    ///< command-line option without "--": "contact-margin"; empty: none
+  std::string_view json_key{};  ///< key in run.json and --json, unit as suffix: "contact_margin_m"
+  std::string_view unit{};    ///< SI unit ("s", "m", "m/s", "m/s^2"), empty when dimensionless
+  ParameterType type = ParameterType::real;
+  double min = 0.0;            ///< real and integer: smallest allowed value
+  double max = 0.0;            ///< real and integer: largest allowed value (may be +inf)
+  bool min_exclusive = false;  ///< real: min itself is not allowed (dt > 0)
+  std::span<const Choice> choices{};  ///< choice: the allowed names, the default first
+  std::string_view help{};     ///< what it means and a typical value, for --help
+  ParameterValue (*get)(const WorldDef&) = nullptr;
+  void (*set)(WorldDef&, const ParameterValue&) = nullptr;
+
+  /// What is allowed, in words: "finite and > 0 (s)", "in [0, 1]", "one of: baumgarte, split".
+  std::string allowed() const;
+  /// std::nullopt if `v` is allowed, else why not ("it must be in [0, 1]"). A value of the wrong
+  /// alternative (a bool for a real) is not allowed.
+  std::optional<std::string> check(const ParameterValue& v) const;
+  /// Parses a value as typed on the command line: a decimal number (no hex, no trailing text),
+  /// a choice's name, true/false, or "x,y,z". Throws std::invalid_argument naming the text and
+  /// what is allowed, for text that does not parse or a value check() refuses.
+  ParameterValue parse(std::string_view text) const;
+  /// The value as text, the inverse of parse (reals with 17 significant digits).
+  std::string format(const ParameterValue& v) const;
+  /// The name of a choice value; throws std::invalid_argument for a value not in choices.
+  std::string_view choice_name(int value) const;
+  /// The Choice called `name`, or nullptr.
+  const Choice* find_choice(std::string_view name) const;
+};
+
+/// The table: every WorldDef member once, in WorldDef's order.
+std::span<const Parameter> world_parameters();
+
+/// The parameter with this name, flag or JSON key, or nullptr.
+const Parameter* find_parameter(std::string_view name);
+
+/// The parameter with this WorldDef member name. Throws std::invalid_argument for an unknown
+/// name (a programming error: names are fixed at compile time).
+const Parameter& parameter(std::string_view name);
+
+/// Names of the methods, from the table: "baumgarte", "pgs", "fixed", "linear", "matrix-free".
+std::string_view name_of(PushMode v);
+std::string_view name_of(SolverKind v);
+std::string_view name_of(FrictionModel v);
+std::string_view name_of(RotationUpdate v);
+std::string_view name_of(Assembly v);
+
+}  // namespace cps

@@ -1,0 +1,411 @@
+// The parameter table (see parameters.h) and the validation, parsing and formatting it drives.
+#include "cps/parameters.h"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+
+namespace cps {
+namespace {
+
+template <auto Member>
+ParameterValue get_member(const WorldDef& d) {
+  using T = std::remove_cvref_t<decltype(d.*Member)>;
+  if constexpr (std::is_enum_v<T>) {
+    return static_cast<int>(d.*Member);
+  } else {
+    return d.*Member;
+  }
+}
+
+template <auto Member>
+void set_member(WorldDef& d, const ParameterValue& v) {
+  using T = std::remove_cvref_t<decltype(d.*Member)>;
+  if constexpr (std::is_enum_v<T>) {
+    d.*Member = static_cast<T>(std::get<int>(v));
+  } else if constexpr (std::is_same_v<T, double>) {
+    // An integer given for a real (set from code as 1 instead of 1.0) is taken as its value.
+    d.*Member = std::holds_alternative<int>(v) ? std::get<int>(v) : std::get<double>(v);
+  } else {
+    d.*Member = std::get<T>(v);
+  }
+}
+
+constexpr std::array kPushChoices = {
+    Choice{"baumgarte", static_cast<int>(PushMode::baumgarte), "Sec. 5.3"},
+    Choice{"split", static_cast<int>(PushMode::split), "Sec. 8.1"},
+};
+constexpr std::array kSolverChoices = {
+    Choice{"pgs", static_cast<int>(SolverKind::pgs), "Sec. 7.2"},
+    Choice{"jacobi", static_cast<int>(SolverKind::jacobi), "Sec. 7.1"},
+};
+constexpr std::array kFrictionModelChoices = {
+    Choice{"fixed", static_cast<int>(FrictionModel::fixed), "Sec. 5.4"},
+    Choice{"coupled", static_cast<int>(FrictionModel::coupled), ""},
+};
+constexpr std::array kRotationChoices = {
+    Choice{"linear", static_cast<int>(RotationUpdate::linear), "Eq. 3.2.4"},
+    Choice{"exact", static_cast<int>(RotationUpdate::exact), "Eq. 12.4.1"},
+};
+constexpr std::array kAssemblyChoices = {
+    Choice{"matrix-free", static_cast<int>(Assembly::matrix_free), ""},
+    Choice{"explicit", static_cast<int>(Assembly::explicit_matrices), "Sec. 6"},
+};
+
+// Every WorldDef member, in its order. Reals and integers are finite and in [min, max].
+const std::array kParameters = {
+    Parameter{.name = "gravity",
+              .flag = "",
+              .json_key = "gravity_mps2",
+              .unit = "m/s^2",
+              .type = ParameterType::vector3,
+              .help = "gravitational acceleration; the paper uses (0, -10, 0)",
+              .get = &get_member<&WorldDef::gravity>,
+              .set = &set_member<&WorldDef::gravity>},
+    Parameter{.name = "dt",
+              .flag = "dt",
+              .json_key = "dt_s",
+              .unit = "s",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = kInfinity,
+              .min_exclusive = true,
+              .help = "time step; the paper uses 1/60",
+              .get = &get_member<&WorldDef::dt>,
+              .set = &set_member<&WorldDef::dt>},
+    Parameter{.name = "iterations",
+              .flag = "iterations",
+              .json_key = "iterations",
+              .unit = "",
+              .type = ParameterType::integer,
+              .min = 1.0,
+              .max = 1000000.0,
+              .help = "solver sweeps per solve of A lambda = b; the paper uses 25",
+              .get = &get_member<&WorldDef::iterations>,
+              .set = &set_member<&WorldDef::iterations>},
+    Parameter{.name = "beta",
+              .flag = "beta",
+              .json_key = "beta",
+              .unit = "",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0,
+              .help = "push factor constant beta (Eq. 5.2.3); the paper uses 0.2",
+              .get = &get_member<&WorldDef::beta>,
+              .set = &set_member<&WorldDef::beta>},
+    Parameter{.name = "friction",
+              .flag = "friction",
+              .json_key = "friction",
+              .unit = "",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0e6,
+              .help = "friction coefficient mu (Sec. 5.4); 0 builds no friction rows; scenes use 0.5",
+              .get = &get_member<&WorldDef::friction>,
+              .set = &set_member<&WorldDef::friction>},
+    Parameter{.name = "restitution",
+              .flag = "restitution",
+              .json_key = "restitution",
+              .unit = "",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0,
+              .help = "coefficient of restitution eps (Eq. 8.2.1); scenes use 0",
+              .get = &get_member<&WorldDef::restitution>,
+              .set = &set_member<&WorldDef::restitution>},
+    Parameter{.name = "restitution_threshold",
+              .flag = "restitution-threshold",
+              .json_key = "restitution_threshold_mps",
+              .unit = "m/s",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0e6,
+              .help = "contacts approaching slower than this get no restitution, so resting "
+                      "contacts do not bounce; typical 1",
+              .get = &get_member<&WorldDef::restitution_threshold>,
+              .set = &set_member<&WorldDef::restitution_threshold>},
+    Parameter{.name = "push",
+              .flag = "push",
+              .json_key = "push",
+              .type = ParameterType::choice,
+              .choices = kPushChoices,
+              .help = "baumgarte: the push factor kept in the velocity (Sec. 5); split: the single "
+                      "frame push factor, two solves (Sec. 8.1)",
+              .get = &get_member<&WorldDef::push>,
+              .set = &set_member<&WorldDef::push>},
+    Parameter{.name = "solver",
+              .flag = "solver",
+              .json_key = "solver",
+              .type = ParameterType::choice,
+              .choices = kSolverChoices,
+              .help = "pgs: projected Gauss-Seidel (Sec. 7.2); jacobi: projected Jacobi (Sec. 7.1)",
+              .get = &get_member<&WorldDef::solver>,
+              .set = &set_member<&WorldDef::solver>},
+    Parameter{.name = "friction_model",
+              .flag = "friction-model",
+              .json_key = "friction_model",
+              .type = ParameterType::choice,
+              .choices = kFrictionModelChoices,
+              .help = "fixed: the paper's limit mu m |g.n| (Sec. 5.4); coupled: mu times the "
+                      "contact row's lambda",
+              .get = &get_member<&WorldDef::friction_model>,
+              .set = &set_member<&WorldDef::friction_model>},
+    Parameter{.name = "rotation",
+              .flag = "rotation",
+              .json_key = "rotation",
+              .type = ParameterType::choice,
+              .choices = kRotationChoices,
+              .help = "linear: Eq. 3.2.4 then normalise; exact: the axis-angle step of Eq. 12.4.1",
+              .get = &get_member<&WorldDef::rotation>,
+              .set = &set_member<&WorldDef::rotation>},
+    Parameter{.name = "assembly",
+              .flag = "assembly",
+              .json_key = "assembly",
+              .type = ParameterType::choice,
+              .choices = kAssemblyChoices,
+              .help = "matrix-free: w = M^-1 J^T lambda per body (the default); explicit: sparse "
+                      "J, M^-1 and A = J M^-1 J^T as in Sec. 6; the same lambda to round-off",
+              .get = &get_member<&WorldDef::assembly>,
+              .set = &set_member<&WorldDef::assembly>},
+    Parameter{.name = "contact_margin",
+              .flag = "contact-margin",
+              .json_key = "contact_margin_m",
+              .unit = "m",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0e6,
+              .help = "speculative contact distance; 0 = contacts only on overlap, as in the "
+                      "paper; typical 0.001 for bodies of 0.5 to 3 m",
+              .get = &get_member<&WorldDef::contact_margin>,
+              .set = &set_member<&WorldDef::contact_margin>},
+    Parameter{.name = "collision",
+              .flag = "",
+              .json_key = "collision",
+              .type = ParameterType::boolean,
+              .help = "false: bodies never collide",
+              .get = &get_member<&WorldDef::collision>,
+              .set = &set_member<&WorldDef::collision>},
+    Parameter{.name = "measure_residual",
+              .flag = "",
+              .json_key = "measure_residual",
+              .type = ParameterType::boolean,
+              .help = "measure the LCP residual of every solve (costs a pass over the rows)",
+              .get = &get_member<&WorldDef::measure_residual>,
+              .set = &set_member<&WorldDef::measure_residual>},
+};
+
+std::string number_text(double v) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", v);
+  // The shortest text that reads back as v, up to 17 digits (0.2 rather than 0.2000...01).
+  for (int digits = 1; digits < 17; ++digits) {
+    char shorter[40];
+    std::snprintf(shorter, sizeof shorter, "%.*g", digits, v);
+    if (std::strtod(shorter, nullptr) == v) return shorter;
+  }
+  return text;
+}
+
+std::string unit_suffix(const Parameter& p) {
+  return p.unit.empty() ? std::string() : " (" + std::string(p.unit) + ")";
+}
+
+// A whole decimal number: no hex, no leading '+', no trailing text.
+std::optional<double> parse_real(std::string_view text) {
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return std::nullopt;
+  return value;
+}
+
+}  // namespace
+
+std::string Parameter::allowed() const {
+  switch (type) {
+    case ParameterType::real: {
+      std::string s = "finite and ";
+      if (max == kInfinity) {
+        s += (min_exclusive ? "> " : ">= ") + number_text(min);
+      } else {
+        s = std::string(min_exclusive ? "in (" : "in [") + number_text(min) + ", " +
+            number_text(max) + "]";
+      }
+      return s + unit_suffix(*this);
+    }
+    case ParameterType::integer:
+      return "a whole number in [" + number_text(min) + ", " + number_text(max) + "]";
+    case ParameterType::boolean:
+      return "true or false";
+    case ParameterType::vector3:
+      return "three finite numbers x,y,z" + unit_suffix(*this);
+    case ParameterType::choice: {
+      std::string s = "one of: ";
+      for (std::size_t i = 0; i < choices.size(); ++i) {
+        s += (i > 0 ? ", " : "") + std::string(choices[i].name);
+      }
+      return s;
+    }
+  }
+  return {};
+}
+
+std::optional<std::string> Parameter::check(const ParameterValue& v) const {
+  const std::string must = "it must be " + allowed();
+  switch (type) {
+    case ParameterType::real: {
+      if (!std::holds_alternative<double>(v) && !std::holds_alternative<int>(v)) return must;
+      const double x = std::holds_alternative<int>(v) ? std::get<int>(v) : std::get<double>(v);
+      // isfinite first: an ordered comparison with NaN would raise FE_INVALID.
+      if (!std::isfinite(x)) return must;
+      if (!(min_exclusive ? x > min : x >= min) || x > max) return must;
+      return std::nullopt;
+    }
+    case ParameterType::integer: {
+      if (!std::holds_alternative<int>(v)) return must;
+      const int x = std::get<int>(v);
+      if (x < min || x > max) return must;
+      return std::nullopt;
+    }
+    case ParameterType::boolean:
+      if (!std::holds_alternative<bool>(v)) return must;
+      return std::nullopt;
+    case ParameterType::vector3:
+      if (!std::holds_alternative<Vec3>(v) || !all_finite(std::get<Vec3>(v))) return must;
+      return std::nullopt;
+    case ParameterType::choice:
+      if (!std::holds_alternative<int>(v)) return must;
+      for (const Choice& c : choices) {
+        if (c.value == std::get<int>(v)) return std::nullopt;
+      }
+      return must;
+  }
+  return must;
+}
+
+ParameterValue Parameter::parse(std::string_view text) const {
+  const auto refuse = [&](const std::string& why) -> std::invalid_argument {
+    const std::string shown = flag.empty() ? std::string(name) : "--" + std::string(flag);
+    return std::invalid_argument(shown + " " + std::string(text) + ": " + why);
+  };
+  ParameterValue v;
+  switch (type) {
+    case ParameterType::real: {
+      const std::optional<double> x = parse_real(text);
+      if (!x) throw refuse("not a number; give a decimal number, " + allowed());
+      v = *x;
+      break;
+    }
+    case ParameterType::integer: {
+      int x = 0;
+      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), x);
+      if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
+        throw refuse("not a whole number; give " + allowed());
+      }
+      v = x;
+      break;
+    }
+    case ParameterType::boolean:
+      if (text == "true") {
+        v = true;
+      } else if (text == "false") {
+        v = false;
+      } else {
+        throw refuse("give true or false");
+      }
+      break;
+    case ParameterType::vector3: {
+      Vec3 x;
+      std::size_t start = 0;
+      for (int k = 0; k < 3; ++k) {
+        const std::size_t comma = k < 2 ? text.find(',', start) : text.size();
+        const std::optional<double> c =
+            comma == std::string_view::npos ? std::nullopt : parse_real(text.substr(start, comma - start));
+        if (!c) throw refuse("give " + allowed());
+        x[k] = *c;
+        start = comma + 1;
+      }
+      v = x;
+      break;
+    }
+    case ParameterType::choice: {
+      const Choice* c = find_choice(text);
+      if (c == nullptr) throw refuse("'" + std::string(text) + "' is not " + allowed());
+      v = c->value;
+      break;
+    }
+  }
+  if (const std::optional<std::string> why = check(v)) throw refuse(*why);
+  return v;
+}
+
+std::string Parameter::format(const ParameterValue& v) const {
+  if (type == ParameterType::choice && std::holds_alternative<int>(v)) {
+    for (const Choice& c : choices) {
+      if (c.value == std::get<int>(v)) return std::string(c.name);
+    }
+  }
+  if (std::holds_alternative<double>(v)) return number_text(std::get<double>(v));
+  if (std::holds_alternative<int>(v)) return std::to_string(std::get<int>(v));
+  if (std::holds_alternative<bool>(v)) return std::get<bool>(v) ? "true" : "false";
+  const Vec3& x = std::get<Vec3>(v);
+  return number_text(x.x()) + "," + number_text(x.y()) + "," + number_text(x.z());
+}
+
+std::string_view Parameter::choice_name(int value) const {
+  for (const Choice& c : choices) {
+    if (c.value == value) return c.name;
+  }
+  throw std::invalid_argument("parameter " + std::string(name) + " has no value " +
+                              std::to_string(value));
+}
+
+const Choice* Parameter::find_choice(std::string_view choice) const {
+  for (const Choice& c : choices) {
+    if (c.name == choice) return &c;
+  }
+  return nullptr;
+}
+
+std::span<const Parameter> world_parameters() { return kParameters; }
+
+const Parameter* find_parameter(std::string_view name) {
+  for (const Parameter& p : kParameters) {
+    if (p.name == name || (!p.flag.empty() && p.flag == name) || p.json_key == name) return &p;
+  }
+  return nullptr;
+}
+
+const Parameter& parameter(std::string_view name) {
+  for (const Parameter& p : kParameters) {
+    if (p.name == name) return p;
+  }
+  throw std::invalid_argument("no world parameter is called '" + std::string(name) + "'");
+}
+
+std::string_view name_of(PushMode v) { return parameter("push").choice_name(static_cast<int>(v)); }
+std::string_view name_of(SolverKind v) { return parameter("solver").choice_name(static_cast<int>(v)); }
+std::string_view name_of(FrictionModel v) {
+  return parameter("friction_model").choice_name(static_cast<int>(v));
+}
+std::string_view name_of(RotationUpdate v) {
+  return parameter("rotation").choice_name(static_cast<int>(v));
+}
+std::string_view name_of(Assembly v) { return parameter("assembly").choice_name(static_cast<int>(v)); }
+
+void WorldDef::validate() const {
+  for (const Parameter& p : kParameters) {
+    const ParameterValue v = p.get(*this);
+    if (const std::optional<std::string> why = p.check(v)) {
+      throw std::invalid_argument("world parameter " + std::string(p.name) + " = " + p.format(v) +
+                                  " is not allowed: " + *why);
+    }
+  }
+}
+
+}  // namespace cps

@@ -1,6 +1,7 @@
 // Distance constraints (Sec. 5.2), restitution (Sec. 8.2), friction (Sec. 5.4), the solver and
 // rotation alternatives, checked against analytic results.
 #include "cps/world.h"
+#include "solver.h"
 
 #include <catch2/catch.hpp>
 

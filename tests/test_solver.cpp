@@ -1,5 +1,5 @@
 // The system of Sec. 6 and projected Gauss-Seidel (Sec. 7).
-#include "cps/solver.h"
+#include "solver.h"
 #include "cps/world.h"
 
 #include <Eigen/Dense>

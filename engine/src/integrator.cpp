@@ -1,5 +1,5 @@
 // Semi-implicit Euler, paper Sec. 3.2.
-#include "cps/integrator.h"
+#include "integrator.h"
 
 #include <cmath>
 

@@ -1,8 +1,9 @@
 // The matrix-free solve (see matrix_free.h): PGS and Jacobi over rows, with w = M^-1 J^T lambda
 // per body in place of A = J M^-1 J^T.
-#include "cps/matrix_free.h"
+#include "matrix_free.h"
 
 #include "buffers.h"
+#include "lcp.h"
 
 #include <algorithm>
 #include <cmath>
@@ -32,13 +33,7 @@ inline void add_to_w(const PackedRow& r, double delta, std::vector<Vec6>& w, int
 
 template <bool kCoupled>
 inline void bounds(const PackedRow& r, const std::vector<double>& lambda, double& lo, double& hi) {
-  if (kCoupled && r.normal_row >= 0) {
-    hi = r.mu * lambda[static_cast<std::size_t>(r.normal_row)];
-    lo = -hi;
-  } else {
-    lo = r.c_min;
-    hi = r.c_max;
-  }
+  detail::force_limits<kCoupled>(r.c_min, r.c_max, r.mu, r.normal_row, lambda.data(), lo, hi);
 }
 
 // A short run row by row through w (Eq. 7.1.1): rows r[0..m) all on w_a and, when kTwoBodies, w_b.
@@ -219,7 +214,8 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
 }
 
 void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
-         const std::vector<Body>& bodies, const Vec3& gravity, double dt, TargetTerms terms) {
+         const std::vector<Body>& bodies, const Eigen::VectorXd& f_ext, double dt,
+         TargetTerms terms) {
   detail::resize_with_headroom(s.b, rows.size());
   // a = v1 / dt + M^-1 f_ext per body, in w's storage (solve() overwrites it).
   detail::resize_with_headroom(s.w, bodies.size() + 1);
@@ -228,7 +224,11 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     Vec6& a = s.w[i];
     a.head<3>() = body.inv_mass * body.p / dt;
     a.tail<3>() = s.inv_inertia[i] * body.l / dt;
-    if (!body.is_static()) a.head<3>() += body.inv_mass * (body.mass * gravity);
+    if (!body.is_static()) {
+      const auto k = static_cast<Eigen::Index>(6 * i);
+      a.head<3>() += body.inv_mass * f_ext.segment<3>(k);
+      a.tail<3>() += s.inv_inertia[i] * f_ext.segment<3>(k + 3);
+    }
   }
   s.w.back().setZero();
   for (std::size_t r = 0; r < rows.size(); ++r) {
@@ -314,18 +314,9 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
       bounds<false>(s.rows[j], lambda, lo, hi);
     }
     const double Ax = row_times_w(s.rows[j], s.w, static_cast<int>(s.w.size()) - 1);
-    const double r = std::abs(lambda[j] - std::clamp(lambda[j] - (Ax - s.b[j]) / diagonal, lo, hi));
+    const double r = detail::natural_map_residual(lambda[j], Ax - s.b[j], diagonal, lo, hi);
     max = std::max(max, r);
     sum_squares += r * r;
-  }
-}
-
-void add_constraint_forces(const std::vector<ConstraintRow>& rows,
-                           const std::vector<double>& lambda, Eigen::VectorXd& f) {
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    const ConstraintRow& row = rows[r];
-    if (row.body_a != kWorldBody) f.segment<6>(6 * row.body_a) += lambda[r] * row.j.head<6>();
-    if (row.body_b != kWorldBody) f.segment<6>(6 * row.body_b) += lambda[r] * row.j.tail<6>();
   }
 }
 

@@ -1,5 +1,7 @@
 // Projected Gauss-Seidel (paper Sec. 7.2) and projected Jacobi (Sec. 7.1).
-#include "cps/solver.h"
+#include "solver.h"
+
+#include "lcp.h"
 
 #include <algorithm>
 #include <cmath>
@@ -46,14 +48,10 @@ Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
   }
   // Bounds of row j given the lambda the row reads from.
   const auto bounds = [&](Eigen::Index j, const Eigen::VectorXd& lambda, double& lo, double& hi) {
-    const int n = coupled ? limits.normal_row[static_cast<std::size_t>(j)] : -1;
-    if (n >= 0) {
-      hi = limits.mu[j] * lambda[n];
-      lo = -hi;
-    } else {
-      lo = limits.c_min[j];
-      hi = limits.c_max[j];
-    }
+    detail::force_limits(coupled, limits.c_min[j], limits.c_max[j],
+                         coupled ? limits.mu[j] : 0.0,
+                         coupled ? limits.normal_row[static_cast<std::size_t>(j)] : -1,
+                         lambda.data(), lo, hi);
   };
 
   // PGS writes into lambda as it goes; Jacobi writes into `next` and swaps after the sweep.
@@ -98,14 +96,12 @@ Eigen::VectorXd lcp_residual(const SparseRowMatrix& A, const Eigen::VectorXd& b,
       if (it.col() == j) diagonal = it.value();
     }
     if (!(diagonal > 0.0)) continue;
-    double lo = limits.c_min[j];
-    double hi = limits.c_max[j];
-    const int n = coupled ? limits.normal_row[static_cast<std::size_t>(j)] : -1;
-    if (n >= 0) {
-      hi = limits.mu[j] * lambda[n];
-      lo = -hi;
-    }
-    r[j] = std::abs(lambda[j] - std::clamp(lambda[j] - (Ax - b[j]) / diagonal, lo, hi));
+    double lo;
+    double hi;
+    detail::force_limits(coupled, limits.c_min[j], limits.c_max[j], coupled ? limits.mu[j] : 0.0,
+                         coupled ? limits.normal_row[static_cast<std::size_t>(j)] : -1,
+                         lambda.data(), lo, hi);
+    r[j] = detail::natural_map_residual(lambda[j], Ax - b[j], diagonal, lo, hi);
   }
   return r;
 }

@@ -1,5 +1,5 @@
 // The system J, M^-1, A, b of paper Sec. 6 (Eqs. 6.1.1-6.1.4, 6.2.9).
-#include "cps/system.h"
+#include "system.h"
 
 #include <stdexcept>
 #include <string>
@@ -52,13 +52,19 @@ System assemble_system(const std::vector<ConstraintRow>& rows, const std::vector
                        const Eigen::VectorXd& v1, const Eigen::VectorXd& f_ext, double dt,
                        TargetTerms terms) {
   const auto n = static_cast<Eigen::Index>(bodies.size());
-  const auto c = static_cast<Eigen::Index>(rows.size());
   if (v1.size() != 6 * n || f_ext.size() != 6 * n) {
     throw std::invalid_argument("assemble_system: v1 has " + std::to_string(v1.size()) +
                                 " and f_ext " + std::to_string(f_ext.size()) +
                                 " entries; both must have 6n = " + std::to_string(6 * n));
   }
+  System s = assemble_matrices(rows, bodies);
+  s.b = assemble_rhs(rows, s.J, s.M_inv, v1, f_ext, dt, terms);
+  return s;
+}
 
+System assemble_matrices(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies) {
+  const auto n = static_cast<Eigen::Index>(bodies.size());
+  const auto c = static_cast<Eigen::Index>(rows.size());
   System s;
   // J: one row per constraint, 12 entries at the columns of its two bodies (Sec. 6.1.2).
   std::vector<Eigen::Triplet<double>> triplets;
@@ -71,7 +77,7 @@ System assemble_system(const std::vector<ConstraintRow>& rows, const std::vector
     const ConstraintRow& row = rows[static_cast<std::size_t>(r)];
     for (int body : {row.body_a, row.body_b}) {
       if (body != kWorldBody && (body < 0 || body >= n)) {
-        throw std::invalid_argument("assemble_system: row " + std::to_string(r) +
+        throw std::invalid_argument("assemble_matrices: row " + std::to_string(r) +
                                     " refers to body " + std::to_string(body) + "; there are " +
                                     std::to_string(n));
       }
@@ -107,7 +113,6 @@ System assemble_system(const std::vector<ConstraintRow>& rows, const std::vector
   // A = J M^-1 J^T (Eq. 6.2.9).
   const SparseRowMatrix JM = s.J * s.M_inv;
   s.A = JM * SparseRowMatrix(s.J.transpose());
-  s.b = assemble_rhs(rows, s.J, s.M_inv, v1, f_ext, dt, terms);
   return s;
 }
 

@@ -1,11 +1,11 @@
-// The step: collide, build rows, assemble, solve, integrate (see world.h).
+// The step as the paper's stages (see world.h): each stage a function, in the paper's order.
 #include "cps/world.h"
 
+#include "broad_phase.h"
 #include "buffers.h"
-
-#include "cps/integrator.h"
-#include "cps/solver.h"
-#include "cps/system.h"
+#include "constraint_solver.h"
+#include "integrator.h"
+#include "system.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +14,31 @@
 #include <stdexcept>
 
 namespace cps {
-World::World(const WorldDef& def) : def_(def) { def_.validate(); }
+
+World::World(const WorldDef& def) : def_(def), broad_phase_(std::make_unique<BroadPhase>()) {
+  def_.validate();
+}
+
+World::World(const World& other)
+    : def_(other.def_),
+      bodies_(other.bodies_),
+      distances_(other.distances_),
+      manifolds_(other.manifolds_),
+      rows_(other.rows_),
+      lambda_(other.lambda_),
+      lambda0_(other.lambda0_),
+      broad_phase_(std::make_unique<BroadPhase>()),
+      counters_(other.counters_),
+      residual_(other.residual_) {}
+
+World& World::operator=(const World& other) {
+  if (this != &other) *this = World(other);
+  return *this;
+}
+
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+World::~World() = default;
 
 void World::set_def(const WorldDef& def) {
   def.validate();
@@ -49,41 +73,22 @@ int World::add_distance(const DistanceConstraint& d) {
 }
 
 void World::step() {
-  collide();
-  build_rows();
-  solve_and_integrate();
+  external_forces();                                  // Sec. 6.1: f_ext
+  collide();                                          // Sec. 4: manifolds
+  build_rows();                                       // Sec. 5: rows of J, targets, limits
+  prepare();                                          // Sec. 6: A or the packed rows
+  solve(TargetTerms::push_and_bias, lambda_, f_cv_);  // Sec. 7: lambda, f_cv
+  if (def_.push == PushMode::split) {
+    solve(TargetTerms::bias_only, lambda0_, f_c0_);   // Sec. 8.1: lambda_0, f_c0
+  } else {
+    lambda0_.clear();
+  }
+  integrate();                                        // Sec. 3.2
   ++counters_.steps;
 }
 
-namespace {
-
-// Broad phase grid. Bodies wider than this many times the median width (dimensionless) are not
-// put in the grid but tested against every body, so that one large body (a static slab, say)
-// does not make every cell large. Typical: 8.
-constexpr double kOversizeFactor = 8.0;
-// Cell edge = widest gridded body times this (dimensionless, > 1): the margin keeps two
-// overlapping bounds in neighbouring cells despite the rounding of lo / edge.
-constexpr double kCellGrowth = 1.001;
-// The grid numbers its cells densely when their box holds at most this many cells per gridded
-// body (dimensionless; memory: 4 bytes a cell), else it hashes its rows. Typical: 16.
-constexpr double kDenseCells = 16.0;
-// Cell coordinates are clamped to +-2^30 (about 1e9 cells): far out, or not finite, bodies
-// share the edge cells, which can only add candidates, never lose one.
-constexpr double kMaxCell = 1073741824.0;
-// Worlds with at most this many bodies that are not planes skip the grid and test every pair of
-// bounds (count; typical 32): below it the n^2 / 2 tests cost less than building the grid
-// (measured on the paper's scenes, 6 to 31 bodies).
-constexpr std::size_t kAllPairsMax = 32;
-
-// Closed intervals overlap on all three axes: no axis separates them (evaluated without
-// branches: | not ||).
-template <class B>
-bool bounds_overlap(const B& a, const B& b) {
-  return !((b.lo.x() > a.hi.x()) | (a.lo.x() > b.hi.x()) | (b.lo.y() > a.hi.y()) |
-           (a.lo.y() > b.hi.y()) | (b.lo.z() > a.hi.z()) | (a.lo.z() > b.hi.z()));
-}
-
-}  // namespace
+// Stage 0, Sec. 6.1: f_ext (6n) = [m g, 0] per movable body, into a buffer that keeps its size.
+void World::external_forces() { gravity_forces(bodies_, def_.gravity, f_ext_); }
 
 // Stage 1, Sec. 4: the broad phase lists the pairs that may touch, in index order, then the
 // narrow phase builds their manifolds. The order is that of testing every pair (a, b), a < b,
@@ -91,7 +96,13 @@ bool bounds_overlap(const B& a, const B& b) {
 void World::collide() {
   manifolds_.clear();
   if (!def_.collision) return;
-  broad_phase();
+  // The rotation matrix of each box and plane, once: the broad phase's bounds and the narrow
+  // phase both read it (spheres need none).
+  rotations_.resize(bodies_.size());
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_[i].shape.kind != ShapeKind::sphere) rotations_[i] = bodies_[i].rotation();
+  }
+  broad_phase_->find_pairs(bodies_, rotations_, def_.contact_margin, pairs_);
   detail::reserve_with_headroom(manifolds_, pairs_.size());
   for (const auto& [a, b] : pairs_) {
     ++counters_.pairs_tested;
@@ -109,232 +120,6 @@ void World::collide() {
     }
   }
 }
-
-// Broad phase: axis-aligned bounds grown by the contact margin; a pair is a candidate when its
-// bounds overlap (closed intervals on x, y and z) and not both bodies are static; every plane is
-// a candidate with every movable body. Bounds go into a uniform grid of cubic cells a little
-// wider than the widest body (Ericson 2005, Sec. 7.1), put in order of their cell's bucket by a
-// counting sort, so the cost grows with the body count and the pairs, not with their square or
-// a sort. Two overlapping bounds have lower corners at most one cell apart, so each body looks
-// in the 27 cells around its own (9 rows of 3) for bodies of higher index; the few candidates
-// of one body are sorted, so the pairs come out in index order without a global sort. Bodies
-// more than kOversizeFactor times wider than the median are kept out of the grid and tested
-// against every body, so that one large body does not make every cell large.
-void World::broad_phase() {
-  const std::size_t n = bodies_.size();
-  bounds_.resize(n);
-  broad_class_.resize(n);
-  rotations_.resize(n);
-  cell_.resize(n);
-  bucket_of_.resize(n);
-  planes_.clear();
-  oversize_.clear();
-  widths_.clear();
-  pairs_.clear();
-  detail::reserve_with_headroom(widths_, n);
-  detail::reserve_with_headroom(planes_, n);
-  detail::reserve_with_headroom(oversize_, n);
-  const double grow = 0.5 * def_.contact_margin;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Body& b = bodies_[i];
-    Vec3 half = Vec3::Zero();
-    switch (b.shape.kind) {
-      case ShapeKind::plane:
-        rotations_[i] = b.rotation();
-        broad_class_[i] = BroadClass::plane;
-        planes_.push_back(static_cast<int>(i));
-        continue;
-      case ShapeKind::box:
-        rotations_[i] = b.rotation();
-        half = rotations_[i].cwiseAbs() * b.shape.half_extents;
-        break;
-      case ShapeKind::sphere:
-        half = Vec3::Constant(b.shape.radius);
-        break;
-    }
-    bounds_[i] = {b.x - half - Vec3::Constant(grow), b.x + half + Vec3::Constant(grow)};
-    broad_class_[i] = BroadClass::gridded;
-    const double width = (bounds_[i].hi - bounds_[i].lo).maxCoeff();
-    widths_.push_back(std::isfinite(width) ? width : 0.0);
-  }
-  if (widths_.size() <= kAllPairsMax) {
-    // A small world: every body is tested against every other, as the oversize ones are.
-    for (std::size_t i = 0; i < n; ++i) {
-      if (broad_class_[i] != BroadClass::plane) broad_class_[i] = BroadClass::oversize;
-    }
-    for (std::size_t i = 0; i < n; ++i) pairs_of_ungridded(i);
-    return;
-  }
-  // Bodies much wider than the median go to the oversize list; the rest set the cell edge.
-  double limit = kInfinity;
-  if (!widths_.empty()) {
-    const auto middle = widths_.begin() + static_cast<std::ptrdiff_t>(widths_.size() / 2);
-    std::nth_element(widths_.begin(), middle, widths_.end());
-    limit = kOversizeFactor * *middle;
-  }
-  double widest = 0.0;
-  std::size_t gridded = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (broad_class_[i] != BroadClass::gridded) continue;
-    const double width = (bounds_[i].hi - bounds_[i].lo).maxCoeff();
-    if (width > limit) {
-      broad_class_[i] = BroadClass::oversize;
-      oversize_.push_back(static_cast<int>(i));
-    } else {
-      widest = std::max(widest, width);
-      ++gridded;
-    }
-  }
-  const double edge = widest > 0.0 && std::isfinite(widest) ? kCellGrowth * widest : 1.0;
-  const double inv_edge = 1.0 / edge;
-  const auto cell_coordinate = [inv_edge](double x) {
-    double q = std::floor(x * inv_edge);
-    if (!(q >= -kMaxCell)) q = -kMaxCell;  // also NaN
-    if (q > kMaxCell) q = kMaxCell;
-    return static_cast<std::int32_t>(q);
-  };
-  // Cells of the gridded bodies and the box of cells they span.
-  std::array<std::int32_t, 3> low{0, 0, 0};
-  std::array<std::int32_t, 3> high{0, 0, 0};
-  bool first = true;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (broad_class_[i] != BroadClass::gridded) continue;
-    const Vec3& lo = bounds_[i].lo;
-    cell_[i] = {cell_coordinate(lo.x()), cell_coordinate(lo.y()), cell_coordinate(lo.z())};
-    for (int k = 0; k < 3; ++k) {
-      low[k] = first ? cell_[i][k] : std::min(low[k], cell_[i][k]);
-      high[k] = first ? cell_[i][k] : std::max(high[k], cell_[i][k]);
-    }
-    first = false;
-  }
-  // Bucket of a cell: x + row(y, z), so that the cells x - 1, x, x + 1 of a row are three
-  // consecutive buckets (one range of the sorted bodies). When the box of cells is at most
-  // kDenseCells times the body count, row(y, z) numbers the rows of the box densely and no two
-  // cells share a bucket; otherwise it is a hash of (y, z) (Teschner et al. 2003) and a bucket
-  // may also hold other cells, which the row test below skips.
-  const std::uint64_t size_x = static_cast<std::uint64_t>(high[0] - low[0]) + 3;
-  const std::uint64_t size_y = static_cast<std::uint64_t>(high[1] - low[1]) + 3;
-  const std::uint64_t size_z = static_cast<std::uint64_t>(high[2] - low[2]) + 3;
-  const double box_cells = static_cast<double>(size_x) * static_cast<double>(size_y) *
-                           static_cast<double>(size_z);
-  const bool dense = box_cells <= kDenseCells * static_cast<double>(gridded);
-  const auto power_of_two_from = [](std::uint64_t count) {
-    std::uint64_t p = 4;  // >= 4: the three buckets of a row range are distinct
-    while (p < count) p *= 2;
-    return p;
-  };
-  const std::uint64_t buckets =
-      power_of_two_from(dense ? static_cast<std::uint64_t>(box_cells) : 2 * gridded);
-  const std::uint64_t mask = buckets - 1;
-  // Room for the most buckets this body count can ask for, so that bodies spreading out (a
-  // larger box of cells) do not make a step allocate.
-  detail::reserve_with_headroom(
-      bucket_start_, static_cast<std::size_t>(power_of_two_from(
-                         static_cast<std::uint64_t>(kDenseCells) * gridded)) + 2);
-  const auto row_key = [&](std::int32_t y, std::int32_t z) -> std::uint64_t {
-    // y - low + 1 and z - low + 1 are in [0, size) for the rows a body looks at.
-    const auto ry = static_cast<std::uint64_t>(static_cast<std::int64_t>(y) - low[1] + 1);
-    const auto rz = static_cast<std::uint64_t>(static_cast<std::int64_t>(z) - low[2] + 1);
-    if (dense) return size_x * (ry + size_y * rz);
-    return (ry * 19349663u) ^ (rz * 83492791u);
-  };
-  const auto key = [&](std::int32_t x, std::int32_t y, std::int32_t z) {
-    const auto rx = static_cast<std::uint64_t>(static_cast<std::int64_t>(x) - low[0] + 1);
-    return (rx + row_key(y, z)) & mask;
-  };
-  // Counting sort of the gridded bodies by bucket (index order within a bucket).
-  detail::assign_with_headroom(bucket_start_, static_cast<std::size_t>(buckets) + 2, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (broad_class_[i] != BroadClass::gridded) continue;
-    bucket_of_[i] = static_cast<std::uint32_t>(key(cell_[i][0], cell_[i][1], cell_[i][2]));
-    ++bucket_start_[bucket_of_[i] + 2];
-  }
-  for (std::size_t k = 2; k < bucket_start_.size(); ++k) bucket_start_[k] += bucket_start_[k - 1];
-  detail::resize_with_headroom(grid_, gridded);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (broad_class_[i] != BroadClass::gridded) continue;
-    grid_[static_cast<std::size_t>(bucket_start_[bucket_of_[i] + 1]++)] = {
-        static_cast<int>(i), bodies_[i].is_static(), cell_[i], bounds_[i]};
-  }
-  detail::resize_with_headroom(candidates_, n + planes_.size());
-
-  for (std::size_t ia = 0; ia < n; ++ia) {
-    const int a = static_cast<int>(ia);
-    const bool a_static = bodies_[ia].is_static();
-    if (broad_class_[ia] != BroadClass::gridded) {
-      pairs_of_ungridded(ia);
-      continue;
-    }
-    // Bodies of higher index in the 27 cells around a's: per neighbour row one range of
-    // buckets. The test is without branches; a hit is kept by advancing the count.
-    std::size_t count = 0;
-    const Bounds& ba = bounds_[ia];
-    const std::array<std::int32_t, 3> c = cell_[ia];
-    const auto scan = [&](int begin, int end, std::int32_t y, std::int32_t z) {
-      for (int k = begin; k < end; ++k) {
-        const GridEntry& e = grid_[static_cast<std::size_t>(k)];
-        // The row test keeps a body that shares its bucket with another row from being taken
-        // twice; cells of this row beyond x +- 1 can only be there by wrapping (hashed rows)
-        // and fail the bounds test.
-        const bool hit = (e.body > a) & (e.cell[1] == y) & (e.cell[2] == z) &
-                         !(a_static & e.is_static) & bounds_overlap(ba, e.bounds);
-        candidates_[count] = e.body;
-        count += hit ? 1 : 0;
-      }
-    };
-    for (std::int32_t y = c[1] - 1; y <= c[1] + 1; ++y) {
-      for (std::int32_t z = c[2] - 1; z <= c[2] + 1; ++z) {
-        const auto first_bucket = static_cast<std::size_t>(key(c[0] - 1, y, z));
-        if (first_bucket + 3 <= buckets) {
-          scan(bucket_start_[first_bucket], bucket_start_[first_bucket + 3], y, z);
-        } else {  // the three buckets wrap around the end of the table
-          for (std::int32_t x = c[0] - 1; x <= c[0] + 1; ++x) {
-            const auto bucket = static_cast<std::size_t>(key(x, y, z));
-            scan(bucket_start_[bucket], bucket_start_[bucket + 1], y, z);
-          }
-        }
-      }
-    }
-    for (const int b : oversize_) {
-      const auto ib = static_cast<std::size_t>(b);
-      if (b > a && !(a_static && bodies_[ib].is_static()) && bounds_overlap(ba, bounds_[ib])) {
-        candidates_[count++] = b;
-      }
-    }
-    if (!a_static) {
-      for (const int p : planes_) {
-        if (p > a) candidates_[count++] = p;
-      }
-    }
-    std::sort(candidates_.begin(), candidates_.begin() + static_cast<std::ptrdiff_t>(count));
-    for (std::size_t k = 0; k < count; ++k) pairs_.emplace_back(a, candidates_[k]);
-  }
-}
-
-// The pairs (ia, b), b > ia, in order, of a body kept out of the grid: a plane pairs with every
-// movable body; an oversize body with every plane (when it is movable) and every body whose
-// bounds overlap its own, not both static.
-void World::pairs_of_ungridded(std::size_t ia) {
-  const std::size_t n = bodies_.size();
-  const int a = static_cast<int>(ia);
-  const bool a_static = bodies_[ia].is_static();
-  if (broad_class_[ia] == BroadClass::plane) {
-    for (std::size_t ib = ia + 1; ib < n; ++ib) {
-      if (broad_class_[ib] != BroadClass::plane && !bodies_[ib].is_static()) {
-        pairs_.emplace_back(a, static_cast<int>(ib));
-      }
-    }
-    return;
-  }
-  for (std::size_t ib = ia + 1; ib < n; ++ib) {
-    if (broad_class_[ib] == BroadClass::plane) {
-      if (!a_static) pairs_.emplace_back(a, static_cast<int>(ib));
-    } else if (!(a_static && bodies_[ib].is_static()) && bounds_overlap(bounds_[ia], bounds_[ib])) {
-      pairs_.emplace_back(a, static_cast<int>(ib));
-    }
-  }
-}
-
 // Stage 2, Sec. 5: contact and friction rows, then distance rows.
 void World::build_rows() {
   rows_.clear();
@@ -371,69 +156,41 @@ void World::count_residual(double max, double sum_squares, std::int64_t rows) {
   residual_.rows += rows;
 }
 
-Eigen::VectorXd World::solve(const SparseRowMatrix& A, const Eigen::VectorXd& b,
-                             const RowLimits& limits) {
-  ++counters_.solves;
-  Eigen::VectorXd lambda = solve_lcp(A, b, limits, def_.friction_model, def_.solver, def_.iterations);
-  if (def_.measure_residual) {
-    const Eigen::VectorXd r = lcp_residual(A, b, limits, def_.friction_model, lambda);
-    count_residual(r.size() > 0 ? r.maxCoeff() : 0.0, r.squaredNorm(), r.size());
+// Stage 3, Sec. 6: what the solves of this step share (a new solver when the assembly changed).
+void World::prepare() {
+  if (rows_.empty()) return;
+  if (!solver_ || solver_assembly_ != def_.assembly) {
+    solver_ = make_constraint_solver(def_.assembly);
+    solver_assembly_ = def_.assembly;
   }
-  return lambda;
+  solver_->prepare(rows_, bodies_);
 }
 
-// Stages 3-5, Secs. 6, 7, 3.2.
-void World::solve_and_integrate() {
-  gravity_forces(bodies_, def_.gravity, f_ext_);  // f_ext (6n), into a buffer that keeps its size
-  lambda0_.clear();
+// Stage 4, Sec. 7 (and the second solve of Sec. 8.1): lambda, then f = f_ext + J^T lambda
+// (Eq. 6.2.1). A step without rows solves nothing: f = f_ext.
+void World::solve(TargetTerms terms, std::vector<double>& lambda, Eigen::VectorXd& f) {
   if (rows_.empty()) {
-    lambda_.clear();
-    integrate(bodies_, f_ext_, f_ext_, def_.dt, def_.rotation);
+    lambda.clear();
+    f = f_ext_;
     return;
   }
-  if (def_.assembly == Assembly::explicit_matrices) {
-    solve_explicit();
-  } else {
-    solve_matrix_free();
+  const SolveSettings settings{def_.dt, def_.iterations, def_.solver, def_.friction_model};
+  solver_->solve(rows_, bodies_, f_ext_, terms, settings, lambda);
+  ++counters_.solves;
+  if (def_.measure_residual) {
+    double max;
+    double sum_squares;
+    solver_->residual(rows_, def_.friction_model, lambda, max, sum_squares);
+    count_residual(max, sum_squares, static_cast<std::int64_t>(rows_.size()));
   }
-  // Positions move with f_cv; the stored momenta with f_c0 (Sec. 8.1), or f_cv for Baumgarte.
-  integrate(bodies_, f_cv_, def_.push == PushMode::split ? f_c0_ : f_cv_, def_.dt, def_.rotation);
+  add_constraint_forces(rows_, lambda, f_ext_, f);
 }
 
-void World::solve_explicit() {
-  const Eigen::VectorXd v1 = system_velocity(bodies_);
-  const System sys =
-      assemble_system(rows_, bodies_, v1, f_ext_, def_.dt, TargetTerms::push_and_bias);
-  const Eigen::VectorXd lambda = solve(sys.A, sys.b, sys.limits);
-  lambda_.assign(lambda.data(), lambda.data() + lambda.size());
-  // f = f_ext + f_c with f_c = J^T lambda (Eq. 6.2.1).
-  f_cv_ = f_ext_ + sys.J.transpose() * lambda;
-  if (def_.push == PushMode::baumgarte) return;
-  // Sec. 8.1: solve again with v holding only the bias (restitution), not the push.
-  const Eigen::VectorXd b0 =
-      assemble_rhs(rows_, sys.J, sys.M_inv, v1, f_ext_, def_.dt, TargetTerms::bias_only);
-  const Eigen::VectorXd lambda0 = solve(sys.A, b0, sys.limits);
-  lambda0_.assign(lambda0.data(), lambda0.data() + lambda0.size());
-  f_c0_ = f_ext_ + sys.J.transpose() * lambda0;
-}
-
-void World::solve_matrix_free() {
-  prepare(mf_, rows_, bodies_);
-  const auto solve_once = [this](TargetTerms terms, std::vector<double>& lambda, Eigen::VectorXd& f) {
-    rhs(mf_, rows_, bodies_, def_.gravity, def_.dt, terms);
-    cps::solve(mf_, rows_, def_.friction_model, def_.solver, def_.iterations, lambda);
-    ++counters_.solves;
-    if (def_.measure_residual) {
-      double max;
-      double sum_squares;
-      cps::residual(mf_, rows_, def_.friction_model, lambda, max, sum_squares);
-      count_residual(max, sum_squares, static_cast<std::int64_t>(rows_.size()));
-    }
-    f = f_ext_;  // same size every step: no allocation
-    add_constraint_forces(rows_, lambda, f);
-  };
-  solve_once(TargetTerms::push_and_bias, lambda_, f_cv_);
-  if (def_.push == PushMode::split) solve_once(TargetTerms::bias_only, lambda0_, f_c0_);
+// Stage 5, Sec. 3.2: positions move with f_cv; the stored momenta with f_c0 (Sec. 8.1), or f_cv
+// for Baumgarte.
+void World::integrate() {
+  cps::integrate(bodies_, f_cv_, def_.push == PushMode::split ? f_c0_ : f_cv_, def_.dt,
+                 def_.rotation);
 }
 
 }  // namespace cps

@@ -1,31 +1,37 @@
 #pragma once
-// The world and its step. One step reads as the paper's stages, in order:
-//   1. collide          Sec. 4    uniform grid broad phase, then manifolds for every pair
-//                                 that can touch (skipped when the world has collision off)
-//   2. build rows       Sec. 5    contact, friction (only with mu > 0) and distance rows
-//   3. assemble         Sec. 6    J, M^-1, A and b of Eq. 6.2.9 (explicit), or per-row
-//                                 M^-1 j^T, A_jj and b (matrix-free, the default)
-//   4. solve            Sec. 7    lambda by PGS (or Jacobi); with the single frame push factor a
-//                                 second solve with the push left out of v (Sec. 8.1)
-//   5. integrate        Sec. 3.2  f = f_ext + J^T lambda, semi-implicit Euler
+// The world and its step. One step reads as the paper's stages, in order, each a function of
+// World (engine/src/world.cpp):
+//   external_forces   Sec. 6.1  f_ext = [m g, 0] per movable body
+//   collide           Sec. 4    each box's and plane's rotation, the broad phase's candidate
+//                               pairs (broad_phase.h), a manifold for each pair that touches
+//                               (skipped when the world has collision off)
+//   build_rows        Sec. 5    contact, friction (only with mu > 0) and distance rows
+//   prepare           Sec. 6    J, M^-1 and A (explicit), or the packed rows (matrix-free)
+//   solve             Sec. 7    lambda by PGS or Jacobi, f_cv = f_ext + J^T lambda (Eq. 6.2.1)
+//   solve again       Sec. 8.1  with the single frame push factor: the push left out of v,
+//                               f_c0 = f_ext + J^T lambda_0
+//   integrate         Sec. 3.2  semi-implicit Euler: positions with f_cv, stored momenta with
+//                               f_c0 (split) or f_cv (baumgarte)
 
 #include "cps/body.h"
 #include "cps/collision.h"
 #include "cps/constraint.h"
-#include "cps/integrator.h"
-#include "cps/matrix_free.h"
 #include "cps/parameters.h"
-#include "cps/solver.h"
 
 #include <Eigen/Core>
 
-#include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
 namespace cps {
+
+// Internal to the engine (engine/src): the broad phase, the solve, the target terms of a solve.
+class BroadPhase;
+class ConstraintSolver;
+enum class TargetTerms : int;
 
 /// Work done by the steps so far, summed over the run.
 struct StepCounters {
@@ -52,6 +58,13 @@ class World {
  public:
   /// Throws std::invalid_argument if def is invalid (see WorldDef::validate).
   explicit World(const WorldDef& def = {});
+  /// A copy has the same parameters, bodies, constraints, last-step results and counters; its
+  /// step buffers start empty (they hold nothing from one step to the next).
+  World(const World& other);
+  World& operator=(const World& other);
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+  ~World();
 
   /// Adds a body and returns its index. Throws std::invalid_argument (see make_body) and leaves
   /// the world unchanged on bad input.
@@ -87,14 +100,12 @@ class World {
   void set_def(const WorldDef& def);
 
  private:
+  void external_forces();
   void collide();
-  void broad_phase();
-  void pairs_of_ungridded(std::size_t body);
   void build_rows();
-  void solve_and_integrate();
-  void solve_explicit();
-  void solve_matrix_free();
-  Eigen::VectorXd solve(const SparseRowMatrix& A, const Eigen::VectorXd& b, const RowLimits& l);
+  void prepare();
+  void solve(TargetTerms terms, std::vector<double>& lambda, Eigen::VectorXd& f);
+  void integrate();
   void count_residual(double max, double sum_squares, std::int64_t rows);
 
   WorldDef def_;
@@ -104,41 +115,19 @@ class World {
   std::vector<ConstraintRow> rows_;
   std::vector<double> lambda_;
   std::vector<double> lambda0_;
-  // Buffers reused from step to step (the matrix-free path allocates nothing once they are big
-  // enough): external and constraint forces per body (6n), the matrix-free system.
+  // Buffers reused from step to step (nothing is allocated once they are big enough): external
+  // and total forces per body (6n: f_ext, f_cv, f_c0), rotation matrices per body, candidate
+  // pairs, body velocities for the rows and which of them are computed.
   Eigen::VectorXd f_ext_;
   Eigen::VectorXd f_cv_;
   Eigen::VectorXd f_c0_;
-  MatrixFreeSystem mf_;
-  // Broad phase (collide()): a uniform grid of cubic cells numbered into buckets, rebuilt every
-  // step by a counting sort, so its cost grows linearly with the body count.
-  struct Bounds {
-    Vec3 lo;
-    Vec3 hi;
-  };
-  enum class BroadClass : unsigned char { plane, gridded, oversize };
-  // A gridded body as the grid stores it, by bucket: what the pair test needs, side by side.
-  struct GridEntry {
-    int body;                          // index
-    bool is_static;
-    std::array<std::int32_t, 3> cell;  // grid cell of the lower corner
-    Bounds bounds;
-  };
-  std::vector<Bounds> bounds_;                       // per body, grown by the contact margin (m)
-  std::vector<Mat3> rotations_;                      // per box or plane: R, for the narrow phase
-  std::vector<BroadClass> broad_class_;              // per body
-  std::vector<std::array<std::int32_t, 3>> cell_;    // per body: grid cell (gridded only)
-  std::vector<std::uint32_t> bucket_of_;             // per body: its cell's bucket (gridded only)
-  std::vector<int> bucket_start_;                    // buckets + 2: k is [start[k], start[k+1])
-  std::vector<GridEntry> grid_;                      // gridded bodies by bucket, then index
-  std::vector<double> widths_;                       // scratch: widths (m) for the median
-  std::vector<int> planes_;                          // plane bodies, by index
-  std::vector<int> oversize_;                        // bodies too wide for the grid, by index
-  std::vector<int> candidates_;                      // scratch (n + planes): b > a near a
-  std::vector<std::pair<int, int>> pairs_;           // candidate pairs (a < b), in index order
-  // build_rows(): body velocities of this step (n), and which of them are computed.
+  std::vector<Mat3> rotations_;
+  std::vector<std::pair<int, int>> pairs_;
   std::vector<BodyVelocity> velocities_;
   std::vector<unsigned char> velocity_known_;
+  std::unique_ptr<BroadPhase> broad_phase_;
+  std::unique_ptr<ConstraintSolver> solver_;  // made for def_.assembly when first needed
+  Assembly solver_assembly_ = Assembly::matrix_free;
   StepCounters counters_;
   ResidualStats residual_;
 };

@@ -6,8 +6,8 @@
 
 #include "cps/body.h"
 #include "cps/constraint.h"
-#include "cps/solver.h"
-#include "cps/system.h"
+#include "solver.h"
+#include "system.h"
 
 #include <array>
 #include <vector>
@@ -56,7 +56,7 @@ struct MatrixFreeSystem {
   /// (column i: A_ki / A_kk for k = i+1..m-1; dimensionless).
   std::vector<double> coupling;
   std::vector<double> diagonal;  ///< per row: A_jj = j M^-1 j^T (1/kg)
-  std::vector<double> b;         ///< per row: right-hand side of Eq. 6.2.9 (N)
+  std::vector<double> b;         ///< per row: right-hand side of Eq. 6.2.9 (m/s^2)
   std::vector<double> next;      ///< Jacobi: the sweep's new values (N)
   std::vector<Vec6> w;           ///< per body, and one zero slot: M^-1 J^T lambda
   std::vector<Mat3> inv_inertia; ///< per body: world inverse inertia this step (1/(kg m^2))
@@ -68,11 +68,12 @@ struct MatrixFreeSystem {
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
              const std::vector<Body>& bodies);
 
-/// Fills s.b (c): b_j = v_j / dt - j_j . (v1 / dt + M^-1 f_ext) (Eq. 6.2.9) with f_ext the
-/// gravity force m g (m/s^2 given) of every movable body, and v_j the row's push and bias
-/// (TargetTerms as in assemble_rhs). dt in s, > 0.
+/// Fills s.b (c): b_j = v_j / dt - j_j . (v1 / dt + M^-1 f_ext) (Eq. 6.2.9) with f_ext (6n:
+/// force and torque per body, N and N m; the explicit path reads the same vector) and v_j the
+/// row's push and bias (TargetTerms as in assemble_rhs). dt in s, > 0.
 void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
-         const std::vector<Body>& bodies, const Vec3& gravity, double dt, TargetTerms terms);
+         const std::vector<Body>& bodies, const Eigen::VectorXd& f_ext, double dt,
+         TargetTerms terms);
 
 /// Solves the bounded system from lambda = 0 with `iterations` sweeps of PGS or Jacobi, the
 /// bounds of solve_lcp (c_min, c_max from the rows, or the coupled friction limit), into
@@ -85,9 +86,5 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
 void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
               FrictionModel friction, const std::vector<double>& lambda, double& max,
               double& sum_squares);
-
-/// Adds f_c = J^T lambda (Eq. 6.2.1) to f (6n: force and torque per body, N and N m).
-void add_constraint_forces(const std::vector<ConstraintRow>& rows,
-                           const std::vector<double>& lambda, Eigen::VectorXd& f);
 
 }  // namespace cps

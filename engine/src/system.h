@@ -24,7 +24,8 @@ using SparseRowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 /// Which parts of each row's target velocity enter v: the full push + bias (the ordinary solve,
 /// and the first solve of Sec. 8.1), or bias only (the second solve of Sec. 8.1, v without the
 /// constraint-correcting push factor).
-enum class TargetTerms { push_and_bias, bias_only };
+enum class TargetTerms : int { push_and_bias, bias_only };
+
 
 /// The bounds on lambda, per row (c each): c_min, c_max (N); for friction rows also the index
 /// of their contact row and mu (dimensionless), for the coupled friction limit; -1 and 0 for
@@ -60,6 +61,10 @@ void gravity_forces(const std::vector<Body>& bodies, const Vec3& gravity, Eigen:
 System assemble_system(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
                        const Eigen::VectorXd& v1, const Eigen::VectorXd& f_ext, double dt,
                        TargetTerms terms);
+
+/// J, M^-1, A and the limits of the rows, without b (left empty). Throws std::invalid_argument for
+/// a row whose body indices are out of range.
+System assemble_matrices(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies);
 
 /// Right-hand side b alone (c), for a second solve that reuses J and A (Eq. 6.2.9).
 Eigen::VectorXd assemble_rhs(const std::vector<ConstraintRow>& rows, const SparseRowMatrix& J,

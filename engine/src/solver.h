@@ -3,7 +3,7 @@
 // projected Gauss-Seidel, and Jacobi for comparison.
 
 #include "cps/parameters.h"
-#include "cps/system.h"
+#include "system.h"
 
 namespace cps {
 

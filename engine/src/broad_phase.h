@@ -1,0 +1,64 @@
+#pragma once
+// The broad phase of collision detection (Sec. 4): which pairs of bodies may touch this step.
+// Internal to the engine: World's collide stage calls it, the narrow phase then builds a manifold
+// for each pair it lists.
+
+#include "cps/body.h"
+
+#include <array>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace cps {
+
+/// Lists the candidate pairs of a step. Bodies get axis-aligned bounds grown by half the contact
+/// margin; a pair is a candidate when its bounds overlap (closed intervals on x, y and z) and not
+/// both bodies are static; every plane is a candidate with every movable body. Worlds of at most
+/// 32 bodies test every pair of bounds; larger ones sort the bounds into a uniform grid of cubic
+/// cells a little wider than the widest body (Ericson, "Real-Time Collision Detection", 2005,
+/// Sec. 7.1) by a counting sort, so the cost grows with the bodies and the pairs, not with their
+/// square. Bodies more than 8 times wider than the median stay out of the grid and are tested
+/// against every body. The pairs come out in index order (a < b, sorted by a then b): the order
+/// of testing every pair, so the manifolds and rows after it do not depend on how the pairs
+/// were found. Its buffers keep their storage, so a step allocates nothing once they have
+/// reached their working size.
+class BroadPhase {
+ public:
+  /// Writes the candidate pairs into `pairs` (cleared first). bodies: n; rotations: n rotation
+  /// matrices R of the bodies' orientations (3 x 3, body to world), read for boxes only;
+  /// contact_margin (m, >= 0): the speculative contact distance. Raises nothing; bodies far out or
+  /// with non-finite positions share the grid's edge cells (more candidates, never fewer).
+  void find_pairs(const std::vector<Body>& bodies, const std::vector<Mat3>& rotations,
+                  double contact_margin, std::vector<std::pair<int, int>>& pairs);
+
+ private:
+  struct Bounds {
+    Vec3 lo;  ///< m
+    Vec3 hi;  ///< m
+  };
+  enum class BroadClass : unsigned char { plane, gridded, oversize };
+  // A gridded body as the grid stores it, by bucket: what the pair test needs, side by side.
+  struct GridEntry {
+    int body;                          // index
+    bool is_static;
+    std::array<std::int32_t, 3> cell;  // grid cell of the lower corner
+    Bounds bounds;
+  };
+  // The pairs (ia, b), b > ia, in order, of a body kept out of the grid.
+  void pairs_of_ungridded(const std::vector<Body>& bodies, std::size_t ia,
+                          std::vector<std::pair<int, int>>& pairs) const;
+
+  std::vector<Bounds> bounds_;                     // per body, grown by the contact margin (m)
+  std::vector<BroadClass> broad_class_;            // per body
+  std::vector<std::array<std::int32_t, 3>> cell_;  // per body: grid cell (gridded only)
+  std::vector<std::uint32_t> bucket_of_;           // per body: its cell's bucket (gridded only)
+  std::vector<int> bucket_start_;                  // buckets + 2: k is [start[k], start[k+1])
+  std::vector<GridEntry> grid_;                    // gridded bodies by bucket, then index
+  std::vector<double> widths_;                     // scratch: widths (m) for the median
+  std::vector<int> planes_;                        // plane bodies, by index
+  std::vector<int> oversize_;                      // bodies too wide for the grid, by index
+  std::vector<int> candidates_;                    // scratch (n + planes): b > a near a
+};
+
+}  // namespace cps

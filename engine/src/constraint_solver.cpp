@@ -1,0 +1,86 @@
+// The two implementations of ConstraintSolver (see constraint_solver.h).
+#include "constraint_solver.h"
+
+#include "matrix_free.h"
+#include "solver.h"
+
+namespace cps {
+namespace {
+
+// The paper's form (Sec. 6): sparse J (c x 6n), M^-1 (6n x 6n) and A = J M^-1 J^T (c x c) built
+// once a step, b (c) for each solve, lambda by solve_lcp over A.
+class ExplicitSolver final : public ConstraintSolver {
+ public:
+  void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies) override {
+    v1_ = system_velocity(bodies);
+    system_ = assemble_matrices(rows, bodies);
+  }
+
+  void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& /*bodies*/,
+             const Eigen::VectorXd& f_ext, TargetTerms terms, const SolveSettings& settings,
+             std::vector<double>& lambda) override {
+    system_.b = assemble_rhs(rows, system_.J, system_.M_inv, v1_, f_ext, settings.dt, terms);
+    const Eigen::VectorXd x = solve_lcp(system_.A, system_.b, system_.limits, settings.friction,
+                                        settings.kind, settings.iterations);
+    lambda.assign(x.data(), x.data() + x.size());
+  }
+
+  void residual(const std::vector<ConstraintRow>& /*rows*/, FrictionModel friction,
+                const std::vector<double>& lambda, double& max,
+                double& sum_squares) const override {
+    const Eigen::VectorXd r =
+        lcp_residual(system_.A, system_.b, system_.limits, friction,
+                     Eigen::Map<const Eigen::VectorXd>(lambda.data(), static_cast<Eigen::Index>(lambda.size())));
+    max = r.size() > 0 ? r.maxCoeff() : 0.0;
+    sum_squares = r.squaredNorm();
+  }
+
+ private:
+  Eigen::VectorXd v1_;  // 6n: [v_i, w_i] per body before the step (m/s, rad/s)
+  System system_;
+};
+
+// The matrix-free form (matrix_free.h): w = M^-1 J^T lambda per body, O(12) a row update, no
+// allocation once its buffers have their working size.
+class MatrixFreeSolver final : public ConstraintSolver {
+ public:
+  void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies) override {
+    cps::prepare(system_, rows, bodies);
+  }
+
+  void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
+             const Eigen::VectorXd& f_ext, TargetTerms terms, const SolveSettings& settings,
+             std::vector<double>& lambda) override {
+    rhs(system_, rows, bodies, f_ext, settings.dt, terms);
+    cps::solve(system_, rows, settings.friction, settings.kind, settings.iterations, lambda);
+  }
+
+  void residual(const std::vector<ConstraintRow>& rows, FrictionModel friction,
+                const std::vector<double>& lambda, double& max,
+                double& sum_squares) const override {
+    cps::residual(system_, rows, friction, lambda, max, sum_squares);
+  }
+
+ private:
+  MatrixFreeSystem system_;
+};
+
+}  // namespace
+
+std::unique_ptr<ConstraintSolver> make_constraint_solver(Assembly assembly) {
+  if (assembly == Assembly::explicit_matrices) return std::make_unique<ExplicitSolver>();
+  return std::make_unique<MatrixFreeSolver>();
+}
+
+void add_constraint_forces(const std::vector<ConstraintRow>& rows,
+                           const std::vector<double>& lambda, const Eigen::VectorXd& f_ext,
+                           Eigen::VectorXd& f) {
+  f = f_ext;  // same size every step: no allocation
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    const ConstraintRow& row = rows[r];
+    if (row.body_a != kWorldBody) f.segment<6>(6 * row.body_a) += lambda[r] * row.j.head<6>();
+    if (row.body_b != kWorldBody) f.segment<6>(6 * row.body_b) += lambda[r] * row.j.tail<6>();
+  }
+}
+
+}  // namespace cps

@@ -1,0 +1,65 @@
+#pragma once
+// The solve of A lambda = b (Secs. 6-7) behind one interface, with two implementations: the
+// paper's explicit sparse J, M^-1 and A = J M^-1 J^T (Sec. 6, system.h and solver.h), and the
+// matrix-free sweep that keeps w = M^-1 J^T lambda per body instead (matrix_free.h). Both read the
+// same rows, the same f_ext and the same settings, bound lambda by the same force limits and
+// measure the same residual (lcp.h), and give the same lambda to round-off (tested on every
+// paper scene). World chooses one by WorldDef::assembly.
+
+#include "cps/body.h"
+#include "cps/constraint.h"
+#include "cps/parameters.h"
+#include "system.h"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+namespace cps {
+
+/// What one solve needs besides the rows and bodies: dt (s, > 0), the number of sweeps (>= 1),
+/// PGS or Jacobi, and the friction model of the force limits.
+struct SolveSettings {
+  double dt = 1.0 / 60.0;
+  int iterations = 25;
+  SolverKind kind = SolverKind::pgs;
+  FrictionModel friction = FrictionModel::fixed;
+};
+
+/// A way to solve the step's bounded system A lambda = b.
+class ConstraintSolver {
+ public:
+  virtual ~ConstraintSolver() = default;
+
+  /// Builds what every solve of this step shares, from the rows (c, bodies by index or
+  /// kWorldBody) and the bodies (n) as they are before the integration: J, M^-1, A and v1
+  /// (explicit), or the packed rows and I^-1 per body (matrix-free).
+  virtual void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies) = 0;
+
+  /// Solves A lambda = b from lambda = 0 with settings.iterations sweeps, b of Eq. 6.2.9 from
+  /// the bodies' momenta, f_ext (6n: force and torque per body, N and N m) and each row's target
+  /// velocity (push and bias, or bias only: `terms`, Sec. 8.1). lambda: resized to c (N). The
+  /// rows and bodies must be those given to prepare().
+  virtual void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
+                     const Eigen::VectorXd& f_ext, TargetTerms terms,
+                     const SolveSettings& settings, std::vector<double>& lambda) = 0;
+
+  /// The natural-map residual (lcp.h) of the lambda the last solve() returned: the largest row
+  /// residual and the sum of their squares (N, N^2).
+  virtual void residual(const std::vector<ConstraintRow>& rows, FrictionModel friction,
+                        const std::vector<double>& lambda, double& max,
+                        double& sum_squares) const = 0;
+};
+
+/// The implementation for `assembly`: Assembly::explicit_matrices or Assembly::matrix_free.
+std::unique_ptr<ConstraintSolver> make_constraint_solver(Assembly assembly);
+
+/// f = f_ext + J^T lambda (6n: force and torque per body, N and N m; Eq. 6.2.1: the constraint
+/// force f_c = J^T lambda added to the external force before the integration of Sec. 3.2).
+/// lambda: c (N), one per row. f is resized to f_ext's size (no allocation once it has it).
+void add_constraint_forces(const std::vector<ConstraintRow>& rows,
+                           const std::vector<double>& lambda, const Eigen::VectorXd& f_ext,
+                           Eigen::VectorXd& f);
+
+}  // namespace cps

@@ -1,4 +1,4 @@
-// cps_compare (issue 5): microseconds per step of the cps scenes next to the same scenes in
+// cps_compare: microseconds per step of the cps scenes next to the same scenes in
 // Bullet and ODE, all measured in this one process, one thread, by the method of `cps bench`
 // (demos/cps/bench.cpp): the world is advanced 1 s untimed so contacts have formed, then stepped
 // in 5 timed blocks, each timed by the CPU time of this thread (so other processes on a shared

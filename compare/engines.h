@@ -1,5 +1,5 @@
 #pragma once
-// The other engines of cps_compare (issue 5): a cps World, once built by a scene, is copied
+// The other engines of cps_compare: a cps World, once built by a scene, is copied
 // into Bullet or ODE (same bodies, shapes, masses, poses, planes, rods, gravity, dt and 25
 // solver iterations) so the scenes are the same by construction, then stepped alone.
 

@@ -43,7 +43,7 @@ TEST_CASE("a stretched rod shrinks and a compressed rod grows", "[constraint][di
   for (const double start : {1.2, 0.8}) {
     World world = ball_on_rod(def, Vec3::Zero(), Vec3(start, 0, 0), 1.0);
     world.step();
-    // One step moves the end by beta (|p_ab| - l) towards the length (NOTES.md sign convention).
+    // One step moves the end by beta (|p_ab| - l) towards the length (docs/conventions.md, Sec. 3).
     const double expected = start - def.beta * (start - 1.0);
     CHECK(rod_length_now(world) == Approx(expected).epsilon(1e-9));
     for (int k = 0; k < 120; ++k) world.step();

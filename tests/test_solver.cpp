@@ -85,7 +85,7 @@ TEST_CASE("solve_pgs rejects mismatched sizes", "[solver]") {
 
 TEST_CASE("an overlap opens at the push factor's velocity beta d / dt", "[solver]") {
   // No gravity, no friction: box b overlaps box a by d = 0.1 m. With the sign convention of
-  // NOTES.md the contact rows ask for a separating velocity of beta d / dt along +y, which the
+  // docs/conventions.md the contact rows ask for a separating velocity of beta d / dt along +y, which the
   // converged solve delivers exactly, shared by the two equal masses.
   WorldDef def;
   def.gravity = Vec3::Zero();

@@ -1,4 +1,4 @@
-// Stress scenes: stiff and extreme cases (issue 4). Each test states the bound it checks and where
+// Stress scenes: stiff and extreme cases. Each test states the bound it checks and where
 // the bound comes from. Floating point exceptions are trapped (fp_trap.cpp): a NaN, an overflow
 // or a division by zero anywhere in a step aborts the test case.
 //

@@ -73,7 +73,7 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
     contact.j = axis_row(c.normal, r_a, r_b);
     const double approach = relative_velocity(contact.j, v_a, w_a, v_b, w_b);  // j . v1 (m/s)
     if (c.depth >= 0.0) {
-      // Eq. 5.3.1 with the sign of NOTES.md: C = -d, v = -beta C / dt = beta d / dt > 0 opens it.
+      // Eq. 5.3.1 (docs/conventions.md, Sec. 3): C = -d, v = -beta C / dt = beta d / dt > 0 opens it.
       contact.push = params.beta * c.depth / params.dt;
     } else {
       // Speculative contact (gap -d within the margin): the points may approach by the gap in this
@@ -136,7 +136,8 @@ void append_distance_row(const DistanceConstraint& d, const std::vector<Body>& b
   row.body_a = d.body_a;
   row.body_b = d.body_b;
   row.j = axis_row(n, r_a, r_b);
-  // C = |p_ab| - l; target v = -beta C / dt (NOTES.md sign: a stretched rod shrinks).
+  // C = |p_ab| - l; target v = -beta C / dt: a stretched rod shrinks (docs/conventions.md, Sec. 3;
+  // Eq. 5.2.3 prints the opposite sign).
   row.push = -params.beta * (dist - d.length) / params.dt;
   row.c_min = -kInfinity;
   row.c_max = kInfinity;

@@ -1,7 +1,8 @@
 #pragma once
 // Constraint rows (paper Sec. 5). Each row is j (12 numbers: linear and angular part for body a,
 // then for body b), a target velocity v (the push factor and any other bias, m/s) and force
-// limits [c_min, c_max] (N). With the unit axis convention of NOTES.md lambda is in newtons.
+// limits [c_min, c_max] (N). With a unit axis (Sec. 9.2; docs/conventions.md) lambda is in
+// newtons.
 
 #include "cps/collision.h"
 
@@ -112,8 +113,8 @@ void distance_endpoints(const DistanceConstraint& d, const std::vector<Body>& bo
 
 /// Appends the row of one distance constraint: unit axis n = (p_b - p_a) / |p_b - p_a| (Sec. 9.2;
 /// +y if the points coincide), j = [-n, -(r_a x n), n, r_b x n] and, with C = |p_b - p_a| - l
-/// (m), push = -beta C / dt (NOTES.md: a stretched rod gets a negative target and shrinks;
-/// Eq. 5.2.3 prints the opposite sign).
+/// (m), push = -beta C / dt (docs/conventions.md, Sec. 3: a stretched rod gets a negative target
+/// and shrinks; Eq. 5.2.3 prints the opposite sign).
 void append_distance_row(const DistanceConstraint& d, const std::vector<Body>& bodies,
                          const RowParams& params, std::vector<ConstraintRow>& rows);
 

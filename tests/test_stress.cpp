@@ -604,3 +604,33 @@ TEST_CASE("bad bodies and rods are rejected by name and leave the world unchange
   CHECK_THROWS_WITH(scenes::populate_mass_ratio(empty, -10.0), Catch::Contains("-10"));
   CHECK(empty.bodies().empty());
 }
+
+TEST_CASE("a pile of bodies in one spot fails with the count instead of asking for gigabytes",
+          "[stress][limits]") {
+  for (const int count : {1000, 10000}) {
+    INFO(count << " unit cubes at the origin");
+    World world;
+    for (int i = 0; i < count; ++i) {
+      BodyDef cube;
+      cube.shape = Shape::box(Vec3::Constant(0.5));
+      cube.position = Vec3(0.0, 1e-6 * i, 0.0);
+      world.add_body(cube);
+    }
+    const std::vector<Body> before = world.bodies();
+    // 1000 cubes: 499,500 pairs, each up to 8 points (past kMaxContactPoints); 10000 cubes:
+    // about 5e7 pairs (past kMaxCandidatePairs).
+    CHECK_THROWS_AS(world.step(), std::length_error);
+    CHECK_THROWS_WITH(world.step(), Catch::Contains(std::to_string(count) + " bodies"));
+    for (std::size_t i = 0; i < before.size(); ++i) CHECK(world.bodies()[i].x == before[i].x);
+  }
+  // A crowded but reasonable pile still steps: 100 cubes in one spot.
+  World world;
+  for (int i = 0; i < 100; ++i) {
+    BodyDef cube;
+    cube.shape = Shape::box(Vec3::Constant(0.5));
+    cube.position = Vec3(0.0, 1e-6 * i, 0.0);
+    world.add_body(cube);
+  }
+  CHECK_NOTHROW(world.step());
+  CHECK(world.counters().contacts > 0);
+}

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace cps {
 namespace {
@@ -36,6 +38,15 @@ bool bounds_overlap(const B& a, const B& b) {
 }
 
 
+// Throws once the pairs listed so far pass the limit (see find_pairs).
+void check_pair_count(std::size_t count, std::size_t max_pairs, std::size_t bodies) {
+  if (count <= max_pairs) return;
+  throw std::length_error("the broad phase listed more than " + std::to_string(max_pairs) +
+                          " candidate pairs (" + std::to_string(count) + " so far, among " +
+                          std::to_string(bodies) +
+                          " bodies): the bodies are too crowded for one step; spread them out");
+}
+
 }  // namespace
 
 
@@ -50,7 +61,8 @@ bool bounds_overlap(const B& a, const B& b) {
 // more than kOversizeFactor times wider than the median are kept out of the grid and tested
 // against every body, so that one large body does not make every cell large.
 void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<Mat3>& rotations,
-                            double contact_margin, std::vector<std::pair<int, int>>& pairs) {
+                            double contact_margin, std::size_t max_pairs,
+                            std::vector<std::pair<int, int>>& pairs) {
   const std::size_t n = bodies.size();
   bounds_.resize(n);
   broad_class_.resize(n);
@@ -90,6 +102,7 @@ void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<M
       if (broad_class_[i] != BroadClass::plane) broad_class_[i] = BroadClass::oversize;
     }
     for (std::size_t i = 0; i < n; ++i) pairs_of_ungridded(bodies, i, pairs);
+    check_pair_count(pairs.size(), max_pairs, n);
     return;
   }
   // Bodies much wider than the median go to the oversize list; the rest set the cell edge.
@@ -186,6 +199,7 @@ void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<M
   detail::resize_with_headroom(candidates_, n + planes_.size());
 
   for (std::size_t ia = 0; ia < n; ++ia) {
+    check_pair_count(pairs.size(), max_pairs, n);  // at most n pairs past the limit
     const int a = static_cast<int>(ia);
     const bool a_static = bodies[ia].is_static();
     if (broad_class_[ia] != BroadClass::gridded) {

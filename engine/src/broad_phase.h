@@ -27,10 +27,13 @@ class BroadPhase {
  public:
   /// Writes the candidate pairs into `pairs` (cleared first). bodies: n; rotations: n rotation
   /// matrices R of the bodies' orientations (3 x 3, body to world), read for boxes only;
-  /// contact_margin (m, >= 0): the speculative contact distance. Raises nothing; bodies far out or
-  /// with non-finite positions share the grid's edge cells (more candidates, never fewer).
+  /// contact_margin (m, >= 0): the speculative contact distance. Bodies far out or with
+  /// non-finite positions share the grid's edge cells (more candidates, never fewer). Throws
+  /// std::length_error naming the count once more than max_pairs pairs have been listed (it
+  /// stops there, so the storage stays bounded).
   void find_pairs(const std::vector<Body>& bodies, const std::vector<Mat3>& rotations,
-                  double contact_margin, std::vector<std::pair<int, int>>& pairs);
+                  double contact_margin, std::size_t max_pairs,
+                  std::vector<std::pair<int, int>>& pairs);
 
  private:
   struct Bounds {

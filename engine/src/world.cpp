@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 namespace cps {
 
@@ -102,8 +103,11 @@ void World::collide() {
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     if (bodies_[i].shape.kind != ShapeKind::sphere) rotations_[i] = bodies_[i].rotation();
   }
-  broad_phase_->find_pairs(bodies_, rotations_, def_.contact_margin, pairs_);
-  detail::reserve_with_headroom(manifolds_, pairs_.size());
+  broad_phase_->find_pairs(bodies_, rotations_, def_.contact_margin, kMaxCandidatePairs, pairs_);
+  // Room for the manifolds a world of this size usually has (a body touches a few others); a
+  // crowded step grows it as it finds them, never to a worst case of one per pair.
+  detail::reserve_with_headroom(manifolds_, std::min(pairs_.size(), 8 * bodies_.size()));
+  std::size_t points = 0;
   for (const auto& [a, b] : pairs_) {
     ++counters_.pairs_tested;
     // Built in place (no copy of the 8 contact slots); dropped again if the pair does not touch.
@@ -115,6 +119,13 @@ void World::collide() {
     if (cps::collide(bodies_[ia], rotations_[ia], bodies_[ib], rotations_[ib], m,
                      def_.contact_margin) > 0) {
       counters_.contacts += m.count;
+      points += static_cast<std::size_t>(m.count);
+      if (points > kMaxContactPoints) {
+        throw std::length_error("the narrow phase found more than " +
+                                std::to_string(kMaxContactPoints) + " contact points among " +
+                                std::to_string(bodies_.size()) +
+                                " bodies in one step: the bodies are too crowded; spread them out");
+      }
     } else {
       manifolds_.pop_back();
     }

@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <utility>
@@ -32,6 +33,16 @@ namespace cps {
 class BroadPhase;
 class ConstraintSolver;
 enum class TargetTerms : int;
+
+/// The most candidate pairs the broad phase may list in one step (count). A pair costs 8 bytes;
+/// the largest scaled scenes list about 10 per body. Beyond it World::step throws.
+inline constexpr std::size_t kMaxCandidatePairs = 4'000'000;
+
+/// The most contact points the narrow phase may find in one step (count). A point costs about
+/// 1.2 kB of rows and solver storage (three rows with friction), so this bounds a step's contact
+/// storage near 300 MB; the largest scaled scene (pyramid_20000) finds about 150,000. Beyond it
+/// World::step throws.
+inline constexpr std::size_t kMaxContactPoints = 250'000;
 
 /// Work done by the steps so far, summed over the run.
 struct StepCounters {
@@ -76,7 +87,10 @@ class World {
   /// or a length that is negative or not finite (m).
   int add_distance(const DistanceConstraint& d);
 
-  /// Advances the world by def().dt (s).
+  /// Advances the world by def().dt (s). Throws std::length_error naming the count when the
+  /// bodies are so crowded that a step would list more than kMaxCandidatePairs pairs or find
+  /// more than kMaxContactPoints contact points (a pile of a thousand bodies in one spot); the
+  /// bodies are then left as they were before the step.
   void step();
 
   const WorldDef& def() const { return def_; }

@@ -73,7 +73,7 @@ TEST_CASE("the engine validates a WorldDef against the table, naming the paramet
   CHECK_THROWS_WITH(World(def), Catch::Contains("beta = 1.5") && Catch::Contains("[0, 1]"));
   def = {};
   def.dt = 0.0;
-  CHECK_THROWS_WITH(World(def), Catch::Contains("dt = 0") && Catch::Contains("> 0"));
+  CHECK_THROWS_WITH(World(def), Catch::Contains("dt = 0") && Catch::Contains("[1e-06, 1]"));
   def = {};
   def.iterations = 0;
   CHECK_THROWS_WITH(World(def), Catch::Contains("iterations = 0"));

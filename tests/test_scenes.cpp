@@ -75,20 +75,34 @@ TEST_CASE("invalid parameters and bodies are rejected and leave the world unchan
   bad.orientation = Quat(2.0, 0.0, 0.0, 0.0);
   CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("unit quaternion"));
   CHECK_THROWS_WITH(Shape::box(Vec3(1.0, 0.0, 1.0)), Catch::Contains("half extents"));
-  // Values whose reciprocals or products leave double precision, checked with the floating
-  // point traps on (the checks themselves must not raise).
+  // Values outside the ranges that keep a step finite (body.h), checked with the floating point
+  // traps on (the checks themselves must not raise): each message names the value and the range.
   bad.orientation = Quat::Identity();
   bad.mass = 1e-310;  // subnormal: 1 / m would be inf
-  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("mass"));
+  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("mass") && Catch::Contains("[1e-06, 1e+09] kg"));
+  bad.mass = 1e300;  // m v would overflow
+  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("mass 1e+300"));
   bad.mass = 1.0;
-  bad.shape = Shape::box(Vec3::Constant(1e-200));  // inertia underflows to 0
-  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("inertia"));
-  bad.shape = Shape::box(Vec3::Ones());
+  CHECK_THROWS_WITH(Shape::box(Vec3::Constant(1e-200)), Catch::Contains("[0.0001, 100000] m"));
+  CHECK_THROWS_WITH(Shape::sphere(1e10), Catch::Contains("radius 1e+10"));
+  CHECK_THROWS_WITH(Shape::plane(Vec3::UnitY(), 1e300), Catch::Contains("offset"));
   bad.velocity = Vec3(INFINITY, 0, 0);
   CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("velocity"));
   bad.velocity = Vec3(1e10, 0, 0);
-  bad.mass = 1e300;  // momentum overflows
-  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("momentum"));
+  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("velocity") && Catch::Contains("100000 m/s"));
+  bad.velocity = Vec3::Zero();
+  bad.angular_velocity = Vec3(0, 0, -1e6);
+  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("angular velocity"));
+  bad.angular_velocity = Vec3::Zero();
+  bad.position = Vec3(0, 2e9, 0);
+  CHECK_THROWS_WITH(world.add_body(bad), Catch::Contains("position"));
+  // World parameters outside the table's ranges: a step that cannot stay finite.
+  def = {};
+  def.dt = 1e308;
+  CHECK_THROWS_WITH(World(def), Catch::Contains("dt = 1e+308"));
+  def = {};
+  def.gravity = Vec3(0, -1e308, 0);
+  CHECK_THROWS_WITH(World(def), Catch::Contains("gravity"));
   CHECK(world.bodies().empty());
 }
 

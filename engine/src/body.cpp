@@ -21,18 +21,27 @@ std::string num(double v) {
   return s.str();
 }
 
-void require_finite(const Vec3& v, const char* what) {
-  if (!all_finite(v)) {
-    throw std::invalid_argument(std::string(what) + " " + str(v) + " is not finite");
+// x finite and in [lo, hi] (isfinite first: no floating point exception on NaN).
+bool in_range(double x, double lo, double hi) { return std::isfinite(x) && x >= lo && x <= hi; }
+
+void require_within(const Vec3& v, double limit, const char* what, const char* unit) {
+  for (int k = 0; k < 3; ++k) {
+    if (!in_range(v[k], -limit, limit)) {
+      throw std::invalid_argument(std::string(what) + " " + str(v) + " " + unit +
+                                  " is not allowed: each component must be finite and within +-" +
+                                  num(limit) + " " + unit);
+    }
   }
 }
 
 }  // namespace
 
 Shape Shape::box(const Vec3& h) {
-  if (!all_finite(h) || (h.array() <= 0.0).any()) {
-    throw std::invalid_argument("box half extents " + str(h) +
-                                " must be finite and > 0 m in every component");
+  for (int k = 0; k < 3; ++k) {
+    if (!in_range(h[k], kMinSize, kMaxSize)) {
+      throw std::invalid_argument("box half extents " + str(h) + " m are not allowed: each must be in [" +
+                                  num(kMinSize) + ", " + num(kMaxSize) + "] m");
+    }
   }
   Shape s;
   s.kind = ShapeKind::box;
@@ -41,8 +50,9 @@ Shape Shape::box(const Vec3& h) {
 }
 
 Shape Shape::sphere(double r) {
-  if (!(std::isfinite(r) && r > 0.0)) {
-    throw std::invalid_argument("sphere radius " + num(r) + " m must be finite and > 0");
+  if (!in_range(r, kMinSize, kMaxSize)) {
+    throw std::invalid_argument("sphere radius " + num(r) + " m is not allowed: it must be in [" +
+                                num(kMinSize) + ", " + num(kMaxSize) + "] m");
   }
   Shape s;
   s.kind = ShapeKind::sphere;
@@ -55,8 +65,9 @@ Shape Shape::plane(const Vec3& n, double offset) {
   if (!all_finite(n) || !(len > 0.0)) {
     throw std::invalid_argument("plane normal " + str(n) + " must be finite and non-zero");
   }
-  if (!std::isfinite(offset)) {
-    throw std::invalid_argument("plane offset " + num(offset) + " m must be finite");
+  if (!in_range(offset, -kMaxCoordinate, kMaxCoordinate)) {
+    throw std::invalid_argument("plane offset " + num(offset) + " m is not allowed: it must be within +-" +
+                                num(kMaxCoordinate) + " m");
   }
   Shape s;
   s.kind = ShapeKind::plane;
@@ -102,9 +113,9 @@ Mat3 shape_inertia(const Shape& shape, double mass) {
 }
 
 Body make_body(const BodyDef& def) {
-  require_finite(def.position, "body position");
-  require_finite(def.velocity, "body velocity");
-  require_finite(def.angular_velocity, "body angular velocity");
+  require_within(def.position, kMaxCoordinate, "body position", "m");
+  require_within(def.velocity, kMaxSpeed, "body velocity", "m/s");
+  require_within(def.angular_velocity, kMaxSpin, "body angular velocity", "rad/s");
   const double qn = def.orientation.norm();
   if (!std::isfinite(qn) || std::abs(qn - 1.0) > 1e-9) {
     throw std::invalid_argument("body orientation has norm " + num(qn) +
@@ -113,10 +124,9 @@ Body make_body(const BodyDef& def) {
   if (!def.is_static && def.shape.kind == ShapeKind::plane) {
     throw std::invalid_argument("a plane must be a static body (set is_static)");
   }
-  // A normal double, so that 1 / m is finite.
-  if (!def.is_static && !(std::isfinite(def.mass) && def.mass >= std::numeric_limits<double>::min())) {
-    throw std::invalid_argument("body mass " + num(def.mass) +
-                                " kg must be finite and > 0 (at least 2.2e-308) for a movable body");
+  if (!def.is_static && !in_range(def.mass, kMinMass, kMaxMass)) {
+    throw std::invalid_argument("body mass " + num(def.mass) + " kg is not allowed: a movable body's mass must be in [" +
+                                num(kMinMass) + ", " + num(kMaxMass) + "] kg");
   }
   if (def.shape.kind == ShapeKind::box) Shape::box(def.shape.half_extents);  // validates
   if (def.shape.kind == ShapeKind::sphere) Shape::sphere(def.shape.radius);    // validates
@@ -138,16 +148,6 @@ Body make_body(const BodyDef& def) {
       throw std::invalid_argument("body of mass " + num(def.mass) +
                                   " kg and this size has an inertia tensor that is zero or not "
                                   "finite in double precision; use a mass and size nearer 1");
-    }
-    // m v and I w must stay finite; compared in logarithms so the check itself cannot overflow.
-    const auto product_overflows = [](double x, double y) {
-      return x > 0.0 && y > 0.0 &&
-             std::log(x) + std::log(y) > std::log(std::numeric_limits<double>::max()) - 2.0;
-    };
-    if (product_overflows(def.velocity.cwiseAbs().maxCoeff(), def.mass) ||
-        product_overflows(def.angular_velocity.cwiseAbs().maxCoeff(), I_body.diagonal().maxCoeff())) {
-      throw std::invalid_argument("body momentum overflows: mass " + num(def.mass) +
-                                  " kg times its velocity is not finite in double precision");
     }
     b.p = def.mass * def.velocity;
     const Mat3 R = b.rotation();

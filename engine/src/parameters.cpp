@@ -65,6 +65,8 @@ const std::array kParameters = {
               .json_key = "gravity_mps2",
               .unit = "m/s^2",
               .type = ParameterType::vector3,
+              .min = -1.0e4,
+              .max = 1.0e4,
               .help = "gravitational acceleration; the paper uses (0, -10, 0)",
               .get = &get_member<&WorldDef::gravity>,
               .set = &set_member<&WorldDef::gravity>},
@@ -73,9 +75,8 @@ const std::array kParameters = {
               .json_key = "dt_s",
               .unit = "s",
               .type = ParameterType::real,
-              .min = 0.0,
-              .max = kInfinity,
-              .min_exclusive = true,
+              .min = 1.0e-6,
+              .max = 1.0,
               .help = "time step; the paper uses 1/60",
               .get = &get_member<&WorldDef::dt>,
               .set = &set_member<&WorldDef::dt>},
@@ -85,7 +86,7 @@ const std::array kParameters = {
               .unit = "",
               .type = ParameterType::integer,
               .min = 1.0,
-              .max = 1000000.0,
+              .max = 10000.0,
               .help = "solver sweeps per solve of A lambda = b; the paper uses 25",
               .get = &get_member<&WorldDef::iterations>,
               .set = &set_member<&WorldDef::iterations>},
@@ -243,7 +244,8 @@ std::string Parameter::allowed() const {
     case ParameterType::boolean:
       return "true or false";
     case ParameterType::vector3:
-      return "three finite numbers x,y,z" + unit_suffix(*this);
+      return "three numbers x,y,z, each in [" + number_text(min) + ", " + number_text(max) + "]" +
+             unit_suffix(*this);
     case ParameterType::choice: {
       std::string s = "one of: ";
       for (std::size_t i = 0; i < choices.size(); ++i) {
@@ -275,9 +277,14 @@ std::optional<std::string> Parameter::check(const ParameterValue& v) const {
     case ParameterType::boolean:
       if (!std::holds_alternative<bool>(v)) return must;
       return std::nullopt;
-    case ParameterType::vector3:
-      if (!std::holds_alternative<Vec3>(v) || !all_finite(std::get<Vec3>(v))) return must;
+    case ParameterType::vector3: {
+      if (!std::holds_alternative<Vec3>(v)) return must;
+      const Vec3& x = std::get<Vec3>(v);
+      for (int k = 0; k < 3; ++k) {
+        if (!std::isfinite(x[k]) || x[k] < min || x[k] > max) return must;
+      }
       return std::nullopt;
+    }
     case ParameterType::choice:
       if (!std::holds_alternative<int>(v)) return must;
       for (const Choice& c : choices) {

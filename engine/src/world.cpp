@@ -15,6 +15,17 @@
 #include <string>
 
 namespace cps {
+namespace {
+
+// Every component finite and within +-limit (isfinite first: no exception on NaN).
+bool within(const Vec3& v, double limit) {
+  for (int k = 0; k < 3; ++k) {
+    if (!std::isfinite(v[k]) || std::abs(v[k]) > limit) return false;
+  }
+  return true;
+}
+
+}  // namespace
 
 World::World(const WorldDef& def) : def_(def), broad_phase_(std::make_unique<BroadPhase>()) {
   def_.validate();
@@ -63,10 +74,10 @@ int World::add_distance(const DistanceConstraint& d) {
         << " bodies; use kWorldBody for a fixed point)";
   } else if (d.body_b == d.body_a) {
     why << "body_a and body_b are both " << d.body_a;
-  } else if (!all_finite(d.local_a) || !all_finite(d.local_b)) {
-    why << "the end points must be finite";
-  } else if (!(std::isfinite(d.length) && d.length >= 0.0)) {
-    why << "length " << d.length << " m must be finite and >= 0";
+  } else if (!within(d.local_a, kMaxCoordinate) || !within(d.local_b, kMaxCoordinate)) {
+    why << "the end points must be finite and within +-" << kMaxCoordinate << " m";
+  } else if (!(std::isfinite(d.length) && d.length >= 0.0 && d.length <= kMaxCoordinate)) {
+    why << "length " << d.length << " m must be in [0, " << kMaxCoordinate << "] m";
   }
   if (!why.str().empty()) throw std::invalid_argument("distance constraint: " + why.str());
   distances_.push_back(d);

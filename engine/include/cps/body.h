@@ -5,6 +5,18 @@
 
 namespace cps {
 
+/// The ranges a body may be built in, chosen so that a step stays finite: with dt <= 1 s and
+/// |g| <= 1e4 m/s^2 (the world parameter table) momenta, positions and the inertia tensor stay
+/// far from overflow and underflow for any run of bounded length. Every one is refused with a
+/// message naming the value and the range.
+inline constexpr double kMinMass = 1e-6;      ///< kg: a movable body's smallest mass
+inline constexpr double kMaxMass = 1e9;       ///< kg: its largest
+inline constexpr double kMinSize = 1e-4;      ///< m: smallest box half extent or sphere radius
+inline constexpr double kMaxSize = 1e5;       ///< m: largest
+inline constexpr double kMaxCoordinate = 1e9; ///< m: largest |component| of a position, plane offset
+inline constexpr double kMaxSpeed = 1e5;      ///< m/s: largest |component| of a velocity
+inline constexpr double kMaxSpin = 1e5;       ///< rad/s: largest |component| of an angular velocity
+
 /// The kinds of collision shape.
 enum class ShapeKind {
   box,     ///< a cuboid given by its half extents
@@ -13,8 +25,8 @@ enum class ShapeKind {
 };
 
 /// A collision shape in body space.
-/// - box: half_extents (m), each finite and > 0.
-/// - sphere: radius (m), finite and > 0, centred on the body origin.
+/// - box: half_extents (m), each in [kMinSize, kMaxSize].
+/// - sphere: radius (m) in [kMinSize, kMaxSize], centred on the body origin.
 /// - plane: the half space {x : dot(normal, x) <= offset} of body space is solid; normal is a
 ///   unit 3-vector pointing out of the solid to the free side, offset in m.
 /// Build one with Shape::box, Shape::sphere or Shape::plane, which validate their input.
@@ -26,13 +38,14 @@ struct Shape {
   double offset = 0.0;
 
   /// A box of half extents h (m, 3-vector). Throws std::invalid_argument naming the value if any
-  /// component is not finite and > 0.
+  /// component is outside [kMinSize, kMaxSize].
   static Shape box(const Vec3& h);
-  /// A sphere of radius r (m). Throws std::invalid_argument naming the value unless finite > 0.
+  /// A sphere of radius r (m). Throws std::invalid_argument naming the value unless it is in
+  /// [kMinSize, kMaxSize].
   static Shape sphere(double r);
   /// A plane with outward normal n (any non-zero finite 3-vector; it is normalised) at signed
   /// distance offset (m) from the body origin along n. Throws std::invalid_argument on a zero or
-  /// non-finite normal or a non-finite offset.
+  /// non-finite normal or an offset with |offset| > kMaxCoordinate.
   static Shape plane(const Vec3& n, double offset);
 };
 
@@ -87,9 +100,11 @@ Mat3 sphere_inertia(double mass, double radius);
 /// Body-space inertia tensor (kg m^2, 3 x 3) of a movable body of the given shape and mass (kg).
 Mat3 shape_inertia(const Shape& shape, double mass);
 
-/// Builds a Body from a definition. Throws std::invalid_argument naming the bad value for a
-/// non-positive or non-finite mass of a movable body, a movable plane, a non-finite position or
-/// velocity, or an orientation whose norm differs from 1 by more than 1e-9.
+/// Builds a Body from a definition. Throws std::invalid_argument naming the bad value and the
+/// allowed range for a movable body's mass outside [kMinMass, kMaxMass], a movable plane, a shape
+/// outside its range (Shape), a position component beyond kMaxCoordinate, a velocity component
+/// beyond kMaxSpeed, an angular velocity component beyond kMaxSpin (all also when not finite), or
+/// an orientation whose norm differs from 1 by more than 1e-9.
 Body make_body(const BodyDef& def);
 
 }  // namespace cps

@@ -52,9 +52,9 @@ enum class Assembly {
 /// World parameters, each with its unit and a typical value; the table below gives each one's
 /// allowed values. Validate with validate().
 struct WorldDef {
-  Vec3 gravity = Vec3(0.0, -10.0, 0.0);  ///< m/s^2; the paper uses (0, -10, 0)
-  double dt = 1.0 / 60.0;                ///< time step (s), > 0; the paper uses 1/60
-  int iterations = 25;                   ///< solver sweeps per solve, >= 1; the paper uses 25
+  Vec3 gravity = Vec3(0.0, -10.0, 0.0);  ///< m/s^2, each component within +-1e4; paper (0, -10, 0)
+  double dt = 1.0 / 60.0;                ///< time step (s) in [1e-6, 1]; the paper uses 1/60
+  int iterations = 25;                   ///< solver sweeps per solve in [1, 1e4]; the paper: 25
   double beta = 0.2;                     ///< push factor constant (dimensionless) in [0, 1]; 0.2
   double friction = 0.5;                 ///< friction coefficient mu (dimensionless) >= 0; 0.5
   double restitution = 0.0;              ///< coefficient of restitution eps in [0, 1]; 0
@@ -76,7 +76,7 @@ struct WorldDef {
 
   /// Checks every parameter against the table. Throws std::invalid_argument naming the
   /// parameter, its value and what is allowed ("world parameter dt = 0 is not allowed: it must
-  /// be finite and > 0 (s)").
+  /// be in [1e-06, 1] (s)"). The ranges keep a step finite (see also body.h's ranges).
   void validate() const;
 };
 
@@ -107,7 +107,7 @@ struct Parameter {
   std::string_view json_key{};  ///< key in run.json and --json, unit as suffix: "contact_margin_m"
   std::string_view unit{};    ///< SI unit ("s", "m", "m/s", "m/s^2"), empty when dimensionless
   ParameterType type = ParameterType::real;
-  double min = 0.0;            ///< real and integer: smallest allowed value
+  double min = 0.0;            ///< real, integer, vector3 (each component): smallest allowed value
   double max = 0.0;            ///< real and integer: largest allowed value (may be +inf)
   bool min_exclusive = false;  ///< real: min itself is not allowed (dt > 0)
   std::span<const Choice> choices{};  ///< choice: the allowed names, the default first

@@ -1,5 +1,6 @@
-#include "bench.h"
-
+// `cps bench`: microseconds per physics step (explicit and matrix-free side by side), the cost
+// growth with body count, and milliseconds per rendered frame.
+#include "command.h"
 #include "scene.h"
 
 #ifdef CPS_HAVE_RENDERER
@@ -15,6 +16,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,12 +25,6 @@
 
 namespace cps::cli {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -87,12 +83,10 @@ double log_log_slope(const std::vector<std::pair<double, double>>& points) {
 }
 
 #ifdef CPS_HAVE_RENDERER
-// The style render_frames draws `run` with (fixed camera, no overlays, no label).
-DrawStyle bench_style(const scenes::Scene& scene, const scenes::Run& run, float aspect) {
-  DrawStyle style{frame_world(run.world, aspect), static_cast<float>(scene.plane_opacity),
-                  Overlays{}};
-  if (scene.camera) style.camera = camera_from_preset(*scene.camera);
-  return style;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 // The rendering table: per paper scene at 1280x720 over its first second at 30 fps.
@@ -132,14 +126,14 @@ void render_table(bool quick) {
     std::fprintf(stderr, "bench: rendering %s\n", std::string(scene.name).c_str());
     {  // Warm-up (untimed).
       scenes::Run run = scenes::make_run(scene);
-      renderer.draw(draw_list(run.world, bench_style(scene, run, k_aspect)));
+      renderer.draw(draw_list(run.world, resolve_style(scene, run.world, View{}, k_aspect)));
     }
     // Stages, one at a time.
     std::vector<double> physics, draw, encode;
     double bytes = 0.0;
     {
       scenes::Run run = scenes::make_run(scene);
-      const DrawStyle style = bench_style(scene, run, k_aspect);
+      const DrawStyle style = resolve_style(scene, run.world, View{}, k_aspect);
       for (int k = 0; k < frames; ++k) {
         auto start = Clock::now();
         run.advance_to(static_cast<double>(k) / k_fps);
@@ -158,7 +152,7 @@ void render_table(bool quick) {
     for (int r = 0; r < repeats; ++r) {
       {
         scenes::Run run = scenes::make_run(scene);
-        const DrawStyle style = bench_style(scene, run, k_aspect);
+        const DrawStyle style = resolve_style(scene, run.world, View{}, k_aspect);
         const auto start = Clock::now();
         for (int k = 0; k < frames; ++k) {
           run.advance_to(static_cast<double>(k) / k_fps);
@@ -169,9 +163,10 @@ void render_table(bool quick) {
       {
         scenes::Run run = scenes::make_run(scene);
         std::vector<Panel> panels{{&run, ""}};
+        const DrawStyle style = resolve_style(scene, run.world, View{}, k_aspect);
         render::PngWriter writer(1, 3);
         const auto start = Clock::now();
-        render_frames(scene, panels, job, renderer, writer, nullptr);
+        render_frames(style, panels, job, renderer, writer, nullptr);
         end_to_end.push_back(1e3 * seconds_since(start) / frames);
       }
     }
@@ -186,8 +181,16 @@ void render_table(bool quick) {
 }
 #endif
 
-}  // namespace
+// The options of `cps bench`.
+struct BenchOptions {
+  bool quick = false;
+  bool rendering = false;  // only the rendering table
+};
 
+// The tables, as Markdown on stdout; progress on stderr. quick: fewer and smaller scenes (seconds
+// instead of minutes), one end-to-end rendering run per scene instead of three. rendering_only:
+// only the rendering table. Returns the exit code (2 for rendering_only in a build without the
+// renderer).
 int run_bench(bool quick, bool rendering_only) {
 #ifdef CPS_HAVE_RENDERER
   if (rendering_only) {
@@ -254,6 +257,18 @@ int run_bench(bool quick, bool rendering_only) {
   render_table(quick);
 #endif
   return 0;
+}
+
+}  // namespace
+
+Command add_bench(CLI::App& app) {
+  auto o = std::make_shared<BenchOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "bench", "microseconds per step (explicit and matrix-free), cost growth, ms per frame");
+  sub->add_flag("--quick", o->quick, "smaller scenes and fewer steps (results in us/step, ms/frame)");
+  sub->add_flag("--rendering", o->rendering,
+                "only the rendering table (ms per frame at 1280x720: draw, PNG, end to end)");
+  return {sub, [o] { return run_bench(o->quick, o->rendering); }};
 }
 
 }  // namespace cps::cli

@@ -1,5 +1,7 @@
 #include "draw.h"
 
+#include "options.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -112,6 +114,10 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
   return list;
 }
 
+namespace {
+
+// A camera that frames the movable bodies and the fixed rod ends of `world` as they are now,
+// with the ground level y = 0 in view (aspect = width / height, > 0).
 render::Camera frame_world(const World& world, float aspect) {
   DrawStyle all;
   all.overlays = Overlays{};  // rods on, no contacts, no orbit: framing ignores the flags
@@ -127,6 +133,7 @@ render::Camera frame_world(const World& world, float aspect) {
   return render::frame_bounds(lo, hi, aspect);
 }
 
+// The renderer camera of a preset (near/far clip planes from the eye-target distance).
 render::Camera camera_from_preset(const scenes::CameraPreset& preset) {
   render::Camera camera;
   camera.eye = to_glm(preset.eye);
@@ -138,22 +145,21 @@ render::Camera camera_from_preset(const scenes::CameraPreset& preset) {
   return camera;
 }
 
-namespace {
-
 constexpr std::array<std::string_view, 5> kCameraNames = {"preset", "auto", "front", "side",
                                                           "top"};
 
-}  // namespace
-
-std::span<const std::string_view> camera_names() { return kCameraNames; }
-
-std::optional<scenes::CameraPreset> camera_preset(const scenes::Scene& scene, const World& world,
-                                                  std::string_view name, float aspect) {
-  if (name == "preset") return scene.camera;
+// The camera preset called `name` (see camera_names()) given the scene's preset `own` (none:
+// the scene has none); nullopt means "frame the world automatically" (frame_world). `world` is
+// the scene as built, framed when there is no preset. Throws UsageError listing the names for an
+// unknown one.
+std::optional<scenes::CameraPreset> camera_preset(const std::optional<scenes::CameraPreset>& own,
+                                                  const World& world, std::string_view name,
+                                                  float aspect) {
+  if (name == "preset") return own;
   if (name == "auto") return std::nullopt;
   scenes::CameraPreset base;
-  if (scene.camera) {
-    base = *scene.camera;
+  if (own) {
+    base = *own;
   } else {
     const render::Camera framed = frame_world(world, aspect);
     base.eye = Vec3(framed.eye.x, framed.eye.y, framed.eye.z);
@@ -172,9 +178,21 @@ std::optional<scenes::CameraPreset> camera_preset(const scenes::Scene& scene, co
   } else {
     std::string known;
     for (std::string_view n : kCameraNames) known += (known.empty() ? "" : ", ") + std::string(n);
-    throw std::invalid_argument("--camera " + std::string(name) + ": allowed are " + known);
+    throw UsageError("--camera " + std::string(name) + ": allowed are " + known);
   }
   return view;
+}
+
+}  // namespace
+
+std::span<const std::string_view> camera_names() { return kCameraNames; }
+
+DrawStyle resolve_style(const scenes::Scene& scene, const World& as_built, const View& view,
+                        float aspect) {
+  const std::optional<scenes::CameraPreset> preset =
+      camera_preset(view.preset ? view.preset : scene.camera, as_built, view.camera, aspect);
+  return {preset ? camera_from_preset(*preset) : frame_world(as_built, aspect),
+          static_cast<float>(scene.plane_opacity), view.overlays};
 }
 
 }  // namespace cps::cli

@@ -31,9 +31,21 @@ struct Overlays {
 };
 
 /// How to draw a world: the camera, the opacity of its planes ([0, 1]) and the overlays.
+/// resolve_style makes one for a scene.
 struct DrawStyle {
   render::Camera camera;
   float plane_opacity = 1.0f;
+  Overlays overlays;
+};
+
+/// The view a command asks for (`cps render`, `cps figure`, `cps bench`): the camera by name,
+/// a camera preset that replaces the scene's own, and the overlays.
+struct View {
+  /// A name from camera_names() (--camera).
+  std::string camera = "preset";
+  /// Replaces the scene's own camera preset (for "preset", "front", "side", "top") if set: the
+  /// views of `cps figure paper`.
+  std::optional<scenes::CameraPreset> preset;
   Overlays overlays;
 };
 
@@ -44,22 +56,20 @@ struct DrawStyle {
 /// through the target by orbit_deg_per_s * world.time() degrees.
 render::DrawList draw_list(const World& world, const DrawStyle& style);
 
-/// A camera that frames the movable bodies and the fixed rod ends of `world` as they are now,
-/// with the ground level y = 0 in view (aspect = width / height, > 0).
-render::Camera frame_world(const World& world, float aspect);
-
-/// The renderer camera of a scene's preset (near/far clip planes from the eye-target distance).
-render::Camera camera_from_preset(const scenes::CameraPreset& preset);
-
 /// The names `--camera` takes: "preset" (the scene's own view; for a scene without one, the
 /// automatic framing), "auto" (frame the bodies as built), and "front", "side", "top": the
 /// preset's target seen from the same distance along +z, along +x, and from above.
 std::span<const std::string_view> camera_names();
 
-/// The camera preset called `name` for `scene` (see camera_names()); nullopt means "frame the
-/// world automatically" (frame_world). `world` is the scene as built, used when the scene has
-/// no preset of its own. Throws std::invalid_argument listing the names for an unknown one.
-std::optional<scenes::CameraPreset> camera_preset(const scenes::Scene& scene, const World& world,
-                                                  std::string_view name, float aspect);
+/// The one place a scene's pictures get their camera and style: the camera that view.camera
+/// names (see camera_names()) for `scene`, whose preset is view.preset if set, else the scene's
+/// own; "auto", and "preset" for a scene without a preset, frame the movable bodies and fixed rod
+/// ends of `as_built` (the scene's world before its first step) with the ground level y = 0 in
+/// view; "front", "side" and "top" look at the preset's target (or the framed one) from the same
+/// distance. Near and far clip planes follow the eye-target distance. `aspect`: width / height of
+/// one picture (> 0). The style draws the planes at the scene's plane_opacity with
+/// view.overlays. Throws UsageError listing the names for an unknown camera name.
+DrawStyle resolve_style(const scenes::Scene& scene, const World& as_built, const View& view,
+                        float aspect);
 
 }  // namespace cps::cli

@@ -1,8 +1,8 @@
 #include "figure.h"
 
+#include "command.h"
 #include "output.h"
-
-#include "simulate.h"
+#include "view_options.h"
 
 #include "cps/render/image_ops.h"
 
@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <stdexcept>
 #include <system_error>
 
@@ -107,20 +108,12 @@ std::string format_time(double t) {
 }  // namespace
 
 render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer) {
-  scenes::Scene scene = *spec.scene;
-  if (spec.preset) scene.camera = spec.preset;
+  const scenes::Scene& scene = *spec.scene;
   std::vector<scenes::Run> runs;
   for (const Variant& v : spec.variants) runs.push_back(make_run_or_usage_error(scene, v.overrides));
 
   const float aspect = static_cast<float>(renderer.width()) / static_cast<float>(renderer.height());
-  std::optional<scenes::CameraPreset> preset;
-  try {
-    preset = camera_preset(scene, runs.front().world, spec.camera, aspect);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  DrawStyle style{preset ? camera_from_preset(*preset) : frame_world(runs.front().world, aspect),
-                  static_cast<float>(scene.plane_opacity), spec.overlays};
+  const DrawStyle style = resolve_style(scene, runs.front().world, spec.view, aspect);
   const int label_scale = std::max(1, renderer.height() / 360);
 
   std::vector<render::Image> rows;
@@ -185,6 +178,7 @@ nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
   }
   const int columns = static_cast<int>(spec.times.size());
   const int rows = static_cast<int>(spec.variants.size());
+  const std::optional<scenes::CameraPreset>& preset = spec.view.preset;
   const nlohmann::json parameters = {
           {"scene", spec.scene->name},
           {"compare", spec.compare},
@@ -194,16 +188,16 @@ nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
           {"layout", "rows = variants, columns = times"},
           {"panel_size_px", {spec.panel_width, spec.panel_height}},
           {"image_size_px", {columns * spec.panel_width, rows * spec.panel_height}},
-          {"camera", spec.camera},
+          {"camera", spec.view.camera},
           {"camera_preset",
-           spec.preset ? nlohmann::json{{"eye_m", {spec.preset->eye.x(), spec.preset->eye.y(), spec.preset->eye.z()}},
-                                        {"target_m", {spec.preset->target.x(), spec.preset->target.y(), spec.preset->target.z()}},
-                                        {"fov_y_deg", spec.preset->fov_y_deg}}
-                       : nlohmann::json("the scene's")},
+           preset ? nlohmann::json{{"eye_m", {preset->eye.x(), preset->eye.y(), preset->eye.z()}},
+                                   {"target_m", {preset->target.x(), preset->target.y(), preset->target.z()}},
+                                   {"fov_y_deg", preset->fov_y_deg}}
+                  : nlohmann::json("the scene's")},
           {"overlays",
-           {{"contacts", spec.overlays.contacts},
-            {"rods", spec.overlays.rods},
-            {"orbit_deg_per_s", spec.overlays.orbit_deg_per_s},
+           {{"contacts", spec.view.overlays.contacts},
+            {"rods", spec.view.overlays.rods},
+            {"orbit_deg_per_s", spec.view.overlays.orbit_deg_per_s},
             {"label", spec.label}}},
           {"variants", variants}};
   nlohmann::json sidecar = run_info("figure", argc, argv, parameters);
@@ -241,6 +235,129 @@ const std::vector<PaperFigure>& paper_figures() {
        "50 pendulums of varied length: the wave-like procession, realigned after the 60 s cycle"},
   };
   return figures;
+}
+
+namespace {
+
+// The options of `cps figure`.
+struct FigureOptions {
+  std::string scene;
+  std::string times;  // "t1,t2,..." (s)
+  std::string compare;
+  std::string size = "640x360";
+  std::string out;
+  bool force = false;
+  scenes::Overrides overrides;
+  View view;  // --camera, --contacts, --rods, --orbit
+  bool label = true;
+};
+
+// Everything is checked (scene, times, size, variants, output ownership) before anything is
+// rendered or written.
+int run_figure(const FigureOptions& o, int argc, char** argv) {
+  const PixelSize size = parse_size(o.size);
+  struct Planned {
+    FigureSpec spec;
+    fs::path png;
+  };
+  std::vector<Planned> plan;
+  const auto base_spec = [&](const scenes::Scene* scene) {
+    FigureSpec spec;
+    spec.scene = scene;
+    spec.panel_width = size.width;
+    spec.panel_height = size.height;
+    spec.view = o.view;
+    spec.label = o.label;
+    return spec;
+  };
+  if (o.scene == "paper") {
+    if (!o.times.empty() || !o.compare.empty()) {
+      throw UsageError("cps figure paper chooses its own --times and --compare for each "
+                       "figure; drop them, or name a scene (e.g. cps figure "
+                       "intersecting_stack --times 0,0.5 --compare push)");
+    }
+    const fs::path folder = o.out.empty() ? fs::path("out/figures") : fs::path(o.out);
+    for (const PaperFigure& f : paper_figures()) {
+      FigureSpec spec = base_spec(select_scenes(f.scene).front());
+      spec.times = f.times;
+      spec.compare = f.compare;
+      spec.variants = compare_variants(f.compare, o.overrides);
+      spec.caption = f.caption + " counterpart";
+      spec.tags = f.tags;
+      spec.view.preset = f.preset;
+      spec.what = f.what;
+      plan.push_back({spec, folder / f.file});
+    }
+  } else {
+    const std::vector<const scenes::Scene*> chosen = select_scenes(o.scene);
+    if (o.scene == "all" || o.scene == "stress") {
+      throw UsageError("figure takes one scene or 'paper', not '" + o.scene + "'");
+    }
+    if (o.times.empty()) {
+      throw UsageError("--times is required: the simulated times (s) of the columns, e.g. "
+                       "--times 0,0.5,2");
+    }
+    FigureSpec spec = base_spec(chosen.front());
+    spec.times = parse_times(o.times);
+    spec.compare = o.compare;
+    spec.variants = compare_variants(o.compare, o.overrides);
+    const fs::path png =
+        o.out.empty()
+            ? fs::path("out/figures") /
+                  (o.scene + (o.compare.empty() ? "" : "-compare-" + o.compare) + ".png")
+            : fs::path(o.out);
+    if (png.extension() != ".png") {
+      throw UsageError("--out " + png.string() + ": the figure is a PNG; give a name ending in .png");
+    }
+    plan.push_back({spec, png});
+  }
+  for (const Planned& p : plan) {
+    for (const Variant& v : p.spec.variants) make_run_or_usage_error(*p.spec.scene, v.overrides);
+    const long long w = static_cast<long long>(p.spec.times.size()) * size.width;
+    const long long h = static_cast<long long>(p.spec.variants.size()) * size.height;
+    if (w > 16384 || h > 16384) {
+      throw UsageError("the figure would be " + std::to_string(w) + "x" + std::to_string(h) +
+                       " pixels (more than 16384 on a side); give fewer --times or a "
+                       "smaller --size");
+    }
+    check_output_is_ours(p.png, o.force);
+  }
+  render::Renderer renderer(size.width, size.height);
+  for (const Planned& p : plan) {
+    const render::Image image = render_figure(p.spec, renderer);
+    write_figure(p.png, image, figure_json(p.spec, argc, argv));
+    std::printf("%s: %dx%d pixels, %zu times x %zu variants (%s)\n", p.png.c_str(), image.width,
+                image.height, p.spec.times.size(), p.spec.variants.size(),
+                sidecar_path(p.png).filename().c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_figure(CLI::App& app, int argc, char** argv) {
+  auto o = std::make_shared<FigureOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "figure",
+      "one labelled PNG of a scene: a panel per time (columns) and per variant (rows); "
+      "'cps figure paper' writes the counterparts of the paper's Figs. 6-10");
+  sub->add_option("scene", o->scene, "scene name (see 'cps list') or 'paper'")->required();
+  sub->add_option("--times", o->times,
+                  "simulated times of the columns (s), comma separated, finite, >= 0, "
+                  "increasing, e.g. 0,0.5,2; required except for 'paper'");
+  sub->add_option("--compare", o->compare,
+                  "one row per value of this option (default: one row, the scene's settings)")
+      ->check(CLI::IsMember(comparable_options()));
+  sub->add_option("--size", o->size, "size of ONE panel, WxH in pixels, each in [16, 8192]")
+      ->capture_default_str();
+  sub->add_option("--out", o->out,
+                  "output PNG (default out/figures/SCENE[-compare-OPTION].png); for 'paper', "
+                  "the folder (default out/figures); a FILE.json sidecar records the run");
+  sub->add_flag("--force", o->force,
+                "replace an output file that cps figure did not write (one without its sidecar)");
+  add_world_options(*sub, o->overrides);
+  add_view_options(*sub, o->view, o->label, /*label_default=*/true);
+  return {sub, [o, argc, argv] { return run_figure(*o, argc, argv); }};
 }
 
 }  // namespace cps::cli

@@ -1,7 +1,7 @@
 #pragma once
 // `cps figure`: one labelled PNG of a scene at chosen times (columns) for each variant of an
 // option (rows), like the paper's Fig. 7 (a)-(c); and the counterparts of the paper's
-// Figs. 6-10 (`cps figure paper`).
+// Figs. 6-10 (`cps figure paper`). The command itself is add_figure in command.h.
 
 #include "draw.h"
 #include "options.h"
@@ -29,11 +29,9 @@ struct FigureSpec {
   /// (times.size() * panel_width) x (variants.size() * panel_height).
   int panel_width = 640;
   int panel_height = 360;
-  /// A name from camera_names(); the same camera for every panel (turned by overlays.orbit).
-  std::string camera = "preset";
-  /// Replaces the scene's own preset (for "preset", "front", "side", "top") if set.
-  std::optional<scenes::CameraPreset> preset;
-  Overlays overlays;
+  /// The camera (the same for every panel, turned by the orbit overlay), the preset that
+  /// replaces the scene's own if set, and the overlays.
+  View view;
   /// Write a label on each panel: caption, tag, scene, variant, time.
   bool label = true;
   /// First line of every label (e.g. "paper Fig. 7"); none if empty.

@@ -1,11 +1,19 @@
 #include "render.h"
 
+#include "command.h"
 #include "draw.h"
+#include "options.h"
+#include "output.h"
+#include "video.h"
+#include "view_options.h"
 
 #include "cps/render/image_ops.h"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <memory>
+#include <optional>
 #include <string>
 
 namespace cps::cli {
@@ -20,13 +28,8 @@ std::string frame_name(int k) {
   return name;
 }
 
-int render_frames(const scenes::Scene& scene, std::vector<Panel>& panels, const RenderJob& job,
+int render_frames(const DrawStyle& style, std::vector<Panel>& panels, const RenderJob& job,
                   render::Renderer& renderer, render::PngWriter& writer, Progress* progress) {
-  const float aspect = static_cast<float>(renderer.width()) / static_cast<float>(renderer.height());
-  // The camera is fixed for the whole sequence.
-  DrawStyle style{frame_world(panels.front().run->world, aspect),
-                  static_cast<float>(scene.plane_opacity), job.overlays};
-  if (scene.camera) style.camera = camera_from_preset(*scene.camera);
   const int label_scale = std::max(1, renderer.height() / 360);
 
   const int frames = frame_count(job);
@@ -51,6 +54,179 @@ int render_frames(const scenes::Scene& scene, std::vector<Panel>& panels, const 
   writer.finish();
   if (progress != nullptr) progress->finish();
   return frames;
+}
+
+namespace {
+
+// The options of `cps render`.
+struct RenderOptions {
+  std::string scene;
+  std::optional<double> seconds;  // s; default: the scene's
+  double fps = 30.0;
+  std::string size = "1280x720";
+  std::string out = "out";
+  std::string compare;
+  bool force = false;
+  scenes::Overrides overrides;
+  std::string backend = "osmesa";
+  std::string video;
+  View view;  // --camera, --contacts, --rods, --orbit
+  bool label = false;
+};
+
+// Everything is checked (scenes, size, variants, camera, output folders) before anything is
+// written.
+int run_render(const RenderOptions& o, int argc, char** argv) {
+  namespace fs = std::filesystem;
+  const PixelSize size = parse_size(o.size);
+  const std::vector<const scenes::Scene*> selected = select_scenes(o.scene);
+  const std::vector<Variant> variants = compare_variants(o.compare, o.overrides);
+  if (!o.compare.empty() && size.width < 32) {
+    throw UsageError("--size " + o.size + ": --compare needs a width of at least 32");
+  }
+  struct Job {
+    const scenes::Scene* scene;
+    std::vector<scenes::Run> runs;
+    DrawStyle style;  // the same camera for the whole sequence
+  };
+  std::vector<Job> jobs;
+  for (const scenes::Scene* s : selected) {
+    Job job{s, {}, {}};
+    for (const Variant& v : variants) job.runs.push_back(make_run_or_usage_error(*s, v.overrides));
+    jobs.push_back(std::move(job));
+  }
+  // --video: ffmpeg is looked for before rendering; without it the frames are still
+  // rendered and kept, and the command ends with an error saying how to finish the video.
+  std::optional<fs::path> ffmpeg;
+  std::vector<VideoJob> videos_left;
+  if (!o.video.empty()) {
+    ffmpeg = find_on_path("ffmpeg");
+    if (!ffmpeg) {
+      std::fprintf(stderr,
+                   "cps: warning: --video %s: ffmpeg is not on PATH; the frames will be "
+                   "rendered and kept, but no video made (install it: apt-get install ffmpeg)\n",
+                   o.video.c_str());
+    }
+  }
+  const int panel_width = size.width / static_cast<int>(variants.size());
+  const float aspect = static_cast<float>(panel_width) / static_cast<float>(size.height);
+  for (Job& job : jobs) job.style = resolve_style(*job.scene, job.runs.front().world, o.view, aspect);
+  // Every output folder is checked (foreign files, see output.h) before any is written.
+  std::vector<RenderJob> specs;
+  std::vector<OutputPlan> plans;
+  for (const Job& job : jobs) {
+    RenderJob spec;
+    spec.seconds = o.seconds.value_or(job.scene->default_seconds);
+    spec.fps = o.fps;
+    spec.folder = fs::path(o.out) /
+                  (std::string(job.scene->name) + (o.compare.empty() ? "" : "-compare-" + o.compare));
+    std::vector<std::string> files;
+    for (int k = 0; k < frame_count(spec); ++k) files.push_back(frame_name(k));
+    plans.push_back(plan_output(spec.folder, std::move(files), o.force));
+    specs.push_back(spec);
+  }
+  render::Renderer renderer(panel_width, size.height, *render::parse_backend(o.backend));
+  std::fprintf(stderr, "render: %s\n", renderer.context_description().c_str());
+  // Encoding overlaps drawing: one encoder thread keeps up with llvmpipe (see cps bench).
+  render::PngWriter writer(1, 3);
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    Job& job = jobs[j];
+    const RenderJob& spec = specs[j];
+    std::vector<Panel> panels;
+    nlohmann::json world = nlohmann::json::array();
+    for (std::size_t v = 0; v < variants.size(); ++v) {
+      std::string label = variants[v].label;
+      if (o.label) label = std::string(job.scene->name) + (label.empty() ? "" : "\n" + label);
+      panels.push_back({&job.runs[v], label});
+      world.push_back({{"label", variants[v].label},
+                       {"overrides", overrides_json(variants[v].overrides)},
+                       {"parameters", parameters_json(job.runs[v].world.def())}});
+    }
+    const Overlays& overlays = o.view.overlays;
+    const nlohmann::json info = run_info(
+        "render", argc, argv,
+        {{"scene", job.scene->name},
+         {"seconds", spec.seconds},
+         {"fps", spec.fps},
+         {"frames", frame_count(spec)},
+         {"size", {{"width", size.width}, {"height", size.height}}},
+         {"compare", o.compare.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.compare)},
+         {"backend", o.backend},
+         {"camera", o.view.camera},
+         {"orbit_deg_per_s", overlays.orbit_deg_per_s},
+         {"contacts", overlays.contacts},
+         {"rods", overlays.rods},
+         {"label", o.label},
+         {"overrides", overrides_json(o.overrides)},
+         {"world", world}});
+    begin_output(plans[j], info);
+    Progress progress("render " + spec.folder.filename().string(), frame_count(spec), "frames");
+    const int frames = render_frames(job.style, panels, spec, renderer, writer, &progress);
+    end_output(plans[j], info);
+    const std::string folder = spec.folder.filename().string();
+    std::printf("%s: %d frames in %s\n", folder.c_str(), frames, spec.folder.c_str());
+    if (!o.video.empty()) {
+      VideoJob video;
+      video.format = *parse_video_format(o.video);
+      video.frames_folder = spec.folder;
+      video.frames = frames;
+      video.fps = o.fps;
+      video.width = panel_width * static_cast<int>(variants.size());
+      video.height = size.height;
+      video.output = fs::path(o.out) / (folder + "." + o.video);
+      if (!ffmpeg) {
+        videos_left.push_back(video);
+        continue;
+      }
+      encode_video(*ffmpeg, video);
+      std::printf("%s: video %s (%ju bytes)\n", folder.c_str(), video.output.c_str(),
+                  static_cast<std::uintmax_t>(fs::file_size(video.output)));
+    }
+  }
+  if (!videos_left.empty()) {
+    std::string how;
+    for (const VideoJob& v : videos_left) {
+      how += "\n  " + shell_command(ffmpeg_arguments("ffmpeg", v, v.output));
+    }
+    throw VideoError("--video " + o.video +
+                     ": ffmpeg is not on PATH, so no video was made; install it "
+                     "(apt-get install ffmpeg). The frames are kept; to assemble them "
+                     "without rendering again, run:" + how);
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_render(CLI::App& app, int argc, char** argv) {
+  auto o = std::make_shared<RenderOptions>();
+  CLI::App* sub = app.add_subcommand("render", "render scenes into PNG frame sequences");
+  sub->add_option("scene", o->scene, "scene name or 'all'")->required();
+  sub->add_option("--seconds", o->seconds, "simulated time (s), > 0; default: the scene's")
+      ->check(kFinitePositive);
+  sub->add_option("--fps", o->fps, "frames per simulated second, > 0")->capture_default_str()
+      ->check(kFinitePositive);
+  sub->add_option("--size", o->size, "frame size WxH in pixels, each in [16, 8192]")->capture_default_str();
+  sub->add_option("--out", o->out, "output folder; frames go to OUT/SCENE/")->capture_default_str();
+  sub->add_option("--compare", o->compare,
+                  "render the two variants of this option side by side, labelled, into "
+                  "OUT/SCENE-compare-OPTION/")
+      ->check(CLI::IsMember(comparable_options()));
+  sub->add_flag("--force", o->force,
+                "write into an output folder that holds files no earlier cps run wrote there "
+                "(they are kept; same-named files are replaced)");
+  add_world_options(*sub, o->overrides);
+  sub->add_option("--backend", o->backend,
+                  "OpenGL context: osmesa (libOSMesa, CPU) or egl (headless EGL: GPU if any, "
+                  "else llvmpipe)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"osmesa", "egl"}));
+  sub->add_option("--video", o->video,
+                  "after the frames, assemble them with ffmpeg into OUT/SCENE.mp4 (H.264) or "
+                  "OUT/SCENE.gif")
+      ->check(CLI::IsMember({"mp4", "gif"}));
+  add_view_options(*sub, o->view, o->label, /*label_default=*/false);
+  return {sub, [o, argc, argv] { return run_render(*o, argc, argv); }};
 }
 
 }  // namespace cps::cli

@@ -1,5 +1,6 @@
 #pragma once
-// `cps render`: steps a scene and writes its frames as PNG files.
+// `cps render`: steps a scene and writes its frames as PNG files (the command itself is
+// add_render in command.h; render_frames is also timed by `cps bench`).
 
 #include "draw.h"
 #include "progress.h"
@@ -19,7 +20,6 @@ struct RenderJob {
   double seconds = 10.0;
   double fps = 30.0;
   std::filesystem::path folder;
-  Overlays overlays;  ///< contacts, rods, camera orbit (see draw.h)
 };
 
 /// Number of frames of a job: floor(seconds * fps) + 1 (frame 0 at t = 0).
@@ -37,13 +37,13 @@ struct Panel {
 /// Renders frame k at simulated time k / fps for k = 0 .. frame_count(job) - 1 into job.folder
 /// (which must exist); every panel's physics steps at its world's own dt in between. The panels
 /// are drawn side by side, each at the renderer's size, so a frame is (panels x renderer width)
-/// by renderer height pixels. The camera is the scene's preset, or frames the first panel's world
-/// as built. Drawing stays on the calling thread (it owns the GL context); each finished frame
+/// by renderer height pixels, all drawn with `style` (resolve_style: camera, plane opacity,
+/// overlays). Drawing stays on the calling thread (it owns the GL context); each finished frame
 /// goes to `writer`, which encodes it on its threads while the next frame is drawn; this returns
 /// after every frame is written. `progress` (may be null) is updated once per frame. Returns the
 /// number of frames. Throws std::runtime_error if a frame cannot be drawn or written (frames
 /// already written stay, each complete; none is left half-written under its final name).
-int render_frames(const scenes::Scene& scene, std::vector<Panel>& panels, const RenderJob& job,
+int render_frames(const DrawStyle& style, std::vector<Panel>& panels, const RenderJob& job,
                   render::Renderer& renderer, render::PngWriter& writer, Progress* progress);
 
 }  // namespace cps::cli

@@ -1,13 +1,19 @@
 #include "report.h"
 
+#include "command.h"
 #include "options.h"
+#include "output.h"
+#include "progress.h"
 #include "stress/mass_ratio.h"
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -19,21 +25,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// How long each scene runs in the sweep (s): long enough for its own metrics (the intersecting
-// stack is judged at 0.5 s as in the paper's Fig. 7, the pendulum wave realigns near 60.26 s).
-double horizon_of(const scenes::Scene& scene) {
-  if (scene.name == "intersecting_stack") return 0.5;
-  return scene.default_seconds;
-}
-
 // The trajectory error compares positions with a reference run (16 substeps, 256 iterations) at
 // this time (s). Contacts make these scenes chaotic: once a stack starts to slide or balls start
 // to roll past each other, nearby trajectories part exponentially and a difference measures
-// chaos, not accuracy. Before the first impacts have settled they do not: 1 s covers the stack's
-// fall and landing, the funnel's fall onto the walls and the grid's catch of its load; the
-// intersecting stack is compared at 0.5 s, the time the paper shows.
+// chaos, not accuracy. Before the first impacts have settled they do not: 1 s covers the first
+// falls, landings and catches of the paper's scenes; a scene whose report horizon is shorter
+// (Scene::report) is compared at its horizon.
 double trajectory_time_of(const scenes::Scene& scene) {
-  return std::min(1.0, horizon_of(scene));
+  return std::min(1.0, scene.report_horizon_s());
 }
 
 std::string name(SolverKind v) { return std::string(name_of(v)); }
@@ -57,31 +56,32 @@ std::string number(double v) {
 
 bool has_friction(const scenes::Scene& scene) { return scene.world_def().friction > 0.0; }
 
-bool is_paper_scene(const std::string& name) {
+// True if `scene` is one of the paper's scenes (its table, scenes::paper_scenes()).
+bool is_paper_scene(const scenes::Scene& scene) {
   for (const scenes::Scene& s : scenes::paper_scenes()) {
-    if (s.name == name) return true;
+    if (s.name == scene.name) return true;
   }
   return false;
-}
-
-// dt is 1 / (60 substeps) for the paper's scenes (substeps of the paper's 60 Hz frame), and the
-// scene's own dt / substeps for the others (stress scenes choose their dt on purpose).
-scenes::Overrides overrides_of(const RunSpec& spec) {
-  scenes::Overrides o;
-  o.set("solver", spec.solver);
-  o.set("push", spec.push);
-  o.set("friction_model", spec.friction_model);
-  o.set("iterations", spec.iterations);
-  o.set("dt", is_paper_scene(spec.scene)
-                  ? 1.0 / (60.0 * spec.substeps)
-                  : scenes::find_scene(spec.scene)->world_def().dt / spec.substeps);
-  return o;
 }
 
 const scenes::Scene& scene_of(const RunSpec& spec) {
   const scenes::Scene* scene = scenes::find_scene(spec.scene);
   if (!scene) throw UsageError("report: unknown scene '" + spec.scene + "'");
   return *scene;
+}
+
+// dt is 1 / (60 substeps) for the paper's scenes (substeps of the paper's 60 Hz frame), and the
+// scene's own dt / substeps for the others (stress scenes choose their dt on purpose).
+scenes::Overrides overrides_of(const RunSpec& spec) {
+  const scenes::Scene& scene = scene_of(spec);
+  scenes::Overrides o;
+  o.set("solver", spec.solver);
+  o.set("push", spec.push);
+  o.set("friction_model", spec.friction_model);
+  o.set("iterations", spec.iterations);
+  o.set("dt", is_paper_scene(scene) ? 1.0 / (60.0 * spec.substeps)
+                                    : scene.world_def().dt / spec.substeps);
+  return o;
 }
 
 std::vector<Vec3> positions(const World& world) {
@@ -172,13 +172,11 @@ constexpr Measure kMeasures[] = {
     {"metric.max_speed_mps", "largest body speed at the end (m/s)"},
 };
 
-// The error measure a scene's headline uses. The intersecting stack's is its largest speed at
-// 0.5 s (the right answer is a stack at rest): its trajectory has no converged reference under
-// Baumgarte, whose correcting velocity beta d / dt grows as dt shrinks.
-const char* primary_measure(const std::string& scene) {
-  if (scene == "pendulum_wave") return "phase_error_deg";
-  if (scene == "intersecting_stack") return "metric.max_speed_mps";
-  return "trajectory_error_m";
+// The error measure the headline of the scene called `scene` uses (its Scene::report); the
+// default one for a name no scene has (a CSV of an older build).
+std::string primary_measure(const std::string& scene) {
+  const scenes::Scene* s = scenes::find_scene(scene);
+  return std::string(s ? s->report.primary_measure : scenes::ReportTraits{}.primary_measure);
 }
 
 std::string variant_of(const Row& r) {
@@ -349,7 +347,7 @@ std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, 
 
 Row execute_run(const RunSpec& spec, int repeats) {
   const scenes::Scene& scene = scene_of(spec);
-  const double horizon = horizon_of(scene);
+  const double horizon = scene.report_horizon_s();
   const double t_traj = trajectory_time_of(scene);
   scenes::Overrides o = overrides_of(spec);
   Row row;
@@ -419,7 +417,7 @@ Row execute_run(const RunSpec& spec, int repeats) {
     if (metrics.contains("energy_drift_rel")) {
       row["energy_drift_rel"] = number(metrics["energy_drift_rel"].get<double>());
     }
-    if (!at_traj.empty() && spec.scene != "pendulum_wave") {
+    if (!at_traj.empty() && !scene.report.has_reference_solution) {
       const std::vector<Vec3> ref = reference_positions(spec);
       double sq = 0.0;
       for (std::size_t i = 0; i < ref.size() && i < at_traj.size(); ++i) {
@@ -530,7 +528,7 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows) {
      << "| scene | measure | paper settings (pgs, baumgarte, fixed, 25 it, 60 Hz) | time (s/s) "
         "| cheapest run with half the error | its time (s/s) | time ratio |\n|---|---|---|---|---|---|---|\n";
   for (const std::string& scene : order) {
-    const char* measure = primary_measure(scene);
+    const std::string measure = primary_measure(scene);
     const Row* base = nullptr;
     for (const Row* r : by_scene[scene]) {
       if (is_paper_setting(*r)) base = r;
@@ -566,12 +564,12 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows) {
         md << "![" << scene << " " << m.column << "](" << scene << "_" << m.column << ".png)\n\n";
       }
     }
-    const char* measure = primary_measure(scene);
+    const std::string measure = primary_measure(scene);
     md << "| solver | push | friction | iterations | substeps | time (s/s) | " << measure
        << " | residual RMS (N) | penetration max (m) | rod error max (m) | diverged |\n"
        << "|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const Row* r : by_scene[scene]) {
-      const auto cell = [r](const char* c) {
+      const auto cell = [r](const std::string& c) {
         const auto it = r->find(c);
         return it == r->end() ? std::string() : it->second;
       };
@@ -596,6 +594,98 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows) {
   std::ofstream out(dir / "report.md");
   if (!out) throw std::runtime_error("report: cannot write " + (dir / "report.md").string());
   out << md.str();
+}
+
+namespace {
+
+// The options of `cps report`.
+struct ReportOptions {
+  std::string scene = "all";
+  std::string out = "out/report";
+  bool quick = false;
+  bool list = false;
+  std::vector<std::string> merge;
+  std::string run;
+};
+
+// The absolute path of this executable, for commands that must run anywhere.
+std::string self_path() {
+  char path[4096];
+  const ssize_t n = readlink("/proc/self/exe", path, sizeof path - 1);
+  if (n <= 0) return "cps";
+  path[n] = '\0';
+  return path;
+}
+
+int run_report(const ReportOptions& o, int argc, char** argv) {
+  // run.json in the report folder: what produced it (written after the report, atomically).
+  const auto write_run_json = [&] {
+    nlohmann::json merged = nlohmann::json::array();
+    for (const std::string& m : o.merge) merged.push_back(m);
+    const nlohmann::json info = run_info(
+        "report", argc, argv,
+        {{"scene", o.scene}, {"quick", o.quick}, {"repeats", o.quick ? 1 : 3}, {"merge", merged}});
+    nlohmann::json j = info;
+    j["tool"] = "cps";
+    write_json_atomic(fs::path(o.out) / k_manifest_name, j);
+  };
+  const int repeats = o.quick ? 1 : 3;
+  if (!o.merge.empty()) {
+    std::vector<fs::path> dirs(o.merge.begin(), o.merge.end());
+    const std::vector<Row> rows = read_rows(dirs);
+    if (rows.empty()) throw UsageError("--merge: no report CSV found below the given folders");
+    write_report(o.out, rows);
+    write_run_json();
+    std::printf("merged %zu runs into %s/report.md\n", rows.size(), o.out.c_str());
+    return 0;
+  }
+  if (!o.run.empty()) {
+    const RunSpec spec = RunSpec::parse(o.run);
+    const Row row = execute_run(spec, repeats);
+    fs::create_directories(o.out);
+    write_csv(fs::path(o.out) / (spec.id() + ".csv"), {row});
+    return 0;
+  }
+  const std::vector<RunSpec> runs = plan_runs(select_scenes(o.scene), o.quick);
+  if (o.list) {
+    const std::string exe = self_path();
+    for (const RunSpec& r : runs) {
+      std::printf("'%s' report --run %s --out '%s/runs'%s\n", exe.c_str(), r.id().c_str(),
+                  o.out.c_str(), o.quick ? " --quick" : "");
+    }
+    std::printf("# when all have finished: '%s' report --merge '%s/runs' --out '%s'\n",
+                exe.c_str(), o.out.c_str(), o.out.c_str());
+    return 0;
+  }
+  std::vector<Row> rows;
+  Progress progress("report " + o.scene, static_cast<long long>(runs.size()), "runs");
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    rows.push_back(execute_run(runs[i], repeats));
+    progress.update(static_cast<long long>(i + 1));
+  }
+  progress.finish();
+  write_report(o.out, rows);
+  write_run_json();
+  std::printf("%zu runs: %s/report.md\n", rows.size(), o.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command add_report(CLI::App& app, int argc, char** argv) {
+  auto o = std::make_shared<ReportOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "report", "error against run time: sweep solver settings, write CSV, plots, report.md");
+  sub->add_option("scene", o->scene, "scene name, 'all' (the paper's) or 'stress'")
+      ->capture_default_str();
+  sub->add_option("--out", o->out, "output folder")->capture_default_str();
+  sub->add_flag("--quick", o->quick, "a reduced sweep (about 2 minutes for all scenes)");
+  sub->add_flag("--list-runs", o->list,
+                "print one self-contained command per run, to spread the sweep over machines");
+  sub->add_option("--merge", o->merge,
+                  "combine the CSV files below these folders into one report in --out");
+  sub->add_option("--run", o->run, "execute one run by its id (see --list-runs)");
+  return {sub, [o, argc, argv] { return run_report(*o, argc, argv); }};
 }
 
 }  // namespace cps::cli

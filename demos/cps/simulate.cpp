@@ -1,11 +1,17 @@
 #include "simulate.h"
 
+#include "command.h"
 #include "options.h"
 #include "output.h"
+#include "progress.h"
 #include "state_hash.h"
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
 #include <string>
 #include <system_error>
 
@@ -120,6 +126,110 @@ nlohmann::json simulate(const scenes::Scene& scene, scenes::Run& run, double sec
             {"solves", c.solves}}},
           {"state_hash", scenes::format_hash(scenes::state_hash(run.world))},
           {"bodies", bodies}};
+}
+
+namespace {
+
+// The options of `cps simulate`.
+struct SimulateOptions {
+  std::string scene;
+  std::optional<double> seconds;  // s; default: the scene's
+  bool json = false;
+  std::string trace;
+  bool force = false;
+  std::string expect_hash;
+  scenes::Overrides overrides;
+};
+
+// Metrics that also report steps done to a Progress: the hook called after every step, so a long
+// `cps simulate` shows progress without changing how it runs.
+class ProgressMetrics final : public scenes::Metrics {
+ public:
+  ProgressMetrics(std::unique_ptr<scenes::Metrics> inner, Progress& progress)
+      : inner_(std::move(inner)), progress_(progress) {}
+  void observe(const World& world) override {
+    inner_->observe(world);
+    progress_.update(++steps_);
+  }
+  nlohmann::json report() const override { return inner_->report(); }
+
+ private:
+  std::unique_ptr<scenes::Metrics> inner_;
+  Progress& progress_;
+  long long steps_ = 0;
+};
+
+int run_simulate(const SimulateOptions& o) {
+  const std::vector<const scenes::Scene*> chosen = select_scenes(o.scene);
+  if (o.scene == "all" || o.scene == "stress") {
+    throw UsageError("simulate takes one scene, not '" + o.scene + "'");
+  }
+  const scenes::Scene* scene = chosen.front();
+  std::optional<std::uint64_t> expected_hash;
+  if (!o.expect_hash.empty()) {
+    expected_hash = scenes::parse_hash(o.expect_hash);
+    if (!expected_hash) {
+      throw UsageError("--expect-hash " + o.expect_hash +
+                       ": give the 16 hex digits of a state_hash, as simulate --json "
+                       "prints it (e.g. 0123456789abcdef)");
+    }
+  }
+  scenes::Run r = make_run_or_usage_error(*scene, o.overrides);
+  const double seconds = o.seconds.value_or(scene->default_seconds);
+  std::optional<TraceWriter> trace;
+  if (!o.trace.empty()) trace.emplace(o.trace, o.force);
+  // Steps on stderr, only once the run has taken 2 s (short runs and --json stay clean).
+  Progress progress("simulate " + o.scene, std::llround(seconds / r.world.def().dt), "steps", 2.0);
+  r.metrics = std::make_unique<ProgressMetrics>(std::move(r.metrics), progress);
+  const nlohmann::json summary = simulate(*scene, r, seconds, trace ? &*trace : nullptr);
+  progress.finish();
+  if (trace) {
+    const long rows = trace->finish();
+    std::cerr << "trace: " << rows << " rows (" << r.world.bodies().size()
+              << " bodies per step) in " << o.trace << "\n";
+  }
+  if (o.json) {
+    std::cout << summary.dump(2) << "\n";
+  } else {
+    std::cout << scene->name << ": " << summary["steps"] << " steps, " << summary["simulated_s"]
+              << " s simulated in " << summary["wall_s"] << " s (" << summary["us_per_step"]
+              << " us/step)\nmetrics: " << summary["metrics"].dump()
+              << "\nstate hash: " << std::string(summary["state_hash"]) << "\n";
+  }
+  if (expected_hash) {
+    const std::string got = summary["state_hash"];
+    if (got != scenes::format_hash(*expected_hash)) {
+      std::cerr << "cps: state hash " << got << " differs from the expected "
+                << scenes::format_hash(*expected_hash) << " (--expect-hash): the run ended in "
+                << "another state\n";
+      return 1;
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_simulate(CLI::App& app) {
+  auto o = std::make_shared<SimulateOptions>();
+  CLI::App* sub = app.add_subcommand("simulate", "run a scene headless and report metrics");
+  sub->add_option("scene", o->scene, "scene name (see 'cps list')")->required();
+  sub->add_option("--seconds", o->seconds, "simulated time (s), > 0; default: the scene's")
+      ->check(kFinitePositive);
+  sub->add_flag("--json", o->json, "print one JSON object (keys carry their unit: _s, _m, ...)");
+  sub->add_option("--trace", o->trace,
+                  "write every body's state per step to this CSV: step, t (s), body index, "
+                  "position (m), orientation quaternion w x y z, velocity (m/s), angular "
+                  "velocity (rad/s); one row per body per step, step 0 = as built");
+  sub->add_flag("--force", o->force,
+                "let --trace replace an existing file that is not a cps trace (a file whose "
+                "first line is the cps trace header is replaced without it)");
+  sub->add_option("--expect-hash", o->expect_hash,
+                  "the state_hash (16 hex digits) the run must end with: if the run ends in "
+                  "another state, print both hashes and exit 1 (a CI check that the physics "
+                  "did not change)");
+  add_world_options(*sub, o->overrides);
+  return {sub, [o] { return run_simulate(*o); }};
 }
 
 }  // namespace cps::cli

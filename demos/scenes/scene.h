@@ -36,6 +36,25 @@ struct CameraPreset {
   double fov_y_deg = 45.0;
 };
 
+/// How `cps report` runs and judges a scene (see demos/cps/report.h). The defaults suit a scene
+/// judged by its trajectory over its default duration.
+struct ReportTraits {
+  /// Simulated time every run of the report's sweep lasts (s, > 0); unset: the scene's
+  /// default_seconds (see Scene::report_horizon_s).
+  std::optional<double> horizon_s;
+  /// Why the horizon is what it is, in one line (documentation for readers of the scene tables;
+  /// the report does not print it).
+  std::string_view horizon_reason = "the scene's default duration";
+  /// The CSV column of the report's headline measure: the error whose value at the paper's
+  /// settings the headline quotes and tries to halve ("trajectory_error_m", "phase_error_deg",
+  /// "metric.max_speed_mps", ...).
+  std::string_view primary_measure = "trajectory_error_m";
+  /// True if the scene's metrics measure its error against a reference solution of their own
+  /// (max_phase_error_deg: the pendulum wave's reduced-coordinate phases); the report then does
+  /// not compute a trajectory error against a reference run.
+  bool has_reference_solution = false;
+};
+
 /// A scene: its name (as typed on the command line), a one-line summary, its default duration
 /// (s), its world parameters, how to add its bodies and how to measure it.
 struct Scene {
@@ -49,6 +68,11 @@ struct Scene {
   /// behind (the funnel).
   double plane_opacity = 1.0;
   std::optional<CameraPreset> camera;
+  /// How `cps report` runs and judges the scene.
+  ReportTraits report;
+
+  /// The simulated time of each run of `cps report` (s): report.horizon_s, or default_seconds.
+  double report_horizon_s() const { return report.horizon_s.value_or(default_seconds); }
 };
 
 /// The paper's result scenes (Sec. 10), in the order `cps list` prints them ("all" on the

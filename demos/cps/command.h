@@ -1,0 +1,51 @@
+#pragma once
+// The commands of `cps`, one file each (list.cpp, simulate.cpp, report.cpp, bench.cpp, and with
+// the renderer render.cpp and figure.cpp). Each owns its options: its add_* function registers
+// a subcommand on the application with its options and returns how to run it; main.cpp parses
+// the command line and runs the command chosen.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace cps::cli {
+
+/// A registered command: its CLI11 subcommand, and what runs it once the command line is parsed
+/// (the options it reads live as long as `run`).
+struct Command {
+  /// The subcommand, owned by the application; true (operator bool) once chosen by the parse.
+  CLI::App* sub = nullptr;
+  /// Runs the command and returns its exit code (0 on success). Throws UsageError for a bad
+  /// value on the command line (exit 2), other exceptions for failures (exit 1).
+  std::function<int()> run;
+};
+
+/// `cps list`: prints the paper's and the stress scenes with their default duration (s) and
+/// summary.
+Command add_list(CLI::App& app);
+
+/// `cps simulate SCENE`: runs one scene headless and prints its metrics (--json: one JSON
+/// object), optionally a per-step trace CSV; --expect-hash makes it exit 1 if the run ends in
+/// another state.
+Command add_simulate(CLI::App& app);
+
+/// `cps report [SCENE]`: the error against run time sweep, written as CSV, plots and report.md
+/// into --out (also --list-runs, --run ID and --merge to spread it over machines). argc and
+/// argv (the whole command line) are recorded in the folder's run.json.
+Command add_report(CLI::App& app, int argc, char** argv);
+
+/// `cps bench`: microseconds per physics step, cost growth with body count and, with the
+/// renderer, milliseconds per rendered frame, as Markdown on stdout.
+Command add_bench(CLI::App& app);
+
+#ifdef CPS_HAVE_RENDERER
+/// `cps render SCENE|all`: PNG frame sequences (optionally side by side per --compare variant,
+/// and assembled into a video). argc and argv are recorded in each folder's run.json.
+Command add_render(CLI::App& app, int argc, char** argv);
+
+/// `cps figure SCENE|paper`: one labelled PNG per figure, a panel per time and variant, with a
+/// JSON sidecar that records argc and argv.
+Command add_figure(CLI::App& app, int argc, char** argv);
+#endif
+
+}  // namespace cps::cli

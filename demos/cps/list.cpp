@@ -1,0 +1,34 @@
+// `cps list`: the scenes with their default duration and summary.
+#include "command.h"
+
+#include "scene.h"
+
+#include <cstdio>
+#include <span>
+#include <string>
+
+namespace cps::cli {
+namespace {
+
+// Prints `title`, then one line per scene: name, default duration (s), summary.
+void print_table(const char* title, std::span<const scenes::Scene> table) {
+  std::printf("%s\n", title);
+  for (const scenes::Scene& s : table) {
+    std::printf("  %-22s %5.0f s  %s\n", std::string(s.name).c_str(), s.default_seconds,
+                std::string(s.summary).c_str());
+  }
+}
+
+}  // namespace
+
+Command add_list(CLI::App& app) {
+  CLI::App* sub = app.add_subcommand(
+      "list", "print the scenes with their default duration (s) and a summary");
+  return {sub, [] {
+            print_table("The paper's scenes (Sec. 10; 'all'):", scenes::paper_scenes());
+            print_table("Stress scenes ('stress'):", scenes::stress_scenes());
+            return 0;
+          }};
+}
+
+}  // namespace cps::cli

@@ -1,0 +1,29 @@
+#pragma once
+// The picture options `cps render` and `cps figure` share: the size of a picture, the camera,
+// the overlays and the labels.
+
+#include "draw.h"
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace cps::cli {
+
+/// A picture size in pixels.
+struct PixelSize {
+  int width = 1280;
+  int height = 720;
+};
+
+/// Parses "WxH" (e.g. "1280x720"), each side in [16, 8192] pixels. Throws UsageError naming
+/// `text` if it is not WxH or a side is out of range.
+PixelSize parse_size(const std::string& text);
+
+/// Registers --contacts, --rods/--no-rods, --camera and --orbit on `cmd`, storing into `view`,
+/// and --label/--no-label, storing into `label` (both must outlive the parse). `label_default`
+/// is --label's default and is stored into `label` now. --camera takes camera_names(); --orbit
+/// a finite rate in degrees per simulated second, |rate| <= 36000.
+void add_view_options(CLI::App& cmd, View& view, bool& label, bool label_default);
+
+}  // namespace cps::cli

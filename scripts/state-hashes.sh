@@ -30,7 +30,7 @@ if [ "${1:-}" = "--check" ]; then
   exit
 fi
 cps=${1:-build/demos/cps}
-scenes=$("$cps" list | awk '/^  /{print $1}')
+scenes=$("$cps" list | awk '/^Scaled/{exit} /^  /{print $1}')
 echo "# scene push solver assembly state_hash   ($("$cps" simulate stack --seconds 0.02 --json | sed -n 's/.*"engine_version": "\(.*\)".*/\1/p'))"
 for scene in $scenes; do
   for push in baumgarte split; do

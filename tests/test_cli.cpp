@@ -61,6 +61,81 @@ TEST_CASE("bad arguments exit with 2, name the problem and write nothing", "[cli
   fs::remove_all(dir);
 }
 
+TEST_CASE("work that would not end and malformed numbers are refused before any work",
+          "[cli][limits]") {
+  const fs::path dir = fresh_dir("limits");
+  struct Case {
+    std::string args;
+    std::string says;
+  };
+  const Case cases[] = {
+      // Runs that would take forever or overflow a count.
+      {"simulate stack --seconds 1e12", "--seconds"},
+      {"simulate stack --seconds 1e5 --dt 1e-6", "steps"},
+      {"simulate stack --dt 1e-300", "--dt"},
+      {"simulate stack --dt 5e-324", "--dt"},
+      {"simulate stack --dt 1e308", "--dt"},
+      {"simulate stack --iterations 1000000", "--iterations"},
+      {"report --run stack.pgs.baumgarte.fixed.it100000.ss100000 --out out", "it100000"},
+      {"report --run pendulum_wave.pgs.baumgarte.fixed.it25.ss1001 --out out", "ss1001"},
+      // Numbers read one way: decimal, whole, nothing after.
+      {"simulate stack --iterations 0x10", "--iterations"},
+      {"simulate stack --friction 0x10", "--friction"},
+      {"simulate stack --contact-margin 0x10", "--contact-margin"},
+      {"simulate stack --dt 0x10", "--dt"},
+      {"simulate stack --seconds 1s", "--seconds"},
+      {"simulate stack --dt 1/0", "--dt"},
+      {"report --run stack.pgs.baumgarte.fixed.it4294967297.ss1 --out out", "it4294967297"},
+      {"report --run stack.pgs.baumgarte.fixed.it1x.ss1 --out out", "it1x"},
+      // Empty names mean nothing: refused.
+      {"report --run '' --out out", "--run"},
+      {"report stack --out ''", "--out"},
+      {"report --merge '' --out out", "--merge"},
+      {"simulate stack --trace ''", "--trace"},
+      {"simulate stack --expect-hash ''", "--expect-hash"},
+#ifdef CPS_HAVE_RENDERER
+      {"render stack --seconds 1e12 --out out", "--seconds"},
+      {"render stack --seconds 1e8 --out out", "--seconds"},
+      {"render stack --fps 1e308 --out out", "--fps"},
+      {"render stack --fps 1e9 --seconds 0.2 --out out", "--fps"},
+      {"render stack --fps 1000 --seconds 1000 --out out", "frames"},
+      {"render stack --out ''", "--out"},
+      {"figure stack --times 0,1 --out ''", "--out"},
+      {"figure stack --times 0,1e12 --out out/f.png", "--times"},
+      {"figure stack --times 0,1e5 --dt 1e-6 --out out/f.png", "steps"},
+#endif
+  };
+  for (const Case& c : cases) {
+    INFO("cps " << c.args);
+    const Result r = cps(c.args, dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find(c.says) != std::string::npos);
+    CHECK(!fs::exists(dir / "out"));
+  }
+  // A time step may be given as a fraction, and means exactly that value.
+  const Result fraction = cps("simulate stack --seconds 0.1 --dt 1/60 --json", dir);
+  REQUIRE(fraction.exit_code == 0);
+  CHECK(nlohmann::json::parse(fraction.out)["parameters"]["dt_s"].get<double>() == 1.0 / 60.0);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps --version names the build; list and unknown scenes name the scaled families",
+          "[cli]") {
+  const fs::path dir = fresh_dir("version");
+  const Result version = cps("--version", dir);
+  CHECK(version.exit_code == 0);
+  CHECK(version.out.rfind("cps ", 0) == 0);
+  const Result list = cps("list", dir);
+  CHECK(list.exit_code == 0);
+  for (const char* family : {"stack_N", "pyramid_N", "funnel_N", "pendulum_wave_N", "pendulum_grid_N"}) {
+    CHECK(list.out.find(family) != std::string::npos);
+  }
+  const Result unknown = cps("simulate pyramid", dir);
+  CHECK(unknown.exit_code == 2);
+  CHECK(unknown.err.find("pyramid_N (about N boxes, 1..20000)") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("cps list names every scene of the paper", "[cli]") {
   const fs::path dir = fresh_dir("list");
   const Result r = cps("list", dir);

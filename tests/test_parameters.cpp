@@ -41,10 +41,14 @@ TEST_CASE("parameters parse whole decimal numbers and known names only", "[param
   const Parameter& dt = parameter("dt");
   CHECK(std::get<double>(dt.parse("0.01")) == 0.01);
   CHECK(std::get<double>(dt.parse("1e-3")) == 1e-3);
-  for (const char* bad : {"0", "-1", "nan", "inf", "abc", "1/60", "1s", "0x10", "", " 1"}) {
+  // A time step may be a fraction, and means exactly that quotient.
+  CHECK(std::get<double>(dt.parse("1/60")) == 1.0 / 60.0);
+  for (const char* bad : {"0", "-1", "nan", "inf", "abc", "1/0", "1/", "/60", "1s", "0x10", "", " 1", "1e308"}) {
     INFO(bad);
     CHECK_THROWS_WITH(dt.parse(bad), Catch::Contains("--dt"));
   }
+  // Only a time takes a fraction.
+  CHECK_THROWS_WITH(parameter("beta").parse("1/5"), Catch::Contains("--beta"));
   const Parameter& iterations = parameter("iterations");
   CHECK(std::get<int>(iterations.parse("25")) == 25);
   for (const char* bad : {"0", "1.5", "0x10", "4294967297", "1x", "-3"}) {

@@ -121,7 +121,7 @@ void render_table(bool quick) {
   job.seconds = k_seconds;
   job.fps = k_fps;
   job.folder = folder;
-  const int frames = frame_count(job);
+  const int frames = static_cast<int>(frame_count(job));  // a few dozen
   for (const scenes::Scene& scene : scenes::paper_scenes()) {
     std::fprintf(stderr, "bench: rendering %s\n", std::string(scene.name).c_str());
     {  // Warm-up (untimed).

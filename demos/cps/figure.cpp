@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 
 std::vector<double> parse_times(const std::string& text) {
   constexpr std::size_t kMaxTimes = 64;
-  constexpr double kMaxTime = 36000.0;  // s: ten hours of simulated time, far beyond any scene
+  constexpr double kMaxTime = kMaxSeconds;
   std::vector<double> times;
   std::size_t start = 0;
   while (true) {
@@ -34,14 +34,13 @@ std::vector<double> parse_times(const std::string& text) {
       throw UsageError("--times " + text + ": an empty entry; give times in seconds separated by "
                        "commas, e.g. --times 0,0.5,2");
     }
-    char* end = nullptr;
-    errno = 0;
-    const double t = std::strtod(entry.c_str(), &end);
-    if (end != entry.c_str() + entry.size()) {
-      throw UsageError("--times: " + quoted + " is not a number; give times in seconds, e.g. "
-                       "--times 0,0.5,2");
+    const std::optional<double> parsed = parse_decimal(entry);
+    if (!parsed) {
+      throw UsageError("--times: " + quoted + " is not a decimal number; give times in seconds, "
+                       "e.g. --times 0,0.5,2");
     }
-    if (!std::isfinite(t) || errno == ERANGE) {
+    const double t = *parsed;
+    if (!std::isfinite(t)) {
       throw UsageError("--times: " + quoted + " is not finite; times are finite seconds >= 0");
     }
     if (t < 0.0) throw UsageError("--times: " + quoted + " is negative; times are seconds >= 0");
@@ -250,6 +249,7 @@ struct FigureOptions {
   scenes::Overrides overrides;
   View view;  // --camera, --contacts, --rods, --orbit
   bool label = true;
+  std::string backend = "osmesa";
 };
 
 // Everything is checked (scene, times, size, variants, output ownership) before anything is
@@ -312,7 +312,10 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
     plan.push_back({spec, png});
   }
   for (const Planned& p : plan) {
-    for (const Variant& v : p.spec.variants) make_run_or_usage_error(*p.spec.scene, v.overrides);
+    for (const Variant& v : p.spec.variants) {
+      const scenes::Run run = make_run_or_usage_error(*p.spec.scene, v.overrides);
+      check_steps(std::string(p.spec.scene->name), p.spec.times.back(), run.world.def().dt);
+    }
     const long long w = static_cast<long long>(p.spec.times.size()) * size.width;
     const long long h = static_cast<long long>(p.spec.variants.size()) * size.height;
     if (w > 16384 || h > 16384) {
@@ -322,7 +325,7 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
     }
     check_output_is_ours(p.png, o.force);
   }
-  render::Renderer renderer(size.width, size.height);
+  render::Renderer renderer(size.width, size.height, *render::parse_backend(o.backend));
   for (const Planned& p : plan) {
     const render::Image image = render_figure(p.spec, renderer);
     write_figure(p.png, image, figure_json(p.spec, argc, argv));
@@ -352,9 +355,15 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
       ->capture_default_str();
   sub->add_option("--out", o->out,
                   "output PNG (default out/figures/SCENE[-compare-OPTION].png); for 'paper', "
-                  "the folder (default out/figures); a FILE.json sidecar records the run");
+                  "the folder (default out/figures); a FILE.json sidecar records the run")
+      ->check(kNotEmpty);
   sub->add_flag("--force", o->force,
                 "replace an output file that cps figure did not write (one without its sidecar)");
+  sub->add_option("--backend", o->backend,
+                  "OpenGL context: osmesa (libOSMesa, CPU) or egl (headless EGL: GPU if any, "
+                  "else llvmpipe)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"osmesa", "egl"}));
   add_world_options(*sub, o->overrides);
   add_view_options(*sub, o->view, o->label, /*label_default=*/true);
   return {sub, [o, argc, argv] { return run_figure(*o, argc, argv); }};

@@ -27,6 +27,10 @@ Command add_list(CLI::App& app) {
   return {sub, [] {
             print_table("The paper's scenes (Sec. 10; 'all'):", scenes::paper_scenes());
             print_table("Stress scenes ('stress'):", scenes::stress_scenes());
+            std::printf("Scaled scenes for benchmarks, made on demand as FAMILY_N (e.g. pyramid_1000):\n");
+            for (const std::string_view family : scenes::scaled_families()) {
+              std::printf("  %s\n", std::string(family).c_str());
+            }
             return 0;
           }};
 }

@@ -3,6 +3,7 @@
 // this file assembles them and turns errors into exit codes.
 #include "command.h"
 #include "options.h"
+#include "output.h"
 
 #include <iostream>
 #include <string>
@@ -15,6 +16,7 @@ using namespace cps;
 int run(int argc, char** argv) {
   CLI::App app{"cps: the constraint based physics solver of Tamis & Maggiore (2015)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("cps ") + cli::engine_version());
   std::vector<cli::Command> commands = {
       cli::add_list(app),
       cli::add_simulate(app),
@@ -42,6 +44,8 @@ int run(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::cerr << "cps: " << e.what() << "\nRun 'cps --help' or 'cps COMMAND --help' for usage.\n";

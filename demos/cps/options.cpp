@@ -1,22 +1,66 @@
 #include "options.h"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
 #include <utility>
 #include <vector>
 #include <sstream>
 
 namespace cps::cli {
 
-const CLI::Validator kFinitePositive(
+namespace {
+
+// The shortest decimal text that reads back as v (up to 17 significant digits).
+std::string exact_text(double v) {
+  char text[40];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    if (std::strtod(text, nullptr) == v) break;
+  }
+  return text;
+}
+
+}  // namespace
+
+CLI::Validator decimal_in(double lo, double hi, bool lo_open, const std::string& unit,
+                          bool allow_fraction) {
+  const std::string range = std::string(lo_open ? "(" : "[") + exact_text(lo) + ", " +
+                            exact_text(hi) + "]" + (unit.empty() ? "" : " " + unit);
+  return CLI::Validator(
+      [=](std::string& input) -> std::string {
+        const std::optional<double> v = parse_decimal(input, allow_fraction);
+        if (!v) {
+          return input + ": not a number; give a decimal number" +
+                 (allow_fraction ? std::string(" or a fraction such as 1/60") : "") + " in " + range;
+        }
+        if (!std::isfinite(*v) || (lo_open ? !(*v > lo) : !(*v >= lo)) || *v > hi) {
+          return input + ": it must be in " + range;
+        }
+        input = exact_text(*v);
+        return {};
+      },
+      range);
+}
+
+const CLI::Validator kNotEmpty(
     [](std::string& input) -> std::string {
-      double value = 0.0;
-      std::istringstream s(input);
-      if (!(s >> value) || !std::isfinite(value) || value <= 0.0) {
-        return "value " + input + " must be a finite number > 0";
-      }
-      return {};
+      return input.empty() ? "an empty value is not allowed; give a name" : std::string();
     },
-    "POSITIVE");
+    "");
+
+void check_steps(const std::string& what, double seconds, double dt) {
+  const double steps = std::ceil(seconds / dt);
+  if (steps > kMaxSteps) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "%s: %.6g s at dt = %.6g s is %.4g steps, more than the %.0f steps a run may "
+                  "take; give fewer --seconds or a larger --dt",
+                  what.c_str(), seconds, dt, steps, kMaxSteps);
+    throw UsageError(text);
+  }
+}
 
 std::string option_help(const Parameter& p) {
   std::string help(p.help);
@@ -64,9 +108,13 @@ std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
   if (const scenes::Scene* s = scenes::find_scene(name)) return {s};
   std::string known;
   for (const scenes::Scene& s : scenes::all_scenes()) known += std::string(known.empty() ? "" : ", ") + std::string(s.name);
+  std::string families;
+  for (const std::string_view f : scenes::scaled_families()) {
+    families += (families.empty() ? "" : ", ") + std::string(f);
+  }
   throw UsageError("unknown scene '" + name + "'; the scenes are: " + known +
-                   " (or 'all' for the paper's scenes, 'stress' for the stress scenes); 'cps list' "
-                   "describes them");
+                   " (or 'all' for the paper's scenes, 'stress' for the stress scenes), and the "
+                   "scaled scenes " + families + "; 'cps list' describes them");
 }
 
 std::vector<std::string> comparable_options() {

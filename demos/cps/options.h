@@ -20,8 +20,30 @@ struct UsageError : std::runtime_error {
 /// table (cps/parameters.h) that has a flag, its help, unit and allowed values from the table.
 void add_world_options(CLI::App& cmd, scenes::Overrides& overrides);
 
-/// CLI11 validator: a finite number > 0 (rejects nan and inf, which CLI::PositiveNumber lets by).
-extern const CLI::Validator kFinitePositive;
+/// Limits that keep one command's work finite. Each is stated in the --help of the options it
+/// bounds, and a command that would pass one is refused before any work (exit 2), naming the
+/// limit and the value.
+inline constexpr double kMaxSeconds = 1.0e5;  ///< s of simulated time a run (--seconds, --times)
+inline constexpr double kMaxSteps = 1.0e7;    ///< physics steps a run: seconds / dt
+inline constexpr double kMaxFps = 1000.0;     ///< frames per simulated second (--fps)
+inline constexpr double kMaxFrames = 1.0e5;   ///< frames in one render folder
+/// Raw pixel bytes one render may draw (frames x width x height x 3): 64 GiB. The PNG files
+/// are smaller; this bounds the drawing work.
+inline constexpr double kMaxPixelBytes = 68719476736.0;
+
+/// CLI11 validator for a decimal number (parse_decimal: no hex, no trailing text; a fraction such
+/// as 1/60 when allow_fraction) in [lo, hi], or (lo, hi] when lo_open, in `unit`. It hands CLI11
+/// the number written back in decimal, so CLI11 converts exactly the value checked. Its message
+/// names the text and the range.
+CLI::Validator decimal_in(double lo, double hi, bool lo_open, const std::string& unit,
+                          bool allow_fraction = false);
+
+/// CLI11 validator that refuses an empty value ("--out ''").
+extern const CLI::Validator kNotEmpty;
+
+/// Throws UsageError naming the run, the steps it would take and kMaxSteps when seconds / dt
+/// (s / s) exceeds kMaxSteps.
+void check_steps(const std::string& what, double seconds, double dt);
 
 /// Scenes named on the command line: "all" or one scene name. Throws UsageError listing the
 /// scenes for an unknown name.

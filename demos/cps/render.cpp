@@ -18,23 +18,25 @@
 
 namespace cps::cli {
 
-int frame_count(const RenderJob& job) {
-  return static_cast<int>(std::floor(job.seconds * job.fps + 1e-9)) + 1;
+long long frame_count(const RenderJob& job) {
+  const double frames = std::floor(job.seconds * job.fps + 1e-9) + 1.0;
+  // Saturates instead of overflowing: the render command refuses anything past kMaxFrames.
+  return frames < 9.0e18 ? static_cast<long long>(frames) : 9'000'000'000'000'000'000LL;
 }
 
-std::string frame_name(int k) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%06d.png", k);
+std::string frame_name(long long k) {
+  char name[40];
+  std::snprintf(name, sizeof name, "frame_%06lld.png", k);
   return name;
 }
 
-int render_frames(const DrawStyle& style, std::vector<Panel>& panels, const RenderJob& job,
+long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, const RenderJob& job,
                   render::Renderer& renderer, render::PngWriter& writer, Progress* progress) {
   const int label_scale = std::max(1, renderer.height() / 360);
 
-  const int frames = frame_count(job);
+  const long long frames = frame_count(job);
   std::vector<render::Image> pictures(panels.size());
-  for (int k = 0; k < frames; ++k) {
+  for (long long k = 0; k < frames; ++k) {
     const double t = static_cast<double>(k) / job.fps;
     for (std::size_t p = 0; p < panels.size(); ++p) {
       panels[p].run->advance_to(t);
@@ -120,8 +122,27 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     spec.fps = o.fps;
     spec.folder = fs::path(o.out) /
                   (std::string(job.scene->name) + (o.compare.empty() ? "" : "-compare-" + o.compare));
+    // The work is bounded before anything is drawn or written: steps, frames and pixels.
+    for (const scenes::Run& run : job.runs) {
+      check_steps(std::string(job.scene->name), spec.seconds, run.world.def().dt);
+    }
+    const long long frames = frame_count(spec);
+    if (static_cast<double>(frames) > kMaxFrames) {
+      throw UsageError(std::string(job.scene->name) + ": " + std::to_string(frames) +
+                       " frames (--seconds x --fps) is more than the " +
+                       std::to_string(static_cast<long long>(kMaxFrames)) +
+                       " frames a render may write; give fewer --seconds or a lower --fps");
+    }
+    const double pixel_bytes = static_cast<double>(frames) * size.width * size.height * 3.0;
+    if (pixel_bytes > kMaxPixelBytes) {
+      throw UsageError(std::string(job.scene->name) + ": " + std::to_string(frames) + " frames of " +
+                       o.size + " pixels is " + std::to_string(static_cast<long long>(pixel_bytes / 1073741824.0)) +
+                       " GiB of pixels, more than the 64 GiB a render may draw; give fewer frames "
+                       "or a smaller --size");
+    }
     std::vector<std::string> files;
-    for (int k = 0; k < frame_count(spec); ++k) files.push_back(frame_name(k));
+    files.reserve(static_cast<std::size_t>(frames));
+    for (long long k = 0; k < frames; ++k) files.push_back(frame_name(k));
     plans.push_back(plan_output(spec.folder, std::move(files), o.force));
     specs.push_back(spec);
   }
@@ -161,15 +182,15 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
          {"world", world}});
     begin_output(plans[j], info);
     Progress progress("render " + spec.folder.filename().string(), frame_count(spec), "frames");
-    const int frames = render_frames(job.style, panels, spec, renderer, writer, &progress);
+    const long long frames = render_frames(job.style, panels, spec, renderer, writer, &progress);
     end_output(plans[j], info);
     const std::string folder = spec.folder.filename().string();
-    std::printf("%s: %d frames in %s\n", folder.c_str(), frames, spec.folder.c_str());
+    std::printf("%s: %lld frames in %s\n", folder.c_str(), frames, spec.folder.c_str());
     if (!o.video.empty()) {
       VideoJob video;
       video.format = *parse_video_format(o.video);
       video.frames_folder = spec.folder;
-      video.frames = frames;
+      video.frames = static_cast<int>(frames);  // at most kMaxFrames
       video.fps = o.fps;
       video.width = panel_width * static_cast<int>(variants.size());
       video.height = size.height;
@@ -202,12 +223,17 @@ Command add_render(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* sub = app.add_subcommand("render", "render scenes into PNG frame sequences");
   sub->add_option("scene", o->scene, "scene name or 'all'")->required();
-  sub->add_option("--seconds", o->seconds, "simulated time (s), > 0; default: the scene's")
-      ->check(kFinitePositive);
-  sub->add_option("--fps", o->fps, "frames per simulated second, > 0")->capture_default_str()
-      ->check(kFinitePositive);
+  sub->add_option("--seconds", o->seconds,
+                  "simulated time (s) in (0, 1e5]; default: the scene's; at most 1e7 physics "
+                  "steps, 1e5 frames and 64 GiB of pixels a render")
+      ->check(decimal_in(0.0, kMaxSeconds, true, "s"));
+  sub->add_option("--fps", o->fps, "frames per simulated second, in (0, 1000]")
+      ->capture_default_str()
+      ->check(decimal_in(0.0, kMaxFps, true, "frames/s"));
   sub->add_option("--size", o->size, "frame size WxH in pixels, each in [16, 8192]")->capture_default_str();
-  sub->add_option("--out", o->out, "output folder; frames go to OUT/SCENE/")->capture_default_str();
+  sub->add_option("--out", o->out, "output folder; frames go to OUT/SCENE/")
+      ->capture_default_str()
+      ->check(kNotEmpty);
   sub->add_option("--compare", o->compare,
                   "render the two variants of this option side by side, labelled, into "
                   "OUT/SCENE-compare-OPTION/")

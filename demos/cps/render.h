@@ -22,11 +22,12 @@ struct RenderJob {
   std::filesystem::path folder;
 };
 
-/// Number of frames of a job: floor(seconds * fps) + 1 (frame 0 at t = 0).
-int frame_count(const RenderJob& job);
+/// Number of frames of a job: floor(seconds * fps) + 1 (frame 0 at t = 0), in 64-bit
+/// arithmetic (a count beyond kMaxFrames is refused by the render command before any work).
+long long frame_count(const RenderJob& job);
 
-/// The file name of frame k (>= 0): "frame_%06d.png".
-std::string frame_name(int k);
+/// The file name of frame k (>= 0): "frame_%06lld.png".
+std::string frame_name(long long k);
 
 /// One picture in a frame: a run of the scene and the label written on it (none if empty).
 struct Panel {
@@ -41,9 +42,9 @@ struct Panel {
 /// overlays). Drawing stays on the calling thread (it owns the GL context); each finished frame
 /// goes to `writer`, which encodes it on its threads while the next frame is drawn; this returns
 /// after every frame is written. `progress` (may be null) is updated once per frame. Returns the
-/// number of frames. Throws std::runtime_error if a frame cannot be drawn or written (frames
+/// number of frames (at most kMaxFrames: the caller checks frame_count first). Throws std::runtime_error if a frame cannot be drawn or written (frames
 /// already written stay, each complete; none is left half-written under its final name).
-int render_frames(const DrawStyle& style, std::vector<Panel>& panels, const RenderJob& job,
+long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, const RenderJob& job,
                   render::Renderer& renderer, render::PngWriter& writer, Progress* progress);
 
 }  // namespace cps::cli

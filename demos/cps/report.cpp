@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -69,6 +70,9 @@ const scenes::Scene& scene_of(const RunSpec& spec) {
   if (!scene) throw UsageError("report: unknown scene '" + spec.scene + "'");
   return *scene;
 }
+
+// The most substeps a run may take per frame (count): dt = 1 / (60 x 1000) s at the most.
+constexpr int kMaxSubsteps = 1000;
 
 // dt is 1 / (60 substeps) for the paper's scenes (substeps of the paper's 60 Hz frame), and the
 // scene's own dt / substeps for the others (stress scenes choose their dt on purpose).
@@ -294,6 +298,8 @@ std::string RunSpec::id() const {
 }
 
 RunSpec RunSpec::parse(const std::string& id) {
+  // The last five parts are the settings; the scene is what comes before them (scene names may
+  // hold a dot: pendulum_wave_dt_0.1).
   std::vector<std::string> parts;
   std::stringstream s(id);
   for (std::string part; std::getline(s, part, '.');) parts.push_back(part);
@@ -301,7 +307,11 @@ RunSpec RunSpec::parse(const std::string& id) {
     return UsageError("run id '" + id + "': " + why +
                       "; expected scene.pgs|jacobi.baumgarte|split.fixed|coupled.itN.ssM");
   };
-  if (parts.size() != 6) throw bad("it has " + std::to_string(parts.size()) + " parts, not 6");
+  if (parts.size() < 6) throw bad("it has " + std::to_string(parts.size()) + " parts, not 6");
+  while (parts.size() > 6) {
+    parts[0] += "." + parts[1];
+    parts.erase(parts.begin() + 1);
+  }
   RunSpec r;
   r.scene = parts[0];
   if (!scenes::find_scene(r.scene)) throw bad("unknown scene");
@@ -314,14 +324,22 @@ RunSpec RunSpec::parse(const std::string& id) {
   r.solver = *solver;
   r.push = *push;
   r.friction_model = *friction_model;
-  const auto count = [&](const std::string& p, const char* prefix) {
+  // A whole decimal count after the prefix, nothing else ("it4294967297" and "it1x" are refused).
+  const auto count = [&](const std::string& p, const char* prefix, int most) {
     if (p.rfind(prefix, 0) != 0) throw bad("'" + p + "' does not start with " + prefix);
-    const int n = std::atoi(p.c_str() + 2);
-    if (n < 1 || n > 100000) throw bad("'" + p + "' is not a count in [1, 100000]");
+    int n = 0;
+    const char* first = p.c_str() + 2;
+    const char* last = p.c_str() + p.size();
+    const auto [end, ec] = std::from_chars(first, last, n);
+    if (first == last || ec != std::errc() || end != last || n < 1 || n > most) {
+      throw bad("'" + p + "' is not a count in [1, " + std::to_string(most) + "]");
+    }
     return n;
   };
-  r.iterations = count(parts[4], "it");
-  r.substeps = count(parts[5], "ss");
+  r.iterations = count(parts[4], "it", static_cast<int>(parameter("iterations").max));
+  r.substeps = count(parts[5], "ss", kMaxSubsteps);
+  const scenes::Scene& scene = scene_of(r);
+  check_steps("run " + id, scene.report_horizon_s(), std::get<double>(*overrides_of(r).find("dt")));
   return r;
 }
 
@@ -678,13 +696,14 @@ Command add_report(CLI::App& app, int argc, char** argv) {
       "report", "error against run time: sweep solver settings, write CSV, plots, report.md");
   sub->add_option("scene", o->scene, "scene name, 'all' (the paper's) or 'stress'")
       ->capture_default_str();
-  sub->add_option("--out", o->out, "output folder")->capture_default_str();
+  sub->add_option("--out", o->out, "output folder")->capture_default_str()->check(kNotEmpty);
   sub->add_flag("--quick", o->quick, "a reduced sweep (about 2 minutes for all scenes)");
   sub->add_flag("--list-runs", o->list,
                 "print one self-contained command per run, to spread the sweep over machines");
   sub->add_option("--merge", o->merge,
-                  "combine the CSV files below these folders into one report in --out");
-  sub->add_option("--run", o->run, "execute one run by its id (see --list-runs)");
+                  "combine the CSV files below these folders into one report in --out")
+      ->check(kNotEmpty);
+  sub->add_option("--run", o->run, "execute one run by its id (see --list-runs)")->check(kNotEmpty);
   return {sub, [o, argc, argv] { return run_report(*o, argc, argv); }};
 }
 

@@ -176,6 +176,7 @@ int run_simulate(const SimulateOptions& o) {
   }
   scenes::Run r = make_run_or_usage_error(*scene, o.overrides);
   const double seconds = o.seconds.value_or(scene->default_seconds);
+  check_steps(o.scene, seconds, r.world.def().dt);
   std::optional<TraceWriter> trace;
   if (!o.trace.empty()) trace.emplace(o.trace, o.force);
   // Steps on stderr, only once the run has taken 2 s (short runs and --json stay clean).
@@ -214,20 +215,24 @@ Command add_simulate(CLI::App& app) {
   auto o = std::make_shared<SimulateOptions>();
   CLI::App* sub = app.add_subcommand("simulate", "run a scene headless and report metrics");
   sub->add_option("scene", o->scene, "scene name (see 'cps list')")->required();
-  sub->add_option("--seconds", o->seconds, "simulated time (s), > 0; default: the scene's")
-      ->check(kFinitePositive);
+  sub->add_option("--seconds", o->seconds,
+                  "simulated time (s) in (0, 1e5]; default: the scene's; at most 1e7 steps "
+                  "(--seconds / --dt) a run")
+      ->check(decimal_in(0.0, kMaxSeconds, true, "s"));
   sub->add_flag("--json", o->json, "print one JSON object (keys carry their unit: _s, _m, ...)");
   sub->add_option("--trace", o->trace,
                   "write every body's state per step to this CSV: step, t (s), body index, "
                   "position (m), orientation quaternion w x y z, velocity (m/s), angular "
-                  "velocity (rad/s); one row per body per step, step 0 = as built");
+                  "velocity (rad/s); one row per body per step, step 0 = as built")
+      ->check(kNotEmpty);
   sub->add_flag("--force", o->force,
                 "let --trace replace an existing file that is not a cps trace (a file whose "
                 "first line is the cps trace header is replaced without it)");
   sub->add_option("--expect-hash", o->expect_hash,
                   "the state_hash (16 hex digits) the run must end with: if the run ends in "
                   "another state, print both hashes and exit 1 (a CI check that the physics "
-                  "did not change)");
+                  "did not change)")
+      ->check(kNotEmpty);
   add_world_options(*sub, o->overrides);
   return {sub, [o] { return run_simulate(*o); }};
 }

@@ -43,16 +43,7 @@ void add_view_options(CLI::App& cmd, View& view, bool& label, bool label_default
                  "turn the camera about the vertical axis through its target (degrees per "
                  "simulated second; 0 = fixed, typical 10)")
       ->capture_default_str()
-      ->check(CLI::Validator(
-          [](std::string& input) -> std::string {
-            double value = 0.0;
-            std::istringstream in(input);
-            if (!(in >> value) || !in.eof() || !std::isfinite(value) || std::abs(value) > 36000.0) {
-              return "--orbit " + input + ": give a finite rate in degrees per second, |rate| <= 36000";
-            }
-            return {};
-          },
-          "DEG/S"));
+      ->check(decimal_in(-36000.0, 36000.0, false, "deg/s"));
 }
 
 }  // namespace cps::cli

@@ -217,15 +217,22 @@ std::string unit_suffix(const Parameter& p) {
   return p.unit.empty() ? std::string() : " (" + std::string(p.unit) + ")";
 }
 
-// A whole decimal number: no hex, no leading '+', no trailing text.
-std::optional<double> parse_real(std::string_view text) {
-  double value = 0.0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return std::nullopt;
-  return value;
-}
-
 }  // namespace
+
+std::optional<double> parse_decimal(std::string_view text, bool allow_fraction) {
+  const auto whole = [](std::string_view t) -> std::optional<double> {
+    double value = 0.0;
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
+    if (t.empty() || ec != std::errc() || end != t.data() + t.size()) return std::nullopt;
+    return value;
+  };
+  const std::size_t slash = text.find('/');
+  if (!allow_fraction || slash == std::string_view::npos) return whole(text);
+  const std::optional<double> a = whole(text.substr(0, slash));
+  const std::optional<double> b = whole(text.substr(slash + 1));
+  if (!a || !b || !std::isfinite(*a) || !std::isfinite(*b) || *b == 0.0) return std::nullopt;
+  return *a / *b;
+}
 
 std::string Parameter::allowed() const {
   switch (type) {
@@ -303,8 +310,12 @@ ParameterValue Parameter::parse(std::string_view text) const {
   ParameterValue v;
   switch (type) {
     case ParameterType::real: {
-      const std::optional<double> x = parse_real(text);
-      if (!x) throw refuse("not a number; give a decimal number, " + allowed());
+      const bool time = unit == "s";
+      const std::optional<double> x = parse_decimal(text, time);
+      if (!x) {
+        throw refuse(std::string("not a number; give a decimal number") +
+                     (time ? " or a fraction such as 1/60" : "") + ", " + allowed());
+      }
       v = *x;
       break;
     }
@@ -332,7 +343,7 @@ ParameterValue Parameter::parse(std::string_view text) const {
       for (int k = 0; k < 3; ++k) {
         const std::size_t comma = k < 2 ? text.find(',', start) : text.size();
         const std::optional<double> c =
-            comma == std::string_view::npos ? std::nullopt : parse_real(text.substr(start, comma - start));
+            comma == std::string_view::npos ? std::nullopt : parse_decimal(text.substr(start, comma - start));
         if (!c) throw refuse("give " + allowed());
         x[k] = *c;
         start = comma + 1;

@@ -120,9 +120,10 @@ struct Parameter {
   /// std::nullopt if `v` is allowed, else why not ("it must be in [0, 1]"). A value of the wrong
   /// alternative (a bool for a real) is not allowed.
   std::optional<std::string> check(const ParameterValue& v) const;
-  /// Parses a value as typed on the command line: a decimal number (no hex, no trailing text),
-  /// a choice's name, true/false, or "x,y,z". Throws std::invalid_argument naming the text and
-  /// what is allowed, for text that does not parse or a value check() refuses.
+  /// Parses a value as typed on the command line: a decimal number (parse_decimal; a fraction
+  /// such as 1/60 too for a time in s), a choice's name, true/false, or "x,y,z". Throws
+  /// std::invalid_argument naming the text and what is allowed, for text that does not parse or
+  /// a value check() refuses.
   ParameterValue parse(std::string_view text) const;
   /// The value as text, the inverse of parse (reals with 17 significant digits).
   std::string format(const ParameterValue& v) const;
@@ -131,6 +132,12 @@ struct Parameter {
   /// The Choice called `name`, or nullptr.
   const Choice* find_choice(std::string_view name) const;
 };
+
+/// Parses the whole of `text` as a decimal number ("0.01", "1e-3", "-2"): no hex, no leading
+/// '+' or space, no trailing text; "inf" and "nan" parse (check the range after). With
+/// allow_fraction, also "a/b" for two such numbers with b != 0 (a time step as 1/60).
+/// std::nullopt for anything else. Every numeric option of the command line is read by it.
+std::optional<double> parse_decimal(std::string_view text, bool allow_fraction = false);
 
 /// The table: every WorldDef member once, in WorldDef's order.
 std::span<const Parameter> world_parameters();

@@ -44,6 +44,12 @@ CLI::Validator decimal_in(double lo, double hi, bool lo_open, const std::string&
       range);
 }
 
+void add_seconds_option(CLI::App& cmd, std::optional<double>& seconds, const std::string& limits) {
+  cmd.add_option("--seconds", seconds,
+                 "simulated time (s) in (0, 1e5]; default: the scene's; " + limits)
+      ->check(decimal_in(0.0, kMaxSeconds, true, "s"));
+}
+
 const CLI::Validator kNotEmpty(
     [](std::string& input) -> std::string {
       return input.empty() ? "an empty value is not allowed; give a name" : std::string();

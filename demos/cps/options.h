@@ -38,6 +38,10 @@ inline constexpr double kMaxPixelBytes = 68719476736.0;
 CLI::Validator decimal_in(double lo, double hi, bool lo_open, const std::string& unit,
                           bool allow_fraction = false);
 
+/// Adds --seconds (simulated time, s, in (0, kMaxSeconds]; unset: the scene's default) to a
+/// command; `limits` says which further limits the command applies (appended to the help).
+void add_seconds_option(CLI::App& cmd, std::optional<double>& seconds, const std::string& limits);
+
 /// CLI11 validator that refuses an empty value ("--out ''").
 extern const CLI::Validator kNotEmpty;
 

@@ -223,10 +223,8 @@ Command add_render(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* sub = app.add_subcommand("render", "render scenes into PNG frame sequences");
   sub->add_option("scene", o->scene, "scene name or 'all'")->required();
-  sub->add_option("--seconds", o->seconds,
-                  "simulated time (s) in (0, 1e5]; default: the scene's; at most 1e7 physics "
-                  "steps, 1e5 frames and 64 GiB of pixels a render")
-      ->check(decimal_in(0.0, kMaxSeconds, true, "s"));
+  add_seconds_option(*sub, o->seconds,
+                     "at most 1e7 physics steps, 1e5 frames and 64 GiB of pixels a render");
   sub->add_option("--fps", o->fps, "frames per simulated second, in (0, 1000]")
       ->capture_default_str()
       ->check(decimal_in(0.0, kMaxFps, true, "frames/s"));

@@ -215,10 +215,7 @@ Command add_simulate(CLI::App& app) {
   auto o = std::make_shared<SimulateOptions>();
   CLI::App* sub = app.add_subcommand("simulate", "run a scene headless and report metrics");
   sub->add_option("scene", o->scene, "scene name (see 'cps list')")->required();
-  sub->add_option("--seconds", o->seconds,
-                  "simulated time (s) in (0, 1e5]; default: the scene's; at most 1e7 steps "
-                  "(--seconds / --dt) a run")
-      ->check(decimal_in(0.0, kMaxSeconds, true, "s"));
+  add_seconds_option(*sub, o->seconds, "at most 1e7 steps (--seconds / --dt) a run");
   sub->add_flag("--json", o->json, "print one JSON object (keys carry their unit: _s, _m, ...)");
   sub->add_option("--trace", o->trace,
                   "write every body's state per step to this CSV: step, t (s), body index, "

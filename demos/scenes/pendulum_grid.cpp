@@ -54,10 +54,7 @@ class PendulumGridMetrics final : public Metrics {
 WorldDef pendulum_grid_world_def() { return stack_world_def(); }
 
 void populate_pendulum_grid(World& world) {
-  BodyDef ground;
-  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
-  ground.is_static = true;
-  world.add_body(ground);
+  add_ground(world);
   for (int i = 0; i < 5; ++i) {
     for (int k = 0; k < 5; ++k) {
       BodyDef ball;

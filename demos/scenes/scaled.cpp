@@ -37,13 +37,6 @@ class ScaledMetrics final : public Metrics {
 
 std::unique_ptr<Metrics> scaled_metrics(const World& world) { return observed<ScaledMetrics>(world); }
 
-void add_ground(World& world) {
-  BodyDef ground;
-  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
-  ground.is_static = true;
-  world.add_body(ground);
-}
-
 // A pyramid wall of unit boxes (1 kg) with base b and b (b + 1) / 2 boxes, 2 cm apart sideways.
 void populate_pyramid(World& world, int boxes) {
   add_ground(world);

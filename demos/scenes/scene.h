@@ -154,6 +154,9 @@ double max_rod_error(const World& world);
 /// narrow phase on all pairs; independent of the last step's contacts).
 double max_penetration_now(const World& world);
 
+/// Adds the static ground plane y = 0 (solid below, normal +y) and returns its body index.
+int add_ground(World& world);
+
 /// Adds the static ground plane y = 0 and the paper's column of five cubes (edge 2.4 m, mass
 /// 1.2 kg) with centres (0, bottom + spacing i, 0), i = 0..4 (m). Shared by the stack (Sec. 10.1)
 /// and the intersecting stack (Sec. 10.2).

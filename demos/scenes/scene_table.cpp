@@ -154,6 +154,13 @@ Run make_run(const Scene& scene, const Overrides& overrides) {
   return run;
 }
 
+int add_ground(World& world) {
+  BodyDef ground;
+  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
+  ground.is_static = true;
+  return world.add_body(ground);
+}
+
 double kinetic_energy(const World& world) {
   double e = 0.0;
   for (const Body& b : world.bodies()) e += b.kinetic_energy();

@@ -66,10 +66,7 @@ WorldDef stack_world_def() {
 }
 
 void add_ground_and_cube_column(World& world, double bottom, double spacing, int count) {
-  BodyDef ground;
-  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
-  ground.is_static = true;
-  world.add_body(ground);
+  add_ground(world);
   for (int i = 0; i < count; ++i) {
     BodyDef cube;
     cube.shape = Shape::box(Vec3::Constant(kHalfEdge));

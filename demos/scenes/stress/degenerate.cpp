@@ -19,13 +19,6 @@ namespace {
 constexpr double kHalf = 0.5;    // m: cube half edge and ball radius
 constexpr double kMass = 1.0;    // kg
 
-void add_ground(World& world) {
-  BodyDef ground;
-  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
-  ground.is_static = true;
-  world.add_body(ground);
-}
-
 void add_cube(World& world, const Vec3& position, const Quat& orientation = Quat::Identity()) {
   BodyDef cube;
   cube.shape = Shape::box(Vec3::Constant(kHalf));

@@ -46,10 +46,7 @@ void populate_mass_ratio(World& world, double ratio) {
     s << "mass ratio " << ratio << " must be finite and > 0";
     throw std::invalid_argument(s.str());
   }
-  BodyDef ground;
-  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
-  ground.is_static = true;
-  world.add_body(ground);
+  add_ground(world);
   BodyDef cube;
   cube.shape = Shape::box(Vec3::Constant(kMassRatioHalfEdge));
   cube.mass = kMassRatioLightMass;

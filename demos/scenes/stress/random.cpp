@@ -74,10 +74,7 @@ class RandomMetrics final : public EnergyMetrics {
 
 void populate_random(World& world, std::uint64_t seed) {
   Sampler s(seed);
-  BodyDef ground;
-  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
-  ground.is_static = true;
-  world.add_body(ground);
+  add_ground(world);
   const int count = kMinBodies + static_cast<int>(s.unit() * (kMaxBodies - kMinBodies + 1));
   for (int i = 0; i < count; ++i) {
     BodyDef body;

@@ -95,10 +95,7 @@ WorldDef scaled_stack_world_def(double s) {
 }
 
 void populate_scaled_stack(World& world, double s) {
-  BodyDef ground;
-  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
-  ground.is_static = true;
-  world.add_body(ground);
+  add_ground(world);
   // populate_stack's layout: edge 2.4 m, 1.2 kg, centres (0, 2 + 3 i, 0) m.
   for (int i = 0; i < 5; ++i) {
     BodyDef cube;

@@ -56,10 +56,7 @@ WorldDef sphere_in_box_world_def() {
 }
 
 void populate_sphere_in_box(World& world) {
-  BodyDef ground;
-  ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
-  ground.is_static = true;
-  world.add_body(ground);
+  add_ground(world);
   BodyDef box;
   box.shape = Shape::box(Vec3::Constant(kBoxHalf));
   box.mass = kBoxMass;

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -26,15 +27,28 @@ Result cps(const std::string& args, const fs::path& dir) { return run_cps(args, 
 
 fs::path fresh_dir(const std::string& name) { return cli_test::fresh_dir("cps_cli_test_" + name); }
 
+// A command line that must be refused, and what its message must name.
+struct Case {
+  std::string args;
+  std::string says;
+};
+
+// Each case exits with 2, its message names what it says, and nothing is written to dir/out.
+void expect_refused(const std::vector<Case>& cases, const fs::path& dir) {
+  for (const Case& c : cases) {
+    INFO("cps " << c.args);
+    const Result r = cps(c.args, dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find(c.says) != std::string::npos);
+    CHECK(!fs::exists(dir / "out"));
+  }
+}
+
 }  // namespace
 
 TEST_CASE("bad arguments exit with 2, name the problem and write nothing", "[cli]") {
   const fs::path dir = fresh_dir("bad");
-  struct Case {
-    std::string args;
-    std::string says;
-  };
-  const Case cases[] = {
+  std::vector<Case> cases = {
       {"render nosuchscene", "unknown scene 'nosuchscene'"},
       {"simulate nosuchscene", "stack"},  // lists the scenes that exist
       {"render stack --size 12x", "--size"},
@@ -50,25 +64,17 @@ TEST_CASE("bad arguments exit with 2, name the problem and write nothing", "[cli
       {"render stack --compare push --push split", "--compare push"},
       {"frobnicate", "unknown command 'frobnicate'"},
   };
-  for (const Case& c : cases) {
-    INFO("cps " << c.args);
-    const bool render = c.args.rfind("render", 0) == 0;
-    const Result r = cps(c.args + (render ? " --out out" : ""), dir);
-    CHECK(r.exit_code == 2);
-    CHECK(r.err.find(c.says) != std::string::npos);
-    CHECK(!fs::exists(dir / "out"));
+  for (Case& c : cases) {
+    if (c.args.rfind("render", 0) == 0) c.args += " --out out";
   }
+  expect_refused(cases, dir);
   fs::remove_all(dir);
 }
 
 TEST_CASE("work that would not end and malformed numbers are refused before any work",
           "[cli][limits]") {
   const fs::path dir = fresh_dir("limits");
-  struct Case {
-    std::string args;
-    std::string says;
-  };
-  const Case cases[] = {
+  const std::vector<Case> cases = {
       // Runs that would take forever or overflow a count.
       {"simulate stack --seconds 1e12", "--seconds"},
       {"simulate stack --seconds 1e5 --dt 1e-6", "steps"},
@@ -105,13 +111,7 @@ TEST_CASE("work that would not end and malformed numbers are refused before any 
       {"figure stack --times 0,1e5 --dt 1e-6 --out out/f.png", "steps"},
 #endif
   };
-  for (const Case& c : cases) {
-    INFO("cps " << c.args);
-    const Result r = cps(c.args, dir);
-    CHECK(r.exit_code == 2);
-    CHECK(r.err.find(c.says) != std::string::npos);
-    CHECK(!fs::exists(dir / "out"));
-  }
+  expect_refused(cases, dir);
   // A time step may be given as a fraction, and means exactly that value.
   const Result fraction = cps("simulate stack --seconds 0.1 --dt 1/60 --json", dir);
   REQUIRE(fraction.exit_code == 0);

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -198,6 +199,35 @@ TEST_CASE("cps simulate --json reports parameters, metrics and the final bodies"
   // After 1 s the lowest cube has fallen 0.8 m onto the ground: centre at about 1.2 m.
   CHECK(j["bodies"][0]["position"][1].get<double>() == Approx(1.2).margin(0.05));
   CHECK(j["bodies"][0]["orientation"].size() == 4);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps bench --scene --json times each scene over a window where it is in contact",
+          "[cli][bench]") {
+  const fs::path dir = fresh_dir("bench_json");
+  const Result r = cps("bench --quick --json --scene intersecting_stack --scene funnel", dir);
+  REQUIRE(r.exit_code == 0);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  REQUIRE(j["physics"].size() == 2);
+  CHECK_FALSE(j.contains("growth"));
+  CHECK_FALSE(j.contains("rendering"));
+  for (const nlohmann::json& row : j["physics"]) {
+    INFO(row.dump());
+    for (const char* key : {"explicit_us_per_step", "matrix_free_us_per_step"}) {
+      CHECK(std::isfinite(row[key].get<double>()));
+      CHECK(row[key].get<double>() > 0.0);
+    }
+    // Timed while the bodies touch: contact points in every scene's window.
+    CHECK(row["contacts_per_step"].get<double>() > 0.0);
+    CHECK(row["window_end_s"].get<double>() > row["window_start_s"].get<double>());
+    CHECK(row["repeats"].get<int>() >= 5);
+  }
+  // The intersecting stack's cubes part about 0.12 s in and fly until about 3.4 s: its window
+  // must close before they part.
+  CHECK(j["physics"][0]["scene"] == "intersecting_stack");
+  CHECK(j["physics"][0]["window_end_s"].get<double>() <= 0.12);
+  CHECK(cps("bench --scene no_such_scene", dir).exit_code == 2);
+  CHECK(cps("bench --scene stack --rendering", dir).exit_code == 2);
   fs::remove_all(dir);
 }
 

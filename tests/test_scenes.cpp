@@ -218,3 +218,35 @@ TEST_CASE("each scene runs only the stages it needs", "[scene][counters]") {
     for (const ConstraintRow& r : run.world.rows()) CHECK(r.kind == RowKind::contact);
   }
 }
+
+TEST_CASE("each paper scene's bench window is spent doing what the scene exists for",
+          "[scene][bench]") {
+  // `cps bench` times a scene over Scene::bench. A window where the bodies fly free would time
+  // the integrator alone, so: at every step of the window, two movable bodies are in contact,
+  // or (a scene of rods) rows are built for its distance constraints.
+  for (const scenes::Scene& scene : scenes::paper_scenes()) {
+    INFO(scene.name);
+    scenes::Run run = scenes::make_run(scene);
+    const double dt = run.world.def().dt;
+    REQUIRE(scene.bench.start_s >= 0.0);
+    REQUIRE(scene.bench.seconds > 0.0);
+    run.advance_to(scene.bench.start_s);
+    const auto steps = static_cast<int>(std::lround(scene.bench.seconds / dt));
+    REQUIRE(steps >= 1);
+    const bool rods = !run.world.distances().empty();
+    int steps_without_work = 0;
+    for (int k = 0; k < steps; ++k) {
+      run.step();
+      int between_movable = 0;
+      for (const Manifold& m : run.world.manifolds()) {
+        if (!run.world.body(m.body_a).is_static() && !run.world.body(m.body_b).is_static()) {
+          between_movable += m.count;
+        }
+      }
+      const bool working = rods ? run.world.rows().size() >= run.world.distances().size()
+                                : between_movable > 0;
+      if (!working) ++steps_without_work;
+    }
+    CHECK(steps_without_work == 0);
+  }
+}

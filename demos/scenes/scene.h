@@ -36,6 +36,18 @@ struct CameraPreset {
   double fov_y_deg = 45.0;
 };
 
+/// The window of simulated time over which `cps bench` times a scene's step: where the scene
+/// does what it exists for (its contacts formed, its rods loaded), so that a step costs there
+/// what it costs in use. The window is timed from a copy of the world taken at its start.
+struct BenchTraits {
+  /// Simulated time (s, >= 0) the world is advanced, untimed, before the window opens.
+  double start_s = 1.0;
+  /// Length of the window (s, > 0; typical 0.5 to 3).
+  double seconds = 3.0;
+  /// Why the window lies there, in one line (printed by `cps bench` and in its JSON).
+  std::string_view reason = "from 1 s: the bodies have landed and rest on each other";
+};
+
 /// How `cps report` runs and judges a scene (see demos/cps/report.h). The defaults suit a scene
 /// judged by its trajectory over its default duration.
 struct ReportTraits {
@@ -68,6 +80,8 @@ struct Scene {
   /// behind (the funnel).
   double plane_opacity = 1.0;
   std::optional<CameraPreset> camera;
+  /// The window `cps bench` times.
+  BenchTraits bench;
   /// How `cps report` runs and judges the scene.
   ReportTraits report;
 

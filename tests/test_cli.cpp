@@ -64,6 +64,8 @@ TEST_CASE("bad arguments exit with 2, name the problem and write nothing", "[cli
       {"simulate stack --push sideways", "baumgarte, split"},
       {"render stack --compare push --push split", "--compare push"},
       {"frobnicate", "unknown command 'frobnicate'"},
+      {"--nosuch", "--nosuch"},
+      {"-z simulate stack", "-z"},
   };
   for (Case& c : cases) {
     if (c.args.rfind("render", 0) == 0) c.args += " --out out";

@@ -34,6 +34,17 @@ int run(int argc, char** argv) {
     names += (names.empty() ? "" : ", ") + sub->get_name();
     known = known || (argc > 1 && sub->get_name() == argv[1]);
   }
+  // cps itself takes only --help and --version before the command; CLI11 would report any other
+  // flag there as "A subcommand is required", without naming it.
+  if (argc > 1 && argv[1][0] == '-') {
+    const std::string flag = argv[1];
+    if (flag != "-h" && flag != "--help" && flag != "--version") {
+      std::cerr << "cps: unknown option '" << flag
+                << "'; before the command cps takes only --help and --version, and the commands "
+                   "are: " << names << "\nRun 'cps --help' for usage.\n";
+      return 2;
+    }
+  }
   if (argc > 1 && argv[1][0] != '-' && !known) {
     std::cerr << "cps: unknown command '" << argv[1] << "'; the commands are: " << names
               << "\nRun 'cps --help' for usage.\n";

@@ -133,6 +133,30 @@ TEST_CASE("cps figure keeps a file it did not write unless --force", "[cli][figu
   CHECK(png_size(dir / "mine.png") == std::make_pair(32, 32));
 }
 
+TEST_CASE("cps figure never touches foreign files beside its targets", "[cli][figure][output]") {
+  const fs::path dir = fresh_dir("foreign_tmp");
+  // Named like temporaries of the figure and its sidecar: not cps's, kept as they are.
+  write_text(dir / "f.png.tmp", "notes 1");
+  write_text(dir / "f.png.json.tmp", "notes 2");
+  for (const std::string force : {"", " --force"}) {
+    const Result r = cps("figure stack --times 0 --size 32x32 --out f.png" + force, dir);
+    INFO(force << ": " << r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(png_size(dir / "f.png") == std::make_pair(32, 32));
+    CHECK(slurp(dir / "f.png.tmp") == "notes 1");
+    CHECK(slurp(dir / "f.png.json.tmp") == "notes 2");
+  }
+}
+
+TEST_CASE("cps figure --out below a file is refused before any work", "[cli][figure][output]") {
+  const fs::path dir = fresh_dir("out_file");
+  write_text(dir / "somefile", "not a folder");
+  const Result r = cps("figure stack --times 0 --size 32x32 --out somefile/f.png", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("somefile") != std::string::npos);
+  CHECK(slurp(dir / "somefile") == "not a folder");
+}
+
 TEST_CASE("cps figure paper writes the counterparts of Figs. 6 to 10", "[cli][figure]") {
   const fs::path dir = fresh_dir("paper");
   const Result r = cps("figure paper --size 32x24 --out figs", dir);
@@ -244,6 +268,22 @@ TEST_CASE("cps simulate --trace keeps a file that is not a trace unless --force"
   const Result missing = cps("simulate stack --seconds 0.1 --trace no/such/dir/t.csv", dir);
   CHECK(missing.exit_code != 0);
   CHECK(missing.err.find("no/such/dir") != std::string::npos);
+}
+
+TEST_CASE("cps simulate --trace never touches a foreign file beside it", "[cli][trace][output]") {
+  const fs::path dir = fresh_dir("trace_tmp");
+  write_text(dir / "t.csv.tmp", "notes");
+  const Result r = cps("simulate stack --seconds 0.1 --trace t.csv", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(slurp(dir / "t.csv.tmp") == "notes");
+  CHECK(slurp(dir / "t.csv").rfind("step,t_s,", 0) == 0);
+  // --trace below a file: refused before the run, naming it.
+  write_text(dir / "somefile", "not a folder");
+  const Result below = cps("simulate stack --seconds 0.1 --trace somefile/t.csv", dir);
+  CHECK(below.exit_code == 2);
+  CHECK(below.err.find("somefile") != std::string::npos);
+  CHECK(slurp(dir / "somefile") == "not a folder");
 }
 
 TEST_CASE("every command's --help states the units of its options", "[cli][help]") {

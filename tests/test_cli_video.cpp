@@ -185,3 +185,26 @@ TEST_CASE("cps render --video with an unknown format is a usage error that write
   CHECK_FALSE(fs::exists(dir / "out"));
   fs::remove_all(dir);
 }
+
+TEST_CASE("cps render --video refuses a video it did not write before rendering anything",
+          "[cli][video][output]") {
+  // Runs with or without ffmpeg: the check comes before any frame is drawn.
+  const fs::path dir = fresh_dir("foreign_video");
+  for (const std::string format : {"mp4", "gif"}) {
+    INFO("--video " << format);
+    fs::remove_all(dir / "out");
+    fs::create_directories(dir / "out");
+    const std::string foreign = "a " + format + " someone made by hand\n";
+    const fs::path video = dir / "out" / ("stack." + format);
+    std::ofstream(video, std::ios::binary) << foreign;
+    const Result r = cps("", "render stack --size 64x36 --seconds 0.1 --fps 10 --video " + format +
+                                 " --out out", dir);
+    INFO("stderr: " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("stack." + format) != std::string::npos);
+    CHECK(r.err.find("--force") != std::string::npos);
+    CHECK(slurp(video) == foreign);
+    CHECK_FALSE(fs::exists(dir / "out" / "stack"));  // no frame was rendered
+  }
+  fs::remove_all(dir);
+}

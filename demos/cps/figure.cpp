@@ -207,7 +207,7 @@ nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
 void write_figure(const fs::path& png, const render::Image& image, const nlohmann::json& sidecar) {
   if (png.has_parent_path()) fs::create_directories(png.parent_path());
   write_json_atomic(sidecar_path(png), sidecar);
-  render::write_png(png, image);
+  write_file_atomic(png, render::encode_png(image));
 }
 
 const std::vector<PaperFigure>& paper_figures() {

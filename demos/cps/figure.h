@@ -73,8 +73,9 @@ void check_output_is_ours(const std::filesystem::path& png, bool force);
 /// variants (label and world parameters with units).
 nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv);
 
-/// Writes the sidecar (temp + rename) and then the PNG (temp + rename, render::write_png),
-/// creating the folder. Throws std::runtime_error naming the path on failure.
+/// Writes the sidecar and then the PNG (render::encode_png), each atomically (write_json_atomic,
+/// write_file_atomic: a temporary of this run, renamed), creating the folder. Throws
+/// std::runtime_error "cannot write PATH: REASON" on failure.
 void write_figure(const std::filesystem::path& png, const render::Image& image,
                   const nlohmann::json& sidecar);
 

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 namespace cps::cli {
@@ -148,8 +149,11 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
   }
   render::Renderer renderer(panel_width, size.height, *render::parse_backend(o.backend));
   std::fprintf(stderr, "render: %s\n", renderer.context_description().c_str());
-  // Encoding overlaps drawing: one encoder thread keeps up with llvmpipe (see cps bench).
-  render::PngWriter writer(1, 3);
+  // Encoding overlaps drawing: one encoder thread keeps up with llvmpipe (see cps bench). Each
+  // frame is written atomically under the output rule (output.h).
+  render::PngWriter writer(
+      [](const fs::path& path, std::span<const std::uint8_t> bytes) { write_file_atomic(path, bytes); },
+      1, 3);
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     Job& job = jobs[j];
     const RenderJob& spec = specs[j];

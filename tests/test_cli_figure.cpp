@@ -146,6 +146,19 @@ TEST_CASE("cps figure never touches foreign files beside its targets", "[cli][fi
     CHECK(slurp(dir / "f.png.tmp") == "notes 1");
     CHECK(slurp(dir / "f.png.json.tmp") == "notes 2");
   }
+  // The folder's run.json lists what cps wrote there, over several runs.
+  REQUIRE(cps("figure stack --times 0 --size 32x32 --out g.png", dir).exit_code == 0);
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(dir / "run.json"));
+  CHECK(manifest["files"] == nlohmann::json({"f.png", "f.png.json", "g.png", "g.png.json"}));
+  // A run.json that is not cps's is foreign, as any other file.
+  const fs::path other = dir / "other";
+  fs::create_directories(other);
+  write_text(other / "run.json", "{\"mine\": true}");
+  const Result refused = cps("figure stack --times 0 --size 32x32 --out other/f.png", dir);
+  CHECK(refused.exit_code == 2);
+  CHECK(refused.err.find("run.json") != std::string::npos);
+  CHECK(slurp(other / "run.json") == "{\"mine\": true}");
+  CHECK_FALSE(fs::exists(other / "f.png"));
 }
 
 TEST_CASE("cps figure --out below a file is refused before any work", "[cli][figure][output]") {
@@ -304,6 +317,8 @@ TEST_CASE("every command's --help states the units of its options", "[cli][help]
                      {"(s)", "pixels", "degrees per", "--contacts", "--no-rods", "--label",
                       "--camera TEXT:{preset,auto,front,side,top}=preset", "--orbit", "=0"}});
   }
+  cases[cases.size() - 2].says.push_back("never removed or changed");  // render --force
+  cases.back().says.push_back("never touched");                         // figure --force
   cases.back().says.push_back("--size TEXT=640x360");
   cases.back().says.push_back("--times");
 #endif

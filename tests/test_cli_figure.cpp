@@ -277,10 +277,14 @@ TEST_CASE("cps simulate --trace keeps a file that is not a trace unless --force"
   CHECK(read_csv(dir / "t.csv").size() == 1u + 13u * 6u);
   CHECK(cps("simulate stack --seconds 0.1 --trace lab.csv --force", dir).exit_code == 0);
   CHECK(slurp(dir / "lab.csv").rfind("step,t_s,", 0) == 0);
-  // A folder that does not exist: exit 1 with the path named, nothing left behind.
+  // A folder that does not exist is created, as for the --out of render and figure.
   const Result missing = cps("simulate stack --seconds 0.1 --trace no/such/dir/t.csv", dir);
-  CHECK(missing.exit_code != 0);
-  CHECK(missing.err.find("no/such/dir") != std::string::npos);
+  CHECK(missing.exit_code == 0);
+  CHECK(read_csv(dir / "no/such/dir/t.csv").size() == 1u + 7u * 6u);
+  // run.json lists the traces cps wrote in that folder; it is cps's, so replaced without --force.
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(dir / "run.json"));
+  CHECK(manifest["files"] == nlohmann::json({"t.csv", "lab.csv"}));
+  CHECK(manifest["complete"] == true);
 }
 
 TEST_CASE("cps simulate --trace never touches a foreign file beside it", "[cli][trace][output]") {
@@ -307,7 +311,7 @@ TEST_CASE("every command's --help states the units of its options", "[cli][help]
   };
   std::vector<Case> cases = {
       {"list", {"(s)"}},
-      {"simulate", {"(s)", "(m)", "(m/s)", "(rad/s)", "--trace", "--force"}},
+      {"simulate", {"(s)", "(m)", "(m/s)", "(rad/s)", "--trace", "--force", "never touched"}},
       {"report", {"about 30 s", "--out TEXT=out/report"}},
       {"bench", {"us/step"}},
   };

@@ -46,8 +46,8 @@ enum class FolderUse {
 
 /// What one run will write into one folder, decided (and checked) before anything is written.
 struct OutputPlan {
-  std::filesystem::path folder;
-  FolderUse use = FolderUse::exclusive;
+  std::filesystem::path folder;          ///< may not exist yet; "" is the current folder
+  FolderUse use = FolderUse::exclusive;  ///< how runs share it
   std::vector<std::string> files;  ///< names (in `folder`) this run writes, run.json aside
   std::vector<std::string> stale;  ///< exclusive: earlier runs' files this run does not rewrite
 };

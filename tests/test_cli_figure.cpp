@@ -133,6 +133,43 @@ TEST_CASE("cps figure keeps a file it did not write unless --force", "[cli][figu
   CHECK(png_size(dir / "mine.png") == std::make_pair(32, 32));
 }
 
+TEST_CASE("cps figure never touches foreign files beside its targets", "[cli][figure][output]") {
+  const fs::path dir = fresh_dir("foreign_tmp");
+  // Named like temporaries of the figure and its sidecar: not cps's, kept as they are.
+  write_text(dir / "f.png.tmp", "notes 1");
+  write_text(dir / "f.png.json.tmp", "notes 2");
+  for (const std::string force : {"", " --force"}) {
+    const Result r = cps("figure stack --times 0 --size 32x32 --out f.png" + force, dir);
+    INFO(force << ": " << r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(png_size(dir / "f.png") == std::make_pair(32, 32));
+    CHECK(slurp(dir / "f.png.tmp") == "notes 1");
+    CHECK(slurp(dir / "f.png.json.tmp") == "notes 2");
+  }
+  // The folder's run.json lists what cps wrote there, over several runs.
+  REQUIRE(cps("figure stack --times 0 --size 32x32 --out g.png", dir).exit_code == 0);
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(dir / "run.json"));
+  CHECK(manifest["files"] == nlohmann::json({"f.png", "f.png.json", "g.png", "g.png.json"}));
+  // A run.json that is not cps's is foreign, as any other file.
+  const fs::path other = dir / "other";
+  fs::create_directories(other);
+  write_text(other / "run.json", "{\"mine\": true}");
+  const Result refused = cps("figure stack --times 0 --size 32x32 --out other/f.png", dir);
+  CHECK(refused.exit_code == 2);
+  CHECK(refused.err.find("run.json") != std::string::npos);
+  CHECK(slurp(other / "run.json") == "{\"mine\": true}");
+  CHECK_FALSE(fs::exists(other / "f.png"));
+}
+
+TEST_CASE("cps figure --out below a file is refused before any work", "[cli][figure][output]") {
+  const fs::path dir = fresh_dir("out_file");
+  write_text(dir / "somefile", "not a folder");
+  const Result r = cps("figure stack --times 0 --size 32x32 --out somefile/f.png", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("somefile") != std::string::npos);
+  CHECK(slurp(dir / "somefile") == "not a folder");
+}
+
 TEST_CASE("cps figure paper writes the counterparts of Figs. 6 to 10", "[cli][figure]") {
   const fs::path dir = fresh_dir("paper");
   const Result r = cps("figure paper --size 32x24 --out figs", dir);
@@ -240,10 +277,30 @@ TEST_CASE("cps simulate --trace keeps a file that is not a trace unless --force"
   CHECK(read_csv(dir / "t.csv").size() == 1u + 13u * 6u);
   CHECK(cps("simulate stack --seconds 0.1 --trace lab.csv --force", dir).exit_code == 0);
   CHECK(slurp(dir / "lab.csv").rfind("step,t_s,", 0) == 0);
-  // A folder that does not exist: exit 1 with the path named, nothing left behind.
+  // A folder that does not exist is created, as for the --out of render and figure.
   const Result missing = cps("simulate stack --seconds 0.1 --trace no/such/dir/t.csv", dir);
-  CHECK(missing.exit_code != 0);
-  CHECK(missing.err.find("no/such/dir") != std::string::npos);
+  CHECK(missing.exit_code == 0);
+  CHECK(read_csv(dir / "no/such/dir/t.csv").size() == 1u + 7u * 6u);
+  // run.json lists the traces cps wrote in that folder; it is cps's, so replaced without --force.
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(dir / "run.json"));
+  CHECK(manifest["files"] == nlohmann::json({"t.csv", "lab.csv"}));
+  CHECK(manifest["complete"] == true);
+}
+
+TEST_CASE("cps simulate --trace never touches a foreign file beside it", "[cli][trace][output]") {
+  const fs::path dir = fresh_dir("trace_tmp");
+  write_text(dir / "t.csv.tmp", "notes");
+  const Result r = cps("simulate stack --seconds 0.1 --trace t.csv", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(slurp(dir / "t.csv.tmp") == "notes");
+  CHECK(slurp(dir / "t.csv").rfind("step,t_s,", 0) == 0);
+  // --trace below a file: refused before the run, naming it.
+  write_text(dir / "somefile", "not a folder");
+  const Result below = cps("simulate stack --seconds 0.1 --trace somefile/t.csv", dir);
+  CHECK(below.exit_code == 2);
+  CHECK(below.err.find("somefile") != std::string::npos);
+  CHECK(slurp(dir / "somefile") == "not a folder");
 }
 
 TEST_CASE("every command's --help states the units of its options", "[cli][help]") {
@@ -254,7 +311,7 @@ TEST_CASE("every command's --help states the units of its options", "[cli][help]
   };
   std::vector<Case> cases = {
       {"list", {"(s)"}},
-      {"simulate", {"(s)", "(m)", "(m/s)", "(rad/s)", "--trace", "--force"}},
+      {"simulate", {"(s)", "(m)", "(m/s)", "(rad/s)", "--trace", "--force", "never touched"}},
       {"report", {"about 30 s", "--out TEXT=out/report"}},
       {"bench", {"us/step"}},
   };
@@ -264,6 +321,8 @@ TEST_CASE("every command's --help states the units of its options", "[cli][help]
                      {"(s)", "pixels", "degrees per", "--contacts", "--no-rods", "--label",
                       "--camera TEXT:{preset,auto,front,side,top}=preset", "--orbit", "=0"}});
   }
+  cases[cases.size() - 2].says.push_back("never removed or changed");  // render --force
+  cases.back().says.push_back("never touched");                         // figure --force
   cases.back().says.push_back("--size TEXT=640x360");
   cases.back().says.push_back("--times");
 #endif

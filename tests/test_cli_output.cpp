@@ -88,6 +88,50 @@ TEST_CASE("render refuses a folder holding foreign files and keeps them", "[cli]
   fs::remove_all(dir);
 }
 
+TEST_CASE("render --force never touches a foreign file that is not a target", "[cli][output]") {
+  const fs::path dir = fresh_dir("foreign_tmp");
+  const fs::path folder = dir / "out/stack";
+  fs::create_directories(folder);
+  // Named like the temporary of a frame: not a frame, so --force must keep it as it is.
+  write_text(folder / "frame_000001.png.tmp", "someone's notes");
+  const Result forced = run_cps(std::string(k_small) + " --seconds 0.2 --force", dir);
+  INFO(forced.err);
+  REQUIRE(forced.exit_code == 0);
+  CHECK(slurp(folder / "frame_000001.png.tmp") == "someone's notes");
+  CHECK(frames_in(folder) == std::vector<std::string>{"frame_000000.png", "frame_000001.png"});
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a file named like a temporary of an own frame is still foreign", "[cli][output]") {
+  const fs::path dir = fresh_dir("own_then_tmp");
+  const fs::path folder = dir / "out/stack";
+  REQUIRE(run_cps(std::string(k_small) + " --seconds 0.2", dir).exit_code == 0);
+  write_text(folder / "frame_000001.png.tmp", "someone's notes");
+  const Result refused = run_cps(std::string(k_small) + " --seconds 0.2", dir);
+  CHECK(refused.exit_code == 2);
+  CHECK(refused.err.find("frame_000001.png.tmp") != std::string::npos);
+  CHECK(slurp(folder / "frame_000001.png.tmp") == "someone's notes");
+  const Result forced = run_cps(std::string(k_small) + " --seconds 0.2 --force", dir);
+  INFO(forced.err);
+  REQUIRE(forced.exit_code == 0);
+  CHECK(slurp(folder / "frame_000001.png.tmp") == "someone's notes");
+  fs::remove_all(dir);
+}
+
+TEST_CASE("--out naming a file, or a path below one, is refused before any work", "[cli][output]") {
+  const fs::path dir = fresh_dir("out_file");
+  write_text(dir / "somefile", "not a folder");
+  for (const std::string out : {"somefile", "somefile/x"}) {
+    INFO("--out " << out);
+    const Result r = run_cps("render stack --size 64x36 --fps 10 --seconds 0.1 --out " + out, dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("somefile") != std::string::npos);
+    CHECK(r.err.find("render stack:") == std::string::npos);  // no progress: nothing rendered
+    CHECK(slurp(dir / "somefile") == "not a folder");
+  }
+  fs::remove_all(dir);
+}
+
 TEST_CASE("render all checks every folder before it writes any", "[cli][output]") {
   const fs::path dir = fresh_dir("all");
   fs::create_directories(dir / "out/pendulum_wave");  // the last scene's folder

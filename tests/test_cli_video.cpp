@@ -67,10 +67,10 @@ int count_frames(const fs::path& folder) {
   return n;
 }
 
-/// No temporary (.partial) file is left in `dir`.
+/// No temporary file (".tmp", or ".partial" as older builds named them) is left in `dir`.
 bool no_partial_files(const fs::path& dir) {
   for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.path().extension() == ".partial") return false;
+    if (e.path().extension() == ".partial" || e.path().extension() == ".tmp") return false;
   }
   return true;
 }
@@ -183,5 +183,54 @@ TEST_CASE("cps render --video with an unknown format is a usage error that write
   CHECK(r.err.find("--video") != std::string::npos);
   CHECK(r.err.find("mp4") != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "out"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps render --video refuses a video it did not write before rendering anything",
+          "[cli][video][output]") {
+  // Runs with or without ffmpeg: the check comes before any frame is drawn.
+  const fs::path dir = fresh_dir("foreign_video");
+  for (const std::string format : {"mp4", "gif"}) {
+    INFO("--video " << format);
+    fs::remove_all(dir / "out");
+    fs::create_directories(dir / "out");
+    const std::string foreign = "a " + format + " someone made by hand\n";
+    const fs::path video = dir / "out" / ("stack." + format);
+    std::ofstream(video, std::ios::binary) << foreign;
+    const Result r = cps("", "render stack --size 64x36 --seconds 0.1 --fps 10 --video " + format +
+                                 " --out out", dir);
+    INFO("stderr: " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("stack." + format) != std::string::npos);
+    CHECK(r.err.find("--force") != std::string::npos);
+    CHECK(slurp(video) == foreign);
+    CHECK_FALSE(fs::exists(dir / "out" / "stack"));  // no frame was rendered
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps render --video --force replaces a foreign video; its own is replaced without it",
+          "[cli][video][output]") {
+  if (!have_ffmpeg()) {
+    WARN("ffmpeg or ffprobe is not installed (apt-get install ffmpeg): video test skipped");
+    return;
+  }
+  const fs::path dir = fresh_dir("force_video");
+  fs::create_directories(dir / "out");
+  std::ofstream(dir / "out" / "stack.mp4", std::ios::binary) << "not a video\n";
+  std::ofstream(dir / "out" / "notes.txt", std::ios::binary) << "mine\n";
+  const std::string args = "render stack --size 64x36 --seconds 0.1 --fps 10 --video mp4 --out out";
+  const Result forced = cps("", args + " --force", dir);
+  INFO("stderr: " << forced.err);
+  REQUIRE(forced.exit_code == 0);
+  CHECK(probe(dir / "out" / "stack.mp4")["codec_name"] == "h264");
+  // OUT/ collects the videos: its run.json lists them, so a rerun needs no --force.
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(dir / "out" / "run.json"));
+  CHECK(manifest["files"] == nlohmann::json({"stack.mp4"}));
+  const Result again = cps("", args, dir);
+  INFO("stderr: " << again.err);
+  CHECK(again.exit_code == 0);
+  CHECK(slurp(dir / "out" / "notes.txt") == "mine\n");
+  CHECK(no_partial_files(dir / "out"));
   fs::remove_all(dir);
 }

@@ -12,7 +12,9 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -56,6 +58,18 @@ struct TempDir {
   TempDir(const TempDir&) = delete;
   TempDir& operator=(const TempDir&) = delete;
 };
+
+/// A plain file sink for these tests (the cps command writes atomically, see demos/cps/output.h):
+/// writes `bytes` to `path`, throws std::runtime_error naming the path if it cannot.
+void write_bytes(const fs::path& path, std::span<const std::uint8_t> bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+}
+
+/// `image` encoded as a PNG file at `path`.
+void write_png(const fs::path& path, const Image& image) { write_bytes(path, encode_png(image)); }
 
 DrawList red_box_scene() {
   DrawList list;
@@ -142,10 +156,6 @@ TEST_CASE("renderer draws a lit box over a plane and the PNG round trips", "[ren
   CHECK(back.width == w);
   CHECK(back.height == h);
   CHECK(back.pixels == img.pixels);
-  for (const fs::directory_entry& e : fs::directory_iterator(dir.path)) {
-    INFO("left in the folder: " << e.path());
-    CHECK(e.path().extension() != ".tmp");
-  }
   // Overwriting an existing frame works too.
   write_png(png, again);
   CHECK(read_png(png).pixels == again.pixels);
@@ -217,23 +227,20 @@ TEST_CASE("renderer rejects invalid sizes", "[renderer]") {
   CHECK_NOTHROW(Renderer(1, 1));
 }
 
-TEST_CASE("write_png and read_png report failures with the path", "[renderer]") {
+TEST_CASE("encode_png refuses invalid images; read_png names the path it cannot read",
+          "[renderer]") {
   TempDir dir;
-  const fs::path missing_dir = dir.path / "does_not_exist" / "frame.png";
   Image img;
   img.width = 4;
   img.height = 3;
   img.pixels.assign(4 * 3 * 3, 128);
-  CHECK_THROWS_AS(write_png(missing_dir, img), std::runtime_error);
-  CHECK_THROWS_WITH(write_png(missing_dir, img), Catch::Contains("does_not_exist"));
-  CHECK_FALSE(fs::exists(dir.path / "does_not_exist"));
-
+  CHECK(encode_png(img).size() > 8);
   Image empty;
-  CHECK_THROWS_AS(write_png(dir.path / "empty.png", empty), std::runtime_error);
+  CHECK_THROWS_AS(encode_png(empty), std::invalid_argument);
   Image short_pixels = img;
   short_pixels.pixels.pop_back();
-  CHECK_THROWS_AS(write_png(dir.path / "short.png", short_pixels), std::runtime_error);
-  CHECK(fs::is_empty(dir.path));
+  CHECK_THROWS_AS(encode_png(short_pixels), std::invalid_argument);
+  CHECK_THROWS_WITH(encode_png(short_pixels), Catch::Contains("4x3"));
 
   CHECK_THROWS_AS(read_png(dir.path / "nope.png"), std::runtime_error);
   CHECK_THROWS_WITH(read_png(dir.path / "nope.png"), Catch::Contains("nope.png"));
@@ -304,7 +311,7 @@ TEST_CASE("frame_bounds keeps the whole box in view", "[renderer]") {
   CHECK_THROWS_AS(frame_bounds(lo, hi, -1.0f), std::invalid_argument);
 }
 
-TEST_CASE("write_png keeps every pixel of noise, flat and tiny images", "[renderer]") {
+TEST_CASE("encode_png keeps every pixel of noise, flat and tiny images", "[renderer]") {
   // Noise does not compress: the encoder must fall back to stored blocks within its output room.
   // read_png (libpng) checks every chunk's CRC and the zlib stream's Adler-32.
   TempDir dir;
@@ -352,8 +359,8 @@ TEST_CASE("PngWriter writes every queued image and reports a failed write by its
   img.pixels.resize(40 * 30 * 3);
   for (std::size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = static_cast<std::uint8_t>(i * 7);
 
-  SECTION("all images arrive, byte for byte, with no temporary file left") {
-    PngWriter writer(2, 3);
+  SECTION("all images arrive, byte for byte, each through the sink") {
+    PngWriter writer(write_bytes, 2, 3);
     for (int k = 0; k < 12; ++k) writer.write(dir.path / (std::to_string(k) + ".png"), img);
     writer.finish();
     CHECK(writer.written() == 12);
@@ -368,14 +375,24 @@ TEST_CASE("PngWriter writes every queued image and reports a failed write by its
     }
   }
   SECTION("a failed write stops the queue and is thrown with its path") {
-    PngWriter writer(1, 2);
+    PngWriter writer(write_bytes, 1, 2);
     writer.write(dir.path / "missing_folder" / "a.png", img);
     CHECK_THROWS_WITH(writer.finish(), Catch::Contains("missing_folder"));
     CHECK_THROWS_AS(writer.write(dir.path / "b.png", img), std::runtime_error);
     CHECK_FALSE(fs::exists(dir.path / "b.png"));
   }
-  CHECK_THROWS_AS(PngWriter(0, 3), std::invalid_argument);
-  CHECK_THROWS_AS(PngWriter(2, 1), std::invalid_argument);
+  SECTION("an invalid image is reported with its path, and the sink is not called") {
+    int calls = 0;
+    PngWriter writer([&calls](const fs::path&, std::span<const std::uint8_t>) { ++calls; }, 1, 2);
+    Image bad = img;
+    bad.pixels.pop_back();
+    writer.write(dir.path / "bad.png", bad);
+    CHECK_THROWS_WITH(writer.finish(), Catch::Contains("bad.png"));
+    CHECK(calls == 0);
+  }
+  CHECK_THROWS_AS(PngWriter(write_bytes, 0, 3), std::invalid_argument);
+  CHECK_THROWS_AS(PngWriter(write_bytes, 2, 1), std::invalid_argument);
+  CHECK_THROWS_AS(PngWriter(FileSink(), 1, 3), std::invalid_argument);
 }
 
 TEST_CASE("spheres stay round at every level of detail", "[renderer]") {

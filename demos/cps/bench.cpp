@@ -6,6 +6,7 @@
 #include "scene.h"
 
 #ifdef CPS_HAVE_RENDERER
+#include "atomic_file.h"
 #include "draw.h"
 #include "render.h"
 
@@ -19,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -110,7 +112,7 @@ double seconds_since(Clock::time_point start) {
 
 // The rendering table: per paper scene at 1280x720 over its first second at 30 fps.
 //  - Stages, one at a time on this thread: milliseconds per frame of physics, draw (including
-//    the readback) and write_png, each the median over the frames.
+//    the readback) and PNG encode + atomic write, each the median over the frames.
 //  - "physics + draw": the real loop without the PNG files (advance, draw, drop the image), and
 //    "end to end": the real pipeline (render_frames: physics and drawing on this thread, PNG
 //    encoding on the writer's thread, until the last file is written); each is the total time /
@@ -166,7 +168,7 @@ nlohmann::json render_table(bool quick, bool markdown) {
         const render::Image image = renderer.draw(draw_list(run.world, style));
         draw.push_back(1e3 * seconds_since(start));
         start = Clock::now();
-        render::write_png(folder / "frame.png", image);
+        write_file_atomic(folder / "frame.png", render::encode_png(image));
         encode.push_back(1e3 * seconds_since(start));
         bytes += static_cast<double>(std::filesystem::file_size(folder / "frame.png"));
       }
@@ -188,7 +190,11 @@ nlohmann::json render_table(bool quick, bool markdown) {
         scenes::Run run = scenes::make_run(scene);
         std::vector<Panel> panels{{&run, ""}};
         const DrawStyle style = resolve_style(scene, run.world, View{}, k_aspect);
-        render::PngWriter writer(1, 3);
+        render::PngWriter writer(
+            [](const std::filesystem::path& path, std::span<const std::uint8_t> png) {
+              write_file_atomic(path, png);
+            },
+            1, 3);
         const auto start = Clock::now();
         render_frames(style, panels, job, renderer, writer, nullptr);
         end_to_end.push_back(1e3 * seconds_since(start) / frames);

@@ -26,8 +26,8 @@ Command add_list(CLI::App& app);
 
 /// `cps simulate SCENE`: runs one scene headless and prints its metrics (--json: one JSON
 /// object), optionally a per-step trace CSV; --expect-hash makes it exit 1 if the run ends in
-/// another state.
-Command add_simulate(CLI::App& app);
+/// another state. argc and argv are recorded in the run.json of the trace's folder.
+Command add_simulate(CLI::App& app, int argc, char** argv);
 
 /// `cps report [SCENE]`: the error against run time sweep, written as CSV, plots and report.md
 /// into --out (also --list-runs, --run ID and --merge to spread it over machines). argc and

@@ -145,30 +145,6 @@ fs::path sidecar_path(const fs::path& png) {
   return p;
 }
 
-namespace {
-
-bool sidecar_is_ours(const fs::path& sidecar) {
-  std::ifstream in(sidecar);
-  if (!in) return false;
-  const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return j.is_object() && j.value("written_by", std::string()) == "cps figure";
-}
-
-}  // namespace
-
-void check_output_is_ours(const fs::path& png, bool force) {
-  if (force) return;
-  const fs::path side = sidecar_path(png);
-  std::error_code ec;
-  const bool png_exists = fs::exists(png, ec);
-  const bool side_exists = fs::exists(side, ec);
-  if (!png_exists && !side_exists) return;
-  if (side_exists && sidecar_is_ours(side)) return;
-  throw UsageError((png_exists ? png : side).string() +
-                   " exists and was not written by cps figure (no " + side.filename().string() +
-                   " sidecar saying so); choose another --out, or pass --force to replace it");
-}
-
 nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
   nlohmann::json variants = nlohmann::json::array();
   for (const Variant& v : spec.variants) {
@@ -205,9 +181,8 @@ nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
 }
 
 void write_figure(const fs::path& png, const render::Image& image, const nlohmann::json& sidecar) {
-  if (png.has_parent_path()) fs::create_directories(png.parent_path());
   write_json_atomic(sidecar_path(png), sidecar);
-  render::write_png(png, image);
+  write_file_atomic(png, render::encode_png(image));
 }
 
 const std::vector<PaperFigure>& paper_figures() {
@@ -252,7 +227,7 @@ struct FigureOptions {
   std::string backend = "osmesa";
 };
 
-// Everything is checked (scene, times, size, variants, output ownership) before anything is
+// Everything is checked (scene, times, size, variants, output files) before anything is
 // rendered or written.
 int run_figure(const FigureOptions& o, int argc, char** argv) {
   const PixelSize size = parse_size(o.size);
@@ -323,9 +298,22 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
                        " pixels (more than 16384 on a side); give fewer --times or a "
                        "smaller --size");
     }
-    check_output_is_ours(p.png, o.force);
   }
+  // The figures' folder collects figures of many runs (output.h, FolderUse::shared): each PNG
+  // and its sidecar are checked before anything is rendered.
+  const fs::path folder = plan.front().png.parent_path();
+  std::vector<std::string> files;
+  nlohmann::json names = nlohmann::json::array();
+  for (const Planned& p : plan) {
+    files.push_back(p.png.filename().string());
+    files.push_back(sidecar_path(p.png).filename().string());
+    names.push_back(p.png.filename().string());
+  }
+  const OutputPlan output = plan_output(folder, files, o.force, FolderUse::shared);
+  const nlohmann::json info =
+      run_info("figure", argc, argv, {{"scene", o.scene}, {"figures", names}});
   render::Renderer renderer(size.width, size.height, *render::parse_backend(o.backend));
+  begin_output(output, info);
   for (const Planned& p : plan) {
     const render::Image image = render_figure(p.spec, renderer);
     write_figure(p.png, image, figure_json(p.spec, argc, argv));
@@ -333,6 +321,7 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
                 image.height, p.spec.times.size(), p.spec.variants.size(),
                 sidecar_path(p.png).filename().c_str());
   }
+  end_output(output, info);
   return 0;
 }
 
@@ -355,10 +344,13 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
       ->capture_default_str();
   sub->add_option("--out", o->out,
                   "output PNG (default out/figures/SCENE[-compare-OPTION].png); for 'paper', "
-                  "the folder (default out/figures); a FILE.json sidecar records the run")
+                  "the folder (default out/figures); a FILE.json sidecar records the run, and the "
+                  "folder's run.json lists the files cps wrote there")
       ->check(kNotEmpty);
   sub->add_flag("--force", o->force,
-                "replace an output file that cps figure did not write (one without its sidecar)");
+                "replace the PNG, its sidecar or the folder's run.json although no earlier cps "
+                "run wrote them (run.json lists the files cps wrote there); any other file in "
+                "the folder is never touched");
   sub->add_option("--backend", o->backend,
                   "OpenGL context: osmesa (libOSMesa, CPU) or egl (headless EGL: GPU if any, "
                   "else llvmpipe)")

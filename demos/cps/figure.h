@@ -60,12 +60,8 @@ render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer);
 /// width x sum(heights). Throws std::invalid_argument if the list is empty or the widths differ.
 render::Image stack_vertically(const std::vector<render::Image>& images);
 
-/// The sidecar that marks `png` as written by cps figure: png with ".json" appended.
+/// The sidecar of `png`, which records how it was made (figure_json): png with ".json" appended.
 std::filesystem::path sidecar_path(const std::filesystem::path& png);
-
-/// Refuses to replace a file cps figure did not write: throws UsageError if `png` or its sidecar
-/// exists and the sidecar is missing or lacks "written_by": "cps figure", unless `force`.
-void check_output_is_ours(const std::filesystem::path& png, bool force);
 
 /// The sidecar's content: run_info("figure", argc, argv, parameters) (command line, engine
 /// version, UTC date; see output.h) with "written_by": "cps figure", where the parameters are
@@ -73,8 +69,10 @@ void check_output_is_ours(const std::filesystem::path& png, bool force);
 /// variants (label and world parameters with units).
 nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv);
 
-/// Writes the sidecar (temp + rename) and then the PNG (temp + rename, render::write_png),
-/// creating the folder. Throws std::runtime_error naming the path on failure.
+/// Writes the sidecar and then the PNG (render::encode_png), each atomically (write_json_atomic,
+/// write_file_atomic: a temporary of this run, renamed). The folder must exist (begin_output
+/// creates it; the caller checked both files with plan_output first). Throws std::runtime_error
+/// "cannot write PATH: REASON" on failure.
 void write_figure(const std::filesystem::path& png, const render::Image& image,
                   const nlohmann::json& sidecar);
 

@@ -19,7 +19,7 @@ int run(int argc, char** argv) {
   app.set_version_flag("--version", std::string("cps ") + cli::engine_version());
   std::vector<cli::Command> commands = {
       cli::add_list(app),
-      cli::add_simulate(app),
+      cli::add_simulate(app, argc, argv),
       cli::add_report(app, argc, argv),
       cli::add_bench(app),
 #ifdef CPS_HAVE_RENDERER

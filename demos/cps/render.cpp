@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 namespace cps::cli {
@@ -146,10 +147,29 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     plans.push_back(plan_output(spec.folder, std::move(files), o.force));
     specs.push_back(spec);
   }
+  // --video: the videos go to OUT/, beside the frames folders, which holds other files too
+  // (other scenes' videos, whatever the user keeps there): only the videos are checked.
+  std::optional<OutputPlan> video_plan;
+  nlohmann::json video_info;
+  if (!o.video.empty()) {
+    std::vector<std::string> names;
+    nlohmann::json folders = nlohmann::json::array();
+    for (const RenderJob& spec : specs) {
+      names.push_back(spec.folder.filename().string() + "." + o.video);
+      folders.push_back(spec.folder.filename().string());
+    }
+    video_plan = plan_output(fs::path(o.out), names, o.force, FolderUse::shared);
+    video_info = run_info("render", argc, argv,
+                          {{"video", o.video}, {"fps", o.fps}, {"frames_folders", folders}});
+  }
   render::Renderer renderer(panel_width, size.height, *render::parse_backend(o.backend));
   std::fprintf(stderr, "render: %s\n", renderer.context_description().c_str());
-  // Encoding overlaps drawing: one encoder thread keeps up with llvmpipe (see cps bench).
-  render::PngWriter writer(1, 3);
+  // Encoding overlaps drawing: one encoder thread keeps up with llvmpipe (see cps bench). Each
+  // frame is written atomically under the output rule (output.h).
+  render::PngWriter writer(
+      [](const fs::path& path, std::span<const std::uint8_t> bytes) { write_file_atomic(path, bytes); },
+      1, 3);
+  if (video_plan && ffmpeg) begin_output(*video_plan, video_info);
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     Job& job = jobs[j];
     const RenderJob& spec = specs[j];
@@ -204,6 +224,7 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
                   static_cast<std::uintmax_t>(fs::file_size(video.output)));
     }
   }
+  if (video_plan && ffmpeg) end_output(*video_plan, video_info);
   if (!videos_left.empty()) {
     std::string how;
     for (const VideoJob& v : videos_left) {
@@ -237,8 +258,9 @@ Command add_render(CLI::App& app, int argc, char** argv) {
                   "OUT/SCENE-compare-OPTION/")
       ->check(CLI::IsMember(comparable_options()));
   sub->add_flag("--force", o->force,
-                "write into an output folder that holds files no earlier cps run wrote there "
-                "(they are kept; same-named files are replaced)");
+                "write into an output folder that holds files no earlier cps run wrote there: "
+                "those files are kept, never removed or changed, except that a file with exactly "
+                "the name of one cps writes (a frame, run.json, OUT/SCENE.mp4) is replaced");
   add_world_options(*sub, o->overrides);
   sub->add_option("--backend", o->backend,
                   "OpenGL context: osmesa (libOSMesa, CPU) or egl (headless EGL: GPU if any, "

@@ -6,9 +6,10 @@
 #include "progress.h"
 #include "state_hash.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -22,68 +23,38 @@ nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
-TraceWriter::TraceWriter(std::filesystem::path path, bool force) : path_(std::move(path)) {
-  std::error_code ec;
-  if (!force && std::filesystem::exists(path_, ec)) {
-    std::ifstream in(path_);
-    std::string first;
-    std::getline(in, first);
-    if (first != kTraceHeader) {
-      throw UsageError("--trace " + path_.string() +
-                       " exists and is not a trace written by cps (its first line is not the "
-                       "trace header); choose another file, or pass --force to replace it");
-    }
-  }
-  tmp_ = path_;
-  tmp_ += ".tmp";
-  file_ = std::fopen(tmp_.c_str(), "w");
-  if (file_ == nullptr) {
-    throw std::runtime_error("--trace: cannot write " + tmp_.string() +
-                             " (does the folder exist and is it writable?)");
-  }
-  std::fprintf(file_, "%s\n", std::string(kTraceHeader).c_str());
-}
-
-TraceWriter::~TraceWriter() {
-  if (file_ != nullptr) {  // not finished: an error happened; leave no partial file behind
-    std::fclose(file_);
-    std::error_code ignored;
-    std::filesystem::remove(tmp_, ignored);
-  }
+TraceWriter::TraceWriter(std::filesystem::path path, bool force, nlohmann::json info)
+    : path_(std::move(path)), info_(std::move(info)) {
+  plan_ = plan_output(path_.parent_path(), {path_.filename().string()}, force, FolderUse::shared,
+                      "--trace");
+  begin_output(plan_, info_);
+  file_.emplace(path_);
+  file_->write(kTraceHeader);
+  file_->write("\n");
 }
 
 void TraceWriter::write(const World& world) {
   const long long step = static_cast<long long>(world.counters().steps);
   const double t = world.time();
   const auto& bodies = world.bodies();
+  char row[512];
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
     const Vec3 v = b.velocity();
     const Vec3 w = b.angular_velocity();
-    std::fprintf(file_,
-                 "%lld,%.9g,%zu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
-                 step, t, i, b.x.x(), b.x.y(), b.x.z(), b.o.w(), b.o.x(), b.o.y(), b.o.z(), v.x(),
-                 v.y(), v.z(), w.x(), w.y(), w.z());
+    const int n = std::snprintf(
+        row, sizeof row,
+        "%lld,%.9g,%zu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", step, t,
+        i, b.x.x(), b.x.y(), b.x.z(), b.o.w(), b.o.x(), b.o.y(), b.o.z(), v.x(), v.y(), v.z(),
+        w.x(), w.y(), w.z());
+    file_->write(std::string_view(row, static_cast<std::size_t>(std::min<int>(n, sizeof row - 1))));
     ++rows_;
   }
 }
 
 long TraceWriter::finish() {
-  const bool ok = std::ferror(file_) == 0;
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  std::error_code ec;
-  if (!ok || !closed) {
-    std::filesystem::remove(tmp_, ec);
-    throw std::runtime_error("--trace: cannot write " + tmp_.string() + " (disk full?)");
-  }
-  std::filesystem::rename(tmp_, path_, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp_, ignored);
-    throw std::runtime_error("--trace: cannot rename " + tmp_.string() + " to " +
-                             path_.string() + ": " + ec.message());
-  }
+  file_->commit();
+  end_output(plan_, info_);
   return rows_;
 }
 
@@ -159,7 +130,7 @@ class ProgressMetrics final : public scenes::Metrics {
   long long steps_ = 0;
 };
 
-int run_simulate(const SimulateOptions& o) {
+int run_simulate(const SimulateOptions& o, int argc, char** argv) {
   const std::vector<const scenes::Scene*> chosen = select_scenes(o.scene);
   if (o.scene == "all" || o.scene == "stress") {
     throw UsageError("simulate takes one scene, not '" + o.scene + "'");
@@ -178,7 +149,15 @@ int run_simulate(const SimulateOptions& o) {
   const double seconds = o.seconds.value_or(scene->default_seconds);
   check_steps(o.scene, seconds, r.world.def().dt);
   std::optional<TraceWriter> trace;
-  if (!o.trace.empty()) trace.emplace(o.trace, o.force);
+  if (!o.trace.empty()) {
+    trace.emplace(o.trace, o.force,
+                  run_info("simulate", argc, argv,
+                           {{"scene", scene->name},
+                            {"seconds", seconds},
+                            {"trace", o.trace},
+                            {"overrides", overrides_json(o.overrides)},
+                            {"parameters", parameters_json(r.world.def())}}));
+  }
   // Steps on stderr, only once the run has taken 2 s (short runs and --json stay clean).
   Progress progress("simulate " + o.scene, std::llround(seconds / r.world.def().dt), "steps", 2.0);
   r.metrics = std::make_unique<ProgressMetrics>(std::move(r.metrics), progress);
@@ -211,7 +190,7 @@ int run_simulate(const SimulateOptions& o) {
 
 }  // namespace
 
-Command add_simulate(CLI::App& app) {
+Command add_simulate(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<SimulateOptions>();
   CLI::App* sub = app.add_subcommand("simulate", "run a scene headless and report metrics");
   sub->add_option("scene", o->scene, "scene name (see 'cps list')")->required();
@@ -220,18 +199,20 @@ Command add_simulate(CLI::App& app) {
   sub->add_option("--trace", o->trace,
                   "write every body's state per step to this CSV: step, t (s), body index, "
                   "position (m), orientation quaternion w x y z, velocity (m/s), angular "
-                  "velocity (rad/s); one row per body per step, step 0 = as built")
+                  "velocity (rad/s); one row per body per step, step 0 = as built; missing "
+                  "folders are created, and the folder's run.json lists the files cps wrote there")
       ->check(kNotEmpty);
   sub->add_flag("--force", o->force,
-                "let --trace replace an existing file that is not a cps trace (a file whose "
-                "first line is the cps trace header is replaced without it)");
+                "let --trace replace a file of that name that no earlier cps run wrote (its "
+                "folder's run.json lists the files cps wrote there; those are replaced without "
+                "it); any other file is never touched");
   sub->add_option("--expect-hash", o->expect_hash,
                   "the state_hash (16 hex digits) the run must end with: if the run ends in "
                   "another state, print both hashes and exit 1 (a CI check that the physics "
                   "did not change)")
       ->check(kNotEmpty);
   add_world_options(*sub, o->overrides);
-  return {sub, [o] { return run_simulate(*o); }};
+  return {sub, [o, argc, argv] { return run_simulate(*o, argc, argv); }};
 }
 
 }  // namespace cps::cli

@@ -1,45 +1,52 @@
 #pragma once
 // `cps simulate`: runs a scene headless and reports its metrics.
 
+#include "output.h"
 #include "scene.h"
 
 #include <nlohmann/json.hpp>
 
-#include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string_view>
 
 namespace cps::cli {
 
-/// The first line of a trace CSV: the column names with their units. A file that starts with this
-/// line was written by `cps simulate --trace` and may be replaced without --force.
+/// The first line of a trace CSV: the column names with their units.
 inline constexpr std::string_view kTraceHeader =
     "step,t_s,body,x_m,y_m,z_m,qw,qx,qy,qz,vx_mps,vy_mps,vz_mps,wx_radps,wy_radps,wz_radps";
 
 /// A per-step trace of every body (static ones too, their index as in World::bodies()): one row
 /// per body per step, step 0 being the state as built; position x (m), orientation o (unit
 /// quaternion w, x, y, z; body to world), linear velocity v (m/s), angular velocity w (rad/s).
-/// Written to `path` + ".tmp" and renamed onto `path` by finish(), so an interrupted run never
-/// leaves a half-written trace under the final name.
+/// Written under the output rule (output.h): the trace's folder is a shared output folder whose
+/// run.json lists it; the rows go to a temporary file of this run (AtomicFile) renamed onto the
+/// path by finish(), so an interrupted run never leaves a half-written trace under the final name.
 class TraceWriter {
  public:
-  /// Refuses (UsageError) if `path` exists and does not start with kTraceHeader, unless `force`;
-  /// opens the temporary file. Throws std::runtime_error naming the path if it cannot.
-  TraceWriter(std::filesystem::path path, bool force);
-  ~TraceWriter();
+  /// Checks the path (plan_output with option "--trace": UsageError if it exists and no earlier
+  /// cps run wrote it, unless `force`; if it is a folder; if its folder cannot be created or
+  /// written into), then creates the folder, records the run in its run.json (begin_output, with
+  /// `info`, see run_info) and creates the temporary file. Throws std::runtime_error "cannot write
+  /// PATH: REASON" if that fails.
+  TraceWriter(std::filesystem::path path, bool force, nlohmann::json info);
   TraceWriter(const TraceWriter&) = delete;
   TraceWriter& operator=(const TraceWriter&) = delete;
 
-  /// Appends one row per body of `world` for its current step.
+  /// Appends one row per body of `world` for its current step. Throws std::runtime_error
+  /// "cannot write PATH: REASON" if a write fails (e.g. the disk is full); the temporary is then
+  /// removed.
   void write(const World& world);
-  /// Closes the temporary file and renames it onto the path. Returns the number of rows
-  /// written (header excluded). Throws std::runtime_error naming the path on failure.
+  /// Writes the rest, closes the temporary file and renames it onto the path, then lists it in
+  /// the folder's run.json (end_output). Returns the number of rows written (header excluded).
+  /// Throws std::runtime_error "cannot write PATH: REASON" on failure.
   long finish();
 
  private:
   std::filesystem::path path_;
-  std::filesystem::path tmp_;
-  std::FILE* file_ = nullptr;
+  OutputPlan plan_;
+  nlohmann::json info_;
+  std::optional<AtomicFile> file_;
   long rows_ = 0;
 };
 

@@ -1,5 +1,7 @@
 #include "video.h"
 
+#include "atomic_file.h"
+
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/stat.h>
@@ -168,24 +170,22 @@ std::string shell_command(const std::vector<std::string>& args) {
 }
 
 void encode_video(const std::filesystem::path& ffmpeg, const VideoJob& job) {
-  namespace fs = std::filesystem;
-  const fs::path temporary = job.output.parent_path() /
-                             (job.output.filename().string() + "." + std::to_string(::getpid()) +
-                              ".partial");
-  const std::vector<std::string> args = ffmpeg_arguments(ffmpeg.string(), job, temporary);
-  std::string log;
-  std::error_code ec;
-  int status = 0;
+  // ffmpeg writes this run's own temporary (created exclusively, then handed over; -y lets it
+  // overwrite that empty file), which is renamed onto the video only when ffmpeg succeeded.
+  AtomicFile video(job.output);
   try {
-    status = run_captured(args, log);
-  } catch (...) {
-    fs::remove(temporary, ec);
-    throw;
+    video.hand_over();
+  } catch (const std::exception& e) {
+    throw VideoError(e.what());
   }
+  const std::vector<std::string> args = ffmpeg_arguments(ffmpeg.string(), job, video.temporary());
+  std::string log;
+  const int status = run_captured(args, log);
   const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-  const bool wrote = fs::exists(temporary, ec) && fs::file_size(temporary, ec) > 0;
+  struct stat st {};
+  const bool wrote = ::stat(video.temporary().c_str(), &st) == 0 && st.st_size > 0;
   if (!ok || !wrote) {
-    fs::remove(temporary, ec);
+    video.discard();
     std::string how = !ok ? (WIFEXITED(status) ? "exited with code " + std::to_string(WEXITSTATUS(status))
                                                : "was killed by signal " + std::to_string(WTERMSIG(status)))
                           : "wrote no file";
@@ -193,11 +193,10 @@ void encode_video(const std::filesystem::path& ffmpeg, const VideoJob& job) {
                      job.frames_folder.string() + ".\ncommand: " + shell_command(args) +
                      "\nffmpeg's log:\n" + log);
   }
-  fs::rename(temporary, job.output, ec);
-  if (ec) {
-    const std::string why = ec.message();
-    fs::remove(temporary, ec);
-    throw VideoError("cannot rename the video to " + job.output.string() + ": " + why);
+  try {
+    video.commit();
+  } catch (const std::exception& e) {
+    throw VideoError(e.what());
   }
 }
 

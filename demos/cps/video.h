@@ -55,10 +55,13 @@ std::vector<std::string> ffmpeg_arguments(const std::string& ffmpeg, const Video
 std::string shell_command(const std::vector<std::string>& args);
 
 /// Runs `ffmpeg` (a path, e.g. from find_on_path) on `job` with posix_spawn and an argument
-/// vector (no shell), stdin from /dev/null, its output captured. The video is written to a
-/// temporary name next to job.output and renamed over it only when ffmpeg succeeded, so an
-/// interrupted or failed run never leaves a half-written video. Throws VideoError holding the
-/// command and ffmpeg's log (its last 8 kB) if ffmpeg cannot start, fails or writes nothing.
+/// vector (no shell), stdin from /dev/null, its output captured. ffmpeg writes this run's own
+/// temporary file of job.output (an AtomicFile handed over to it, atomic_file.h), which is renamed
+/// onto job.output only when ffmpeg succeeded, so an interrupted or failed run never leaves a
+/// half-written video, and no other file is opened. The caller checks job.output first
+/// (plan_output, output.h). Throws VideoError holding the command and ffmpeg's log (its last
+/// 8 kB) if ffmpeg cannot start, fails or writes nothing, or "cannot write OUTPUT: REASON" if the
+/// temporary cannot be made or renamed.
 void encode_video(const std::filesystem::path& ffmpeg, const VideoJob& job);
 
 }  // namespace cps::cli

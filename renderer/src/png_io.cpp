@@ -1,5 +1,6 @@
-// write_png (a PNG file assembled here around a zlib stream from Intel's ISA-L, or from zlib when
-// the build has no ISA-L), PngWriter (encoding on worker threads) and read_png through libpng.
+// encode_png (a PNG file assembled here around a zlib stream from Intel's ISA-L, or from zlib when
+// the build has no ISA-L), PngWriter (encoding on worker threads, files written by its sink) and
+// read_png through libpng.
 
 #include "cps/render/renderer.h"
 
@@ -165,43 +166,20 @@ struct PngEncoder {
 
 }  // namespace
 
-// write_png: image of width x height > 0 with 3 * width * height bytes (RGB8, rows top to bottom),
-// else std::runtime_error naming the path. Encodes into this thread's buffers (kept for the next
-// call: about 2 x 3 x width x height bytes), writes "<path>.tmp" in the same folder and renames it
-// over `path` (atomic on POSIX within one file system); on any failure the temporary file is
-// removed and std::runtime_error names the path and the reason.
-void write_png(const std::filesystem::path& path, const Image& image) {
+// encode_png: image of width x height > 0 with 3 * width * height bytes (RGB8, rows top to
+// bottom), else std::invalid_argument. Encodes into this thread's buffers (kept for the next call:
+// about 2 x 3 x width x height bytes) and returns a view of the file's bytes in them.
+std::span<const std::uint8_t> encode_png(const Image& image) {
   const auto expected = static_cast<std::size_t>(image.width > 0 ? image.width : 0) *
                         static_cast<std::size_t>(image.height > 0 ? image.height : 0) * 3u;
   if (image.width <= 0 || image.height <= 0 || image.pixels.size() != expected) {
-    throw std::runtime_error("write_png: invalid image (" + std::to_string(image.width) + "x" +
-                             std::to_string(image.height) + ", " +
-                             std::to_string(image.pixels.size()) + " bytes) for " + path.string());
+    throw std::invalid_argument("encode_png: invalid image (" + std::to_string(image.width) + "x" +
+                                std::to_string(image.height) + ", " +
+                                std::to_string(image.pixels.size()) + " bytes)");
   }
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
-  const auto fail = [&](const std::string& why) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw std::runtime_error("write_png: cannot write " + path.string() + ": " + why);
-  };
   thread_local PngEncoder encoder;
-  try {
-    encoder.encode(image);
-  } catch (const std::exception& e) {
-    fail(e.what());
-  }
-  std::FILE* file = std::fopen(tmp.c_str(), "wb");
-  if (file == nullptr) fail(std::strerror(errno));
-  const bool written = std::fwrite(encoder.file.data(), 1, encoder.size, file) == encoder.size;
-  const int write_errno = errno;
-  const bool closed = std::fclose(file) == 0;
-  const int close_errno = errno;
-  if (!written) fail(std::strerror(write_errno));
-  if (!closed) fail(std::strerror(close_errno));
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) fail("cannot rename " + tmp.string() + ": " + ec.message());
+  encoder.encode(image);
+  return {encoder.file.data(), encoder.size};
 }
 
 struct PngWriter::Impl {
@@ -209,6 +187,7 @@ struct PngWriter::Impl {
     std::filesystem::path path;
     Image image;
   };
+  FileSink sink;
   int max_in_flight;
   mutable std::mutex mutex;
   std::condition_variable work_ready;  // a job was queued, or stop
@@ -236,10 +215,19 @@ struct PngWriter::Impl {
         }
       }
       std::exception_ptr failure;
+      std::span<const std::uint8_t> bytes;
       try {
-        write_png(job.path, job.image);
-      } catch (...) {
-        failure = std::current_exception();
+        bytes = encode_png(job.image);
+      } catch (const std::exception& e) {
+        failure = std::make_exception_ptr(
+            std::runtime_error("cannot write " + job.path.string() + ": " + e.what()));
+      }
+      if (!failure) {
+        try {
+          sink(job.path, bytes);
+        } catch (...) {
+          failure = std::current_exception();
+        }
       }
       std::lock_guard lock(mutex);
       if (failure && !error) error = failure;
@@ -250,12 +238,15 @@ struct PngWriter::Impl {
   }
 };
 
-PngWriter::PngWriter(int threads, int max_in_flight) : impl_(std::make_unique<Impl>()) {
+PngWriter::PngWriter(FileSink sink, int threads, int max_in_flight)
+    : impl_(std::make_unique<Impl>()) {
+  if (!sink) throw std::invalid_argument("PngWriter: no sink to write the files");
   if (threads < 1 || threads > 16 || max_in_flight < threads) {
     throw std::invalid_argument("PngWriter: threads " + std::to_string(threads) +
                                 " must be in [1, 16] and max_in_flight " +
                                 std::to_string(max_in_flight) + " at least threads");
   }
+  impl_->sink = std::move(sink);
   impl_->max_in_flight = max_in_flight;
   for (int i = 0; i < threads; ++i) impl_->workers.emplace_back([this] { impl_->run(); });
 }

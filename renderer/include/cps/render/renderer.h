@@ -1,12 +1,14 @@
 #pragma once
-// Offscreen OpenGL renderer (OSMesa or EGL, both headless) and PNG output.
+// Offscreen OpenGL renderer (OSMesa or EGL, both headless) and PNG encoding.
 
 #include "cps/render/draw_list.h"
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -66,29 +68,38 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Writes `image` as an 8-bit RGB PNG at `path` (no row filter, deflate by Intel's ISA-L at level 2,
+/// Encodes `image` as an 8-bit RGB PNG file (no row filter, deflate by Intel's ISA-L at level 2,
 /// or by zlib at level 1 in a build without ISA-L: the fastest of the encoders measured for these
-/// renders, see png_io.cpp). The file is first written as
-/// "<path>.tmp" in the same folder and then renamed, so an interrupted run never leaves a
-/// half-written frame under its final name. Thread-safe: each thread has its own encoder, whose
-/// buffers (about 6 bytes per pixel of the largest image) stay for its next call.
-/// Throws std::runtime_error naming the path if it cannot be written; the temporary file is then
-/// removed.
-void write_png(const std::filesystem::path& path, const Image& image);
+/// renders, see png_io.cpp). Returns the file's bytes, held in this thread's encoder: valid until
+/// this thread's next encode_png call. Thread-safe: each thread has its own encoder, whose
+/// buffers (about 6 bytes per pixel of the largest image) stay for its next call. Throws
+/// std::invalid_argument for an invalid image (width or height <= 0, or pixels.size() !=
+/// 3 * width * height; the message gives the sizes), std::runtime_error if the compressor fails.
+/// Writes no file: the caller decides how (the cps command writes atomically, see FileSink).
+std::span<const std::uint8_t> encode_png(const Image& image);
 
-/// Writes PNG files on background threads while the caller draws the next frames (the GL context
-/// stays on the caller's thread: only finished images are handed over). At most `max_in_flight`
-/// images are queued or being encoded at any time, so memory stays bounded (one 1280x720 frame
-/// is 2.7 MB). Every file goes through write_png (temporary name, then rename).
+/// Writes one file: `bytes` as the whole content of `path`. The renderer writes no file itself;
+/// PngWriter hands every encoded frame to its sink. Called on PngWriter's threads (one call per
+/// file, distinct paths at the same time), so it must be thread-safe; it must throw an exception
+/// (std::runtime_error naming the path and the reason) if the file cannot be written.
+using FileSink =
+    std::function<void(const std::filesystem::path& path, std::span<const std::uint8_t> bytes)>;
+
+/// Encodes PNG files on background threads while the caller draws the next frames (the GL context
+/// stays on the caller's thread: only finished images are handed over) and writes each through
+/// the sink. At most `max_in_flight` images are queued or being encoded at any time, so memory
+/// stays bounded (one 1280x720 frame is 2.7 MB).
 ///
-/// Errors: the first failed write is kept; from then on queued images are dropped (never written
-/// partially), and the next write() or finish() throws it as std::runtime_error naming the file.
+/// Errors: the first failure (an invalid image: std::runtime_error naming the path; or whatever
+/// the sink threw) is kept; from then on queued images are dropped (the sink is not called for
+/// them), and the next write() or finish() rethrows it.
 /// Not copyable; use from one thread.
 class PngWriter {
  public:
-  /// threads: encoder threads in [1, 16] (typical 1-2); max_in_flight: images queued or being
-  /// encoded, >= threads (typical 3). Throws std::invalid_argument otherwise.
-  explicit PngWriter(int threads = 1, int max_in_flight = 3);
+  /// sink: writes each file (must not be empty); threads: encoder threads in [1, 16] (typical
+  /// 1-2); max_in_flight: images queued or being encoded, >= threads (typical 3). Throws
+  /// std::invalid_argument otherwise.
+  explicit PngWriter(FileSink sink, int threads = 1, int max_in_flight = 3);
   /// Waits for the queued writes to end, then joins the threads. Errors are not reported here:
   /// call finish() to see them.
   ~PngWriter();
@@ -96,13 +107,13 @@ class PngWriter {
   PngWriter& operator=(const PngWriter&) = delete;
 
   /// Queues `image` for `path`; blocks while max_in_flight images are pending. Throws the error
-  /// of an earlier failed write (std::runtime_error), and then queues nothing.
+  /// of an earlier failed write, and then queues nothing.
   void write(std::filesystem::path path, Image image);
 
   /// Blocks until every queued image is written; throws the first write error if there was one.
   void finish();
 
-  /// Files written so far (completed renames).
+  /// Files written so far (sink calls that returned).
   long long written() const;
 
  private:

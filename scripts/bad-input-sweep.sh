@@ -9,7 +9,8 @@
 # classify stops the sweep with exit 3 before anything runs, so coverage cannot shrink silently.
 # Options whose --help shows a choice list {a, b} are classified as choices automatically.
 #
-# Each command line runs in a fresh temporary folder (its cwd, with a few fixture files:
+# Each command line (nproc of them at a time, or SWEEP_JOBS; SWEEP_TIMEOUT, SWEEP_VERBOSE=1 to
+# list every verdict) runs in a fresh temporary folder (its cwd, with a few fixture files:
 # `file` and `file.png` regular files, `adir` and `dir.png` folders) under `timeout 20` and a
 # 1 GiB address-space cap (prlimit --as; see choose_cap below), stdout and stderr captured.
 # A bad command line PASSES when cps exits 2 with a message on stderr that names the option or
@@ -34,6 +35,7 @@ fi
 TIMEOUT=${SWEEP_TIMEOUT:-20}  # s per command line
 MEM=$((1 << 30))              # bytes
 VERBOSE=${SWEEP_VERBOSE:-0}   # 1: print every command line and its verdict
+JOBS=${SWEEP_JOBS:-$(nproc)}  # command lines run at a time
 
 root=$(mktemp -d "${TMPDIR:-/tmp}/cps-bad-input-sweep.XXXXXX")
 trap 'rm -rf "$root"' EXIT
@@ -196,7 +198,8 @@ cap_works() {  # runs the first control (and a render if there is one) under "${
     [[ $line == render* ]] && ! "$CPS" render --help > /dev/null 2>&1 && continue
     rm -rf "$d" && mkdir -p "$d"
     # shellcheck disable=SC2086
-    (cd "$d" && timeout "$TIMEOUT" "${CAP[@]}" "$CPS" $line > /dev/null 2> "$d.err") || return 1
+    { (cd "$d" && exec timeout "$TIMEOUT" "${CAP[@]}" "$CPS" $line > /dev/null 2> "$d.err"); } \
+      2> /dev/null || return 1
   done
 }
 choose_cap() {
@@ -223,8 +226,9 @@ choose_cap() {
 }
 
 # Runs "$@" as cps's arguments in a fresh folder; sets RC, OUT, ERR, WROTE (what was written).
+CASE_DIR=$root/case
 run_cps() {
-  local d=$root/case
+  local d=$CASE_DIR
   rm -rf "$d"
   mkdir -p "$d/cwd/adir" "$d/cwd/dir.png" "$d/tmp"
   printf 'not written by cps\n' > "$d/cwd/file"
@@ -286,29 +290,55 @@ message() {  # STDERR -> its first line that starts with "cps", else its last li
   done <<< "$1"
   printf '%s' "${last:-(nothing on stderr)}"
 }
-N=0 P=0 F=0
-FAILURES=()
-show() {  # the command line as a shell would take it
-  local s="cps" a
-  for a in "$@"; do s+=" $(printf '%q' "$a")"; done
+quoted() {  # ARGS... -> " ARG1 ARG2 ..." quoted for the shell (eval "args=(...)" reads it back)
+  local s= a q
+  for a in "$@"; do
+    printf -v q '%q' "$a"
+    s+=" $q"
+  done
   printf '%s' "$s"
 }
-# bad NEEDLES ARGS...: a bad command line.
+show() { printf 'cps%s' "$(quoted "$@")"; }  # the command line as a shell would take it
+
+# bad NEEDLES ARGS...: plans a bad command line (run_sweep runs them).
+CASE_NEEDLES=() CASE_ARGS=()
 bad() {
-  local needles=$1 why first
+  CASE_NEEDLES+=("$1")
   shift
-  run_cps "$@"
-  why=$(verdict_bad "$needles")
-  N=$((N + 1))
-  if [[ -z $why ]]; then
-    P=$((P + 1))
-    ((VERBOSE)) && echo "ok   $(show "$@")$NL    -> $(message "$ERR")"
-  else
-    F=$((F + 1))
-    first=$(message "$ERR")
-    FAILURES+=("$(show "$@")$NL    -> $why; stderr: ${first:0:240}")
-    echo "FAIL $(show "$@")$NL    -> $why; stderr: ${first:0:240}"
-  fi
+  CASE_ARGS+=("$(quoted "$@")")
+}
+# Runs the planned command lines, JOBS at a time (worker w takes w, w + JOBS, ...), each
+# verdict into $root/res/I, then prints the failures in plan order and sets N, P, F.
+sweep_worker() {
+  local w=$1 i why args
+  CASE_DIR=$root/w$w
+  for ((i = w; i < ${#CASE_ARGS[@]}; i += JOBS)); do
+    eval "args=(${CASE_ARGS[i]})"
+    run_cps "${args[@]}"
+    why=$(verdict_bad "${CASE_NEEDLES[i]}")
+    printf '%s\n%s\n' "$why" "$(message "$ERR")" > "$root/res/$i"
+  done
+}
+run_sweep() {
+  local w i why msg
+  mkdir -p "$root/res"
+  echo "bad-input-sweep: ${#CASE_ARGS[@]} bad command lines, $JOBS at a time"
+  for ((w = 0; w < JOBS; w++)); do sweep_worker "$w" & done
+  wait
+  N=${#CASE_ARGS[@]} P=0 F=0
+  FAILURES=()
+  for ((i = 0; i < N; i++)); do
+    why="no verdict (the worker died)" msg=
+    [[ -f $root/res/$i ]] && { IFS= read -r why; IFS= read -r msg; } < "$root/res/$i"
+    if [[ -z $why ]]; then
+      P=$((P + 1))
+      ((VERBOSE)) && echo "ok   cps${CASE_ARGS[i]}$NL    -> $msg"
+    else
+      F=$((F + 1))
+      FAILURES+=("cps${CASE_ARGS[i]}$NL    -> $why; stderr: ${msg:0:240}")
+      ((VERBOSE)) && echo "FAIL cps${CASE_ARGS[i]}$NL    -> $why; stderr: ${msg:0:240}"
+    fi
+  done
 }
 
 # ---------------------------------------------------------------------------------------------
@@ -515,7 +545,7 @@ for sub in "${COMMANDS[@]}"; do
         done
         continue
       fi
-      # A missing value: at the end, before another option, with '='.
+      # A missing value: at the end, and with '='.
       bad "$needles" "${W[@]}" "$long"
       bad "$needles" "${W[@]}" "$long="
       # Bad values.
@@ -547,6 +577,7 @@ for e in "${EXTRA[@]}"; do
   has_command "${words[0]}" && bad "$needles" "${words[@]}"
 done
 
+run_sweep
 merge_after=$(snapshot_dir "$MERGE_SRC")
 if [[ $merge_after != "$merge_before" ]]; then
   CONTROL_FAILS+=("the --merge source folder $MERGE_SRC was changed")

@@ -1,0 +1,597 @@
+#!/usr/bin/env bash
+# Bad-input sweep of the cps command line: every option of every command, fed bad values.
+#
+# Usage: scripts/bad-input-sweep.sh [CPS]          (CPS: default build/demos/cps)
+#
+# The options are read from `cps --help` and `cps SUB --help`, so a new option is swept without
+# editing this file; the table below says which bad values each kind of option gets (the type and
+# range matter: -1 is bad for --fps, not for --orbit). An option (or command) the table does not
+# classify stops the sweep with exit 3 before anything runs, so coverage cannot shrink silently.
+# Options whose --help shows a choice list {a, b} are classified as choices automatically.
+#
+# Each command line (nproc of them at a time, or SWEEP_JOBS; SWEEP_TIMEOUT, SWEEP_VERBOSE=1 to
+# list every verdict) runs in a fresh temporary folder (its cwd, with a few fixture files:
+# `file` and `file.png` regular files, `adir` and `dir.png` folders) under `timeout 20` and a
+# 1 GiB address-space cap (prlimit --as; see choose_cap below), stdout and stderr captured.
+# A bad command line PASSES when cps exits 2 with a message on stderr that names the option or
+# the value, and wrote nothing (no new file in the cwd or in its TMPDIR, fixture files
+# unchanged). Anything else FAILS: exit 0, another exit code, a timeout, a signal, bad_alloc,
+# or files written. Controls (valid command lines, some at the edges of the ranges) must exit
+# 0, and a self-test checks that the classifier calls an accepted line and an exit 1 failures.
+#
+# Prints each failure with its command line, then
+#   N command lines: P refused cleanly, F failures
+# and exits 1 when F > 0 (or a control or self-test failed), 3 on an unclassified option.
+# Needs only bash, coreutils (timeout, mktemp, stat, ...) and util-linux (prlimit).
+set -u
+shopt -s extglob
+
+CPS=${1:-build/demos/cps}
+case $CPS in /*) ;; */*) CPS=$PWD/$CPS ;; *) CPS=$(command -v "$CPS" || echo "$CPS") ;; esac
+if [[ ! -x $CPS ]]; then
+  echo "bad-input-sweep: $CPS is not an executable (build it: cmake --build build --target cps)" >&2
+  exit 2
+fi
+TIMEOUT=${SWEEP_TIMEOUT:-20}  # s per command line
+MEM=$((1 << 30))              # bytes
+VERBOSE=${SWEEP_VERBOSE:-0}   # 1: print every command line and its verdict
+JOBS=${SWEEP_JOBS:-$(nproc)}  # command lines run at a time
+
+root=$(mktemp -d "${TMPDIR:-/tmp}/cps-bad-input-sweep.XXXXXX")
+trap 'rm -rf "$root"' EXIT
+start_s=$SECONDS
+
+# ---------------------------------------------------------------------------------------------
+# The table.
+
+# Kind of each option, by "SUB:--name" (or "*:--name" for every command that has it), and of
+# each positional, by "SUB:name". The kinds' bad values are in bad_values below.
+declare -A KIND=(
+  ['*:--help']=skip ['top:--version']=skip
+  ['*:--json']=flag ['*:--force']=flag ['*:--quick']=flag ['*:--list-runs']=flag
+  ['*:--rendering']=flag ['*:--contacts']=flag ['*:--rods']=flag ['*:--label']=flag
+  ['*:--seconds']=seconds ['*:--fps']=fps ['*:--orbit']=orbit
+  ['*:--dt']=dt ['*:--iterations']=iterations
+  ['*:--beta']=unit_interval ['*:--restitution']=unit_interval
+  ['*:--friction']=nonneg_1e6 ['*:--restitution-threshold']=nonneg_1e6
+  ['*:--contact-margin']=nonneg_1e6
+  ['*:--size']=size ['*:--times']=times
+  ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png
+  ['*:--trace']=trace ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
+  ['simulate:scene']=scene_one ['render:scene']=scene_many ['figure:scene']=scene_figure
+  ['report:scene']=scene_report
+)
+
+# The commands, each with the valid command line an option under test is added to (a short,
+# cheap run: a bad value accepted by mistake costs little). The option under test is removed
+# from it first; a positional under test replaces its first word after the command. Contexts
+# for one option ("SUB:--name") override the command's, several separated by ';'.
+declare -A BASE=(
+  [list]='list'
+  [simulate]='simulate stack --seconds 0.1'
+  [render]='render stack --seconds 0.1 --fps 10 --size 16x16 --out out'
+  [figure]='figure stack --times 0,0.1 --size 16x16 --out out/f.png'
+  [report]='report intersecting_stack --list-runs --out out'
+  [bench]='bench'
+)
+RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
+MERGE_SRC=$root/merge-src                              # one run's CSV, made below
+BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick"
+BASE['report:--run']='report --out out'
+BASE['report:--merge']='report --out out'
+
+NL=$'\n'
+# Bad values shared by every number (one per line; an empty line is the empty value). Each is
+# outside every numeric range below or not a decimal number as parse_decimal reads it.
+NUM_COMMON="$NL""nan${NL}NaN${NL}-nan${NL}inf${NL}-inf${NL}infinity${NL}1e308${NL}1e12${NL}4294967297"
+NUM_COMMON+="${NL}0x10${NL}1x${NL}10s${NL}+1${NL} 1${NL}1 ${NL}1,5${NL}1e${NL}.${NL}-${NL}1..2"
+# Kinds whose values are not numbers get their own full lists.
+bad_values() {  # KIND [CHOICES...] -> one bad value per line
+  local kind=$1
+  shift
+  case $kind in
+    seconds) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 100001 1/2 ;;  # (0, 1e5], no fraction
+    fps) printf '%s\n' "$NUM_COMMON" -1 0 1e-400 1001 1/2 ;;           # (0, 1000]
+    orbit) printf '%s\n' "$NUM_COMMON" -36001 36001 -1e5 1/2 ;;        # [-36000, 36000]
+    dt)  # [1e-6, 1] s, a fraction allowed
+      printf '%s\n' "$NUM_COMMON" -1 0 1e-7 1e-320 5e-324 1e-400 2 1/0 0/1 1/-60 -1/60 1/60x \
+        1//60 /60 1/ 1/inf nan/1 1/1e-7 ;;
+    unit_interval) printf '%s\n' "$NUM_COMMON" -1 -1e-9 1.5 1/2 ;;     # [0, 1]
+    nonneg_1e6) printf '%s\n' "$NUM_COMMON" -1 -1e-9 1000001 1/2 ;;    # [0, 1e6]
+    iterations)  # whole numbers in [1, 1e4]
+      printf '%s\n' "$NUM_COMMON" -1 0 10001 1.5 25.0 1e3 1/2 1e-320 5e-324 2147483648 \
+        99999999999999999999 ;;
+    choice)  # the choices from --help
+      printf '%s\n' "" nosuch "${1^^}" "$1 " " $1" "$1,$1" 1 ;;
+    size)  # WxH, each in [16, 8192]
+      printf '%s\n' "" 12x 8x8 15x16 16x15 8193x16 16x8193 0x0 -16x16 16x-16 1280x720x3 1280X720 \
+        1280*720 0x10 99999x99999 123456x720 1e3x720 " 1280x720" nan x 1280 16x16junk ;;
+    times)  # comma separated, finite, >= 0, increasing, at most 1e5 s, at most 64 of them
+      printf '%s\n' "" , 0, ,0 0,,1 nan inf -inf -1 0,-1 1,0 0,0 0x10 1x 10s 1/2 1e308 1e12 \
+        100001 4294967297 0,1e-400x "0;1" "$(seq_csv 65)" ;;
+    out_folder)  # cannot be a folder: an existing file, a path under a file, a device
+      printf '%s\n' "" file file/sub /dev/null ;;
+    out_png)  # not a PNG path that can be written
+      printf '%s\n' "" file.png file/f.png dir.png f.txt file /dev/null ;;
+    trace)  # cannot be written as a new trace
+      printf '%s\n' "" file file/t.csv adir ;;
+    hash)  # 16 hex digits (0x prefix allowed)
+      printf '%s\n' "" xyz 0123456789abcde 0123456789abcdef0 0123456789abcdeg 0x0123456789abcde \
+        -123456789abcdef " 0123456789abcdef" "0123456789abcdef " 0x 0xx0123456789abcdef nan ;;
+    run_id)  # scene.solver.push.friction.itN.ssM
+      local good=intersecting_stack.pgs.baumgarte.fixed
+      printf '%s\n' "" garbage intersecting_stack "$good.it25" "$good.it25.ss1.extra" \
+        nosuch.pgs.baumgarte.fixed.it1.ss1 intersecting_stack.sor.baumgarte.fixed.it1.ss1 \
+        intersecting_stack.pgs.nopush.fixed.it1.ss1 intersecting_stack.pgs.baumgarte.nofric.it1.ss1 \
+        "$good.it0.ss1" "$good.it-1.ss1" "$good.it10001.ss1" "$good.it4294967297.ss1" \
+        "$good.it1x.ss1" "$good.it0x10.ss1" "$good.it1e3.ss1" "$good.it.ss1" "$good.it 1.ss1" \
+        "$good.x1.ss1" "$good.it1.ss0" "$good.ss1.it1" "$good.it1.ss1001" "$good.it1.ss-1" \
+        "$good.it1.ss1.5" ..... "$good.IT1.SS1" ;;
+    merge)  # folders holding report CSVs
+      printf '%s\n' "" nosuch file file/sub adir /dev/null ;;
+    scene_one | scene_many | scene_figure | scene_report)
+      printf '%s\n' "" nosuch STACK "stack " " stack" stack,funnel stack_0 stack_41 stack_ \
+        _1 stack_1x stack_0x10 stack_-1 pyramid_20001 pyramid_0000001 pyramid_4294967297 \
+        pendulum_grid_101 funnel_1e3 -
+      case $kind in
+        scene_one) printf '%s\n' all stress paper ;;
+        scene_many) printf '%s\n' paper ;;
+        scene_figure) printf '%s\n' all stress ;;
+        scene_report) printf '%s\n' paper ;;
+      esac ;;
+    *) echo "bad-input-sweep: no bad values for kind '$kind'" >&2; exit 3 ;;
+  esac
+}
+seq_csv() {  # N -> 0,1,...,N-1
+  local i s=0
+  for ((i = 1; i < $1; i++)); do s+=",$i"; done
+  printf '%s' "$s"
+}
+
+# Command lines that are bad only in combination, and option conflicts; each "NEEDLES|ARGS"
+# with ARGS split on spaces (NEEDLES: what the message must name, alternatives separated by
+# '/'). Run only when the command exists (render and figure need the renderer).
+EXTRA=(
+  "steps/--seconds/--dt|simulate stack --seconds 1e5 --dt 1e-6"
+  "frames/--fps/--seconds|render stack --seconds 1e5 --fps 1000 --size 16x16 --out out"
+  "GiB/--size|render stack --seconds 1e5 --fps 0.5 --size 8192x8192 --out out"
+  "--size/--compare|render stack --size 16x16 --compare push --seconds 0.1 --fps 10 --out out"
+  "--compare|render stack --compare push --push split --seconds 0.1 --fps 10 --size 64x16 --out out"
+  "--times|figure paper --times 0,1"
+  "--compare|figure paper --compare push"
+  "--out/file|figure paper --size 16x16 --out file"
+  "--out/file|figure paper --size 16x16 --out file/sub"
+  "--out/null|figure paper --size 16x16 --out /dev/null"
+  "--out/dir.png|figure stack --times 0,0.1 --size 16x16 --out dir.png --force"
+  "--times/--size/16384|figure stack --times 0,1,2 --size 8192x16 --out out/f.png"
+  "--compare|figure stack --compare push --push split --times 0 --size 16x16 --out out/f.png"
+  "steps/--times/--dt|figure stack --times 0,1e5 --dt 1e-6 --size 16x16 --out out/f.png"
+  "--trace/adir|simulate stack --seconds 0.1 --trace adir --force"
+  "--run/--merge|report --merge $MERGE_SRC --run $RUN_ID --out out"
+  "--run/--list-runs|report --list-runs --run $RUN_ID --out out"
+  "--rendering/--quick|bench --rendering=false --quick=junk"
+)
+
+# Valid command lines (some at the edges of the ranges): each must exit 0.
+CONTROLS=(
+  "list"
+  "simulate stack --seconds 0.1"
+  "simulate stack --seconds 5e-324"
+  "simulate stack --seconds 0.1 --dt 1/60 --beta 1e-320 --friction 0 --iterations 10000"
+  "report --list-runs --out out"
+  "render stack --seconds 0.1 --fps 10 --size 16x16 --out out"
+  "render stack --seconds 0.1 --fps 5e-324 --size 16x16 --out out --orbit -36000"
+  "figure stack --times 0,0.1 --size 16x16 --out out/f.png"
+)
+
+# ---------------------------------------------------------------------------------------------
+# Running one command line.
+
+# The memory cap: 1 GiB of address space, unless that breaks a valid command line (a sanitizer
+# build maps terabytes of shadow memory; a GL driver may reserve large areas); then 1 GiB of data
+# segment (prlimit --data: heap and private writable mappings); if that breaks it too, no rlimit
+# but, for a sanitizer build, ASan's own limits (hard_rss_limit_mb, malloc_limit_mb).
+CAP=(prlimit "--as=$MEM" --)
+cap_works() {  # runs the first control (and a render if there is one) under "${CAP[@]}"
+  local d=$root/probe line
+  for line in "list" "render stack --seconds 0.05 --fps 10 --size 16x16 --out out"; do
+    [[ $line == render* ]] && ! "$CPS" render --help > /dev/null 2>&1 && continue
+    rm -rf "$d" && mkdir -p "$d"
+    # shellcheck disable=SC2086
+    { (cd "$d" && exec timeout "$TIMEOUT" "${CAP[@]}" "$CPS" $line > /dev/null 2> "$d.err"); } \
+      2> /dev/null || return 1
+  done
+}
+choose_cap() {
+  if cap_works; then
+    MEM_NOTE="address space <= 1 GiB (prlimit --as)"
+    return
+  fi
+  local why
+  why=$(head -c 300 "$root/probe.err")
+  CAP=()
+  if ! cap_works; then  # not the cap's doing: keep it, the controls will show the failure
+    CAP=(prlimit "--as=$MEM" --)
+    MEM_NOTE="address space <= 1 GiB (prlimit --as; a valid run fails even without it: $why)"
+    return
+  fi
+  CAP=(prlimit "--data=$MEM" --)
+  if cap_works; then
+    MEM_NOTE="data segment <= 1 GiB (prlimit --data: --as=1GiB broke a valid run: $why)"
+    return
+  fi
+  CAP=()
+  export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}hard_rss_limit_mb=1024:malloc_limit_mb=1024"
+  MEM_NOTE="no rlimit (--as and --data broke a valid run: $why); ASan limits 1 GiB if ASan"
+}
+
+# Runs "$@" as cps's arguments in a fresh folder; sets RC, OUT, ERR, WROTE (what was written).
+CASE_DIR=$root/case
+run_cps() {
+  local d=$CASE_DIR
+  rm -rf "$d"
+  mkdir -p "$d/cwd/adir" "$d/cwd/dir.png" "$d/tmp"
+  printf 'not written by cps\n' > "$d/cwd/file"
+  printf 'not a png, not written by cps\n' > "$d/cwd/file.png"
+  local before
+  before=$(snapshot "$d")
+  (cd "$d/cwd" && TMPDIR="$d/tmp" exec timeout -k 5 "$TIMEOUT" "${CAP[@]}" "$CPS" "$@" \
+    > "$d/out" 2> "$d/err")
+  RC=$?
+  OUT=$(head -c 4000 "$d/out")
+  ERR=$(head -c 4000 "$d/err")
+  WROTE=
+  local after
+  after=$(snapshot "$d")
+  if [[ $after != "$before" ]]; then
+    local line
+    while IFS= read -r line; do
+      [[ $NL$before$NL == *"$NL$line$NL"* ]] || WROTE+="${WROTE:+, }${line%%|*}"
+    done <<< "$after"
+    [[ -n $WROTE ]] || WROTE="(a fixture file changed)"
+    local -a paths
+    IFS=, read -ra paths <<< "$WROTE"
+    ((${#paths[@]} > 3)) && WROTE="${paths[0]},${paths[1]},${paths[2]} and $((${#paths[@]} - 3)) more"
+  fi
+}
+snapshot() {  # every path below cwd and tmp; size and time of the fixture files
+  (
+    cd "$1" || exit
+    shopt -s globstar dotglob nullglob
+    printf '%s\n' cwd/** tmp/**
+    stat -c '%n|%s|%y' cwd/file cwd/file.png
+  )
+}
+
+# Why the last run (of a bad command line) is not a clean refusal, or nothing if it is.
+# $1: what the message must name, alternatives separated by '/' (those under 2 characters ignored).
+verdict_bad() {
+  local needles=$1 n named=0
+  if ((RC == 124 || RC == 137)); then echo "timeout: still running after ${TIMEOUT} s"; return; fi
+  if ((RC > 128)); then echo "killed by signal $((RC - 128)) ($(kill -l $((RC - 128)) 2> /dev/null))"; return; fi
+  if [[ $ERR == *bad_alloc* || $ERR == *"out of memory"* || $ERR == *"Cannot allocate"* ]]; then
+    echo "memory exhausted (exit $RC)"; return
+  fi
+  if ((RC == 0)); then echo "accepted (exit 0)${WROTE:+; wrote $WROTE}"; return; fi
+  if ((RC != 2)); then echo "exit $RC, not 2${WROTE:+; wrote $WROTE}"; return; fi
+  if [[ -n $WROTE ]]; then echo "exit 2 but wrote $WROTE"; return; fi
+  local IFS=/
+  for n in $needles; do
+    ((${#n} >= 2)) && [[ $ERR == *"$n"* ]] && named=1
+  done
+  ((named)) || echo "exit 2 but the message does not name ${needles//\// or }"
+}
+
+message() {  # STDERR -> its first line that starts with "cps", else its last line
+  local line last=
+  while IFS= read -r line; do
+    [[ $line == cps* ]] && { printf '%s' "$line"; return; }
+    [[ -n $line ]] && last=$line
+  done <<< "$1"
+  printf '%s' "${last:-(nothing on stderr)}"
+}
+quoted() {  # ARGS... -> " ARG1 ARG2 ..." quoted for the shell (eval "args=(...)" reads it back)
+  local s= a q
+  for a in "$@"; do
+    printf -v q '%q' "$a"
+    s+=" $q"
+  done
+  printf '%s' "$s"
+}
+show() { printf 'cps%s' "$(quoted "$@")"; }  # the command line as a shell would take it
+
+# bad NEEDLES ARGS...: plans a bad command line (run_sweep runs them).
+CASE_NEEDLES=() CASE_ARGS=()
+bad() {
+  CASE_NEEDLES+=("$1")
+  shift
+  CASE_ARGS+=("$(quoted "$@")")
+}
+# Runs the planned command lines, JOBS at a time (worker w takes w, w + JOBS, ...), each
+# verdict into $root/res/I, then prints the failures in plan order and sets N, P, F.
+sweep_worker() {
+  local w=$1 i why args
+  CASE_DIR=$root/w$w
+  for ((i = w; i < ${#CASE_ARGS[@]}; i += JOBS)); do
+    eval "args=(${CASE_ARGS[i]})"
+    run_cps "${args[@]}"
+    why=$(verdict_bad "${CASE_NEEDLES[i]}")
+    printf '%s\n%s\n' "$why" "$(message "$ERR")" > "$root/res/$i"
+  done
+}
+run_sweep() {
+  local w i why msg
+  mkdir -p "$root/res"
+  echo "bad-input-sweep: ${#CASE_ARGS[@]} bad command lines, $JOBS at a time"
+  for ((w = 0; w < JOBS; w++)); do sweep_worker "$w" & done
+  wait
+  N=${#CASE_ARGS[@]} P=0 F=0
+  FAILURES=()
+  for ((i = 0; i < N; i++)); do
+    why="no verdict (the worker died)" msg=
+    [[ -f $root/res/$i ]] && { IFS= read -r why; IFS= read -r msg; } < "$root/res/$i"
+    if [[ -z $why ]]; then
+      P=$((P + 1))
+      ((VERBOSE)) && echo "ok   cps${CASE_ARGS[i]}$NL    -> $msg"
+    else
+      F=$((F + 1))
+      FAILURES+=("cps${CASE_ARGS[i]}$NL    -> $why; stderr: ${msg:0:240}")
+      ((VERBOSE)) && echo "FAIL cps${CASE_ARGS[i]}$NL    -> $why; stderr: ${msg:0:240}"
+    fi
+  done
+}
+
+# ---------------------------------------------------------------------------------------------
+# Reading --help.
+
+# parse_help SUB: sets OPTS (one entry per option: "NAMES|TYPE", NAMES comma separated, TYPE
+# empty for a flag) and POSITIONALS ("NAME|TYPE"), SUBS for the top level.
+parse_help() {
+  local sub=$1 section= line rest head token type
+  OPTS=() POSITIONALS=() SUBS=()
+  local text
+  if [[ $sub == top ]]; then text=$("$CPS" --help 2>&1); else text=$("$CPS" "$sub" --help 2>&1); fi
+  if [[ -z $text ]]; then echo "bad-input-sweep: cps $sub --help printed nothing" >&2; exit 3; fi
+  while IFS= read -r line; do
+    case $line in
+      Positionals:) section=pos; continue ;;
+      Options:) section=opt; continue ;;
+      Subcommands:) section=sub; continue ;;
+    esac
+    [[ $line =~ ^\ \ ([^\ ].*)$ ]] || continue  # an entry: two spaces, then its name
+    rest=${BASH_REMATCH[1]}
+    head=${rest%%  *}   # the help column starts after two spaces
+    token=${head%% *}
+    type=${head#"$token"}
+    type=${type# }
+    case $section in
+      opt)
+        token=${token//\{+([^\}])\}/}  # --rods,--no-rods{false} -> --rods,--no-rods
+        OPTS+=("$token|$type") ;;
+      pos) POSITIONALS+=("$token|$type") ;;
+      sub) SUBS+=("$token") ;;
+    esac
+  done <<< "$text"
+}
+
+kind_of() {  # SUB NAME TYPE -> kind, or nothing (a value shown as {a, b} is a choice)
+  local k=${KIND["$1:$2"]:-${KIND["*:$2"]:-}}
+  if [[ -z $k && $3 == *\{*\}* ]]; then k=choice; fi
+  printf "%s" "$k"
+}
+long_name() {  # NAMES (comma separated) -> the first --long one
+  local n
+  for n in ${1//,/ }; do
+    if [[ $n == --* ]]; then printf "%s" "$n"; return; fi
+  done
+  printf "%s" "${1%%,*}"
+}
+choices_of() {  # TYPE "{a, b}" or "TEXT:{a,b}=a" -> a b
+  local t=${1#*\{}
+  t=${t%%\}*}
+  t=${t//,/ }
+  printf '%s' "$t"
+}
+
+# ---------------------------------------------------------------------------------------------
+# The plan: every command, option and positional from --help, classified before anything runs.
+
+parse_help top
+COMMANDS=("${SUBS[@]}")
+if ((${#COMMANDS[@]} == 0)); then echo "bad-input-sweep: no commands in cps --help" >&2; exit 3; fi
+unclassified=()
+for o in "${OPTS[@]}"; do
+  long=$(long_name "${o%%|*}")
+  [[ -n ${KIND["top:$long"]:-${KIND["*:$long"]:-}} ]] || unclassified+=("cps: option $long")
+done
+declare -A PLAN_OPTS PLAN_POS
+for sub in "${COMMANDS[@]}"; do
+  [[ -n ${BASE[$sub]:-} ]] || unclassified+=("command $sub (no base command line in BASE)")
+  parse_help "$sub"
+  PLAN_OPTS[$sub]=
+  for o in "${OPTS[@]}"; do
+    names=${o%%|*}
+    type=${o#*|}
+    long=$(long_name "$names")
+    kind=$(kind_of "$sub" "$long" "$type")
+    if [[ -z $kind ]]; then
+      unclassified+=("cps $sub: option $long ${type:-(a flag)}")
+      continue
+    fi
+    if [[ $kind == flag && -n $type ]] || [[ $kind != flag && $kind != skip && -z $type ]]; then
+      unclassified+=("cps $sub: option $long is classified $kind but --help shows '${type:-no value}'")
+      continue
+    fi
+    PLAN_OPTS[$sub]+="$names|$kind|$type$NL"
+  done
+  PLAN_POS[$sub]=
+  for p in "${POSITIONALS[@]}"; do
+    name=${p%%|*}
+    kind=${KIND["$sub:$name"]:-}
+    if [[ -z $kind ]]; then unclassified+=("cps $sub: positional $name"); continue; fi
+    PLAN_POS[$sub]+="$name|$kind$NL"
+  done
+done
+if ((${#unclassified[@]})); then
+  echo "bad-input-sweep: --help shows what this sweep does not know how to classify;" \
+    "add it to KIND (and BASE) in $0:" >&2
+  printf '  %s\n' "${unclassified[@]}" >&2
+  exit 3
+fi
+
+choose_cap
+echo "bad-input-sweep: $CPS; ${#COMMANDS[@]} commands (${COMMANDS[*]});" \
+  "timeout ${TIMEOUT} s, memory: $MEM_NOTE"
+
+# ---------------------------------------------------------------------------------------------
+# Fixture and controls.
+
+CONTROL_FAILS=()
+control() {  # ARGS...: must exit 0
+  run_cps "$@"
+  if ((RC != 0)); then
+    CONTROL_FAILS+=("$(show "$@") -> exit $RC: ${ERR:0:300}")
+    echo "CONTROL FAILED (valid, must exit 0): $(show "$@") -> exit $RC: ${ERR:0:300}"
+  fi
+}
+# The --merge source: one run's CSV.
+mkdir -p "$MERGE_SRC"
+(cd "$MERGE_SRC" && timeout "$TIMEOUT" "$CPS" report --run "$RUN_ID" --out . > /dev/null 2>&1)
+if ! compgen -G "$MERGE_SRC/*.csv" > /dev/null; then
+  CONTROL_FAILS+=("cps report --run $RUN_ID --out DIR wrote no CSV")
+  echo "CONTROL FAILED: cps report --run $RUN_ID --out DIR wrote no CSV"
+fi
+snapshot_dir() { (shopt -s dotglob nullglob; stat -c '%n|%s|%y' "$1"/*); }
+merge_before=$(snapshot_dir "$MERGE_SRC")
+
+has_command() { [[ " ${COMMANDS[*]} " == *" $1 "* ]]; }
+for line in "${CONTROLS[@]}"; do
+  read -ra words <<< "$line"
+  has_command "${words[0]}" && control "${words[@]}"
+done
+control report --merge "$MERGE_SRC" --out merged
+# An expected hash: the one simulate prints, and the same in capitals with 0X.
+run_cps simulate stack --seconds 0.1 --json
+if [[ $OUT =~ \"state_hash\":\ \"([0-9a-f]{16})\" ]]; then
+  hash=${BASH_REMATCH[1]}
+  control simulate stack --seconds 0.1 --expect-hash "$hash"
+  control simulate stack --seconds 0.1 --expect-hash "0X${hash^^}"
+else
+  CONTROL_FAILS+=("cps simulate stack --seconds 0.1 --json printed no state_hash")
+fi
+# Self-test: the classifier must call these failures.
+SELF_FAILS=()
+run_cps simulate stack --seconds 0.1
+[[ -n $(verdict_bad --seconds) ]] || SELF_FAILS+=("an accepted command line (exit 0) was not a failure")
+run_cps simulate stack --seconds 0.1 --expect-hash 0000000000000000
+[[ $(verdict_bad --expect-hash) == "exit 1"* ]] || SELF_FAILS+=("exit 1 was not a failure")
+RC=2 ERR="cps: something" WROTE=
+[[ -n $(verdict_bad --seconds) ]] || SELF_FAILS+=("a message that names nothing was not a failure")
+RC=2 ERR="cps: --seconds: x" WROTE=out
+[[ -n $(verdict_bad --seconds) ]] || SELF_FAILS+=("a written file was not a failure")
+RC=124 ERR= WROTE=
+[[ -n $(verdict_bad --seconds) ]] || SELF_FAILS+=("a timeout was not a failure")
+((${#SELF_FAILS[@]} == 0)) || printf 'SELF-TEST FAILED: %s\n' "${SELF_FAILS[@]}"
+
+# ---------------------------------------------------------------------------------------------
+# The sweep.
+
+# base_for SUB KEY -> the contexts (';' separated) for an option or positional
+base_for() { printf '%s' "${BASE["$1:$2"]:-${BASE[$1]}}"; }
+# without OPT VALUED WORDS... -> WORDS with OPT (and its value when VALUED) removed, into W
+without() {
+  local opt=$1 valued=$2 skip=0 w
+  shift 2
+  W=()
+  for w in "$@"; do
+    if ((skip)); then skip=0; continue; fi
+    if [[ $w == "$opt" ]]; then ((valued)) && skip=1; continue; fi
+    W+=("$w")
+  done
+}
+
+# The command line alone, and the top level.
+bad "subcommand"
+bad "--nosuch" --nosuch
+bad "--nosuch" --nosuch list
+bad "nosuchcommand" nosuchcommand
+bad "LIST" LIST
+bad "--version" --version=junk
+bad "-z" -z
+
+for sub in "${COMMANDS[@]}"; do
+  IFS=';' read -ra contexts <<< "${BASE[$sub]}"
+  read -ra words <<< "${contexts[0]}"
+  # Unknown options and stray positionals.
+  bad "--nosuch" "${words[@]}" --nosuch
+  bad "--nosuch" "${words[@]}" --nosuch=1
+  bad "-z" "${words[@]}" -z
+  bad "extra" "${words[@]}" extra
+  bad "---" "${words[@]}" ---
+  # Options.
+  while IFS='|' read -r names kind type; do
+    [[ -n $names && $kind != skip ]] || continue
+    long=$(long_name "$names")
+    needles=${names//,//}
+    valued=1
+    [[ $kind == flag ]] && valued=0
+    IFS=';' read -ra contexts <<< "$(base_for "$sub" "$long")"
+    for ctx in "${contexts[@]}"; do
+      read -ra words <<< "$ctx"
+      without "$long" "$valued" "${words[@]}"
+      if ((!valued)); then
+        for name in ${names//,/ }; do
+          bad "$needles/junk" "${W[@]}" "$name=junk"
+        done
+        continue
+      fi
+      # A missing value: at the end, and with '='.
+      bad "$needles" "${W[@]}" "$long"
+      bad "$needles" "${W[@]}" "$long="
+      # Bad values.
+      if [[ $kind == choice ]]; then
+        mapfile -t values < <(bad_values choice $(choices_of "$type"))
+      else
+        mapfile -t values < <(bad_values "$kind")
+      fi
+      for v in "${values[@]}"; do
+        bad "$needles/$v" "${W[@]}" "$long" "$v"
+      done
+    done
+  done <<< "${PLAN_OPTS[$sub]}"
+  # Positionals (the first word after the command).
+  while IFS='|' read -r name kind; do
+    [[ -n $name ]] || continue
+    IFS=';' read -ra contexts <<< "$(base_for "$sub" "$name")"
+    read -ra words <<< "${contexts[0]}"
+    mapfile -t values < <(bad_values "$kind")
+    for v in "${values[@]}"; do
+      bad "$name/$v" "${words[0]}" "$v" "${words[@]:2}"
+    done
+  done <<< "${PLAN_POS[$sub]}"
+done
+
+for e in "${EXTRA[@]}"; do
+  needles=${e%%|*}
+  read -ra words <<< "${e#*|}"
+  has_command "${words[0]}" && bad "$needles" "${words[@]}"
+done
+
+run_sweep
+merge_after=$(snapshot_dir "$MERGE_SRC")
+if [[ $merge_after != "$merge_before" ]]; then
+  CONTROL_FAILS+=("the --merge source folder $MERGE_SRC was changed")
+  echo "FAIL: the --merge source folder was changed by the sweep"
+fi
+
+# ---------------------------------------------------------------------------------------------
+echo
+if ((F > 0)); then
+  echo "Failures:"
+  printf '  %s\n' "${FAILURES[@]}"
+fi
+controls_ok=$(( ${#CONTROL_FAILS[@]} == 0 && ${#SELF_FAILS[@]} == 0 ))
+echo "controls: $((${#CONTROL_FAILS[@]} == 0 ? 1 : 0)) (1 = every valid command line exited 0);" \
+  "self-test: $((${#SELF_FAILS[@]} == 0 ? 1 : 0)); $((SECONDS - start_s)) s"
+echo "$N command lines: $P refused cleanly, $F failures"
+((F == 0 && controls_ok)) || exit 1

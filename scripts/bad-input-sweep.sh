@@ -59,7 +59,7 @@ declare -A KIND=(
   ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png
   ['*:--trace']=trace ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
   ['simulate:scene']=scene_one ['render:scene']=scene_many ['figure:scene']=scene_figure
-  ['report:scene']=scene_report
+  ['report:scene']=scene_report ['bench:--scene']=scene_bench
 )
 
 # The commands, each with the valid command line an option under test is added to (a short,
@@ -72,7 +72,7 @@ declare -A BASE=(
   [render]='render stack --seconds 0.1 --fps 10 --size 16x16 --out out'
   [figure]='figure stack --times 0,0.1 --size 16x16 --out out/f.png'
   [report]='report intersecting_stack --list-runs --out out'
-  [bench]='bench'
+  [bench]='bench --quick --scene intersecting_stack'
 )
 RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
 MERGE_SRC=$root/merge-src                              # one run's CSV, made below
@@ -129,7 +129,7 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         "$good.it1.ss1.5" ..... "$good.IT1.SS1" ;;
     merge)  # folders holding report CSVs
       printf '%s\n' "" nosuch file file/sub adir /dev/null ;;
-    scene_one | scene_many | scene_figure | scene_report)
+    scene_one | scene_many | scene_figure | scene_report | scene_bench)
       printf '%s\n' "" nosuch STACK "stack " " stack" stack,funnel stack_0 stack_41 stack_ \
         _1 stack_1x stack_0x10 stack_-1 pyramid_20001 pyramid_0000001 pyramid_4294967297 \
         pendulum_grid_101 funnel_1e3 -

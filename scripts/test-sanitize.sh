@@ -12,4 +12,6 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 cmake --build build-asan --parallel "$(nproc)"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-ctest --test-dir build-asan --output-on-failure --parallel "$(nproc)"
+# The bad-input sweep (label sweep, ~1300 command lines) runs in the Release build of the test
+# command; here it would add about 5 minutes (it found the same results in both builds).
+ctest --test-dir build-asan --output-on-failure --parallel "$(nproc)" -LE sweep

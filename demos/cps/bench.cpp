@@ -367,7 +367,11 @@ int run_bench(const BenchOptions& o) {
   }
   std::vector<std::string> names;
   for (const std::string& name : o.scenes) {
-    for (const scenes::Scene* scene : select_scenes(name)) names.emplace_back(scene->name);
+    try {
+      for (const scenes::Scene* scene : select_scenes(name)) names.emplace_back(scene->name);
+    } catch (const UsageError& e) {
+      throw UsageError(std::string("--scene ") + name + ": " + e.what());
+    }
   }
   const bool markdown = !o.json;
   nlohmann::json out = {{"engine_version", engine_version()}, {"quick", o.quick}};

@@ -1369,14 +1369,15 @@ Command add_report(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<ReportOptions>();
   CLI::App* sub = app.add_subcommand(
       "report", "error against run time: sweep solver settings, write CSV, plots, report.md");
-  sub->add_option("scene", o->scene, "scene name, 'all' (the paper's) or 'stress'")
+  sub->add_option("scene", o->scene,
+                  "scene name, 'all' (the paper's) or 'stress'; with --run, the sweep the run "
+                  "belongs to")
       ->capture_default_str();
   sub->add_option("--out", o->out, "output folder")->capture_default_str()->check(kNotEmpty);
   sub->add_flag("--quick", o->quick,
                 "a reduced sweep: iterations 1, 4, 16, 25, 64 and 4 substeps, fixed friction "
                 "only, each run timed by the median of 3 timing runs as in the full sweep (the "
-                "paper's five scenes: 120 runs; measured 104 s on 2 cores shared with other "
-                "jobs, 69 s of CPU)");
+                "paper's five scenes: 120 runs, measured 64 s on 2 cores)");
   sub->add_flag("--list-runs", o->list,
                 "print one self-contained command per run, to spread the sweep over machines");
   sub->add_option("--merge", o->merge,

@@ -75,7 +75,7 @@ declare -A BASE=(
   [bench]='bench --quick --scene intersecting_stack'
 )
 RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
-MERGE_SRC=$root/merge-src                              # one run's CSV, made below
+MERGE_SRC=$root/merge-src                              # a complete sweep, made below
 BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick"
 BASE['report:--run']='report --out out'
 BASE['report:--merge']='report --out out'
@@ -364,6 +364,9 @@ parse_help() {
     token=${head%% *}
     type=${head#"$token"}
     type=${type# }
+    type=${type%%Excludes:*}  # CLI11's notes on options that exclude or need others
+    type=${type%%Needs:*}
+    type=${type%"${type##*[! ]}"}  # trailing spaces
     case $section in
       opt)
         token=${token//\{+([^\}])\}/}  # --rods,--no-rods{false} -> --rods,--no-rods
@@ -454,12 +457,12 @@ control() {  # ARGS...: must exit 0
     echo "CONTROL FAILED (valid, must exit 0): $(show "$@") -> exit $RC: ${ERR:0:300}"
   fi
 }
-# The --merge source: one run's CSV.
-mkdir -p "$MERGE_SRC"
-(cd "$MERGE_SRC" && timeout "$TIMEOUT" "$CPS" report --run "$RUN_ID" --out . > /dev/null 2>&1)
+# The --merge source: a complete sweep (the intersecting stack's quick one, 24 runs, a few
+# seconds; RUN_ID is one of them), so that merging it is valid (a merge with runs missing exits 1).
+timeout "$TIMEOUT" "$CPS" report intersecting_stack --quick --out "$MERGE_SRC" > /dev/null 2>&1
 if ! compgen -G "$MERGE_SRC/*.csv" > /dev/null; then
-  CONTROL_FAILS+=("cps report --run $RUN_ID --out DIR wrote no CSV")
-  echo "CONTROL FAILED: cps report --run $RUN_ID --out DIR wrote no CSV"
+  CONTROL_FAILS+=("cps report intersecting_stack --quick --out DIR wrote no CSV")
+  echo "CONTROL FAILED: cps report intersecting_stack --quick --out DIR wrote no CSV"
 fi
 snapshot_dir() { (shopt -s dotglob nullglob; stat -c '%n|%s|%y' "$1"/*); }
 merge_before=$(snapshot_dir "$MERGE_SRC")

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -43,6 +44,33 @@ void expect_refused(const std::vector<Case>& cases, const fs::path& dir) {
     CHECK(r.err.find(c.says) != std::string::npos);
     CHECK(!fs::exists(dir / "out"));
   }
+}
+
+// The rows of a CSV file with a header line, each as column name -> cell ("" where empty).
+std::vector<std::map<std::string, std::string>> read_table(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  std::stringstream hs(line);
+  for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::map<std::string, std::string> row;
+    for (const std::string& c : header) {
+      std::string cell;
+      std::getline(ls, cell, ',');
+      row[c] = cell;
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+double value(const std::map<std::string, std::string>& row, const std::string& column) {
+  const auto it = row.find(column);
+  return it == row.end() || it->second.empty() ? std::nan("") : std::stod(it->second);
 }
 
 }  // namespace
@@ -139,33 +167,60 @@ TEST_CASE("cps --version names the build; list and unknown scenes name the scale
   fs::remove_all(dir);
 }
 
-TEST_CASE("cps report flags a run whose penetration passes the largest body's size as diverged",
-          "[cli][report]") {
-  const fs::path dir = fresh_dir("diverged");
-  // The funnel's balls are 1 m across. Jacobi at 60 Hz and 16 iterations pushes them metres into
-  // each other and the walls (212 m by 10 s, once reported as not diverged); PGS at the paper's
-  // settings keeps the penetration under 0.2 m.
-  const auto diverged = [&](const std::string& id) {
-    const Result r = cps("report --run " + id + " --quick --out runs", dir);
-    REQUIRE(r.exit_code == 0);
-    std::ifstream csv(dir / "runs" / (id + ".csv"));
-    std::string header;
-    std::string values;
-    std::getline(csv, header);
-    std::getline(csv, values);
-    const auto column = [](const std::string& line, std::size_t k) {
-      std::stringstream s(line);
-      std::string cell;
-      for (std::size_t i = 0; i <= k; ++i) std::getline(s, cell, ',');
-      return cell;
-    };
-    std::stringstream h(header);
-    std::size_t k = 0;
-    for (std::string name; std::getline(h, name, ',') && name != "diverged";) ++k;
-    return column(values, k) == "1";
+TEST_CASE("cps report's quick funnel sweep: trajectory errors where the balls are in the funnel, "
+          "diverged runs flagged and timed, a blow-up far off", "[cli][report]") {
+  const fs::path dir = fresh_dir("funnel");
+  const Result r = cps("report funnel --quick --out q", dir);
+  REQUIRE(r.exit_code == 0);
+  const auto rows = read_table(dir / "q/funnel.csv");
+  REQUIRE(rows.size() == 24u);
+  const auto find = [&](const std::string& solver, const std::string& push, int it, int ss) {
+    for (const auto& row : rows) {
+      if (row.at("solver") == solver && row.at("push") == push &&
+          row.at("iterations") == std::to_string(it) && row.at("substeps") == std::to_string(ss)) {
+        return row;
+      }
+    }
+    FAIL("no run " << solver << " " << push << " it" << it << " ss" << ss);
+    return rows.front();
   };
-  CHECK(diverged("funnel.jacobi.baumgarte.fixed.it16.ss1"));
-  CHECK_FALSE(diverged("funnel.pgs.baumgarte.fixed.it25.ss1"));
+  // The balls are 1 m across. Jacobi at 60 Hz and 16 iterations pushes them metres into each
+  // other and the walls (212 m by 10 s, once reported as not diverged); PGS at the paper's
+  // settings keeps the penetration under 0.2 m.
+  CHECK(find("jacobi", "baumgarte", 16, 1).at("diverged") == "1");
+  CHECK(find("pgs", "baumgarte", 25, 1).at("diverged") == "0");
+  // The balls reach the walls at about 1 s. At 1 s every run at 60 Hz was 0.0707 m from the
+  // reference, whatever its iterations: the free fall's time-step error, before any contact.
+  // At the funnel's trajectory time the pile has formed and come to rest; a solve of 1 sweep
+  // leaves it sagging and spread far more than 64 sweeps do (by over a factor 2).
+  for (const std::string push : {"baumgarte", "split"}) {
+    INFO(push);
+    std::vector<double> errors;
+    for (const int it : {1, 4, 16, 25, 64}) errors.push_back(value(find("pgs", push, it, 1), "trajectory_error_m"));
+    for (const double e : errors) REQUIRE(e >= 0.0);
+    CHECK(errors.front() > 2.0 * errors.back());
+    CHECK(value(find("pgs", push, 25, 1), "trajectory_time_s") > 3.0);  // after the pile settles
+  }
+  int diverged = 0;
+  for (const auto& row : rows) {
+    if (row.at("diverged") != "1") continue;
+    ++diverged;
+    INFO(row.at("solver") << " " << row.at("push") << " it" << row.at("iterations"));
+    // Timed until it diverged, so that the diagrams can place it.
+    CHECK(value(row, "wall_s_per_sim_s") > 0.0);
+    CHECK(value(row, "diverged_at_s") > 0.0);
+    CHECK(value(row, "diverged_at_s") <= value(row, "horizon_s"));
+  }
+  CHECK(diverged >= 1);
+  // Jacobi with the coupled friction model blows the balls apart within 1.3 s, before the
+  // trajectory time: it steps on to it, and the blow-up has carried the balls further from the
+  // reference pile than a ball's radius.
+  const std::string id = "funnel.jacobi.baumgarte.coupled.it32.ss1";
+  REQUIRE(cps("report funnel --run " + id + " --out runs", dir).exit_code == 0);
+  const auto blown = read_table(dir / "runs" / (id + ".csv")).at(0);
+  CHECK(blown.at("diverged") == "1");
+  CHECK(value(blown, "diverged_at_s") < value(blown, "trajectory_time_s"));
+  CHECK(value(blown, "trajectory_error_m") > 0.5);
   fs::remove_all(dir);
 }
 
@@ -233,6 +288,39 @@ TEST_CASE("cps bench --scene --json times each scene over a window where it is i
   fs::remove_all(dir);
 }
 
+TEST_CASE("cps report never overwrites a foreign report.md, CSV or run.json", "[cli][output]") {
+  const fs::path dir = fresh_dir("report_foreign");
+  // A complete sweep to merge (the intersecting stack's quick one: 24 short runs).
+  REQUIRE(cps("report intersecting_stack --quick --out src", dir).exit_code == 0);
+  for (const char* name : {"report.md", "intersecting_stack.csv", "run.json"}) {
+    INFO(name);
+    const fs::path out = dir / (std::string("out_") + name);
+    fs::create_directories(out);
+    { std::ofstream(out / name) << "mine\n"; }
+    const Result merge = cps("report --merge src --out " + out.filename().string(), dir);
+    CHECK(merge.exit_code == 2);
+    CHECK(merge.err.find(name) != std::string::npos);
+    CHECK(slurp(out / name) == "mine\n");
+    CHECK_FALSE(fs::exists(out / "intersecting_stack_trajectory_error_m.png"));
+    // The run of one id is refused the same way, before it runs.
+    const Result run =
+        cps("report --run intersecting_stack.pgs.baumgarte.fixed.it1.ss1 --out " +
+                out.filename().string(), dir);
+    CHECK(run.exit_code == (std::string(name) == "run.json" ? 2 : 0));
+  }
+  // --force replaces a same-named foreign file, and run.json then lists what was written.
+  const Result forced = cps("report --merge src --out out_report.md --force", dir);
+  CHECK(forced.exit_code == 0);
+  CHECK(slurp(dir / "out_report.md" / "report.md") != "mine\n");
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(dir / "out_report.md" / "run.json"));
+  const auto& files = manifest["files"];
+  for (const char* name : {"report.md", "intersecting_stack.csv", "mass_ratio.csv"}) {
+    INFO(name);
+    CHECK(std::find(files.begin(), files.end(), name) != files.end());
+  }
+  fs::remove_all(dir);
+}
+
 TEST_CASE("cps simulate --expect-hash exits 1 on another state, 0 on the same", "[cli][state_hash]") {
   const fs::path dir = fresh_dir("hash");
   const Result first = cps("simulate funnel --seconds 0.5 --json", dir);
@@ -283,30 +371,52 @@ TEST_CASE("cps render writes numbered frames of the requested size", "[cli][rend
 TEST_CASE("cps report writes CSVs with units and plots and report.md and runs spread and merge",
           "[cli][report]") {
   const fs::path dir = fresh_dir("report");
-  SECTION("one id, run on its own, then merged with another") {
+  SECTION("one id, run on its own, then merged with another: an INCOMPLETE report, exit 1") {
     const char* ids[] = {"stack.pgs.split.fixed.it4.ss1", "stack.jacobi.split.fixed.it4.ss1"};
     for (const char* id : ids) {
-      const Result r = cps(std::string("report --run ") + id + " --out runs --quick", dir);
+      const Result r = cps(std::string("report stack --run ") + id + " --out runs --quick", dir);
       REQUIRE(r.exit_code == 0);
       CHECK(fs::exists(dir / "runs" / (std::string(id) + ".csv")));
     }
+    // The quick timing takes the median of several timing runs (a stack run is far under the
+    // 2 s after which a run is timed once).
+    CHECK(value(read_table(dir / "runs/stack.pgs.split.fixed.it4.ss1.csv").at(0), "timing_repeats") >= 3);
     const Result merged = cps("report --merge runs --out merged", dir);
-    REQUIRE(merged.exit_code == 0);
+    // 2 of the 24 runs of the quick stack sweep: the other 22 are named (a few, then a count).
+    CHECK(merged.exit_code == 1);
+    CHECK(merged.err.find("22 of the 24 planned runs are missing") != std::string::npos);
+    CHECK(merged.err.find("stack.pgs.baumgarte.fixed.it1.ss1") != std::string::npos);
+    CHECK(merged.err.find("and 17 more") != std::string::npos);
+    CHECK(merged.err.find("INCOMPLETE") != std::string::npos);
+    const std::string md = slurp(dir / "merged/report.md");
+    CHECK(md.find("INCOMPLETE") < md.find("## Headline"));
     const std::string csv = slurp(dir / "merged/stack.csv");
     CHECK(csv.find("wall_s_per_sim_s") != std::string::npos);
     CHECK(csv.find("residual_rms_N") != std::string::npos);
     CHECK(csv.find("penetration_max_m") != std::string::npos);
     CHECK(std::count(csv.begin(), csv.end(), '\n') == 3);  // header and two runs
-    CHECK(fs::exists(dir / "merged/report.md"));
     CHECK(fs::file_size(dir / "merged/stack_residual_rms_N.png") > 1000);
     CHECK(fs::exists(dir / "merged/stack_residual_rms_N.svg"));
   }
-  SECTION("--list-runs prints one command per run") {
-    const Result r = cps("report pendulum_wave --quick --list-runs --out o", dir);
+  SECTION("--list-runs prints one command per run; all of them merge into a complete report") {
+    const Result r = cps("report mass_ratio_10 --quick --list-runs --out o", dir);
     REQUIRE(r.exit_code == 0);
     CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 25);  // 24 runs and the merge line
-    CHECK(r.out.find("report --run pendulum_wave.pgs.baumgarte.fixed.it25.ss1") != std::string::npos);
+    CHECK(r.out.find("--run mass_ratio_10.pgs.baumgarte.fixed.it25.ss1") != std::string::npos);
     CHECK(r.out.find("--merge") != std::string::npos);
+    std::stringstream lines(r.out);
+    int ran = 0;
+    for (std::string line; std::getline(lines, line);) {
+      if (line.rfind("#", 0) == 0) continue;
+      const std::string command = "cd '" + dir.string() + "' && " + line + " > /dev/null 2>&1";
+      CHECK(std::system(command.c_str()) == 0);
+      ++ran;
+    }
+    CHECK(ran == 24);
+    const Result merged = cps("report --merge o/runs --out o", dir);
+    CHECK(merged.exit_code == 0);
+    CHECK(merged.err.find("missing") == std::string::npos);
+    CHECK(slurp(dir / "o/report.md").find("INCOMPLETE") == std::string::npos);
   }
   SECTION("a malformed run id is a usage error") {
     const Result r = cps("report --run stack.pgs.sideways.fixed.it4.ss1 --out o", dir);
@@ -314,5 +424,44 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
     CHECK(r.err.find("unknown push 'sideways'") != std::string::npos);
     CHECK(!fs::exists(dir / "o"));
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps report's mass ratio table says whether each stack held", "[cli][report]") {
+  const fs::path dir = fresh_dir("held");
+  REQUIRE(cps("report --run stack.pgs.split.fixed.it4.ss1 --out runs", dir).exit_code == 0);
+  cps("report --merge runs --out r", dir);  // incomplete (exit 1), but with the mass ratio table
+  const auto rows = read_table(dir / "r/mass_ratio.csv");
+  REQUIRE(rows.size() == 12u);  // ratios 10, 100, 1000 x solvers x pushes
+  // Cubes of edge 1 m: stacked, the heavy one's centre is at 1.5 m; squeezed out, at 0.5 m.
+  const double h = 0.5;
+  for (const auto& row : rows) {
+    INFO(row.at("mass_ratio") << " " << row.at("solver") << " " << row.at("push"));
+    const double offset = value(row, "light_offset_m");
+    const double height = value(row, "heavy_height_m");
+    // The stated definition: the light cube's centre within its half edge of the heavy cube's
+    // axis, the heavy cube within h / 2 of its stacked height.
+    const bool held = offset <= h && std::abs(height - 3.0 * h) <= 0.5 * h;
+    CHECK((row.at("held") == "1") == held);
+  }
+  const auto pair = [&](const std::string& ratio, const std::string& solver, const std::string& push) {
+    for (const auto& row : rows) {
+      if (row.at("mass_ratio") == ratio && row.at("solver") == solver && row.at("push") == push) return row;
+    }
+    FAIL("no row " << ratio << " " << solver << " " << push);
+    return rows.front();
+  };
+  // Ratio 10: PGS converges by rho = R / (1 + R) = 0.91 per sweep; 25 sweeps hold the light
+  // cube in place (the 1D model needs about 4; the 3D pair about 16).
+  const auto ten = pair("10", "pgs", "baumgarte");
+  CHECK(ten.at("held") == "1");
+  CHECK(value(ten, "heavy_height_m") == Approx(1.5).margin(0.05));
+  CHECK(value(ten, "light_offset_m") < 0.1);
+  // Ratio 1000: rho = 0.999, 25 sweeps leave the ground row most of the load unsolved; the light
+  // cube is walked out from under the heavy one, which lands on the ground.
+  const auto thousand = pair("1000", "pgs", "baumgarte");
+  CHECK(thousand.at("held") == "0");
+  CHECK(value(thousand, "light_offset_m") > h);
+  CHECK(value(thousand, "heavy_height_m") == Approx(h).margin(0.05));
   fs::remove_all(dir);
 }

@@ -312,7 +312,7 @@ TEST_CASE("every command's --help states the units of its options", "[cli][help]
   std::vector<Case> cases = {
       {"list", {"(s)"}},
       {"simulate", {"(s)", "(m)", "(m/s)", "(rad/s)", "--trace", "--force", "never touched"}},
-      {"report", {"about 30 s", "--out TEXT=out/report"}},
+      {"report", {"120 runs", "median of 3", "INCOMPLETE", "--out TEXT=out/report"}},
       {"bench", {"us/step"}},
   };
 #ifdef CPS_HAVE_RENDERER

@@ -250,3 +250,24 @@ TEST_CASE("each paper scene's bench window is spent doing what the scene exists 
     CHECK(steps_without_work == 0);
   }
 }
+
+TEST_CASE("every scene's report compares trajectories at a frame time within its horizon",
+          "[scenes][report]") {
+  for (const scenes::Scene& s : scenes::all_scenes()) {
+    INFO(s.name);
+    const double t = s.report_trajectory_time_s();
+    CHECK(t > 0.0);
+    CHECK(t <= s.report_horizon_s());
+    // A whole number of the scene's steps (1/60 s for the paper's): runs at 1, 4 and 16
+    // substeps all step onto it exactly, so a trajectory error never holds the motion of a
+    // fraction of a step.
+    const double steps = t / s.world_def().dt;
+    CHECK(std::abs(steps - std::round(steps)) < 1e-9 * steps);
+    CHECK_FALSE(s.report.trajectory_reason.empty());
+  }
+  // The paper's scenes judged by a trajectory have a time chosen for them.
+  for (const scenes::Scene& s : scenes::paper_scenes()) {
+    INFO(s.name);
+    CHECK((s.report.has_reference_solution || s.report.trajectory_time_s.has_value()));
+  }
+}

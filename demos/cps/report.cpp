@@ -26,16 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The trajectory error compares positions with a reference run (16 substeps, 256 iterations) at
-// this time (s). Contacts make these scenes chaotic: once a stack starts to slide or balls start
-// to roll past each other, nearby trajectories part exponentially and a difference measures
-// chaos, not accuracy. Before the first impacts have settled they do not: 1 s covers the first
-// falls, landings and catches of the paper's scenes; a scene whose report horizon is shorter
-// (Scene::report) is compared at its horizon.
-double trajectory_time_of(const scenes::Scene& scene) {
-  return std::min(1.0, scene.report_horizon_s());
-}
-
 std::string name(SolverKind v) { return std::string(name_of(v)); }
 std::string name(PushMode v) { return std::string(name_of(v)); }
 std::string name(FrictionModel v) { return std::string(name_of(v)); }
@@ -119,23 +109,62 @@ bool sane_state(const World& world) {
   return true;
 }
 
-// Positions of the reference run (pgs, 256 iterations, 16 substeps, same push and friction
-// model) at the trajectory time; computed once per process and kept.
-std::vector<Vec3> reference_positions(const RunSpec& spec) {
+// The reference of the trajectory error: PGS with this many iterations and substeps per 1/60 s
+// frame, and the run's own push and friction model.
+constexpr int kReferenceIterations = 256;
+constexpr int kReferenceSubsteps = 16;
+
+// Positions of the movable bodies (m) once `spec` has been stepped to time t (s), or nullopt if
+// the run blew up on the way (see sane_state).
+std::optional<std::vector<Vec3>> positions_at(const RunSpec& spec, double t) {
+  scenes::Run run = scenes::make_run(scene_of(spec), overrides_of(spec));
+  run.world.step();  // at least one step, as every run
+  while (run.world.time() + 0.5 * run.world.def().dt < t) {
+    if (!sane_state(run.world)) return std::nullopt;
+    run.world.step();
+  }
+  if (!sane_state(run.world)) return std::nullopt;
+  return positions(run.world);
+}
+
+// RMS distance (m) between two lists of the same bodies' positions.
+double rms_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double sq = 0.0;
+  const std::size_t n = std::min(a.size(), b.size());
+  for (std::size_t i = 0; i < n; ++i) sq += (a[i] - b[i]).squaredNorm();
+  return n ? std::sqrt(sq / static_cast<double>(n)) : 0.0;
+}
+
+// The reference of a run at its scene's trajectory time: the positions (nullopt if the reference
+// blew up), and its own error estimate check_m (m), the RMS distance between the reference and
+// the same run at half its substeps. For a first-order method halving dt halves the error, so
+// the distance between the two is about the reference's own error; where contacts make the
+// scene chaotic it is large, and trajectory errors below it mean nothing.
+struct Reference {
+  std::optional<std::vector<Vec3>> positions;
+  double check_m = std::nan("");
+};
+
+// The reference of `spec` (its solver, iterations and substeps replaced); computed once per
+// process and kept.
+const Reference& reference_of(const RunSpec& spec) {
   static std::mutex mutex;
-  static std::map<std::string, std::vector<Vec3>> cache;
+  static std::map<std::string, Reference> cache;
   RunSpec ref = spec;
   ref.solver = SolverKind::pgs;
-  ref.iterations = 256;
-  ref.substeps = 16;
+  ref.iterations = kReferenceIterations;
+  ref.substeps = kReferenceSubsteps;
   const std::lock_guard<std::mutex> lock(mutex);
   const auto it = cache.find(ref.id());
   if (it != cache.end()) return it->second;
-  const scenes::Scene& scene = scene_of(ref);
-  scenes::Run run = scenes::make_run(scene, overrides_of(ref));
-  run.world.step();  // at least one step, as every run below
-  while (run.world.time() + 0.5 * run.world.def().dt < trajectory_time_of(scene)) run.world.step();
-  return cache[ref.id()] = positions(run.world);
+  const double t = scene_of(ref).report_trajectory_time_s();
+  Reference r;
+  r.positions = positions_at(ref, t);
+  RunSpec half = ref;
+  half.substeps = kReferenceSubsteps / 2;
+  const std::optional<std::vector<Vec3>> check = positions_at(half, t);
+  if (r.positions && check) r.check_m = rms_distance(*r.positions, *check);
+  return cache[ref.id()] = r;
 }
 
 // The numeric entries of a scene's metrics, as "metric.NAME" columns (booleans as 0/1, arrays
@@ -157,9 +186,11 @@ double to_double(const Row& row, const std::string& column) {
 std::vector<std::string> ordered_columns(const std::vector<Row>& rows) {
   static const std::vector<std::string> first = {
       "scene", "solver", "push", "friction_model", "iterations", "substeps", "dt_s", "horizon_s",
-      "diverged", "wall_s_per_sim_s", "us_per_step", "trajectory_time_s", "trajectory_error_m",
-      "phase_error_deg", "residual_max_N", "residual_rms_N", "penetration_max_m",
-      "penetration_rms_m", "rod_error_max_m", "rod_error_rms_m", "energy_drift_rel"};
+      "diverged", "diverged_at_s", "wall_s_per_sim_s", "us_per_step", "timing_repeats",
+      "trajectory_time_s", "trajectory_error_m", "reference_check_m", "phase_error_deg",
+      "residual_max_N", "residual_rms_N", "penetration_max_m", "penetration_rms_m",
+      "rod_error_max_m", "rod_error_rms_m", "energy_drift_rel", "sweep", "quick", "mass_ratio",
+      "seconds", "held", "heavy_height_m", "light_offset_m", "overlap_m", "iterations_holding"};
   std::set<std::string> all;
   for (const Row& r : rows) {
     for (const auto& kv : r) all.insert(kv.first);
@@ -172,20 +203,64 @@ std::vector<std::string> ordered_columns(const std::vector<Row>& rows) {
   return columns;
 }
 
-// What the work-precision diagrams show, with axis labels.
+// What the work-precision diagrams show: the CSV column, the axis label (with its unit), and the
+// round-off floor, the value under which the measure shows double precision round-off rather
+// than the method (see kFloorNotes). For the residual the floor is relative: floor times the
+// scene's largest body weight m |g| (N).
 struct Measure {
   const char* column;
-  const char* label;
+  const char* label;  // what it is, with its unit
+  const char* axis;   // the y axis' short label
+  const char* unit;   // "" for a ratio
+  double floor;
+  bool floor_per_weight = false;
 };
 constexpr Measure kMeasures[] = {
-    {"trajectory_error_m", "trajectory error against the reference run (m)"},
-    {"phase_error_deg", "largest phase error against the reduced-coordinate reference (deg)"},
-    {"residual_rms_N", "RMS LCP residual (N)"},
-    {"penetration_max_m", "largest penetration (m)"},
-    {"rod_error_max_m", "largest rod length error (m)"},
-    {"energy_drift_rel", "largest relative energy drift"},
-    {"metric.max_speed_mps", "largest body speed at the end (m/s)"},
+    {"trajectory_error_m", "RMS distance from the reference run at the trajectory time (m)",
+     "trajectory error (m)", "m", 1e-10},
+    {"phase_error_deg", "largest phase error against the reduced-coordinate reference (deg)",
+     "phase error (deg)", "deg", 1e-8},
+    {"residual_rms_N", "RMS LCP residual over every row of every solve (N)", "residual RMS (N)",
+     "N", 1e-12, true},
+    {"penetration_max_m", "deepest contact penetration over the run (m)", "penetration (m)", "m",
+     1e-10},
+    {"rod_error_max_m", "largest rod length error over the run (m)", "rod error (m)", "m", 1e-10},
+    {"energy_drift_rel", "largest relative energy drift |E(t) / E(0) - 1|", "|E / E0 - 1|", "",
+     1e-12},
+    {"metric.max_speed_mps",
+     "largest body speed at the end of the run (m/s; at rest, 0, is right)", "speed (m/s)", "m/s",
+     1e-10},
 };
+
+// Why the floors are where they are, for report.md.
+constexpr const char* kFloorNotes =
+    "values under a measure's round-off floor are drawn on the floor (dotted line) with their "
+    "own mark: double precision carries 2.2e-16 of relative round-off per operation, so there "
+    "they show round-off, not the method. Lengths (trajectory error, penetration, rod error): "
+    "1e-10 m; positions metres from the origin carry about 1e-15 m per operation, and a run "
+    "takes 1e3 to 1e5 steps of many operations each. LCP residual: 1e-12 of the scene's largest "
+    "body weight m |g| (N); a solve exact to round-off leaves about 1e-16 of the forces solved "
+    "for. Phase error: 1e-8 deg (2e-10 rad); the pendulum wave's phases grow to 630 rad over "
+    "3720 steps, each adding about 1e-13 rad. Energy drift: 1e-12, energies summed over 50 "
+    "bodies for 3720 steps. Speed: 1e-10 m/s.";
+
+// The largest weight m |g| (N) among the movable bodies of `scene`; 1 N without gravity or for a
+// scene this build does not know.
+double largest_weight(const std::string& scene) {
+  const scenes::Scene* s = scenes::find_scene(scene);
+  if (!s) return 1.0;
+  const scenes::Run run = scenes::make_run(*s);
+  double w = 0.0;
+  for (const Body& b : run.world.bodies()) {
+    if (!b.is_static()) w = std::max(w, b.mass * run.world.def().gravity.norm());
+  }
+  return w > 0.0 ? w : 1.0;
+}
+
+// The round-off floor of measure m in `scene` (the measure's unit).
+double floor_of(const Measure& m, const std::string& scene) {
+  return m.floor_per_weight ? m.floor * largest_weight(scene) : m.floor;
+}
 
 // The error measure the headline of the scene called `scene` uses (its Scene::report); the
 // default one for a name no scene has (a CSV of an older build).
@@ -219,86 +294,498 @@ void run_gnuplot(const fs::path& script) {
   }
 }
 
-// One diagram: error against physics time, log-log, a line per variant and sweep, points
-// labelled by iterations (solid lines) or substeps (dashed).
-bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& m,
-                  const std::vector<const Row*>& rows) {
-  struct Line {
-    std::string title;
-    bool substeps;
-    std::vector<std::tuple<double, double, std::string>> points;
+// A gnuplot string: single quotes, a quote inside doubled.
+std::string gp_text(const std::string& s) {
+  std::string q = "'";
+  for (const char c : s) q += c == '\'' ? std::string("''") : std::string(1, c);
+  return q + "'";
+}
+
+// The place of a setting's name in the order the diagrams' panels take (unknown names last).
+int rank_of(const std::string& value, std::initializer_list<const char*> order) {
+  int i = 0;
+  for (const char* o : order) {
+    if (value == o) return i;
+    ++i;
+  }
+  return i;
+}
+
+// One point of a diagram: physics time (s/s), the value drawn, and its label.
+struct PlotPoint {
+  double x = 0.0;
+  double y = 0.0;
+  std::string label;
+};
+
+// One panel of a work-precision diagram: the runs of one solver, push and friction model.
+struct Panel {
+  std::string title;
+  std::vector<PlotPoint> iterations;  // 1 substep, by iteration count (solid line)
+  std::vector<PlotPoint> substeps;    // 25 iterations, by substep count (dashed line)
+  std::vector<PlotPoint> paper;       // the paper's settings (25 iterations, 1 substep)
+  std::vector<PlotPoint> clamped;     // values under the floor, drawn on it
+  std::vector<PlotPoint> diverged;    // drawn at the top edge (y set once the range is known)
+  // Labels, placed by place_labels (x, y: the label's centre): the first and last point of the
+  // iteration line, the last of the substep line, every diverged run.
+  std::vector<PlotPoint> labels_it;
+  std::vector<PlotPoint> labels_ss;
+  std::vector<PlotPoint> labels_div;
+  double reference = std::nan("");    // the reference's own error (trajectory error only), or NaN
+};
+
+// A work-precision diagram of one measure for one scene: a panel per solver, push and friction
+// model, all on the same axes.
+struct Diagram {
+  std::vector<Panel> panels;
+  double floor = 0.0;
+  bool show_floor = false;
+  bool any_clamped = false;
+  bool any_diverged = false;
+  bool any_reference = false;
+  double x_lo = 0.0, x_hi = 0.0, y_lo = 0.0, y_hi = 0.0;  // y_hi: the top edge
+};
+
+// Sizes in a panel's frame, as fractions of its width (u) and height (v): a panel's frame is
+// about 480 x 240 pixels, a label character (font size 8) about 5 x 11 pixels.
+constexpr double kCharU = 5.0 / 480.0, kLabelV = 11.0 / 240.0;
+constexpr double kPointU = 6.0 / 480.0, kPointV = 6.0 / 240.0;  // half a point mark, with a gap
+
+// Places a panel's labels so that no label overlaps another label, a point mark or the frame's
+// edge: each takes the first free place of eight around its point (above, below, right, left,
+// then the corners; diverged runs' labels only under their mark, further down if need be), or
+// the least crowded one. The labels' positions are in data coordinates (log-log axes).
+void place_labels(Panel& p, const Diagram& d);
+
+// The diagram of measure m over the rows of one scene, or nullopt if no run that finished has a
+// value of it (floor: the measure's round-off floor in its unit).
+std::optional<Diagram> make_diagram(const Measure& m, double floor,
+                                    const std::vector<const Row*>& rows) {
+  const auto key_of = [](const Row& r) {
+    return std::make_tuple(rank_of(r.at("friction_model"), {"fixed", "coupled"}),
+                           rank_of(r.at("push"), {"baumgarte", "split"}),
+                           rank_of(r.at("solver"), {"pgs", "jacobi"}), variant_of(r));
   };
-  std::map<std::string, Line> lines;
-  for (const Row* r : rows) {
-    const double t = to_double(*r, "wall_s_per_sim_s");
-    const double e = to_double(*r, m.column);
-    if (!(t > 0.0) || !(e > 0.0)) continue;  // log axes: only positive values
-    const bool iteration_sweep = r->at("substeps") == "1";
-    const bool substep_sweep = r->at("iterations") == "25";
-    if (iteration_sweep) {
-      Line& line = lines[variant_of(*r) + ", iterations"];
-      line.title = variant_of(*r) + ", iterations";
-      line.points.emplace_back(t, e, r->at("iterations"));
+  std::map<std::tuple<int, int, int, std::string>, std::vector<const Row*>> by_panel;
+  for (const Row* r : rows) by_panel[key_of(*r)].push_back(r);
+  Diagram d;
+  d.floor = floor;
+  double raw_min = kInfinity, y_max = 0.0, x_min = kInfinity, x_max = 0.0;
+  bool any_value = false;
+  for (auto& [key, panel_rows] : by_panel) {
+    Panel p;
+    const Row& first = *panel_rows.front();
+    p.title = first.at("solver") + ", " + first.at("push") + " push, " +
+              first.at("friction_model") + " friction";
+    const auto count = [](const Row& r, const char* c) { return std::atoi(r.at(c).c_str()); };
+    std::vector<const Row*> sorted = panel_rows;
+    std::sort(sorted.begin(), sorted.end(), [&](const Row* a, const Row* b) {
+      return std::make_pair(count(*a, "substeps"), count(*a, "iterations")) <
+             std::make_pair(count(*b, "substeps"), count(*b, "iterations"));
+    });
+    std::vector<std::pair<int, PlotPoint>> it_line, ss_line;
+    for (const Row* r : sorted) {
+      const double t = to_double(*r, "wall_s_per_sim_s");
+      if (!(t > 0.0)) continue;
+      const int it = count(*r, "iterations");
+      const int ss = count(*r, "substeps");
+      const std::string label = ss == 1 ? std::to_string(it) + " it" : std::to_string(ss) + " ss";
+      if (r->at("diverged") == "1") {
+        p.diverged.push_back({t, 0.0, label});
+        d.any_diverged = true;
+        x_min = std::min(x_min, t);
+        x_max = std::max(x_max, t);
+        continue;
+      }
+      const double e = to_double(*r, m.column);
+      if (std::isnan(e)) continue;
+      any_value = true;
+      raw_min = std::min(raw_min, e);
+      const PlotPoint point{t, std::max(e, floor), label};
+      if (e < floor) {
+        p.clamped.push_back(point);
+        d.any_clamped = true;
+      }
+      y_max = std::max(y_max, point.y);
+      x_min = std::min(x_min, t);
+      x_max = std::max(x_max, t);
+      if (ss == 1) it_line.emplace_back(it, point);
+      if (it == 25) ss_line.emplace_back(ss, point);
+      if (ss == 1 && it == 25) p.paper.push_back(point);
     }
-    if (substep_sweep) {
-      Line& line = lines[variant_of(*r) + ", substeps"];
-      line.title = variant_of(*r) + ", substeps";
-      line.substeps = true;
-      line.points.emplace_back(t, e, "s" + r->at("substeps"));
+    std::sort(it_line.begin(), it_line.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::sort(ss_line.begin(), ss_line.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [n, point] : it_line) p.iterations.push_back(point);
+    for (const auto& [n, point] : ss_line) p.substeps.push_back(point);
+    if (!p.iterations.empty()) p.labels_it.push_back(p.iterations.front());
+    if (p.iterations.size() > 1) p.labels_it.push_back(p.iterations.back());
+    if (p.substeps.size() > 1) p.labels_ss.push_back(p.substeps.back());
+    if (std::string(m.column) == "trajectory_error_m") {
+      // A reference whose own error is under the floor (the same positions to round-off) has
+      // no line: it would lie on the floor's.
+      const double ref = to_double(first, "reference_check_m");
+      if (ref >= floor) {
+        p.reference = ref;
+        d.any_reference = true;
+        y_max = std::max(y_max, p.reference);
+      }
+    }
+    d.panels.push_back(std::move(p));
+  }
+  if (!any_value) return std::nullopt;
+  // The floor is drawn when a value comes within two decades of it; otherwise it would only
+  // stretch the axis.
+  d.show_floor = raw_min < 100.0 * floor;
+  double y_min = kInfinity;
+  for (const Panel& p : d.panels) {
+    for (const auto* line : {&p.iterations, &p.substeps}) {
+      for (const PlotPoint& q : *line) y_min = std::min(y_min, q.y);
+    }
+    if (p.reference > 0.0) y_min = std::min(y_min, p.reference);
+  }
+  if (d.show_floor) y_min = std::min(y_min, floor / 3.0);  // room for the floor's label
+  d.y_lo = y_min / 3.0;
+  d.y_hi = std::max(y_max, y_min) * 3.0;
+  if (d.any_diverged) d.y_hi *= 10.0;  // a decade of room: the diverged marks sit on the top edge
+  for (Panel& p : d.panels) {
+    for (PlotPoint& q : p.diverged) q.y = d.y_hi;
+  }
+  d.x_lo = x_min / 1.5;
+  d.x_hi = x_max * 1.5;
+  for (Panel& p : d.panels) place_labels(p, d);
+  return d;
+}
+
+void place_labels(Panel& p, const Diagram& d) {
+  const double lu = std::log(d.x_hi / d.x_lo), lv = std::log(d.y_hi / d.y_lo);
+  const auto u_of = [&](double x) { return std::log(x / d.x_lo) / lu; };
+  const auto v_of = [&](double y) { return std::log(y / d.y_lo) / lv; };
+  struct Box {
+    double u0, u1, v0, v1;
+  };
+  std::vector<Box> taken;
+  for (const auto* list : {&p.iterations, &p.substeps, &p.clamped, &p.diverged, &p.paper}) {
+    const double grow = list == &p.paper ? 1.7 : 1.0;  // the paper's ring is larger
+    for (const PlotPoint& q : *list) {
+      const double u = u_of(q.x), v = v_of(q.y);
+      taken.push_back({u - grow * kPointU, u + grow * kPointU, v - grow * kPointV, v + grow * kPointV});
     }
   }
-  if (lines.empty()) return false;
-  // Runs that blow up (Jacobi on contact stacks) would squash every other line into the bottom
-  // of the diagram: the y range stops a decade above the largest PGS value; the table and the
-  // CSV keep every figure.
-  double pgs_max = 0.0;
-  for (const Row* r : rows) {
-    if (r->at("solver") == "pgs") pgs_max = std::max(pgs_max, to_double(*r, m.column));
+  // The floor's and the reference's lines, as thin boxes across the frame.
+  for (const double y : {d.show_floor ? d.floor : 0.0, p.reference}) {
+    if (y > 0.0) taken.push_back({0.0, 1.0, v_of(y) - 0.01, v_of(y) + 0.01});
   }
-  const std::string stem = scene + "_" + m.column;
-  const fs::path data = dir / "plots" / (stem + ".dat");
-  const fs::path script = dir / "plots" / (stem + ".gp");
-  fs::create_directories(dir / "plots");
-  {
-    std::ofstream out(data);
-    for (auto& [key, line] : lines) {
-      std::sort(line.points.begin(), line.points.end());
-      out << "# " << line.title << "\n";
-      for (const auto& [t, e, label] : line.points) out << t << " " << e << " " << label << "\n";
+  const auto overlap = [](const Box& a, const Box& b) {
+    const double du = std::min(a.u1, b.u1) - std::max(a.u0, b.u0);
+    const double dv = std::min(a.v1, b.v1) - std::max(a.v0, b.v0);
+    return du > 0.0 && dv > 0.0 ? du * dv : 0.0;
+  };
+  const auto place = [&](const PlotPoint& q, bool under_only) {
+    const double u = u_of(q.x), v = v_of(q.y);
+    const double hw = 0.5 * kCharU * static_cast<double>(q.label.size()), hh = 0.5 * kLabelV;
+    const double du = kPointU + hw, dv = kPointV + hh;
+    std::vector<std::pair<double, double>> offsets;
+    if (under_only) {
+      for (int k = 1; k <= 4; ++k) offsets.emplace_back(0.0, -dv - (k - 1) * 2.0 * hh);
+    } else {
+      offsets = {{0.0, dv}, {0.0, -dv}, {du, 0.0}, {-du, 0.0},
+                 {du, dv}, {-du, dv}, {du, -dv}, {-du, -dv}};
+    }
+    Box best{};
+    double best_cost = kInfinity;
+    for (const auto& [ou, ov] : offsets) {
+      const Box b{u + ou - hw, u + ou + hw, v + ov - hh, v + ov + hh};
+      double cost = 0.0;
+      for (const Box& t : taken) cost += overlap(b, t);
+      // Outside the frame counts as crowded as a full overlap.
+      if (b.u0 < 0.0 || b.u1 > 1.0 || b.v0 < 0.0 || b.v1 > 1.0) cost += 4.0 * hw * hh;
+      if (cost < best_cost) best_cost = cost, best = b;
+      if (cost == 0.0) break;
+    }
+    taken.push_back(best);
+    return PlotPoint{d.x_lo * std::exp(0.5 * (best.u0 + best.u1) * lu),
+                     d.y_lo * std::exp(0.5 * (best.v0 + best.v1) * lv), q.label};
+  };
+  std::vector<PlotPoint> diverged = p.diverged;
+  std::sort(diverged.begin(), diverged.end(),
+            [](const PlotPoint& a, const PlotPoint& b) { return a.x < b.x; });
+  for (const PlotPoint& q : diverged) p.labels_div.push_back(place(q, true));
+  std::vector<PlotPoint> it = std::move(p.labels_it), ss = std::move(p.labels_ss);
+  p.labels_it.clear();
+  p.labels_ss.clear();
+  for (const PlotPoint& q : it) p.labels_it.push_back(place(q, false));
+  for (const PlotPoint& q : ss) p.labels_ss.push_back(place(q, false));
+}
+
+// The diagram's data: one gnuplot index block per non-empty list, in the order plot_script
+// reads them; per line x, y and a "label" (for the label lists, x and y are where the label's
+// centre goes).
+void write_plot_data(std::ostream& out, const Diagram& d) {
+  for (const Panel& p : d.panels) {
+    for (const auto* list : {&p.iterations, &p.substeps, &p.paper, &p.clamped, &p.diverged,
+                             &p.labels_it, &p.labels_ss, &p.labels_div}) {
+      if (list->empty()) continue;
+      for (const PlotPoint& q : *list) out << q.x << " " << q.y << " \"" << q.label << "\"\n";
       out << "\n\n";
     }
   }
-  std::ofstream gp(script);
-  gp << "set logscale xy\nset grid\nset key outside right top font ',9'\n"
-     << "set xlabel 'physics wall time per simulated second (s/s)'\n"
-     << "set ylabel '" << m.label << "'\n"
-     << "set title '" << scene << ": " << m.label << " against run time'\n";
-  if (pgs_max > 0.0) gp << "set yrange [*:" << 10.0 * pgs_max << "]\n";
-  // One colour per variant (solver, push, friction model); iterations solid, substeps dashed.
-  std::map<std::string, int> colour;
-  for (const auto& [key, line] : lines) {
-    const std::string variant = key.substr(0, key.rfind(','));
-    colour.emplace(variant, static_cast<int>(colour.size()) + 1);
+}
+
+// True if the label of the panel's reference line goes under the line: where most of the
+// panel's points lie above it, unless the line is near the frame's bottom (near its top, always).
+bool label_under_reference(const Panel& p, const Diagram& d) {
+  const double v = std::log(p.reference / d.y_lo) / std::log(d.y_hi / d.y_lo);
+  if (v < 0.12) return false;
+  if (v > 0.88) return true;
+  int above = 0, below = 0;
+  for (const auto* line : {&p.iterations, &p.substeps}) {
+    for (const PlotPoint& q : *line) (q.y > p.reference ? above : below) += 1;
   }
-  std::string plot = "plot ";
+  return above > below;
+}
+
+// The gnuplot commands that draw the diagram from `data` (written by write_plot_data) into the
+// current terminal: a grid of panels (pgs left, jacobi right, a row per push and friction
+// model) on shared axes, and a key below them.
+std::string plot_script(const Diagram& d, const fs::path& data, const std::string& title,
+                        const Measure& m, int height) {
+  std::ostringstream gp;
+  const int n = static_cast<int>(d.panels.size());
+  const int cols = n > 1 ? 2 : 1;
+  const int rows = (n + cols - 1) / cols;
+  const double title_h = 40.0 / height, key_h = 70.0 / height;
+  const double panel_w = 1.0 / cols, panel_h = (1.0 - title_h - key_h) / rows;
+  // x tics at 1, 2 and 5 per decade: the time axis spans one or two decades.
+  std::string xtics;
+  for (double decade = std::pow(10.0, std::floor(std::log10(d.x_lo))); decade < d.x_hi; decade *= 10.0) {
+    for (const double f : {1.0, 2.0, 5.0}) {
+      if (f * decade >= d.x_lo && f * decade <= d.x_hi) {
+        xtics += (xtics.empty() ? "" : ", ") + number(f * decade);
+      }
+    }
+  }
+  gp << "reset\nset multiplot\n"
+     << "set logscale xy\nset format x '%g'\nset format y '1e%T'\n"
+     << "set xrange [" << d.x_lo << ":" << d.x_hi << "]\nset yrange [" << d.y_lo << ":" << d.y_hi
+     << "]\nset grid xtics ytics lc rgb '#d8d8d8'\nset tics font ',8'\nunset key\n"
+     << (xtics.empty() ? std::string() : "set xtics (" + xtics + ")\n")
+     << "set lmargin 9\nset rmargin 2\nset tmargin 1.8\nset bmargin 2.6\n"
+     << "set label 100 " << gp_text(title) << " at screen 0.5, screen " << 1.0 - 0.5 * title_h
+     << " center font ',12'\n";
+  if (d.show_floor) {
+    gp << "set arrow 1 from graph 0, first " << d.floor << " to graph 1, first " << d.floor
+       << " nohead dt 3 lw 1.2 lc rgb 'gray30' back\n"
+       << "set label 1 'round-off floor' at graph 0.02, first " << d.floor
+       << " offset 0,-0.7 font ',7' tc rgb 'gray30'\n";
+  }
   int index = 0;
-  for (const auto& [key, line] : lines) {
-    const int lc = colour.at(key.substr(0, key.rfind(',')));
-    plot += (index ? ", " : "") + std::string("'") + data.string() + "' index " +
-            std::to_string(index) + " using 1:2 with linespoints lw 1.5 pt 7 ps 0.6 dt " +
-            (line.substeps ? "2" : "1") + " lc " + std::to_string(lc) + " title '" +
-            line.title + "', '' index " + std::to_string(index) +
-            " using 1:2:3 with labels offset 0.6,0.6 font ',7' tc lt " + std::to_string(lc) +
-            " notitle";
-    ++index;
+  for (int i = 0; i < n; ++i) {
+    const Panel& p = d.panels[static_cast<std::size_t>(i)];
+    const int col = i % cols, row = i / cols;
+    gp << "set origin " << col * panel_w << ", " << key_h + (rows - 1 - row) * panel_h << "\n"
+       << "set size " << panel_w << ", " << panel_h << "\n"
+       << "set title " << gp_text(p.title) << " font ',10' offset 0,-0.4\n"
+       << (row == rows - 1 ? "set xlabel 'physics wall time per simulated second (s/s)' "
+                             "font ',9' offset 0,0.4\n"
+                           : "unset xlabel\n")
+       << (col == 0 ? "set ylabel " + gp_text(m.axis) + " font ',9' offset 1,0\n" : "unset ylabel\n");
+    if (p.reference > 0.0) {
+      gp << "set arrow 2 from graph 0, first " << p.reference << " to graph 1, first "
+         << p.reference << " nohead dt 4 lw 1.2 lc rgb '#b8860b' back\n"
+         << "set label 2 'reference''s own error' at graph 0.02, first " << p.reference
+         << " offset 0," << (label_under_reference(p, d) ? "-0.7" : "0.7")
+         << " font ',7' tc rgb '#b8860b'\n";
+    } else {
+      gp << "unset arrow 2\nunset label 2\n";
+    }
+    std::vector<std::string> parts;
+    // Adds the plot of the next index block (list, if not empty).
+    const auto block = [&](const std::vector<PlotPoint>& list, const std::string& style) {
+      if (list.empty()) return;
+      parts.push_back((parts.empty() ? gp_text(data.string()) : std::string("''")) + " index " +
+                      std::to_string(index++) + " " + style);
+    };
+    block(p.iterations, "using 1:2 with linespoints lw 1.5 pt 7 ps 0.7 lc rgb '#1f77b4'");
+    block(p.substeps, "using 1:2 with linespoints lw 1.5 dt 2 pt 5 ps 0.7 lc rgb '#e377c2'");
+    block(p.paper, "using 1:2 with points pt 6 ps 2.2 lw 1.5 lc rgb 'black'");
+    block(p.clamped, "using 1:2 with points pt 10 ps 1.6 lw 1.5 lc rgb 'black'");
+    block(p.diverged, "using 1:2 with points pt 2 ps 1.8 lw 2.5 lc rgb '#d62728'");
+    block(p.labels_it, "using 1:2:3 with labels font ',8' tc rgb '#1f77b4'");
+    block(p.labels_ss, "using 1:2:3 with labels font ',8' tc rgb '#c0399c'");
+    block(p.labels_div, "using 1:2:3 with labels font ',8' tc rgb '#d62728'");
+    gp << "plot ";
+    for (std::size_t k = 0; k < parts.size(); ++k) gp << (k ? ", \\\n     " : "") << parts[k];
+    gp << "\n";
+    if (i == 0) gp << "unset label 100\n";
   }
-  gp << "set terminal pngcairo size 1100,650 font ',10' noenhanced\nset output '"
-     << (dir / (stem + ".png")).string() << "'\n" << plot << "\n";
-  gp << "set terminal svg size 1100,650 font ',10' noenhanced\nset output '"
-     << (dir / (stem + ".svg")).string() << "'\n" << plot << "\nunset output\n";
-  gp.close();
+  // The key: a frameless plot of nothing under the panels.
+  gp << "unset arrow\nunset label\nunset title\nunset xlabel\nunset ylabel\nunset logscale\n"
+     << "unset border\nunset tics\nunset grid\nset origin 0, 0\nset size 1, " << key_h << "\n"
+     << "set lmargin 0\nset rmargin 0\nset tmargin 0\nset bmargin 0\n"
+     << "set xrange [0:1]\nset yrange [0:1]\n"
+     << "set key center center horizontal maxrows 2 width 1 samplen 3 font ',9'\nplot "
+     << "NaN with linespoints lw 1.5 pt 7 lc rgb '#1f77b4' title 'iterations, 1 substep (60 Hz)'"
+     << ", NaN with linespoints lw 1.5 dt 2 pt 5 lc rgb '#e377c2' title "
+        "'substeps per 1/60 s frame, 25 iterations'"
+     << ", NaN with points pt 6 ps 2 lw 1.5 lc rgb 'black' title 'the paper''s settings'";
+  if (d.any_diverged) {
+    gp << ", NaN with points pt 2 ps 1.5 lw 2.5 lc rgb '#d62728' title "
+          "'diverged (on the top edge; time until it diverged)'";
+  }
+  if (d.show_floor) {
+    gp << ", NaN with lines dt 3 lw 1.2 lc rgb 'gray30' title "
+       << gp_text("round-off floor: " + number(d.floor) + " " + m.unit);
+  }
+  if (d.any_clamped) {
+    gp << ", NaN with points pt 10 ps 1.5 lw 1.5 lc rgb 'black' title "
+          "'under the floor (drawn on it)'";
+  }
+  if (d.any_reference) {
+    gp << ", NaN with lines dt 4 lw 1.2 lc rgb '#b8860b' title "
+          "'reference''s own error (16 vs 8 substeps)'";
+  }
+  gp << "\nunset multiplot\n";
+  return gp.str();
+}
+
+// One diagram DIR/SCENE_<measure>.png and .svg: the measure against physics time, log-log, in
+// small multiples (see plot_script). False if no run has a value of the measure.
+bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& m,
+                  const std::vector<const Row*>& rows, const std::string& title_note) {
+  const std::optional<Diagram> diagram = make_diagram(m, floor_of(m, scene), rows);
+  if (!diagram) return false;
+  const std::string stem = scene + "_" + m.column;
+  const fs::path data = dir / "plots" / (stem + ".dat");
+  const fs::path script = dir / "plots" / (stem + ".gp");
+  {
+    std::ostringstream out;
+    write_plot_data(out, *diagram);
+    write_text_atomic(data, out.str());
+  }
+  const int rows_of_panels = (static_cast<int>(diagram->panels.size()) + 1) / 2;
+  const int width = 1100, height = 110 + 300 * rows_of_panels;
+  const std::string title = scene + ": " + m.label + title_note;
+  const std::string body = plot_script(*diagram, data, title, m, height);
+  // gnuplot writes the pictures into temporaries of this run, renamed once it has succeeded.
+  AtomicFile png(dir / (stem + ".png"));
+  AtomicFile svg(dir / (stem + ".svg"));
+  png.hand_over();
+  svg.hand_over();
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size " << width << "," << height << " font ',10' noenhanced\n"
+     << "set output '" << png.temporary().string() << "'\n" << body;
+  gp << "set terminal svg size " << width << "," << height << " font ',10' noenhanced\n"
+     << "set output '" << svg.temporary().string() << "'\n" << body << "unset output\n";
+  write_text_atomic(script, gp.str());
   run_gnuplot(script);
+  png.commit();
+  svg.commit();
   return true;
+}
+
+// The mass ratio pair (stress scenes mass_ratio_R: a heavy cube of R kg resting on a light cube
+// of 1 kg on the ground, both of half edge h = scenes::kMassRatioHalfEdge) at the end of a run.
+struct PairOutcome {
+  bool finite = false;                    // false: the run blew up (nothing below is measured)
+  double light_offset_m = std::nan("");   // light cube centre to the heavy cube's vertical axis
+  double heavy_height_m = std::nan("");   // heavy cube centre height; 3 h = 1.5 m when stacked
+  double overlap_m = std::nan("");        // deepest overlap between any two bodies now
+  bool held = false;                      // see pair_outcome
+};
+
+// How far the heavy cube's centre may be from its stacked height 3 h and the pair still count
+// as held (m): h / 2, a light cube crushed by under a quarter of its edge. Squeezed out from
+// under, the heavy cube drops to h, 2 h lower.
+constexpr double kHeldHeightTolerance = 0.5 * scenes::kMassRatioHalfEdge;
+// The heavy cube's stacked height (m): on the light cube, on the ground.
+constexpr double kStackedHeight = 3.0 * scenes::kMassRatioHalfEdge;
+
+// The pair in `world` (made by scenes::populate_mass_ratio: body 1 light, body 2 heavy). Held:
+// the light cube is still between the heavy cube and the ground, that is its centre is within
+// h of the heavy cube's vertical axis (the heavy cube's centre of mass is over the light cube's
+// top face: it rests on it, not beside it) and the heavy cube's centre is within
+// kHeldHeightTolerance of its stacked height.
+PairOutcome pair_outcome(const World& world) {
+  PairOutcome o;
+  if (!sane_state(world)) return o;
+  const Vec3& light = world.body(1).x;
+  const Vec3& heavy = world.body(2).x;
+  o.finite = true;
+  o.light_offset_m = std::hypot(light.x() - heavy.x(), light.z() - heavy.z());
+  o.heavy_height_m = heavy.y();
+  o.overlap_m = scenes::max_penetration_now(world);
+  o.held = o.light_offset_m <= scenes::kMassRatioHalfEdge &&
+           std::abs(o.heavy_height_m - kStackedHeight) <= kHeldHeightTolerance;
+  return o;
+}
+
+// Runs the pair of mass ratio `ratio` (> 0) from rest for `seconds` (s) at the paper's settings
+// (scenes::mass_ratio_world_def(): 60 Hz, beta 0.2, mu 0.5) with this solver, push and
+// iteration count.
+PairOutcome run_pair(double ratio, SolverKind solver, PushMode push, int iterations,
+                     double seconds) {
+  WorldDef def = scenes::mass_ratio_world_def();
+  def.solver = solver;
+  def.push = push;
+  def.iterations = iterations;
+  World world(def);
+  scenes::populate_mass_ratio(world, ratio);
+  while (world.time() + 0.5 * def.dt < seconds) {
+    world.step();
+    if (!sane_state(world)) return {};
+  }
+  return pair_outcome(world);
+}
+
+// The mass ratio table: for ratios 10, 100, 1000 and each solver and push, the pair after
+// kPairSeconds at 25 iterations, and the iteration counts of 1, 2, 4, ..., 256 with which it
+// holds with under 1 cm of overlap (space-separated; holding need not be monotone in the count).
+// One row each (columns mass_ratio, solver, push, iterations, seconds, held, heavy_height_m,
+// light_offset_m, overlap_m, iterations_holding).
+constexpr double kPairSeconds = 5.0;
+std::vector<Row> mass_ratio_rows() {
+  std::vector<Row> rows;
+  for (const double ratio : {10.0, 100.0, 1000.0}) {
+    for (const PushMode push : {PushMode::baumgarte, PushMode::split}) {
+      for (const SolverKind solver : {SolverKind::pgs, SolverKind::jacobi}) {
+        const PairOutcome o = run_pair(ratio, solver, push, 25, kPairSeconds);
+        std::string holding;
+        for (int n = 1; n <= 256; n *= 2) {
+          const PairOutcome q = run_pair(ratio, solver, push, n, kPairSeconds);
+          if (q.held && q.overlap_m < 0.01) holding += (holding.empty() ? "" : " ") + std::to_string(n);
+        }
+        Row r;
+        r["mass_ratio"] = number(ratio);
+        r["solver"] = name(solver);
+        r["push"] = name(push);
+        r["iterations"] = "25";
+        r["seconds"] = number(kPairSeconds);
+        r["held"] = o.held ? "1" : "0";
+        r["heavy_height_m"] = number(o.heavy_height_m);
+        r["light_offset_m"] = number(o.light_offset_m);
+        r["overlap_m"] = number(o.overlap_m);
+        r["iterations_holding"] = holding;
+        rows.push_back(r);
+      }
+    }
+  }
+  return rows;
+}
+
+// The id (RunSpec::id) of the run a CSV row holds.
+std::string id_of(const Row& r) {
+  return r.at("scene") + "." + r.at("solver") + "." + r.at("push") + "." +
+         r.at("friction_model") + ".it" + r.at("iterations") + ".ss" + r.at("substeps");
+}
+
+// A human label of a CSV column: the diagram's label of a measure, else the column's name.
+std::string label_of(const std::string& column) {
+  for (const Measure& m : kMeasures) {
+    if (column == m.column) return m.label;
+  }
+  return column;
 }
 
 }  // namespace
@@ -377,7 +864,8 @@ std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, 
 Row execute_run(const RunSpec& spec, int repeats) {
   const scenes::Scene& scene = scene_of(spec);
   const double horizon = scene.report_horizon_s();
-  const double t_traj = trajectory_time_of(scene);
+  const bool has_trajectory = !scene.report.has_reference_solution;
+  const double t_traj = std::min(scene.report_trajectory_time_s(), horizon);
   scenes::Overrides o = overrides_of(spec);
   Row row;
   row["scene"] = spec.scene;
@@ -397,7 +885,7 @@ Row execute_run(const RunSpec& spec, int repeats) {
   double pen_max = 0.0, pen_sq = 0.0, rod_max = 0.0, rod_sq = 0.0;
   std::int64_t pen_n = 0, rod_n = 0;
   std::vector<Vec3> at_traj;
-  bool diverged = false;
+  std::optional<double> diverged_at;  // s
   // A run has diverged when its state is not finite or its penetration or rod error passes the
   // size of the largest movable body (bodies then pass through each other, rods stretch past any
   // shape in the scene): its numbers measure the blow-up, not the method's accuracy.
@@ -405,7 +893,7 @@ Row execute_run(const RunSpec& spec, int repeats) {
   while (run.world.time() + 0.5 * run.world.def().dt < horizon) {
     run.step();
     if (!sane_state(run.world)) {
-      diverged = true;
+      diverged_at = run.world.time();
       break;
     }
     for (const Manifold& m : run.world.manifolds()) {
@@ -429,11 +917,28 @@ Row execute_run(const RunSpec& spec, int repeats) {
       at_traj = positions(run.world);
     }
     if (pen_max > size_bound || rod_max > size_bound) {
-      diverged = true;
+      diverged_at = run.world.time();
       break;
     }
   }
+  const double error_run_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - error_start).count();
+  const bool diverged = diverged_at.has_value();
+  // A run that diverged before the trajectory time steps on to it (the physics alone) while its
+  // state stays finite: how far the blow-up has carried the bodies by then is its trajectory
+  // error. A step that refuses the blown-up state (too many contacts) ends it without one.
+  if (has_trajectory && diverged && at_traj.empty()) {
+    try {
+      while (sane_state(run.world) && run.world.time() + 0.5 * run.world.def().dt < t_traj) {
+        run.world.step();
+      }
+      if (sane_state(run.world)) at_traj = positions(run.world);
+    } catch (const std::exception&) {
+      at_traj.clear();
+    }
+  }
   row["diverged"] = diverged ? "1" : "0";
+  if (diverged) row["diverged_at_s"] = number(*diverged_at);
   const ResidualStats& res = run.world.residual();
   row["residual_max_N"] = number(res.max);
   row["residual_rms_N"] = number(res.rms());
@@ -454,67 +959,74 @@ Row execute_run(const RunSpec& spec, int repeats) {
     if (metrics.contains("energy_drift_rel")) {
       row["energy_drift_rel"] = number(metrics["energy_drift_rel"].get<double>());
     }
-    if (!at_traj.empty() && !scene.report.has_reference_solution) {
-      const std::vector<Vec3> ref = reference_positions(spec);
-      double sq = 0.0;
-      for (std::size_t i = 0; i < ref.size() && i < at_traj.size(); ++i) {
-        sq += (at_traj[i] - ref[i]).squaredNorm();
-      }
-      row["trajectory_time_s"] = number(t_traj);
-      row["trajectory_error_m"] = number(std::sqrt(sq / static_cast<double>(ref.size())));
+  }
+  if (has_trajectory) {
+    const Reference& ref = reference_of(spec);
+    row["trajectory_time_s"] = number(t_traj);
+    row["reference_check_m"] = number(ref.check_m);
+    if (!at_traj.empty() && ref.positions) {
+      row["trajectory_error_m"] = number(rms_distance(at_traj, *ref.positions));
     }
   }
 
   // Timing runs: the physics step alone, residuals off, metrics not fed; the median of repeats.
-  // The error run above was the warm-up. A run whose error run took over 2 s is timed once.
-  if (std::chrono::duration<double>(std::chrono::steady_clock::now() - error_start).count() > 2.0) {
-    repeats = std::min(repeats, 1);
-  }
+  // The error run above was the warm-up. A run whose error run took over 2 s is timed once. A
+  // diverged run is timed up to the time it diverged: what the method cost until it failed.
+  if (error_run_s > 2.0) repeats = std::min(repeats, 1);
+  const double timed_until = diverged ? *diverged_at : horizon;
   o.set("measure_residual", false);
   std::vector<double> seconds;
   std::int64_t steps = 0;
-  for (int r = 0; r < (diverged ? 0 : repeats); ++r) {
+  double simulated = 0.0;
+  for (int r = 0; r < repeats; ++r) {
     scenes::Run timed = scenes::make_run(scene, o);
     const auto start = std::chrono::steady_clock::now();
-    while (timed.world.time() + 0.5 * timed.world.def().dt < horizon) timed.world.step();
+    do {
+      timed.world.step();
+    } while (timed.world.time() + 0.5 * timed.world.def().dt < timed_until);
     seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     steps = timed.world.counters().steps;
+    simulated = timed.world.time();
   }
   if (!seconds.empty()) {
     std::sort(seconds.begin(), seconds.end());
     const double median = seconds[seconds.size() / 2];
-    row["wall_s_per_sim_s"] = number(median / horizon);
+    row["wall_s_per_sim_s"] = number(median / simulated);
     row["us_per_step"] = number(1e6 * median / static_cast<double>(std::max<std::int64_t>(steps, 1)));
+    row["timing_repeats"] = std::to_string(seconds.size());
   }
   return row;
 }
 
 void write_csv(const fs::path& file, const std::vector<Row>& rows) {
   const std::vector<std::string> columns = ordered_columns(rows);
-  const fs::path temporary = file.string() + ".tmp";
-  {
-    std::ofstream out(temporary);
-    if (!out) throw std::runtime_error("report: cannot write " + file.string());
-    for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c];
-    out << "\n";
-    for (const Row& r : rows) {
-      for (std::size_t c = 0; c < columns.size(); ++c) {
-        const auto it = r.find(columns[c]);
-        out << (c ? "," : "") << (it == r.end() ? "" : it->second);
-      }
-      out << "\n";
+  std::ostringstream out;
+  for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c];
+  out << "\n";
+  for (const Row& r : rows) {
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      const auto it = r.find(columns[c]);
+      out << (c ? "," : "") << (it == r.end() ? "" : it->second);
     }
+    out << "\n";
   }
-  fs::rename(temporary, file);
+  write_text_atomic(file, out.str());
 }
 
 std::vector<Row> read_rows(const std::vector<fs::path>& dirs) {
   std::vector<Row> rows;
   for (const fs::path& dir : dirs) {
-    if (!fs::is_directory(dir)) throw std::runtime_error("report --merge: no folder " + dir.string());
+    if (!fs::is_directory(dir)) {
+      throw UsageError("--merge " + dir.string() + ": no such folder (give folders holding the "
+                       "CSV files of report runs)");
+    }
     std::vector<fs::path> files;
     for (const auto& entry : fs::recursive_directory_iterator(dir)) {
-      if (entry.is_regular_file() && entry.path().extension() == ".csv") files.push_back(entry.path());
+      // mass_ratio.csv (the report's mass ratio table) holds no runs.
+      if (entry.is_regular_file() && entry.path().extension() == ".csv" &&
+          entry.path().filename() != "mass_ratio.csv") {
+        files.push_back(entry.path());
+      }
     }
     std::sort(files.begin(), files.end());
     for (const fs::path& file : files) {
@@ -525,7 +1037,8 @@ std::vector<Row> read_rows(const std::vector<fs::path>& dirs) {
       std::stringstream hs(line);
       for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
       if (header.empty() || header[0] != "scene") {
-        throw std::runtime_error("report --merge: " + file.string() + " is not a cps report CSV");
+        throw UsageError("--merge: " + file.string() +
+                         " is not a cps report CSV (its header does not start with 'scene')");
       }
       while (std::getline(in, line)) {
         if (line.empty()) continue;
@@ -543,51 +1056,135 @@ std::vector<Row> read_rows(const std::vector<fs::path>& dirs) {
   return rows;
 }
 
-void write_report(const fs::path& dir, const std::vector<Row>& rows) {
-  fs::create_directories(dir);
+std::vector<std::string> missing_runs(const std::vector<Row>& rows, std::size_t& planned) {
+  std::set<std::pair<std::string, bool>> sweeps;
+  std::set<std::string> present;
+  for (const Row& r : rows) {
+    const auto sweep = r.find("sweep");
+    const auto quick = r.find("quick");
+    sweeps.emplace(sweep != r.end() ? sweep->second : r.at("scene"),
+                   quick != r.end() && quick->second == "1");
+    present.insert(id_of(r));
+  }
+  std::vector<std::string> missing;
+  std::set<std::string> seen;
+  for (const auto& [sweep, quick] : sweeps) {
+    std::vector<const scenes::Scene*> scenes;
+    try {
+      scenes = select_scenes(sweep);
+    } catch (const std::exception&) {
+      // A sweep this build does not know (a CSV of another build): its plan is unknown.
+    }
+    for (const RunSpec& spec : plan_runs(scenes, quick)) {
+      const std::string id = spec.id();
+      if (seen.insert(id).second && !present.count(id)) missing.push_back(id);
+    }
+  }
+  planned = seen.size();
+  return missing;
+}
+
+void write_report(const fs::path& dir, const std::vector<Row>& rows,
+                  const std::vector<std::string>& missing, std::size_t planned) {
   std::map<std::string, std::vector<const Row*>> by_scene;
   std::vector<std::string> order;
   for (const Row& r : rows) {
     if (!by_scene.count(r.at("scene"))) order.push_back(r.at("scene"));
     by_scene[r.at("scene")].push_back(&r);
   }
+  const auto cell = [](const Row& r, const std::string& c) {
+    const auto it = r.find(c);
+    return it == r.end() ? std::string() : it->second;
+  };
   std::ostringstream md;
-  md << "# Error against run time\n\n"
-     << "Made by `cps report`. Each run steps the scene for its horizon with the settings in its "
-        "row; the physics wall time per simulated second is the median of timing runs of the "
-        "step alone (no metrics, no residual), after the error run as warm-up. Trajectory error: "
-        "RMS distance of the bodies from a reference run (PGS, 256 iterations, 16 substeps, same "
-        "push and friction model) at the trajectory time, kept short because contacts make "
-        "these scenes chaotic. The LCP residual is the natural-map residual "
-        "|lambda - clamp(lambda - (A lambda - b) / A_jj, c_min, c_max)| over every row of every "
-        "solve. Substeps are steps per 1/60 s frame.\n\n"
-     << "## Headline: error at the paper's settings and the time needed to halve it\n\n"
-     << "The cheapest run with half the error is searched among every run of the scene (every "
-        "solver, push and friction model), diverged runs left out.\n\n"
-     << "| scene | measure | paper settings (pgs, baumgarte, fixed, 25 it, 60 Hz) | time (s/s) "
-        "| cheapest run with half the error | its time (s/s) | time ratio |\n|---|---|---|---|---|---|---|\n";
+  std::string title_note;
+  md << "# Error against run time\n\n";
+  if (!missing.empty()) {
+    title_note = " (INCOMPLETE: " + std::to_string(missing.size()) + " of " +
+                 std::to_string(planned) + " runs missing)";
+    md << "**INCOMPLETE: " << missing.size() << " of the " << planned
+       << " planned runs are missing.** Every table and diagram below lacks them; the "
+          "headline compares only the runs present. Missing:";
+    for (std::size_t i = 0; i < missing.size() && i < 20; ++i) md << (i ? ", " : " ") << "`" << missing[i] << "`";
+    if (missing.size() > 20) md << " and " << missing.size() - 20 << " more";
+    md << ".\n\n";
+  }
+  int repeats_min = 1 << 30, repeats_max = 0;
+  for (const Row& r : rows) {
+    const int n = std::atoi(cell(r, "timing_repeats").c_str());
+    if (n > 0) repeats_min = std::min(repeats_min, n), repeats_max = std::max(repeats_max, n);
+  }
+  md << "Made by `cps report` from " << rows.size() << " runs. What the numbers are:\n\n"
+     << "- **Time (s/s)**: physics wall time per simulated second, the median of ";
+  if (repeats_max > 0 && repeats_min == repeats_max) {
+    md << repeats_max;
+  } else if (repeats_max > 0) {
+    md << repeats_min << " to " << repeats_max;
+  } else {
+    md << "the";
+  }
+  md << " timing runs of the step alone (no metrics, no residual; column timing_repeats) after "
+        "the error run as warm-up; a run whose error run took over 2 s is timed once. A "
+        "diverged run is timed until it diverged.\n"
+     << "- **Diverged**: the state stopped being finite, or a penetration or rod error passed "
+        "the size of the largest movable body (the time: diverged_at_s). Its other measures "
+        "stop there and are left out of the headline. In the diagrams it is a red x on the top "
+        "edge, at its time until it diverged.\n"
+     << "- **Trajectory error (m)**: RMS distance of the movable bodies from a reference run "
+        "(PGS, " << kReferenceIterations << " iterations, " << kReferenceSubsteps
+     << " substeps, the run's push and friction model) at the scene's trajectory time, given "
+        "with its reason under each scene. A run that diverged before that time steps on to it "
+        "(the physics alone) while its state stays finite. **The reference's own error** (reference_check_m) is its "
+        "distance from the same run at " << kReferenceSubsteps / 2
+     << " substeps: halving dt halves a first-order method's error, so that distance is about "
+        "the reference's error. Trajectory errors under it are not resolved.\n"
+     << "- **LCP residual (N)**: the natural-map residual |lambda - clamp(lambda - (A lambda - "
+        "b) / A_jj, c_min, c_max)| over every row of every solve.\n"
+     << "- **Substeps**: steps per 1/60 s frame (dt = 1 / (60 substeps) s); the iteration sweep "
+        "runs at 1 substep, the substep sweep at 25 iterations.\n"
+     << "- **Round-off floors** (diagrams only; tables and CSVs keep every value): " << kFloorNotes
+     << "\n\n"
+     << "## Headline: the paper's settings and the cheapest run with at most half their error\n\n"
+     << "The cheapest run (least time) whose value of the scene's measure is at most half the "
+        "value at the paper's settings, among every run of the scene (every solver, push and "
+        "friction model), diverged runs left out. For the trajectory error a run counts only "
+        "if half the paper's value is above its reference's own error.\n\n"
+     << "| scene | measure | at the paper's settings (PGS, Baumgarte, fixed friction, 25 it, 60 Hz) "
+        "| its time (s/s) | cheapest run with at most half of it | its time (s/s) | time ratio |\n"
+        "|---|---|---|---|---|---|---|\n";
   for (const std::string& scene : order) {
     const std::string measure = primary_measure(scene);
     const Row* base = nullptr;
     for (const Row* r : by_scene[scene]) {
       if (is_paper_setting(*r)) base = r;
     }
-    if (!base) continue;
+    md << "| " << scene << " | " << label_of(measure) << " | ";
+    if (!base || base->at("diverged") == "1" || std::isnan(to_double(*base, measure))) {
+      md << (base ? "diverged or not measured" : "not in this sweep") << " | | | | |\n";
+      continue;
+    }
     const double e0 = to_double(*base, measure);
     const double t0 = to_double(*base, "wall_s_per_sim_s");
+    const bool trajectory = measure == "trajectory_error_m";
     const Row* best = nullptr;
     for (const Row* r : by_scene[scene]) {
       if (r->at("diverged") == "1") continue;
       const double e = to_double(*r, measure);
       const double t = to_double(*r, "wall_s_per_sim_s");
+      if (trajectory && !(0.5 * e0 > to_double(*r, "reference_check_m"))) continue;
       if (e <= 0.5 * e0 && std::isfinite(t) && (!best || t < to_double(*best, "wall_s_per_sim_s"))) best = r;
     }
-    md << "| " << scene << " | " << measure << " | " << number(e0) << " | " << number(t0) << " | ";
+    md << number(e0);
+    if (trajectory && e0 < to_double(*base, "reference_check_m")) {
+      md << " (under its reference's own error, " << cell(*base, "reference_check_m") << ")";
+    }
+    md << " | " << number(t0) << " | ";
     if (best) {
       const double t1 = to_double(*best, "wall_s_per_sim_s");
       md << best->at("solver") << ", " << best->at("push") << ", " << best->at("friction_model")
          << ", " << best->at("iterations") << " it, " << best->at("substeps")
-         << " substeps: " << number(to_double(*best, measure)) << " | " << number(t1) << " | "
+         << (best->at("substeps") == "1" ? " substep" : " substeps")
+         << ": " << number(to_double(*best, measure)) << " | " << number(t1) << " | "
          << number(t1 / t0) << " |\n";
     } else {
       md << "none in this sweep | | |\n";
@@ -598,45 +1195,107 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows) {
     std::vector<Row> scene_rows;
     for (const Row* r : by_scene[scene]) scene_rows.push_back(*r);
     write_csv(dir / (scene + ".csv"), scene_rows);
-    md << "## " << scene << "\n\nAll runs: [" << scene << ".csv](" << scene << ".csv).\n\n";
+    md << "## " << scene << "\n\n";
+    if (const scenes::Scene* s = scenes::find_scene(scene)) {
+      md << "- **Horizon** " << number(s->report_horizon_s()) << " s: " << s->report.horizon_reason
+         << ".\n- **Trajectory time** ";
+      if (s->report.has_reference_solution) {
+        md << s->report.trajectory_reason << ".";
+      } else {
+        md << number(std::min(s->report_trajectory_time_s(), s->report_horizon_s())) << " s: "
+           << s->report.trajectory_reason << ".";
+      }
+      md << "\n";
+    }
+    std::map<std::string, std::string> checks;  // push, friction -> reference's own error
+    for (const Row* r : by_scene[scene]) {
+      if (!cell(*r, "reference_check_m").empty()) {
+        checks[r->at("push") + ", " + r->at("friction_model") + " friction"] = cell(*r, "reference_check_m");
+      }
+    }
+    if (!checks.empty()) {
+      md << "- **The reference's own error** at the trajectory time (m):";
+      bool first = true;
+      for (const auto& [variant, value] : checks) {
+        md << (first ? " " : "; ") << variant << ": " << value;
+        first = false;
+      }
+      md << ".\n";
+    }
+    md << "\nAll runs: [" << scene << ".csv](" << scene << ".csv).\n\n";
     for (const Measure& m : kMeasures) {
-      if (plot_measure(dir, scene, m, by_scene[scene])) {
+      if (plot_measure(dir, scene, m, by_scene[scene], title_note)) {
         md << "![" << scene << " " << m.column << "](" << scene << "_" << m.column << ".png)\n\n";
       }
     }
     const std::string measure = primary_measure(scene);
-    md << "| solver | push | friction | iterations | substeps | time (s/s) | " << measure
-       << " | residual RMS (N) | penetration max (m) | rod error max (m) | diverged |\n"
+    md << "| solver | push | friction | iterations | substeps | time (s/s) | " << label_of(measure)
+       << " | residual RMS (N) | penetration max (m) | rod error max (m) | diverged at (s) |\n"
        << "|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const Row* r : by_scene[scene]) {
-      const auto cell = [r](const std::string& c) {
-        const auto it = r->find(c);
-        return it == r->end() ? std::string() : it->second;
-      };
-      md << "| " << cell("solver") << " | " << cell("push") << " | " << cell("friction_model")
-         << " | " << cell("iterations") << " | " << cell("substeps") << " | "
-         << cell("wall_s_per_sim_s") << " | " << cell(measure) << " | " << cell("residual_rms_N")
-         << " | " << cell("penetration_max_m") << " | " << cell("rod_error_max_m") << " | "
-         << cell("diverged") << " |\n";
+      md << "| " << cell(*r, "solver") << " | " << cell(*r, "push") << " | "
+         << cell(*r, "friction_model") << " | " << cell(*r, "iterations") << " | "
+         << cell(*r, "substeps") << " | " << cell(*r, "wall_s_per_sim_s") << " | "
+         << cell(*r, measure) << " | " << cell(*r, "residual_rms_N") << " | "
+         << cell(*r, "penetration_max_m") << " | " << cell(*r, "rod_error_max_m") << " | "
+         << (cell(*r, "diverged") == "1" ? cell(*r, "diverged_at_s") : "no") << " |\n";
     }
     md << "\n";
   }
-  md << "## Mass ratios: iterations each needs\n\n"
-     << "A heavy cube resting on a light one on the ground (stress scenes mass_ratio_R), paper "
-        "settings otherwise: the smallest PGS iteration count in 1, 2, 4, ..., 256 with which "
-        "the pair still stands after 5 s with less than 1 cm of overlap (-1: none).\n\n"
-     << "| mass ratio | iterations needed | penetration at 25 iterations after 5 s (m) |\n|---|---|---|\n";
-  for (const double ratio : {10.0, 100.0, 1000.0}) {
-    md << "| " << ratio << " | " << scenes::iterations_needed(ratio) << " | "
-       << number(scenes::run_mass_ratio(ratio, 25, 5.0).final_penetration_m) << " |\n";
+  const std::vector<Row> pairs = mass_ratio_rows();
+  write_csv(dir / "mass_ratio.csv", pairs);
+  md << "## Mass ratios: does the stack hold?\n\n"
+     << "A heavy cube (R kg) resting on a light one (1 kg), both of edge "
+     << number(2.0 * scenes::kMassRatioHalfEdge) << " m, on the ground (stress scenes "
+        "mass_ratio_R), started at rest and run for " << number(kPairSeconds)
+     << " s at 60 Hz with 25 iterations. **Held** means the light cube is still between the "
+        "heavy cube and the ground: its centre within its half edge ("
+     << number(scenes::kMassRatioHalfEdge) << " m) of the heavy cube's vertical axis, so the "
+        "heavy cube's centre of mass is over its top face, and the heavy cube's centre within "
+     << number(kHeldHeightTolerance) << " m of its stacked height " << number(kStackedHeight)
+     << " m (squeezed out, it drops to " << number(scenes::kMassRatioHalfEdge)
+     << " m). The last column lists the iteration counts of 1, 2, 4, ..., 256 with which the "
+        "same run holds with under 1 cm of overlap (holding need not grow with the count). All "
+        "in [mass_ratio.csv](mass_ratio.csv).\n\n"
+     << "| mass ratio | solver | push | held at 25 it | heavy cube height (m) | light cube off "
+        "the heavy one's axis (m) | deepest overlap (m) | iterations that hold, overlap under "
+        "1 cm |\n|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : pairs) {
+    md << "| " << cell(r, "mass_ratio") << " | " << cell(r, "solver") << " | " << cell(r, "push")
+       << " | " << (cell(r, "held") == "1" ? "yes" : "no") << " | " << cell(r, "heavy_height_m")
+       << " | " << cell(r, "light_offset_m") << " | " << cell(r, "overlap_m") << " | "
+       << (cell(r, "iterations_holding").empty() ? std::string("none")
+                                                  : cell(r, "iterations_holding")) << " |\n";
   }
   md << "\n";
-  std::ofstream out(dir / "report.md");
-  if (!out) throw std::runtime_error("report: cannot write " + (dir / "report.md").string());
-  out << md.str();
+  write_text_atomic(dir / "report.md", md.str());
+}
+
+std::vector<std::string> report_files(const std::vector<std::string>& scenes) {
+  std::vector<std::string> files = {"report.md", "mass_ratio.csv"};
+  for (const std::string& scene : scenes) {
+    files.push_back(scene + ".csv");
+    for (const Measure& m : kMeasures) {
+      for (const char* ext : {".png", ".svg"}) files.push_back(scene + "_" + m.column + ext);
+    }
+  }
+  return files;
+}
+
+std::vector<std::string> plot_files(const std::vector<std::string>& scenes) {
+  std::vector<std::string> files;
+  for (const std::string& scene : scenes) {
+    for (const Measure& m : kMeasures) {
+      for (const char* ext : {".dat", ".gp"}) files.push_back(scene + "_" + m.column + ext);
+    }
+  }
+  return files;
 }
 
 namespace {
+
+// Timing runs per run (the median is taken), in the quick sweep as in the full one.
+constexpr int kTimingRepeats = 3;
 
 // The options of `cps report`.
 struct ReportOptions {
@@ -646,6 +1305,7 @@ struct ReportOptions {
   bool list = false;
   std::vector<std::string> merge;
   std::string run;
+  bool force = false;
 };
 
 // The absolute path of this executable, for commands that must run anywhere.
@@ -657,55 +1317,109 @@ std::string self_path() {
   return path;
 }
 
+// The report's two folders (OUT and OUT/plots, both shared: see output.h), checked for the
+// report of `scenes` before any work; write() then begins them, calls `body` and ends them, so
+// that each folder's run.json lists what was written.
+struct ReportOutput {
+  OutputPlan main;
+  OutputPlan plots;
+  nlohmann::json info;
+
+  ReportOutput(const fs::path& out, const std::vector<std::string>& scenes, bool force,
+               nlohmann::json run)
+      : main(plan_output(out, report_files(scenes), force, FolderUse::shared)),
+        plots(plan_output(out / "plots", plot_files(scenes), force, FolderUse::shared)),
+        info(std::move(run)) {}
+
+  template <class Body>
+  void write(Body&& body) {
+    begin_output(main, info);
+    begin_output(plots, info);
+    body();
+    end_output(plots, info);
+    end_output(main, info);
+  }
+};
+
+std::vector<std::string> scene_names(const std::vector<const scenes::Scene*>& scenes) {
+  std::vector<std::string> names;
+  for (const scenes::Scene* s : scenes) names.emplace_back(s->name);
+  return names;
+}
+
 int run_report(const ReportOptions& o, int argc, char** argv) {
-  // run.json in the report folder: what produced it (written after the report, atomically).
-  const auto write_run_json = [&] {
-    nlohmann::json merged = nlohmann::json::array();
-    for (const std::string& m : o.merge) merged.push_back(m);
-    const nlohmann::json info = run_info(
-        "report", argc, argv,
-        {{"scene", o.scene}, {"quick", o.quick}, {"repeats", o.quick ? 1 : 3}, {"merge", merged}});
-    nlohmann::json j = info;
-    j["tool"] = "cps";
-    write_json_atomic(fs::path(o.out) / k_manifest_name, j);
+  nlohmann::json merged = nlohmann::json::array();
+  for (const std::string& m : o.merge) merged.push_back(m);
+  const nlohmann::json info = run_info(
+      "report", argc, argv,
+      {{"scene", o.scene}, {"quick", o.quick}, {"repeats", kTimingRepeats}, {"merge", merged},
+       {"run", o.run.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.run)}});
+  const int repeats = kTimingRepeats;
+  // The sweep a run belongs to, recorded in its row so that --merge can tell what is missing.
+  const auto mark_sweep = [&o](Row& row) {
+    row["sweep"] = o.scene;
+    row["quick"] = o.quick ? "1" : "0";
   };
-  const int repeats = o.quick ? 1 : 3;
   if (!o.merge.empty()) {
     std::vector<fs::path> dirs(o.merge.begin(), o.merge.end());
     const std::vector<Row> rows = read_rows(dirs);
     if (rows.empty()) throw UsageError("--merge: no report CSV found below the given folders");
-    write_report(o.out, rows);
-    write_run_json();
+    std::size_t planned = 0;
+    const std::vector<std::string> missing = missing_runs(rows, planned);
+    std::vector<std::string> scenes;
+    for (const Row& r : rows) {
+      if (std::find(scenes.begin(), scenes.end(), r.at("scene")) == scenes.end()) {
+        scenes.push_back(r.at("scene"));
+      }
+    }
+    ReportOutput output(o.out, scenes, o.force, info);
+    output.write([&] { write_report(o.out, rows, missing, planned); });
+    if (!missing.empty()) {
+      std::string named;
+      for (std::size_t i = 0; i < missing.size() && i < 5; ++i) named += (i ? ", " : "") + missing[i];
+      if (missing.size() > 5) named += " and " + std::to_string(missing.size() - 5) + " more";
+      std::fprintf(stderr,
+                   "report --merge: %zu of the %zu planned runs are missing: %s. %s/report.md "
+                   "is marked INCOMPLETE.\n",
+                   missing.size(), planned, named.c_str(), o.out.c_str());
+      return 1;
+    }
     std::printf("merged %zu runs into %s/report.md\n", rows.size(), o.out.c_str());
     return 0;
   }
   if (!o.run.empty()) {
     const RunSpec spec = RunSpec::parse(o.run);
-    const Row row = execute_run(spec, repeats);
-    fs::create_directories(o.out);
-    write_csv(fs::path(o.out) / (spec.id() + ".csv"), {row});
+    select_scenes(o.scene);  // the sweep it belongs to must be one
+    const std::string file = spec.id() + ".csv";
+    const OutputPlan plan = plan_output(o.out, {file}, o.force, FolderUse::shared);
+    Row row = execute_run(spec, repeats);
+    mark_sweep(row);
+    begin_output(plan, info);
+    write_csv(fs::path(o.out) / file, {row});
+    end_output(plan, info);
     return 0;
   }
   const std::vector<RunSpec> runs = plan_runs(select_scenes(o.scene), o.quick);
   if (o.list) {
     const std::string exe = self_path();
     for (const RunSpec& r : runs) {
-      std::printf("'%s' report --run %s --out '%s/runs'%s\n", exe.c_str(), r.id().c_str(),
-                  o.out.c_str(), o.quick ? " --quick" : "");
+      std::printf("'%s' report '%s' --run %s --out '%s/runs'%s\n", exe.c_str(), o.scene.c_str(),
+                  r.id().c_str(), o.out.c_str(), o.quick ? " --quick" : "");
     }
     std::printf("# when all have finished: '%s' report --merge '%s/runs' --out '%s'\n",
                 exe.c_str(), o.out.c_str(), o.out.c_str());
     return 0;
   }
+  ReportOutput output(o.out, scene_names(select_scenes(o.scene)), o.force, info);
   std::vector<Row> rows;
   Progress progress("report " + o.scene, static_cast<long long>(runs.size()), "runs");
   for (std::size_t i = 0; i < runs.size(); ++i) {
     rows.push_back(execute_run(runs[i], repeats));
+    mark_sweep(rows.back());
     progress.update(static_cast<long long>(i + 1));
   }
   progress.finish();
-  write_report(o.out, rows);
-  write_run_json();
+  output.write([&] { write_report(o.out, rows, {}, rows.size()); });
   std::printf("%zu runs: %s/report.md\n", rows.size(), o.out.c_str());
   return 0;
 }
@@ -716,16 +1430,32 @@ Command add_report(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<ReportOptions>();
   CLI::App* sub = app.add_subcommand(
       "report", "error against run time: sweep solver settings, write CSV, plots, report.md");
-  sub->add_option("scene", o->scene, "scene name, 'all' (the paper's) or 'stress'")
+  sub->add_option("scene", o->scene,
+                  "scene name, 'all' (the paper's) or 'stress'; with --run, the sweep the run "
+                  "belongs to")
       ->capture_default_str();
   sub->add_option("--out", o->out, "output folder")->capture_default_str()->check(kNotEmpty);
-  sub->add_flag("--quick", o->quick, "a reduced sweep: iterations 1, 4, 16, 25, 64 and 4 substeps, fixed friction only (the paper's five scenes: 120 runs, about 30 s on 2 cores)");
-  sub->add_flag("--list-runs", o->list,
+  sub->add_flag("--quick", o->quick,
+                "a reduced sweep: iterations 1, 4, 16, 25, 64 and 4 substeps, fixed friction "
+                "only, each run timed by the median of 3 timing runs as in the full sweep (the "
+                "paper's five scenes: 120 runs, measured 64 s on 2 cores)");
+  CLI::Option* list = sub->add_flag("--list-runs", o->list,
                 "print one self-contained command per run, to spread the sweep over machines");
-  sub->add_option("--merge", o->merge,
-                  "combine the CSV files below these folders into one report in --out")
+  CLI::Option* merge = sub->add_option("--merge", o->merge,
+                  "combine the CSV files below these folders into one report in --out; if runs "
+                  "of the sweeps they belong to are missing, it names them on stderr, writes the "
+                  "report marked INCOMPLETE at the top (and in every diagram's title) and exits "
+                  "with 1")
       ->check(kNotEmpty);
-  sub->add_option("--run", o->run, "execute one run by its id (see --list-runs)")->check(kNotEmpty);
+  CLI::Option* run = sub->add_option("--run", o->run,
+                  "execute one run by its id (see --list-runs); the scene argument and --quick "
+                  "name the sweep it belongs to, recorded in its CSV for --merge")
+      ->check(kNotEmpty);
+  run->excludes(merge)->excludes(list);
+  merge->excludes(list);
+  sub->add_flag("--force", o->force,
+                "let the report replace files in --out that have the names of its own outputs "
+                "but that no earlier cps run wrote there (other files are never touched)");
   return {sub, [o, argc, argv] { return run_report(*o, argc, argv); }};
 }
 

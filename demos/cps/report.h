@@ -31,27 +31,55 @@ struct RunSpec {
 /// One CSV row: column name (with its unit) -> value as text ("" where it does not apply).
 using Row = std::map<std::string, std::string>;
 
-/// The runs of the sweep for these scenes. Full: iterations 1, 2, 4, ..., 256 at 1 substep and
-/// substeps 2, 4, 8, 16 at 25 iterations, for solver pgs and jacobi, push baumgarte and split,
-/// friction model fixed and coupled where the scene has friction. Quick: iterations 1, 4, 16, 64
-/// and substeps 4 (plus the paper's 25 / 1), friction model fixed only.
+/// The runs of the sweep for these scenes. Full: iterations 1, 2, 4, 8, 16, 25, 32, 64, 128, 256
+/// at 1 substep and substeps 2, 4, 8, 16 at 25 iterations, for solver pgs and jacobi, push baumgarte and split,
+/// friction model fixed and coupled where the scene has friction. Quick: iterations 1, 4, 16, 25,
+/// 64 at 1 substep and 4 substeps at 25 iterations, friction model fixed only.
 std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, bool quick);
 
 /// Runs one spec: the error run (residuals measured) and `repeats` timing runs of the physics
-/// step alone; the wall time per simulated second is their median. Returns its CSV row.
+/// step alone; the wall time per simulated second is their median (timing_repeats: how many;
+/// one if the error run took over 2 s; a diverged run is timed until it diverged,
+/// diverged_at_s). The trajectory error (m) is the RMS distance of the movable bodies from a
+/// reference run (PGS, 256 iterations, 16 substeps, same push and friction model) at the scene's
+/// Scene::report_trajectory_time_s(); reference_check_m (m) is the reference's distance from
+/// the same run at 8 substeps, an estimate of its own error. Returns its CSV row, without the
+/// sweep columns (sweep, quick), which the caller adds.
 Row execute_run(const RunSpec& spec, int repeats);
 
-/// Writes DIR/SCENE.csv (one per scene present in rows, columns sorted with the settings first),
-/// the work-precision diagrams DIR/SCENE_<measure>.png and .svg through gnuplot, and
-/// DIR/report.md. Throws std::runtime_error if a file cannot be written or gnuplot fails
-/// (the message says to install gnuplot-nox when it is missing; the CSVs are kept).
-void write_report(const std::filesystem::path& dir, const std::vector<Row>& rows);
+/// The ids (RunSpec::id) of the runs that the sweeps named in `rows` plan (plan_runs of the
+/// row's sweep column, a scene selector as select_scenes takes, and its quick column) and that
+/// no row holds, in plan order. A row without a sweep column (an older build's CSV) belongs to
+/// the full sweep of its own scene. `planned` is set to the number of distinct planned runs.
+std::vector<std::string> missing_runs(const std::vector<Row>& rows, std::size_t& planned);
 
-/// Reads every *.csv below the given folders (as written by write_report or `--run`).
-/// Throws std::runtime_error naming a folder that does not exist or a malformed file.
+/// Writes DIR/SCENE.csv (one per scene present in rows, columns sorted with the settings first),
+/// the work-precision diagrams DIR/SCENE_<measure>.png and .svg through gnuplot (a panel per
+/// solver, push and friction model on shared axes; diverged runs on the top edge; values under
+/// the measure's round-off floor drawn on it), DIR/mass_ratio.csv (the mass ratio pair: held or
+/// not per ratio, solver and push) and DIR/report.md. If `missing` (run ids, of `planned`) is
+/// not empty, report.md opens with INCOMPLETE and names them, and every diagram's title says
+/// so. Throws std::runtime_error if a file cannot be written or gnuplot fails (the message says
+/// to install gnuplot-nox when it is missing; the CSVs are kept).
+void write_report(const std::filesystem::path& dir, const std::vector<Row>& rows,
+                  const std::vector<std::string>& missing, std::size_t planned);
+
+/// The files write_report may write into DIR for these scenes (plain names): report.md,
+/// mass_ratio.csv, and per scene SCENE.csv and each measure's SCENE_<measure>.png and .svg. Every
+/// one is checked by the output rule (output.h) before a report's work begins.
+std::vector<std::string> report_files(const std::vector<std::string>& scenes);
+
+/// The files write_report may write into DIR/plots for these scenes: each measure's gnuplot data
+/// SCENE_<measure>.dat and script SCENE_<measure>.gp.
+std::vector<std::string> plot_files(const std::vector<std::string>& scenes);
+
+/// Reads every *.csv below the given folders (as written by write_report or `--run`), except
+/// mass_ratio.csv, which holds no runs. Throws UsageError naming a folder that does not exist
+/// or a file that is not a report CSV.
 std::vector<Row> read_rows(const std::vector<std::filesystem::path>& dirs);
 
-/// Writes rows as one CSV file (header, then one line per row).
+/// Writes rows as one CSV file (header, then one line per row), atomically (atomic_file.h).
+/// Throws std::runtime_error "cannot write FILE: REASON" on failure.
 void write_csv(const std::filesystem::path& file, const std::vector<Row>& rows);
 
 }  // namespace cps::cli

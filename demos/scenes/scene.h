@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -54,8 +55,7 @@ struct ReportTraits {
   /// Simulated time every run of the report's sweep lasts (s, > 0); unset: the scene's
   /// default_seconds (see Scene::report_horizon_s).
   std::optional<double> horizon_s;
-  /// Why the horizon is what it is, in one line (documentation for readers of the scene tables;
-  /// the report does not print it).
+  /// Why the horizon is what it is, in one line (report.md prints it with the horizon).
   std::string_view horizon_reason = "the scene's default duration";
   /// The CSV column of the report's headline measure: the error whose value at the paper's
   /// settings the headline quotes and tries to halve ("trajectory_error_m", "phase_error_deg",
@@ -65,6 +65,16 @@ struct ReportTraits {
   /// (max_phase_error_deg: the pendulum wave's reduced-coordinate phases); the report then does
   /// not compute a trajectory error against a reference run.
   bool has_reference_solution = false;
+  /// The time (s, in (0, horizon], a whole number of the scene's steps, 1/60 s for the paper's,
+  /// so that every substep count steps onto it exactly) at which the trajectory error compares the bodies' positions
+  /// with the reference run: chosen where the scene's contacts have acted but before chaos
+  /// dominates (before runs that differ by round-off part by as much as the errors measured).
+  /// Unset: 1 s, or the horizon if it is shorter (a default, not chosen for the scene). Not
+  /// used when has_reference_solution is true.
+  std::optional<double> trajectory_time_s;
+  /// Why the trajectory time is what it is, in one line (report.md prints it with the time).
+  std::string_view trajectory_reason =
+      "not chosen for this scene: 1 s (the horizon if shorter), the first falls and landings";
 };
 
 /// A scene: its name (as typed on the command line), a one-line summary, its default duration
@@ -87,6 +97,11 @@ struct Scene {
 
   /// The simulated time of each run of `cps report` (s): report.horizon_s, or default_seconds.
   double report_horizon_s() const { return report.horizon_s.value_or(default_seconds); }
+  /// The time of `cps report`'s trajectory error (s): report.trajectory_time_s, or 1 s, or the
+  /// horizon if that is shorter.
+  double report_trajectory_time_s() const {
+    return report.trajectory_time_s.value_or(std::min(1.0, report_horizon_s()));
+  }
 };
 
 /// The paper's result scenes (Sec. 10), in the order `cps list` prints them ("all" on the

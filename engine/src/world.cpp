@@ -142,7 +142,7 @@ void World::collide() {
     }
   }
 }
-// Stage 2, Sec. 5: contact and friction rows, then distance rows.
+// Stage 2, Sec. 5: contact rows, friction rows, then distance rows.
 void World::build_rows() {
   rows_.clear();
   // The row count is known from the manifolds: make room once, with headroom (no allocation in
@@ -165,8 +165,21 @@ void World::build_rows() {
     }
     return velocities_[k];
   };
+  // The contact rows of every manifold first, then their friction rows, then the rods. PGS with
+  // a fixed number of sweeps leaves its residual mostly in the rows it updated first; the rows
+  // updated last hold at the end of the solve. Sliding velocity left over is never corrected
+  // (no push acts along a tangent), while a normal row's residual is a small sink the push
+  // factor takes back. With the friction rows after all contact rows, the contact rows updated
+  // later in a sweep no longer disturb the sliding velocity the friction rows set (README, "Why
+  // the paper's stack drifts": the stack slid 2.4 m in 600 s with each point's friction rows
+  // right after its contact row).
   for (const Manifold& m : manifolds_) {
-    append_contact_rows(m, bodies_, velocity(m.body_a), velocity(m.body_b), params, rows_);
+    append_normal_rows(m, bodies_, velocity(m.body_a), velocity(m.body_b), params, rows_);
+  }
+  int first_normal_row = 0;
+  for (const Manifold& m : manifolds_) {
+    append_friction_rows(m, bodies_, params, first_normal_row, rows_);
+    first_normal_row += m.count;
   }
   for (const DistanceConstraint& d : distances_) append_distance_row(d, bodies_, params, rows_);
   counters_.rows += static_cast<std::int64_t>(rows_.size());

@@ -91,7 +91,7 @@ void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
 
 void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
                           const RowParams& params, int first_normal_row,
-                          std::vector<ConstraintRow>& rows) {
+                          std::vector<ConstraintRow>& rows, const Vec3* tangents) {
   if (params.friction <= 0.0 || m.count == 0) return;
   const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
   const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
@@ -104,7 +104,12 @@ void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
     const Vec3 r_b = c.point - b.x;
     const double limit = params.friction * mass_per_point * std::abs(params.gravity.dot(c.normal));
     Vec3 t[2];
-    tangent_basis(c.normal, t[0], t[1]);
+    if (tangents != nullptr) {
+      t[0] = tangents[i];
+      t[1] = c.normal.cross(t[0]);
+    } else {
+      tangent_basis(c.normal, t[0], t[1]);
+    }
     for (const Vec3& tangent : t) {
       ConstraintRow& friction = rows.emplace_back();
       friction.kind = RowKind::friction;

@@ -285,9 +285,18 @@ void build_runs(MatrixFreeSystem& s) {
 }  // namespace
 
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
-           SolverKind kind, int iterations, std::vector<double>& lambda) {
-  detail::assign_with_headroom(lambda, rows.size(), 0.0);  // initial guess 0
+           SolverKind kind, int iterations, std::vector<double>& lambda,
+           const std::vector<double>* initial) {
+  detail::assign_with_headroom(lambda, rows.size(), 0.0);  // initial guess 0 (Sec. 7.2) ...
   for (Vec6& w : s.w) w.setZero();
+  if (initial != nullptr) {  // ... or the one given, with w = M^-1 J^T lambda to match
+    const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+    for (std::size_t j = 0; j < rows.size(); ++j) {
+      if (s.rows[j].inv_diagonal == 0.0) continue;  // touches no movable body: stays 0
+      lambda[j] = (*initial)[j];
+      add_to_w(s.rows[j], lambda[j], s.w, fixed_slot);
+    }
+  }
   const bool coupled = friction == FrictionModel::coupled;
   if (kind == SolverKind::jacobi) {
     detail::assign_with_headroom(s.next, rows.size(), 0.0);

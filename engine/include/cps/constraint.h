@@ -109,10 +109,12 @@ void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
 /// the two bodies divided over the manifold's points (the movable body's mass when the other is
 /// static). normal_row of point i's rows is first_normal_row + i: the index in `rows` of that
 /// point's contact row (append_normal_rows), for the coupled limit mu lambda_n. Appends nothing
-/// when params.friction is 0. No errors.
+/// when params.friction is 0. tangents: nullptr (the paper's directions), or m.count unit
+/// vectors t1 perpendicular to each point's normal, with t2 = n x t1 (the warm start keeps a
+/// persisting contact's directions so its friction lambdas carry over). No errors.
 void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
                           const RowParams& params, int first_normal_row,
-                          std::vector<ConstraintRow>& rows);
+                          std::vector<ConstraintRow>& rows, const Vec3* tangents = nullptr);
 
 /// A distance constraint (Sec. 5.2): point local_a of body_a and point local_b of body_b stay
 /// `length` apart (m, >= 0). local_a, local_b are in body space (m); when body_b is kWorldBody,

@@ -24,7 +24,7 @@ namespace cps {
 /// and starting the next step from it pushes the bodies apart harder than they need; with a fixed
 /// number of sweeps PGS does not take all of it back, and the step gains energy (Catto,
 /// erincatto/solver2d issue 8: "errors in warm starting energy can grow unbounded"). So a contact
-/// is warm started from its second step on. Measured per step against the energy bound of
+/// starts from a cached value in its third step, once it has two. Measured per step against the energy bound of
 /// tests/test_stress.cpp (the largest dE - dW - dR over the run, tolerance in brackets), factor
 /// 0.8, last lambda only / smaller of the last two: stack landing 0.080 / 0.011 J (0.0106 J),
 /// stack_dt_0.1 1.75 / -0.039 J (0.013 J), mass_ratio_10 0.0087 / -0.0028 J (0.0036 J).

@@ -31,7 +31,7 @@ WorldDef funnel_world_def() {
   // rule) a ball in the pile that the push factor has just lifted clear loses its contact, falls
   // g dt^2 = 2.8 mm back in and is pushed out again: 44 to 52 of the ~50 contacts come and go
   // from step to step, and the pile keeps 1e-3 to 7e-3 J of kinetic energy. A 1 mm margin keeps
-  // every resting contact in the system and the pile comes to rest (about 3e-5 J at 10 s).
+  // every resting contact in the system and the pile comes to rest (about 5e-6 J at 10 s).
   def.contact_margin = 0.001;
   return def;
 }

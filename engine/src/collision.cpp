@@ -30,7 +30,8 @@ int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Mani
     const double separation = n.dot(v) - offset;
     if (separation < margin) {
       // Midway between the vertex and its projection on the plane.
-      out.add({v - 0.5 * separation * n, n, -separation});
+      out.add({v - 0.5 * separation * n, n, -separation,
+               contact_feature(kFeatureBoxVertex, static_cast<std::uint32_t>(corner))});
     }
   }
   return out.count - before;
@@ -41,7 +42,7 @@ int collide_sphere_plane(const Vec3& c, double r, const Vec3& n, double offset, 
   const double separation = n.dot(c) - offset - r;
   if (separation >= margin) return 0;
   // Midway between the deepest point of the sphere, c - r n, and the plane.
-  out.add({c - (r + 0.5 * separation) * n, n, -separation});
+  out.add({c - (r + 0.5 * separation) * n, n, -separation, contact_feature(kFeatureSphere, 0)});
   return 1;
 }
 
@@ -52,7 +53,7 @@ int collide_sphere_sphere(const Vec3& c_a, double r_a, const Vec3& c_b, double r
   const double depth = r_a + r_b - dist;
   if (depth <= -margin) return 0;
   const Vec3 n = dist > 1e-12 ? Vec3(d / dist) : Vec3(Vec3::UnitY());
-  out.add({c_a + (r_a - 0.5 * depth) * n, n, depth});
+  out.add({c_a + (r_a - 0.5 * depth) * n, n, depth, contact_feature(kFeatureSphere, 0)});
   return 1;
 }
 
@@ -90,7 +91,7 @@ int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold
   const Vec3 n = box.R * n_local;
   const Vec3 surface_world = box.c + box.R * surface;
   // Midway between the box surface and the deepest point of the sphere, c - r n.
-  out.add({0.5 * (surface_world + c - r * n), n, depth});
+  out.add({0.5 * (surface_world + c - r * n), n, depth, contact_feature(kFeatureSphere, 0)});
   return 1;
 }
 

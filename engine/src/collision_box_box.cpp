@@ -16,6 +16,7 @@
 #include <array>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace cps {
 namespace {
@@ -55,29 +56,56 @@ bool test_axis(const OrientedBox& a, const OrientedBox& b, const Vec3& d, const 
   return true;
 }
 
-using Polygon = std::array<Vec3, 16>;
+// A clipped polygon: its vertices, and for each the two lines it lies on (the edge into it and
+// the edge out of it: 0..3 an incident-face edge, 4..7 a side plane of the reference face), from
+// which its feature id is made.
+struct Polygon {
+  std::array<Vec3, 16> p;
+  std::array<unsigned char, 16> in;
+  std::array<unsigned char, 16> out;
+};
 
-// Keeps the part of polygon `in` (n_in vertices) with dot(m, x) <= offset. Returns the count.
-int clip(const Polygon& in, int n_in, const Vec3& m, double offset, Polygon& out) {
+// Keeps the part of polygon `in` (n_in vertices) with dot(m, x) <= offset (Sutherland-Hodgman).
+// A vertex made where an edge crosses the plane lies on that edge and on the plane, `line`.
+// Returns the count.
+int clip(const Polygon& in, int n_in, const Vec3& m, double offset, unsigned char line,
+         Polygon& out) {
   int n_out = 0;
   for (int i = 0; i < n_in; ++i) {
-    const Vec3& prev = in[static_cast<std::size_t>((i + n_in - 1) % n_in)];
-    const Vec3& cur = in[static_cast<std::size_t>(i)];
+    const auto ip = static_cast<std::size_t>((i + n_in - 1) % n_in);
+    const auto ic = static_cast<std::size_t>(i);
+    const Vec3& prev = in.p[ip];
+    const Vec3& cur = in.p[ic];
     const double d_prev = m.dot(prev) - offset;
     const double d_cur = m.dot(cur) - offset;
     if ((d_prev <= 0.0) != (d_cur <= 0.0)) {
       const double t = d_prev / (d_prev - d_cur);
-      out[static_cast<std::size_t>(n_out++)] = prev + t * (cur - prev);
+      const auto k = static_cast<std::size_t>(n_out++);
+      out.p[k] = prev + t * (cur - prev);
+      const unsigned char edge = in.out[ip];  // the line from prev to cur
+      // Leaving the kept side: along the edge, then the plane; entering: the other way round.
+      out.in[k] = d_prev <= 0.0 ? edge : line;
+      out.out[k] = d_prev <= 0.0 ? line : edge;
     }
-    if (d_cur <= 0.0) out[static_cast<std::size_t>(n_out++)] = cur;
+    if (d_cur <= 0.0) {
+      const auto k = static_cast<std::size_t>(n_out++);
+      out.p[k] = cur;
+      out.in[k] = in.in[ic];
+      out.out[k] = in.out[ic];
+    }
   }
   return n_out;
 }
 
+// Face index of a box's face with outward normal +-R.col(axis): 2 axis, +1 for the - side.
+std::uint32_t face_index(int axis, bool negative) {
+  return static_cast<std::uint32_t>(2 * axis + (negative ? 1 : 0));
+}
+
 // Face contact with reference face `axis` of `ref` whose outward normal is n_ref (pointing at
-// `inc`). normal_ab is the manifold normal from box a to box b.
+// `inc`). normal_ab is the manifold normal from box a to box b; kind says which box is `ref`.
 void face_contact(const OrientedBox& ref, int axis, const Vec3& n_ref, const OrientedBox& inc,
-                  const Vec3& normal_ab, double margin, Manifold& out) {
+                  const Vec3& normal_ab, double margin, ContactFeatureKind kind, Manifold& out) {
   // Incident face: the face of inc whose outward normal is most anti-parallel to n_ref.
   int k = 0;
   double best = -1.0;
@@ -88,33 +116,46 @@ void face_contact(const OrientedBox& ref, int axis, const Vec3& n_ref, const Ori
       k = c;
     }
   }
-  const Vec3 inc_n = inc.R.col(k).dot(n_ref) > 0.0 ? Vec3(-inc.R.col(k)) : Vec3(inc.R.col(k));
+  const bool inc_negative = inc.R.col(k).dot(n_ref) > 0.0;
+  const Vec3 inc_n = inc_negative ? Vec3(-inc.R.col(k)) : Vec3(inc.R.col(k));
   const Vec3 face_centre = inc.c + inc.e[k] * inc_n;
   const Vec3 u = inc.e[(k + 1) % 3] * inc.R.col((k + 1) % 3);
   const Vec3 v = inc.e[(k + 2) % 3] * inc.R.col((k + 2) % 3);
   Polygon poly{};
-  poly[0] = face_centre + u + v;
-  poly[1] = face_centre - u + v;
-  poly[2] = face_centre - u - v;
-  poly[3] = face_centre + u - v;
+  poly.p[0] = face_centre + u + v;
+  poly.p[1] = face_centre - u + v;
+  poly.p[2] = face_centre - u - v;
+  poly.p[3] = face_centre + u - v;
+  for (unsigned char i = 0; i < 4; ++i) {
+    poly.in[i] = static_cast<unsigned char>((i + 3) % 4);  // edge i joins vertex i to i + 1
+    poly.out[i] = i;
+  }
   int count = 4;
 
-  // Side planes of the reference face.
+  // Side planes of the reference face, lines 4..7.
   Polygon scratch{};
+  unsigned char line = 4;
   for (int s : {(axis + 1) % 3, (axis + 2) % 3}) {
     for (double sign : {1.0, -1.0}) {
       const Vec3 m = sign * ref.R.col(s);
-      count = clip(poly, count, m, m.dot(ref.c) + ref.e[s], scratch);
+      count = clip(poly, count, m, m.dot(ref.c) + ref.e[s], line++, scratch);
       poly = scratch;
       if (count == 0) return;
     }
   }
 
+  const std::uint32_t faces =
+      face_index(axis, n_ref.dot(ref.R.col(axis)) < 0.0) | (face_index(k, inc_negative) << 3);
   const double ref_offset = n_ref.dot(ref.c) + ref.e[axis];
   for (int i = 0; i < count; ++i) {
-    const Vec3& p = poly[static_cast<std::size_t>(i)];
+    const auto ii = static_cast<std::size_t>(i);
+    const Vec3& p = poly.p[ii];
     const double separation = n_ref.dot(p) - ref_offset;
-    if (separation <= margin) out.add({p - 0.5 * separation * n_ref, normal_ab, -separation});
+    if (separation > margin) continue;
+    const std::uint32_t lo = std::min(poly.in[ii], poly.out[ii]);
+    const std::uint32_t hi = std::max(poly.in[ii], poly.out[ii]);
+    out.add({p - 0.5 * separation * n_ref, normal_ab, -separation,
+             contact_feature(kind, faces | (lo << 6) | (hi << 9))});
   }
 }
 
@@ -142,14 +183,26 @@ void edge_contact(const OrientedBox& a, const OrientedBox& b, const Axis& axis, 
   // Supporting edge of a along +n and of b along -n.
   Vec3 pa = a.c;
   Vec3 pb = b.c;
+  // Edge ids (collision.h): 4 axis + 1 for the + side of the next axis + 2 for the one after.
+  std::uint32_t edge_a = static_cast<std::uint32_t>(4 * i);
+  std::uint32_t edge_b = static_cast<std::uint32_t>(4 * k);
   for (int m = 0; m < 3; ++m) {
-    if (m != i) pa += (a.R.col(m).dot(n) > 0.0 ? 1.0 : -1.0) * a.e[m] * a.R.col(m);
-    if (m != k) pb += (b.R.col(m).dot(n) > 0.0 ? -1.0 : 1.0) * b.e[m] * b.R.col(m);
+    if (m != i) {
+      const bool plus = a.R.col(m).dot(n) > 0.0;
+      pa += (plus ? 1.0 : -1.0) * a.e[m] * a.R.col(m);
+      if (plus) edge_a |= (m == (i + 1) % 3) ? 1u : 2u;
+    }
+    if (m != k) {
+      const bool plus = !(b.R.col(m).dot(n) > 0.0);
+      pb += (plus ? 1.0 : -1.0) * b.e[m] * b.R.col(m);
+      if (plus) edge_b |= (m == (k + 1) % 3) ? 1u : 2u;
+    }
   }
   Vec3 ca;
   Vec3 cb;
   closest_points_of_edges(pa, a.R.col(i), a.e[i], pb, b.R.col(k), b.e[k], ca, cb);
-  out.add({0.5 * (ca + cb), n, -axis.separation});
+  out.add({0.5 * (ca + cb), n, -axis.separation,
+           contact_feature(kFeatureEdges, edge_a | (edge_b << 4))});
 }
 
 }  // namespace
@@ -184,9 +237,9 @@ int collide_box_box(const OrientedBox& a, const OrientedBox& b, Manifold& out, d
   if (edge.index >= 0 && clearly_better(edge.separation, face.separation)) {
     edge_contact(a, b, edge, out);
   } else if (use_b) {
-    face_contact(b, face_b.index, -face_b.n, a, face_b.n, margin, out);
+    face_contact(b, face_b.index, -face_b.n, a, face_b.n, margin, kFeatureFaceB, out);
   } else {
-    face_contact(a, face_a.index, face_a.n, b, face_a.n, margin, out);
+    face_contact(a, face_a.index, face_a.n, b, face_a.n, margin, kFeatureFaceA, out);
   }
   return out.count - before;
 }

@@ -49,29 +49,26 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
 void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
                          const BodyVelocity& vel_a, const BodyVelocity& vel_b,
                          const RowParams& params, std::vector<ConstraintRow>& rows) {
-  if (m.count == 0) return;
+  const int first_normal_row = static_cast<int>(rows.size());
+  append_normal_rows(m, bodies, vel_a, vel_b, params, rows);
+  append_friction_rows(m, bodies, params, first_normal_row, rows);
+}
+
+void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
+                        const BodyVelocity& vel_a, const BodyVelocity& vel_b,
+                        const RowParams& params, std::vector<ConstraintRow>& rows) {
   const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
   const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
-  // Sec. 5.4: m is the combined mass of both bodies divided over the contact points (a static
-  // body has mass 0 here, so the movable body's mass remains).
-  const double mass_per_point = (a.mass + b.mass) / static_cast<double>(m.count);
-  const Vec3& v_a = vel_a.v;
-  const Vec3& w_a = vel_a.w;
-  const Vec3& v_b = vel_b.v;
-  const Vec3& w_b = vel_b.w;
   for (int i = 0; i < m.count; ++i) {
     const Contact& c = m.contacts[static_cast<std::size_t>(i)];
-    const Vec3 r_a = c.point - a.x;
-    const Vec3 r_b = c.point - b.x;
-
-    // Rows are built in place (no copy of the 12-vector j per row).
-    const int normal_row = static_cast<int>(rows.size());
+    // Built in place (no copy of the 12-vector j per row).
     ConstraintRow& contact = rows.emplace_back();
     contact.kind = RowKind::contact;
     contact.body_a = m.body_a;
     contact.body_b = m.body_b;
-    contact.j = axis_row(c.normal, r_a, r_b);
-    const double approach = relative_velocity(contact.j, v_a, w_a, v_b, w_b);  // j . v1 (m/s)
+    contact.j = axis_row(c.normal, c.point - a.x, c.point - b.x);
+    // j . v1 (m/s)
+    const double approach = relative_velocity(contact.j, vel_a.v, vel_a.w, vel_b.v, vel_b.w);
     if (c.depth >= 0.0) {
       // Eq. 5.3.1 (docs/conventions.md, Sec. 3): C = -d, v = -beta C / dt = beta d / dt > 0 opens it.
       contact.push = params.beta * c.depth / params.dt;
@@ -89,11 +86,30 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
     }
     contact.c_min = 0.0;
     contact.c_max = kInfinity;
+  }
+}
 
-    if (params.friction <= 0.0) continue;
+void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
+                          const RowParams& params, int first_normal_row,
+                          std::vector<ConstraintRow>& rows, const Vec3* tangents) {
+  if (params.friction <= 0.0 || m.count == 0) return;
+  const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
+  const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
+  // Sec. 5.4: m is the combined mass of both bodies divided over the contact points (a static
+  // body has mass 0 here, so the movable body's mass remains).
+  const double mass_per_point = (a.mass + b.mass) / static_cast<double>(m.count);
+  for (int i = 0; i < m.count; ++i) {
+    const Contact& c = m.contacts[static_cast<std::size_t>(i)];
+    const Vec3 r_a = c.point - a.x;
+    const Vec3 r_b = c.point - b.x;
     const double limit = params.friction * mass_per_point * std::abs(params.gravity.dot(c.normal));
     Vec3 t[2];
-    tangent_basis(c.normal, t[0], t[1]);
+    if (tangents != nullptr) {
+      t[0] = tangents[i];
+      t[1] = c.normal.cross(t[0]);
+    } else {
+      tangent_basis(c.normal, t[0], t[1]);
+    }
     for (const Vec3& tangent : t) {
       ConstraintRow& friction = rows.emplace_back();
       friction.kind = RowKind::friction;
@@ -102,7 +118,7 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
       friction.j = axis_row(tangent, r_a, r_b);
       friction.c_min = -limit;
       friction.c_max = limit;
-      friction.normal_row = normal_row;
+      friction.normal_row = first_normal_row + i;
       friction.mu = params.friction;
     }
   }

@@ -18,10 +18,11 @@ class ExplicitSolver final : public ConstraintSolver {
 
   void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& /*bodies*/,
              const Eigen::VectorXd& f_ext, TargetTerms terms, const SolveSettings& settings,
-             std::vector<double>& lambda) override {
+             std::vector<double>& lambda, const std::vector<double>* initial) override {
     system_.b = assemble_rhs(rows, system_.J, system_.M_inv, v1_, f_ext, settings.dt, terms);
-    const Eigen::VectorXd x = solve_lcp(system_.A, system_.b, system_.limits, settings.friction,
-                                        settings.kind, settings.iterations);
+    const Eigen::VectorXd x =
+        solve_lcp(system_.A, system_.b, system_.limits, settings.friction, settings.kind,
+                  settings.iterations, initial != nullptr ? initial->data() : nullptr);
     lambda.assign(x.data(), x.data() + x.size());
   }
 
@@ -50,9 +51,10 @@ class MatrixFreeSolver final : public ConstraintSolver {
 
   void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
              const Eigen::VectorXd& f_ext, TargetTerms terms, const SolveSettings& settings,
-             std::vector<double>& lambda) override {
+             std::vector<double>& lambda, const std::vector<double>* initial) override {
     rhs(system_, rows, bodies, f_ext, settings.dt, terms);
-    cps::solve(system_, rows, settings.friction, settings.kind, settings.iterations, lambda);
+    cps::solve(system_, rows, settings.friction, settings.kind, settings.iterations, lambda,
+               initial);
   }
 
   void residual(const std::vector<ConstraintRow>& rows, FrictionModel friction,

@@ -37,13 +37,15 @@ class ConstraintSolver {
   /// (explicit), or the packed rows and I^-1 per body (matrix-free).
   virtual void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies) = 0;
 
-  /// Solves A lambda = b from lambda = 0 with settings.iterations sweeps, b of Eq. 6.2.9 from
-  /// the bodies' momenta, f_ext (6n: force and torque per body, N and N m) and each row's target
-  /// velocity (push and bias, or bias only: `terms`, Sec. 8.1). lambda: resized to c (N). The
-  /// rows and bodies must be those given to prepare().
+  /// Solves A lambda = b with settings.iterations sweeps, b of Eq. 6.2.9 from the bodies'
+  /// momenta, f_ext (6n: force and torque per body, N and N m) and each row's target velocity
+  /// (push and bias, or bias only: `terms`, Sec. 8.1), from `initial` (c values, N: the warm
+  /// start of Sec. 6.2.3) when given, else from lambda = 0. lambda: resized to c (N). The rows
+  /// and bodies must be those given to prepare().
   virtual void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
                      const Eigen::VectorXd& f_ext, TargetTerms terms,
-                     const SolveSettings& settings, std::vector<double>& lambda) = 0;
+                     const SolveSettings& settings, std::vector<double>& lambda,
+                     const std::vector<double>* initial = nullptr) = 0;
 
   /// The natural-map residual (lcp.h) of the lambda the last solve() returned: the largest row
   /// residual and the sum of their squares (N, N^2).

@@ -285,9 +285,39 @@ void build_runs(MatrixFreeSystem& s) {
 }  // namespace
 
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
-           SolverKind kind, int iterations, std::vector<double>& lambda) {
-  detail::assign_with_headroom(lambda, rows.size(), 0.0);  // initial guess 0
+           SolverKind kind, int iterations, std::vector<double>& lambda,
+           const std::vector<double>* initial) {
+  detail::assign_with_headroom(lambda, rows.size(), 0.0);  // initial guess 0 (Sec. 7.2) ...
   for (Vec6& w : s.w) w.setZero();
+  if (initial != nullptr) {  // ... or the one given, with w = M^-1 J^T lambda to match
+    const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+    // Consecutive rows on the same two slots (a manifold's contact rows, its friction rows) sum
+    // their M^-1 j^T lambda in registers and add it to w once, so the rows do not wait on each
+    // other's w stores.
+    Vec6 sum_a = Vec6::Zero();
+    Vec6 sum_b = Vec6::Zero();
+    int a = fixed_slot;
+    int b = fixed_slot;
+    const auto flush = [&] {
+      if (a != fixed_slot) s.w[static_cast<std::size_t>(a)] += sum_a;
+      if (b != fixed_slot) s.w[static_cast<std::size_t>(b)] += sum_b;
+      sum_a.setZero();
+      sum_b.setZero();
+    };
+    for (std::size_t j = 0; j < rows.size(); ++j) {
+      const PackedRow& r = s.rows[j];
+      if (r.inv_diagonal == 0.0) continue;  // touches no movable body: stays 0
+      if (r.a != a || r.b != b) {
+        flush();
+        a = r.a;
+        b = r.b;
+      }
+      lambda[j] = (*initial)[j];
+      sum_a += lambda[j] * ConstMap6(r.minv_jt.data());
+      sum_b += lambda[j] * ConstMap6(r.minv_jt.data() + 6);
+    }
+    flush();
+  }
   const bool coupled = friction == FrictionModel::coupled;
   if (kind == SolverKind::jacobi) {
     detail::assign_with_headroom(s.next, rows.size(), 0.0);

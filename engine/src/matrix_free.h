@@ -75,11 +75,15 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
          const std::vector<Body>& bodies, const Eigen::VectorXd& f_ext, double dt,
          TargetTerms terms);
 
-/// Solves the bounded system from lambda = 0 with `iterations` sweeps of PGS or Jacobi, the
-/// bounds of solve_lcp (c_min, c_max from the rows, or the coupled friction limit), into
-/// lambda (resized to c, N). s must be prepared for these rows and s.b filled.
+/// Solves the bounded system with `iterations` sweeps of PGS or Jacobi, the bounds of solve_lcp
+/// (c_min, c_max from the rows, or the coupled friction limit), into lambda (resized to c, N).
+/// It starts from `initial` (c values, N; warm starting, Sec. 6.2.3) when given, with
+/// w = M^-1 J^T initial, else from lambda = 0 and w = 0; a row that touches no movable body
+/// starts at 0 whatever the guess (as solve_lcp). s must be prepared for these rows and s.b
+/// filled.
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
-           SolverKind kind, int iterations, std::vector<double>& lambda);
+           SolverKind kind, int iterations, std::vector<double>& lambda,
+           const std::vector<double>* initial = nullptr);
 
 /// The natural-map residual of lcp_residual for the lambda that solve() left (using its w),
 /// per row: the largest value and the sum of squares (N, N^2).

@@ -185,6 +185,19 @@ const std::array kParameters = {
                       "paper; typical 0.001 for bodies of 0.5 to 3 m",
               .get = &get_member<&WorldDef::contact_margin>,
               .set = &set_member<&WorldDef::contact_margin>},
+    Parameter{.name = "warm_start",
+              .flag = "warm-start",
+              .json_key = "warm_start",
+              .unit = "",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0,
+              .help = "warm starting (Sec. 6.2.3): each row's lambda starts from this factor times "
+                      "its lambda of the previous steps when its contact or rod persists; 0 = the "
+                      "paper's initial guess 0; typical 0.8 (1 can feed energy into stiff piles "
+                      "and chains)",
+              .get = &get_member<&WorldDef::warm_start>,
+              .set = &set_member<&WorldDef::warm_start>},
     Parameter{.name = "collision",
               .flag = "",
               .json_key = "collision",

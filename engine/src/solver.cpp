@@ -29,7 +29,7 @@ void row_sum(const SparseRowMatrix& A, const Eigen::VectorXd& b, const Eigen::Ve
 
 Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
                           const RowLimits& limits, FrictionModel friction, SolverKind kind,
-                          int iterations) {
+                          int iterations, const double* initial) {
   const Eigen::Index c = b.size();
   if (A.rows() != c || A.cols() != c || limits.c_min.size() != c || limits.c_max.size() != c) {
     throw std::invalid_argument("solve_lcp: A is " + std::to_string(A.rows()) + " x " +
@@ -56,7 +56,10 @@ Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
 
   // PGS writes into lambda as it goes; Jacobi writes into `next` and swaps after the sweep.
   const bool jacobi = kind == SolverKind::jacobi;
-  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(c);  // initial guess 0
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(c);  // initial guess 0 (Sec. 7.2) ...
+  if (initial != nullptr) {  // ... or the one given (warm starting, Sec. 6.2.3)
+    for (Eigen::Index j = 0; j < c; ++j) lambda[j] = A.coeff(j, j) > 0.0 ? initial[j] : 0.0;
+  }
   Eigen::VectorXd next = Eigen::VectorXd::Zero(jacobi ? c : 0);
   for (int k = 0; k < iterations; ++k) {
     Eigen::VectorXd& out = jacobi ? next : lambda;

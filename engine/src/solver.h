@@ -9,7 +9,9 @@ namespace cps {
 
 /// Solves A lambda = b subject to the bounds of each row (Eq. 7.1.1 with clamping):
 ///   lambda_j = clamp((b_j - sum_{i != j} A_ji lambda_i) / A_jj, lo_j, hi_j)
-/// with initial guess 0 and a fixed number of sweeps over the rows in order. lo_j, hi_j are
+/// from an initial guess and with a fixed number of sweeps over the rows in order. The guess is
+/// `initial` (c values, N) when given, else 0 (the paper's); a row with A_jj <= 0 starts at 0
+/// whatever the guess. lo_j, hi_j are
 /// limits.c_min_j, limits.c_max_j, except for friction rows under FrictionModel::coupled, where
 /// they are -+mu_j lambda_{normal_row_j} with the current contact-row value.
 /// A: c x c (row-major sparse, symmetric, A_jj > 0); b: c. Returns lambda (c, N for unit-axis
@@ -17,7 +19,7 @@ namespace cps {
 /// Throws std::invalid_argument on mismatched sizes or iterations < 0.
 Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
                           const RowLimits& limits, FrictionModel friction, SolverKind kind,
-                          int iterations);
+                          int iterations, const double* initial = nullptr);
 
 /// The natural-map residual of the bounded problem at `lambda` (c), per row
 ///   r_j = |lambda_j - clamp(lambda_j - (A lambda - b)_j / A_jj, lo_j, hi_j)|   (N)

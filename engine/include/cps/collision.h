@@ -8,17 +8,58 @@
 #include "cps/body.h"
 
 #include <array>
+#include <cstdint>
 
 namespace cps {
+
+/// Contact feature ids: which features of the two shapes a contact point comes from, so that a
+/// point of the next step can be recognised as the same contact while the bodies stay in
+/// contact (the idea of Box2D's b2ContactFeature; Catto, "Iterative Dynamics with Temporal
+/// Coherence", GDC 2005, on matching contacts by feature for warm starting). An id is unique
+/// within a manifold and says nothing across body pairs. 32 bits: the kind in bits 28..31, then
+/// per kind:
+/// - kFeatureSphere: 0. A sphere's contact with a plane, a sphere or a box is one point.
+/// - kFeatureBoxVertex: bits 0..2, the box vertex below the plane (bit k set: the vertex on the
+///   +e_k side of box axis k).
+/// - kFeatureFaceA, kFeatureFaceB: a face contact of box-box, with the reference face on the
+///   first (A) or the second (B) box of collide_box_box. Bits 0..2: the reference face, bits
+///   3..5: the incident face of the other box (face = 2 axis + 1 if its outward normal is -axis,
+///   0 if +axis). Bits 6..8 and 9..11: the two lines the clipped point lies on, the smaller
+///   first: 0..3 the incident face's edges, 4..7 the reference face's side planes. A vertex of
+///   the incident face is its two edges; a clipped point is an edge and a side plane; a corner
+///   of the reference face inside the incident face is two side planes.
+/// - kFeatureEdges: edge-edge. Bits 0..3: the edge of the first box, bits 4..7: the edge of the
+///   second (edge = 4 axis + 1 if it lies on the + side of the next axis + 2 if on the + side of
+///   the one after).
+enum ContactFeatureKind : std::uint32_t {
+  kFeatureSphere = 1,
+  kFeatureBoxVertex = 2,
+  kFeatureFaceA = 3,
+  kFeatureFaceB = 4,
+  kFeatureEdges = 5,
+};
+
+/// The id of kind `kind` with the fields `bits` (bits 0..27, see ContactFeatureKind).
+constexpr std::uint32_t contact_feature(ContactFeatureKind kind, std::uint32_t bits) {
+  return (static_cast<std::uint32_t>(kind) << 28) | (bits & 0x0FFFFFFFu);
+}
+
+/// The kind of a feature id.
+constexpr ContactFeatureKind contact_feature_kind(std::uint32_t feature) {
+  return static_cast<ContactFeatureKind>(feature >> 28);
+}
 
 /// One contact point. normal: unit 3-vector from body a to body b (the direction along which
 /// b must move to separate). depth: penetration along the normal (m); negative for a
 /// speculative contact, where -depth is the gap (less than the collision margin). point: world
-/// position (m), midway between the two surfaces.
+/// position (m), midway between the two surfaces. feature: which features of the two shapes it
+/// comes from (ContactFeatureKind); a contact of the next step with the same body pair and the
+/// same feature is the same contact.
 struct Contact {
   Vec3 point = Vec3::Zero();
   Vec3 normal = Vec3::UnitY();
   double depth = 0.0;
+  std::uint32_t feature = 0;
 };
 
 /// Most points a manifold holds: clipping a quadrilateral against four planes leaves at most 8.
@@ -60,32 +101,35 @@ struct OrientedBox {
 
 /// Box-plane contacts: every vertex of `box` below the plane {x : dot(n, x) = offset} (n unit,
 /// offset in m), with normal n (from plane to box) and depth offset - dot(n, v). Returns the
-/// number of contacts written to `out` (0..8). The caller flips normals if the box is body a.
+/// number of contacts written to `out` (0..8), each with the feature id of its vertex
+/// (kFeatureBoxVertex). The caller flips normals if the box is body a.
 int collide_box_plane(const OrientedBox& box, const Vec3& n, double offset, Manifold& out,
                       double margin = 0.0);
 
 /// Box-box contacts by the separating axis test over the 15 axes (3 face normals of each box and
 /// the 9 cross products of their edge directions). Normals point from box a to box b. Returns
-/// the number of contacts written to `out` (0 when a separating axis exists).
+/// the number of contacts written to `out` (0 when a separating axis exists). Feature ids:
+/// kFeatureFaceA or kFeatureFaceB (reference face, incident face and the clipped point's two
+/// lines) for a face contact, kFeatureEdges (the two edges) for an edge contact.
 int collide_box_box(const OrientedBox& a, const OrientedBox& b, Manifold& out,
                     double margin = 0.0);
 
 /// Sphere-plane contact: sphere of centre c (m) and radius r (m) against the plane
 /// {x : dot(n, x) = offset}; normal n (from plane to sphere), depth r - (dot(n, c) - offset).
-/// Returns 0 or 1 contacts written to `out`.
+/// Returns 0 or 1 contacts written to `out` (feature kFeatureSphere).
 int collide_sphere_plane(const Vec3& c, double r, const Vec3& n, double offset, Manifold& out,
                          double margin = 0.0);
 
 /// Sphere-sphere contact between spheres (c_a, r_a) and (c_b, r_b) (m); normal from a to b,
 /// depth r_a + r_b - |c_b - c_a|. Coincident centres (closer than 1e-12 m) get the normal +y,
-/// so the pair still separates. Returns 0 or 1 contacts written to `out`.
+/// so the pair still separates. Returns 0 or 1 contacts written to `out` (feature kFeatureSphere).
 int collide_sphere_sphere(const Vec3& c_a, double r_a, const Vec3& c_b, double r_b, Manifold& out,
                           double margin = 0.0);
 
 /// Box-sphere contact by the closest point of the box to the sphere centre c (m), radius r (m)
 /// (Ericson 2005, Sec. 5.1.4). Normal from the box to the sphere. A centre inside the box is
 /// pushed out through the face it is nearest to (depth = distance to that face + r). Returns 0
-/// or 1 contacts written to `out`.
+/// or 1 contacts written to `out` (feature kFeatureSphere).
 int collide_box_sphere(const OrientedBox& box, const Vec3& c, double r, Manifold& out,
                        double margin = 0.0);
 

@@ -68,14 +68,11 @@ struct RowParams {
   double restitution_threshold = 1.0;
 };
 
-/// Appends the rows of one manifold to `rows`: per contact point a contact row (Sec. 5.3:
-/// c_min = 0, c_max = +inf, push = beta d / dt; for a speculative contact with d < 0 instead
-/// bias = d / dt, which lets the points close the gap within the step and no further) and, when friction > 0, two friction rows
-/// (Sec. 5.4: target 0, limits +-mu m |g . n| where m is the combined mass of the two bodies
-/// divided over the manifold's points, the movable body's mass when the other is static).
-/// Rows come per point in the order contact, friction t1, friction t2. With restitution > 0 a
-/// contact whose points approach faster than the threshold (j . v1 < -threshold) and touch or
-/// close their gap within the step gets the bias v_r = -eps j . v1 (Eq. 8.2.1).
+/// Appends the rows of one manifold to `rows`: first its contact rows, one per point in point
+/// order (append_normal_rows), then its friction rows, two per point in point order
+/// (append_friction_rows, only when friction > 0). A world step puts the contact rows of every
+/// manifold before the friction rows of any (World::step); for a single manifold the order is
+/// the same.
 void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
                          const RowParams& params, std::vector<ConstraintRow>& rows);
 
@@ -95,6 +92,29 @@ BodyVelocity body_velocity(const Body& b);
 void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
                          const BodyVelocity& v_a, const BodyVelocity& v_b,
                          const RowParams& params, std::vector<ConstraintRow>& rows);
+
+/// Appends one contact row per point of m (Sec. 5.3), in point order: j about the normal n (from
+/// a to b), c_min = 0, c_max = +inf, push = beta d / dt for a depth d >= 0 (Eq. 5.3.1); for a
+/// speculative contact (d < 0) instead bias = d / dt (m/s), which lets the points close the gap
+/// within the step and no further. With restitution > 0 a contact whose points approach faster
+/// than the threshold (j . v1 < -threshold) and touch or close their gap within the step gets
+/// the bias v_r = -eps j . v1 instead (Eq. 8.2.1). v_a, v_b: the velocities of m.body_a and
+/// m.body_b (m/s, rad/s). No errors.
+void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
+                        const BodyVelocity& v_a, const BodyVelocity& v_b,
+                        const RowParams& params, std::vector<ConstraintRow>& rows);
+
+/// Appends two friction rows per point of m (Sec. 5.4), in point order, along t1 and t2 of
+/// tangent_basis(n): target 0, limits +-mu m |g . n| (N) where m (kg) is the combined mass of
+/// the two bodies divided over the manifold's points (the movable body's mass when the other is
+/// static). normal_row of point i's rows is first_normal_row + i: the index in `rows` of that
+/// point's contact row (append_normal_rows), for the coupled limit mu lambda_n. Appends nothing
+/// when params.friction is 0. tangents: nullptr (the paper's directions), or m.count unit
+/// vectors t1 perpendicular to each point's normal, with t2 = n x t1 (the warm start keeps a
+/// persisting contact's directions so its friction lambdas carry over). No errors.
+void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
+                          const RowParams& params, int first_normal_row,
+                          std::vector<ConstraintRow>& rows, const Vec3* tangents = nullptr);
 
 /// A distance constraint (Sec. 5.2): point local_a of body_a and point local_b of body_b stay
 /// `length` apart (m, >= 0). local_a, local_b are in body space (m); when body_b is kWorldBody,

@@ -69,6 +69,14 @@ struct WorldDef {
   /// break and re-form each step. 0 gives the paper's contacts, made only on overlap. Typical:
   /// 1e-3 m for bodies of 0.5 to 3 m.
   double contact_margin = 0.0;
+  /// Warm starting (Sec. 6.2.3: "the value from the previous frame can be used by caching the
+  /// constraint information"), dimensionless in [0, 1]: each row's lambda starts from this
+  /// factor times its lambda of the previous steps (the smaller of the last two, so an impact's
+  /// impulse is not carried over) when its contact (same body pair and contact feature) or rod
+  /// persists, and from 0 when it is new (engine/src/warm_start.h). 0 (the default) is the
+  /// paper's initial guess 0 everywhere. Typical 0.8; 1 can feed energy into stiff piles and
+  /// chains (README, "Warm starting").
+  double warm_start = 0.0;
   bool collision = true;  ///< false: the bodies never collide and the collide stage is skipped
   /// true: after every solve, measure the LCP residual into World::residual(); it costs one pass
   /// over the rows per solve, so it is off unless a report asks for it.

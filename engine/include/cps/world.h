@@ -5,7 +5,8 @@
 //   collide           Sec. 4    each box's and plane's rotation, the broad phase's candidate
 //                               pairs (broad_phase.h), a manifold for each pair that touches
 //                               (skipped when the world has collision off)
-//   build_rows        Sec. 5    contact, friction (only with mu > 0) and distance rows
+//   build_rows        Sec. 5    contact, friction (only with mu > 0) and distance rows; with
+//                               warm starting, each row's initial guess (Sec. 6.2.3)
 //   prepare           Sec. 6    J, M^-1 and A (explicit), or the packed rows (matrix-free)
 //   solve             Sec. 7    lambda by PGS or Jacobi, f_cv = f_ext + J^T lambda (Eq. 6.2.1)
 //   solve again       Sec. 8.1  with the single frame push factor: the push left out of v,
@@ -32,6 +33,7 @@ namespace cps {
 // Internal to the engine (engine/src): the broad phase, the solve, the target terms of a solve.
 class BroadPhase;
 class ConstraintSolver;
+class WarmStartCache;
 enum class TargetTerms : int;
 
 /// The most candidate pairs the broad phase may list in one step (count). A pair costs 8 bytes;
@@ -69,8 +71,9 @@ class World {
  public:
   /// Throws std::invalid_argument if def is invalid (see WorldDef::validate).
   explicit World(const WorldDef& def = {});
-  /// A copy has the same parameters, bodies, constraints, last-step results and counters; its
-  /// step buffers start empty (they hold nothing from one step to the next).
+  /// A copy has the same parameters, bodies, constraints, last-step results, counters and warm
+  /// start cache (so it steps on exactly as the original would); its step buffers start empty
+  /// (they hold nothing from one step to the next).
   World(const World& other);
   World& operator=(const World& other);
   World(World&&) noexcept;
@@ -108,6 +111,10 @@ class World {
   const std::vector<double>& lambda() const { return lambda_; }
   /// lambda of the last step's second solve (c, N; Sec. 8.1, push split only; empty otherwise).
   const std::vector<double>& lambda_second() const { return lambda0_; }
+  /// With warm starting on (WorldDef::warm_start > 0): the contact points of the last step that
+  /// persisted from the step before it (same body pair and contact feature), whose rows started
+  /// from the cached lambdas (count). 0 with warm starting off.
+  std::size_t persisting_contacts() const;
 
   /// Replaces the parameters (validated first: throws std::invalid_argument and keeps the old
   /// ones on a bad value). The bodies and constraints stay as they are.
@@ -118,7 +125,8 @@ class World {
   void collide();
   void build_rows();
   void prepare();
-  void solve(TargetTerms terms, std::vector<double>& lambda, Eigen::VectorXd& f);
+  void solve(TargetTerms terms, std::vector<double>& lambda, Eigen::VectorXd& f,
+             const std::vector<double>* initial);
   void integrate();
   void count_residual(double max, double sum_squares, std::int64_t rows);
 
@@ -141,6 +149,11 @@ class World {
   std::vector<unsigned char> velocity_known_;
   std::unique_ptr<BroadPhase> broad_phase_;
   std::unique_ptr<ConstraintSolver> solver_;  // made for def_.assembly when first needed
+  // Warm starting (Sec. 6.2.3): the last step's contacts and lambdas (made when first needed),
+  // and this step's initial guesses of the two solves (c each, N).
+  std::unique_ptr<WarmStartCache> warm_start_;
+  std::vector<double> initial_;
+  std::vector<double> initial_second_;
   Assembly solver_assembly_ = Assembly::matrix_free;
   StepCounters counters_;
   ResidualStats residual_;

@@ -1,0 +1,194 @@
+// The warm start cache (see warm_start.h).
+#include "warm_start.h"
+
+#include "buffers.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cps {
+namespace {
+
+// Pair order of the manifolds (a, then b), as the collide stage lists them.
+bool pair_less(int a1, int b1, int a2, int b2) { return a1 < a2 || (a1 == a2 && b1 < b2); }
+
+// The number of points in all manifolds.
+std::size_t point_count(const std::vector<Manifold>& manifolds) {
+  std::size_t n = 0;
+  for (const Manifold& m : manifolds) n += static_cast<std::size_t>(m.count);
+  return n;
+}
+
+// Whether the rows hold two friction rows per point (rows = points + 2 points + rods).
+bool rows_have_friction(std::size_t points, std::size_t rows, std::size_t rods) {
+  return points > 0 && rows == 3 * points + rods;
+}
+
+}  // namespace
+
+void WarmStartCache::match(const std::vector<Manifold>& manifolds) {
+  const std::size_t points = point_count(manifolds);
+  detail::assign_with_headroom(match_, points, -1);
+  detail::resize_with_headroom(tangents_, points);
+  matched_ = 0;
+  std::size_t k = 0;  // this step's point
+  std::size_t j = 0;  // cached manifold
+  for (const Manifold& m : manifolds) {
+    // Both lists are in pair order: walk the cached one along (a missing or extra pair, or any
+    // other order, only means fewer matches).
+    while (j < manifolds_.size() &&
+           pair_less(manifolds_[j].body_a, manifolds_[j].body_b, m.body_a, m.body_b)) {
+      ++j;
+    }
+    const bool same_pair = j < manifolds_.size() && manifolds_[j].body_a == m.body_a &&
+                           manifolds_[j].body_b == m.body_b;
+    unsigned used = 0;  // cached points of this pair already matched (at most 8: one bit each)
+    for (int i = 0; i < m.count; ++i, ++k) {
+      const Contact& c = m.contacts[static_cast<std::size_t>(i)];
+      Vec3 t1;
+      Vec3 t2;
+      tangent_basis(c.normal, t1, t2);  // the paper's directions for a new point
+      if (same_pair) {
+        const CachedManifold& cm = manifolds_[j];
+        for (int q = 0; q < cm.count; ++q) {
+          const CachedPoint& p = points_[static_cast<std::size_t>(cm.first + q)];
+          if ((used >> q) & 1u || p.feature != c.feature) continue;
+          used |= 1u << q;
+          match_[k] = cm.first + q;
+          ++matched_;
+          // The cached t1 in the new contact plane: the friction rows keep their directions.
+          const Vec3 projected = p.t1 - p.t1.dot(c.normal) * c.normal;
+          if (projected.norm() > 0.5) t1 = projected.normalized();
+          break;
+        }
+      }
+      tangents_[k] = t1;
+    }
+  }
+}
+
+void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
+                                     const std::vector<ConstraintRow>& rows, std::size_t rods,
+                                     double factor, FrictionModel friction,
+                                     std::vector<double>& first,
+                                     std::vector<double>& second) const {
+  const std::size_t c = rows.size();
+  const std::size_t points = point_count(manifolds);
+  const bool friction_rows = rows_have_friction(points, c, rods);
+  const bool coupled = friction == FrictionModel::coupled;
+  detail::assign_with_headroom(first, c, 0.0);
+  if (has_second_) {
+    detail::assign_with_headroom(second, c, 0.0);
+  } else {
+    second.clear();
+  }
+  for (int solve = 0; solve < (has_second_ ? 2 : 1); ++solve) {
+    std::vector<double>& out = solve == 0 ? first : second;
+    std::size_t k = 0;
+    for (const Manifold& m : manifolds) {
+      for (int i = 0; i < m.count; ++i, ++k) {
+        if (k >= match_.size() || match_[k] < 0) continue;  // a new point: 0
+        const CachedPoint& p = points_[static_cast<std::size_t>(match_[k])];
+        const double* cached = solve == 0 ? p.first : p.second;
+        const double older = p.older[solve];
+        // Contact row k: the smaller of its last two lambdas (see the class comment).
+        const double sustained = std::max(0.0, std::min(cached[0], older));
+        out[k] = factor * sustained;
+        if (!friction_rows || !has_friction_) continue;
+        // The cached friction force, scaled as the contact's, along this step's directions (t1
+        // is the cached t1 in the new plane, so this is close to a copy), within the row's limits.
+        const double scale = cached[0] > 0.0 ? sustained / cached[0] : 0.0;
+        const Vec3 force = scale * (cached[1] * p.t1 + cached[2] * p.t2);
+        const Vec3& t1 = tangents_[k];
+        const Vec3 t2 = m.contacts[static_cast<std::size_t>(i)].normal.cross(t1);
+        for (int r = 0; r < 2; ++r) {
+          const std::size_t row = points + 2 * k + static_cast<std::size_t>(r);
+          double lo = rows[row].c_min;
+          double hi = rows[row].c_max;
+          if (coupled) {
+            hi = rows[row].mu * out[k];
+            lo = -hi;
+          }
+          out[row] = std::clamp(factor * force.dot(r == 0 ? t1 : t2), lo, hi);
+        }
+      }
+    }
+    // Rods: kept by index, always the same rows at the end; the smaller of the last two lambdas
+    // when they have the same sign, else 0.
+    const std::vector<double>& cached_rods = solve == 0 ? rods_first_ : rods_second_;
+    const std::vector<double>& older_rods = solve == 0 ? rods_older_first_ : rods_older_second_;
+    for (std::size_t r = 0; r < rods && r < cached_rods.size(); ++r) {
+      const double a = cached_rods[r];
+      const double b = older_rods[r];
+      out[c - rods + r] = (a > 0.0) == (b > 0.0) ? factor * (std::abs(a) < std::abs(b) ? a : b) : 0.0;
+    }
+  }
+}
+
+void WarmStartCache::store(const std::vector<Manifold>& manifolds,
+                           const std::vector<ConstraintRow>& rows, std::size_t rods,
+                           const std::vector<double>& first, const std::vector<double>& second) {
+  const std::size_t c = rows.size();
+  const std::size_t points = point_count(manifolds);
+  has_friction_ = rows_have_friction(points, c, rods);
+  has_second_ = !second.empty();
+  manifolds_.clear();
+  detail::reserve_with_headroom(manifolds_, manifolds.size());
+  detail::resize_with_headroom(next_points_, points);
+  std::size_t k = 0;
+  for (const Manifold& m : manifolds) {
+    manifolds_.push_back({m.body_a, m.body_b, static_cast<int>(k), m.count});
+    for (int i = 0; i < m.count; ++i, ++k) {
+      CachedPoint& p = next_points_[k];
+      const bool matched = k < match_.size() && match_[k] >= 0;
+      const CachedPoint* before = matched ? &points_[static_cast<std::size_t>(match_[k])] : nullptr;
+      p.older[0] = before != nullptr ? before->first[0] : 0.0;
+      p.older[1] = before != nullptr ? before->second[0] : 0.0;
+      const Contact& contact = m.contacts[static_cast<std::size_t>(i)];
+      p.feature = contact.feature;
+      for (int s = 0; s < 2; ++s) {
+        const std::vector<double>& lambda = s == 0 ? first : second;
+        double* out = s == 0 ? p.first : p.second;
+        const bool have = s == 0 || has_second_;
+        out[0] = have && k < lambda.size() ? lambda[k] : 0.0;
+        out[1] = have && has_friction_ ? lambda[points + 2 * k] : 0.0;
+        out[2] = have && has_friction_ ? lambda[points + 2 * k + 1] : 0.0;
+      }
+      if (has_friction_) {
+        // The directions of its friction rows: the linear part of body b's half of j is t.
+        p.t1 = rows[points + 2 * k].j.segment<3>(6);
+        p.t2 = rows[points + 2 * k + 1].j.segment<3>(6);
+      } else {
+        tangent_basis(contact.normal, p.t1, p.t2);
+      }
+    }
+  }
+  points_.swap(next_points_);
+  const std::size_t had_rods = rods_first_.size();
+  rods_older_first_.swap(rods_first_);
+  rods_older_second_.swap(rods_second_);
+  detail::resize_with_headroom(rods_older_first_, rods);  // rods added since: 0
+  detail::resize_with_headroom(rods_older_second_, rods);
+  for (std::size_t r = had_rods; r < rods; ++r) rods_older_first_[r] = rods_older_second_[r] = 0.0;
+  detail::resize_with_headroom(rods_first_, rods);
+  detail::resize_with_headroom(rods_second_, rods);
+  for (std::size_t r = 0; r < rods; ++r) {
+    rods_first_[r] = first[c - rods + r];
+    rods_second_[r] = has_second_ ? second[c - rods + r] : 0.0;
+  }
+}
+
+void WarmStartCache::clear() {
+  manifolds_.clear();
+  points_.clear();
+  rods_first_.clear();
+  rods_second_.clear();
+  rods_older_first_.clear();
+  rods_older_second_.clear();
+  has_second_ = false;
+  has_friction_ = false;
+  match_.clear();
+  matched_ = 0;
+}
+
+}  // namespace cps

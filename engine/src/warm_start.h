@@ -1,0 +1,111 @@
+#pragma once
+// Warm starting (paper Sec. 6.2.3: "the initial guess for lambda can be 0, but the value from the
+// previous frame can be used by caching the constraint information"). Internal to the engine:
+// World keeps one cache, fills it after its solves and reads it when it builds the next step's
+// rows. A contact persists when the next step finds a contact with the same body pair and the
+// same feature id (collision.h, ContactFeatureKind; the idea of Box2D's b2ContactFeature and of
+// Catto, "Iterative Dynamics with Temporal Coherence", GDC 2005); a rod persists always (it is
+// kept by index).
+
+#include "cps/collision.h"
+#include "cps/constraint.h"
+#include "cps/parameters.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace cps {
+
+/// The contacts and rods of the last step with their lambdas, and this step's matches to them.
+///
+/// The guess is the factor times the smaller of a row's lambdas of the last two steps (for a rod,
+/// the one of smaller magnitude if both have the same sign, else 0), not of the last step alone:
+/// a lambda that has just jumped is an impulse (an impact, a landing), not a force that lasts,
+/// and starting the next step from it pushes the bodies apart harder than they need; with a fixed
+/// number of sweeps PGS does not take all of it back, and the step gains energy (Catto,
+/// erincatto/solver2d issue 8: "errors in warm starting energy can grow unbounded"). So a contact
+/// starts from a cached value in its third step, once it has two. Measured per step against the energy bound of
+/// tests/test_stress.cpp (the largest dE - dW - dR over the run, tolerance in brackets), factor
+/// 0.8, last lambda only / smaller of the last two: stack landing 0.080 / 0.011 J (0.0106 J),
+/// stack_dt_0.1 1.75 / -0.039 J (0.013 J), mass_ratio_10 0.0087 / -0.0028 J (0.0036 J).
+/// The step's rows must be laid out as World::build_rows lays them out: one contact row per
+/// point of the manifolds (manifolds in order, points in order), then, when friction rows are
+/// built, two friction rows per point in the same order, then one row per rod. Every buffer
+/// keeps its storage, so after warm-up nothing is allocated.
+class WarmStartCache {
+ public:
+  /// Matches the points of this step's manifolds (in pair order, as the collide stage lists
+  /// them) to the cached ones: same body pair and same feature id, each cached point used at
+  /// most once. For each point it also picks the friction direction t1 (unit, perpendicular to
+  /// the point's normal): for a matched point the cached t1 projected onto the new contact plane
+  /// and normalised, so that the friction lambdas carry over (if the normal turned so far that
+  /// the projection is shorter than 1/2, tangent_basis instead); for a new point tangent_basis's
+  /// t1 (the paper's choice, Sec. 5.4).
+  void match(const std::vector<Manifold>& manifolds);
+
+  /// The t1 picked by match() for the points of one manifold, m.count of them, for
+  /// append_friction_rows; first_point: the number of points in the manifolds before it. Valid
+  /// until the next match().
+  const Vec3* tangents(std::size_t first_point) const { return tangents_.data() + first_point; }
+
+  /// The initial guesses (N) of this step's rows (c = rows.size(), laid out as the class says,
+  /// `rods` rod rows at the end): `factor` (dimensionless, [0, 1]) times the smaller of the last
+  /// two cached lambdas of a matched point's contact row, its friction rows' cached force scaled
+  /// alike and re-expressed along this step's t1, t2, and each rod's (class comment); 0 for new
+  /// rows. Each guess lies within its
+  /// row's limits: a contact's in [0, inf), a friction row's in [c_min, c_max] (fixed model) or
+  /// within +-mu times its contact row's guess (coupled model). `first` is for the solve with the
+  /// push (Sec. 7), `second` for the solve without it (Sec. 8.1), each from the cached lambda of
+  /// the same solve; `second` is left empty when the cache holds no second solve.
+  void initial_guesses(const std::vector<Manifold>& manifolds,
+                       const std::vector<ConstraintRow>& rows, std::size_t rods, double factor,
+                       FrictionModel friction, std::vector<double>& first,
+                       std::vector<double>& second) const;
+
+  /// Replaces the cache by this step's points (features, t1, t2) and lambdas: `first` (c, N)
+  /// from the solve with the push, `second` (c, N, or empty) from the solve without it (Sec.
+  /// 8.1). The rows are laid out as the class says with `rods` rod rows at the end.
+  void store(const std::vector<Manifold>& manifolds, const std::vector<ConstraintRow>& rows,
+             std::size_t rods, const std::vector<double>& first,
+             const std::vector<double>& second);
+
+  /// Forgets everything: the next step starts every row from 0.
+  void clear();
+
+  /// Cached contact points (count), for tests.
+  std::size_t cached_points() const { return points_.size(); }
+  /// Points of the last match() that found their cached point (count), for tests.
+  std::size_t matched_points() const { return matched_; }
+
+ private:
+  struct CachedManifold {
+    int body_a;
+    int body_b;
+    int first;  // first point in points_
+    int count;
+  };
+  struct CachedPoint {
+    std::uint32_t feature;
+    Vec3 t1;           // friction directions of its rows (unit)
+    Vec3 t2;
+    double first[3];   // lambda (N) of its contact, t1 and t2 rows, first solve
+    double second[3];  // the same, second solve (Sec. 8.1)
+    double older[2];   // its contact row's lambda (N) one step earlier (first, second solve);
+                       // 0 if it is new
+  };
+  std::vector<CachedManifold> manifolds_;
+  std::vector<CachedPoint> points_;
+  std::vector<CachedPoint> next_points_;  // store() builds here, then swaps with points_
+  std::vector<double> rods_first_;
+  std::vector<double> rods_second_;
+  std::vector<double> rods_older_first_;   // the rods' lambdas one step earlier (N)
+  std::vector<double> rods_older_second_;
+  bool has_second_ = false;
+  bool has_friction_ = false;
+  // This step: per point, the cached point it matched (-1: none) and its t1.
+  std::vector<int> match_;
+  std::vector<Vec3> tangents_;
+  std::size_t matched_ = 0;
+};
+
+}  // namespace cps

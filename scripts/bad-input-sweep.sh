@@ -52,7 +52,7 @@ declare -A KIND=(
   ['*:--rendering']=flag ['*:--contacts']=flag ['*:--rods']=flag ['*:--label']=flag
   ['*:--seconds']=seconds ['*:--fps']=fps ['*:--orbit']=orbit
   ['*:--dt']=dt ['*:--iterations']=iterations
-  ['*:--beta']=unit_interval ['*:--restitution']=unit_interval
+  ['*:--beta']=unit_interval ['*:--restitution']=unit_interval ['*:--warm-start']=unit_interval
   ['*:--friction']=nonneg_1e6 ['*:--restitution-threshold']=nonneg_1e6
   ['*:--contact-margin']=nonneg_1e6
   ['*:--size']=size ['*:--times']=times

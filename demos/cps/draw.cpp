@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -69,6 +70,13 @@ render::Camera orbit(render::Camera camera, double deg) {
 }
 
 
+std::string vec_text(const glm::vec3& v) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%g, %g, %g", static_cast<double>(v.x),
+                static_cast<double>(v.y), static_cast<double>(v.z));
+  return text;
+}
+
 }  // namespace
 
 render::DrawList draw_list(const World& world, const DrawStyle& style) {
@@ -93,25 +101,78 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
     distance_endpoints(d, bodies, p_a, p_b);
     list.lines.push_back({to_glm(p_a), to_glm(p_b), glm::vec3(0.15f), 2.0f});
   }
-  glm::vec3 lo(-5.0f);
-  glm::vec3 hi(5.0f);
-  render::bounds(list, lo, hi);  // the bodies only: contact markers do not move the planes
   if (style.overlays.contacts) add_contacts(world, list);
-  const glm::vec3 centre = 0.5f * (lo + hi);
-  const float extent = glm::length(hi - lo);
   for (const Body& b : bodies) {
     if (b.shape.kind != ShapeKind::plane) continue;
     const Vec3 n = b.rotation() * b.shape.normal;
     render::PlaneItem plane;
     plane.normal = to_glm(n);
     plane.offset = static_cast<float>(b.shape.offset + n.dot(b.x));
-    plane.center_hint = centre;
-    plane.half_size = std::max(30.0f, 3.0f * extent);
+    plane.center_hint = style.plane_centre;
+    plane.half_size = style.plane_half_size_m;
     plane.checker_m = 1.0f;
     plane.alpha = style.plane_opacity;
     list.planes.push_back(plane);
   }
   return list;
+}
+
+void Bounds::add(const Vec3& a, const Vec3& b) {
+  if (!a.allFinite() || !b.allFinite()) return;
+  if (!any) {
+    lo = a;
+    hi = b;
+    any = true;
+  } else {
+    lo = lo.cwiseMin(a);
+    hi = hi.cwiseMax(b);
+  }
+}
+
+void Bounds::add(const Bounds& other) {
+  if (other.any) add(other.lo, other.hi);
+}
+
+Bounds world_bounds(const World& world) {
+  Bounds out;
+  const auto& bodies = world.bodies();
+  for (const Body& b : bodies) {
+    if (b.shape.kind == ShapeKind::box) {
+      // World half extents of the oriented box: e_i = sum_j |R_ij| h_j (Ericson 4.2.6).
+      const Vec3 e = b.rotation().cwiseAbs() * b.shape.half_extents;
+      out.add(b.x - e, b.x + e);
+    } else if (b.shape.kind == ShapeKind::sphere) {
+      const Vec3 e = Vec3::Constant(b.shape.radius);
+      out.add(b.x - e, b.x + e);
+    }
+  }
+  for (const DistanceConstraint& d : world.distances()) {
+    Vec3 p_a;
+    Vec3 p_b;
+    distance_endpoints(d, bodies, p_a, p_b);
+    out.add(p_a, p_a);
+    out.add(p_b, p_b);
+  }
+  return out;
+}
+
+Bounds run_bounds(std::span<const World* const> worlds, double seconds) {
+  Bounds out;
+  for (const World* w : worlds) {
+    World copy = *w;
+    out.add(world_bounds(copy));
+    while (copy.time() + 0.5 * copy.def().dt < seconds) {
+      copy.step();
+      out.add(world_bounds(copy));
+    }
+  }
+  return out;
+}
+
+void plane_extent(const Bounds& b, glm::vec3& centre, float& half_size_m) {
+  centre = b.any ? to_glm(0.5 * (b.lo + b.hi)) : glm::vec3(0.0f);
+  const float extent = b.any ? static_cast<float>((b.hi - b.lo).norm()) : 0.0f;
+  half_size_m = std::max(30.0f, 3.0f * extent);
 }
 
 namespace {
@@ -145,8 +206,8 @@ render::Camera camera_from_preset(const scenes::CameraPreset& preset) {
   return camera;
 }
 
-constexpr std::array<std::string_view, 5> kCameraNames = {"preset", "auto", "front", "side",
-                                                          "top"};
+constexpr std::array<std::string_view, 6> kCameraNames = {"preset", "auto", "fit",
+                                                          "front", "side", "top"};
 
 // The camera preset called `name` (see camera_names()) given the scene's preset `own` (none:
 // the scene has none); nullopt means "frame the world automatically" (frame_world). `world` is
@@ -155,7 +216,7 @@ constexpr std::array<std::string_view, 5> kCameraNames = {"preset", "auto", "fro
 std::optional<scenes::CameraPreset> camera_preset(const std::optional<scenes::CameraPreset>& own,
                                                   const World& world, std::string_view name,
                                                   float aspect) {
-  if (name == "preset") return own;
+  if (name == "preset" || name == "fit") return own;
   if (name == "auto") return std::nullopt;
   scenes::CameraPreset base;
   if (own) {
@@ -185,14 +246,67 @@ std::optional<scenes::CameraPreset> camera_preset(const std::optional<scenes::Ca
 
 }  // namespace
 
+nlohmann::json camera_json(const render::Camera& c) {
+  return {{"eye_m", {c.eye.x, c.eye.y, c.eye.z}},
+          {"target_m", {c.target.x, c.target.y, c.target.z}},
+          {"fov_y_deg", c.fov_y_deg}};
+}
+
 std::span<const std::string_view> camera_names() { return kCameraNames; }
 
 DrawStyle resolve_style(const scenes::Scene& scene, const World& as_built, const View& view,
                         float aspect) {
+  const World* worlds[] = {&as_built};
+  return resolve_style(scene, worlds, view, aspect, 0.0);
+}
+
+DrawStyle resolve_style(const scenes::Scene& scene, std::span<const World* const> as_built,
+                        const View& view, float aspect, double seconds) {
+  if (as_built.empty()) throw std::invalid_argument("resolve_style: no world");
+  const World& first = *as_built.front();
   const std::optional<scenes::CameraPreset> preset =
-      camera_preset(view.preset ? view.preset : scene.camera, as_built, view.camera, aspect);
-  return {preset ? camera_from_preset(*preset) : frame_world(as_built, aspect),
-          static_cast<float>(scene.plane_opacity), view.overlays};
+      camera_preset(view.preset ? view.preset : scene.camera, first, view.camera, aspect);
+  DrawStyle style;
+  style.camera = preset ? camera_from_preset(*preset) : frame_world(first, aspect);
+  style.plane_opacity = static_cast<float>(scene.plane_opacity);
+  style.overlays = view.overlays;
+  if (view.fov_y_deg) style.camera.fov_y_deg = static_cast<float>(*view.fov_y_deg);
+  Bounds bounds;
+  if (view.camera == "fit") {
+    bounds = run_bounds(as_built, seconds);
+    if (bounds.any) {
+      // The bounding sphere of the run's bounds, seen along the named camera's direction.
+      const glm::vec3 lo = to_glm(bounds.lo);
+      const glm::vec3 hi = to_glm(bounds.hi);
+      const float radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
+      const float half_v = glm::radians(0.5f * style.camera.fov_y_deg);
+      const float half_h = std::atan(std::tan(half_v) * aspect);
+      const float distance = 1.1f * radius / std::sin(std::min(half_v, half_h));
+      const glm::vec3 dir = glm::normalize(style.camera.eye - style.camera.target);
+      style.camera.target = 0.5f * (lo + hi);
+      style.camera.eye = style.camera.target + distance * dir;
+      style.camera.near_m = distance / 50.0f;
+      style.camera.far_m = distance * 50.0f;
+    }
+  } else {
+    for (const World* w : as_built) bounds.add(world_bounds(*w));
+  }
+  if (view.eye || view.target) {
+    if (view.eye) style.camera.eye = to_glm(*view.eye);
+    if (view.target) style.camera.target = to_glm(*view.target);
+    const float distance = glm::length(style.camera.eye - style.camera.target);
+    if (!(distance > 1e-6f)) {
+      throw UsageError("--eye and --target: the eye (" + vec_text(style.camera.eye) +
+                       ") equals the target; give points at least 1e-6 m apart");
+    }
+    style.camera.near_m = distance / 50.0f;
+    style.camera.far_m = distance * 50.0f;
+    // Looking straight up or down makes the up vector (0, 1, 0) degenerate: tilt it.
+    const glm::vec3 d = (style.camera.target - style.camera.eye) / distance;
+    if (std::abs(d.y) > 0.999f) style.camera.up = glm::vec3(0.0f, 0.0f, -1.0f);
+  }
+  plane_extent(bounds, style.plane_centre, style.plane_half_size_m);
+  return style;
 }
 
 }  // namespace cps::cli

@@ -5,6 +5,8 @@
 #include "cps/world.h"
 #include "scene.h"
 
+#include <nlohmann/json.hpp>
+
 #include <optional>
 #include <span>
 #include <string>
@@ -30,13 +32,47 @@ struct Overlays {
   double orbit_deg_per_s = 0.0;
 };
 
-/// How to draw a world: the camera, the opacity of its planes ([0, 1]) and the overlays.
-/// resolve_style makes one for a scene.
+/// How to draw a world: the camera, the opacity of its planes ([0, 1]), where the planes are
+/// drawn and the overlays. resolve_style makes one for a scene, once for a whole run.
 struct DrawStyle {
   render::Camera camera;
   float plane_opacity = 1.0f;
   Overlays overlays;
+  /// Every plane is drawn as a square of half side plane_half_size_m (m, > 0) centred on its
+  /// point nearest to plane_centre (m). Fixed for the whole run, so a plane's edge never moves
+  /// from frame to frame (resolve_style: around the bodies' bounds, see plane_extent).
+  glm::vec3 plane_centre{0.0f};
+  float plane_half_size_m = 30.0f;
 };
+
+/// Axis-aligned bounds (m) of what a scene shows: its movable boxes and spheres (oriented boxes
+/// bounded by |R| h) and the end points of its distance constraints (rods and their fixed
+/// points). `any` is false while nothing has been added.
+struct Bounds {
+  Vec3 lo = Vec3::Zero();
+  Vec3 hi = Vec3::Zero();
+  bool any = false;
+  /// Grows the bounds to hold the box [a, b] (m, a <= b per axis).
+  void add(const Vec3& a, const Vec3& b);
+  /// Grows the bounds to hold `other` (nothing if other.any is false).
+  void add(const Bounds& other);
+};
+
+/// The bounds of `world` as it is now (see Bounds); non-finite positions are skipped.
+Bounds world_bounds(const World& world);
+
+/// The bounds of a headless pre-run: a copy of every world in `worlds` (none is changed) is
+/// stepped at its own dt until its time reaches `seconds` (s, >= 0; within half a step, as
+/// scenes::Run::advance_to), and the union of world_bounds over the worlds as given and after
+/// every step is returned. Every picture of those runs at any time in [0, seconds] (each is
+/// drawn after a whole step) shows bodies inside these bounds. Costs as much physics as the
+/// runs themselves.
+Bounds run_bounds(std::span<const World* const> worlds, double seconds);
+
+/// The square the planes are drawn on for bounds `b`: centre the middle of b (the origin if
+/// b.any is false) and half side max(30, 3 |hi - lo|) m, large enough that its edge lies far
+/// outside any view framed on b.
+void plane_extent(const Bounds& b, glm::vec3& centre, float& half_size_m);
 
 /// The view a command asks for (`cps render`, `cps figure`, `cps bench`): the camera by name,
 /// a camera preset that replaces the scene's own, and the overlays.
@@ -46,19 +82,30 @@ struct View {
   /// Replaces the scene's own camera preset (for "preset", "front", "side", "top") if set: the
   /// views of `cps figure paper`.
   std::optional<scenes::CameraPreset> preset;
+  /// --eye, --target (m) and --fov (vertical field of view, degrees, in (1, 170)): replace the
+  /// eye, the target and the field of view of the camera the name gives, if set. resolve_style
+  /// refuses an eye equal to the target.
+  std::optional<Vec3> eye;
+  std::optional<Vec3> target;
+  std::optional<double> fov_y_deg;
   Overlays overlays;
 };
 
 /// A snapshot of `world` for the renderer: every box and sphere, every distance constraint as a
-/// rod (unless style.overlays.rods is false), every plane (checkered, sized around the movable
-/// bodies), the contact overlay if asked. Colours come from the body index, so a body keeps its
+/// rod (unless style.overlays.rods is false), every plane (checkered, on the square of
+/// style.plane_centre and style.plane_half_size_m), the contact overlay if asked. Colours come from the body index, so a body keeps its
 /// colour from frame to frame. With an orbit, the camera eye is turned about the vertical axis
 /// through the target by orbit_deg_per_s * world.time() degrees.
 render::DrawList draw_list(const World& world, const DrawStyle& style);
 
+/// The camera as JSON for run.json and figure sidecars: eye_m, target_m (m), fov_y_deg.
+nlohmann::json camera_json(const render::Camera& camera);
+
 /// The names `--camera` takes: "preset" (the scene's own view; for a scene without one, the
-/// automatic framing), "auto" (frame the bodies as built), and "front", "side", "top": the
-/// preset's target seen from the same distance along +z, along +x, and from above.
+/// automatic framing), "auto" (frame the bodies as built), "fit" (frame every body over the
+/// whole run: the bounds of a headless pre-run, see run_bounds, seen from the preset's
+/// direction), and "front", "side", "top": the preset's target seen from the same distance
+/// along +z, along +x, and from above.
 std::span<const std::string_view> camera_names();
 
 /// The one place a scene's pictures get their camera and style: the camera that view.camera
@@ -69,7 +116,22 @@ std::span<const std::string_view> camera_names();
 /// distance. Near and far clip planes follow the eye-target distance. `aspect`: width / height of
 /// one picture (> 0). The style draws the planes at the scene's plane_opacity with
 /// view.overlays. Throws UsageError listing the names for an unknown camera name.
+/// Same as the overload below with the one world `as_built` and seconds = 0 ("fit" then frames
+/// the bodies as built).
 DrawStyle resolve_style(const scenes::Scene& scene, const World& as_built, const View& view,
                         float aspect);
+
+/// The camera and style of a job whose runs start from `as_built` (one world per run, e.g. the
+/// variants of --compare; at least one) and last `seconds` (s, >= 0). "fit" frames run_bounds
+/// of all of them over [0, seconds]: the bounding sphere of those bounds (centre the target,
+/// radius r = |hi - lo| / 2) is seen from the direction of the preset's eye (or of the
+/// automatic framing's) at distance d = 1.1 r / sin(min(half vertical, half horizontal field
+/// of view)), so it fits the picture with 10 % margin, for any orbit. Then view.fov_y_deg,
+/// view.eye and view.target replace the camera's (with "fit", the field of view is set before
+/// the distance is computed). The planes are drawn on the square plane_extent gives for the
+/// pre-run bounds with "fit", else for the bounds as built (of all runs). Throws UsageError if
+/// the eye equals the target.
+DrawStyle resolve_style(const scenes::Scene& scene, std::span<const World* const> as_built,
+                        const View& view, float aspect, double seconds);
 
 }  // namespace cps::cli

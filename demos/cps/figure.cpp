@@ -112,7 +112,9 @@ render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer) 
   for (const Variant& v : spec.variants) runs.push_back(make_run_or_usage_error(scene, v.overrides));
 
   const float aspect = static_cast<float>(renderer.width()) / static_cast<float>(renderer.height());
-  const DrawStyle style = resolve_style(scene, runs.front().world, spec.view, aspect);
+  std::vector<const World*> worlds;
+  for (const scenes::Run& run : runs) worlds.push_back(&run.world);
+  const DrawStyle style = resolve_style(scene, worlds, spec.view, aspect, spec.times.back());
   const int label_scale = std::max(1, renderer.height() / 360);
 
   std::vector<render::Image> rows;
@@ -169,6 +171,11 @@ nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
                                    {"target_m", {preset->target.x(), preset->target.y(), preset->target.z()}},
                                    {"fov_y_deg", preset->fov_y_deg}}
                   : nlohmann::json("the scene's")},
+          {"eye_m", spec.view.eye ? nlohmann::json{spec.view.eye->x(), spec.view.eye->y(), spec.view.eye->z()}
+                                  : nlohmann::json(nullptr)},
+          {"target_m", spec.view.target ? nlohmann::json{spec.view.target->x(), spec.view.target->y(), spec.view.target->z()}
+                                        : nlohmann::json(nullptr)},
+          {"fov_y_deg", spec.view.fov_y_deg ? nlohmann::json(*spec.view.fov_y_deg) : nlohmann::json(nullptr)},
           {"overlays",
            {{"contacts", spec.view.overlays.contacts},
             {"rods", spec.view.overlays.rods},

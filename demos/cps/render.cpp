@@ -20,9 +20,28 @@
 namespace cps::cli {
 
 long long frame_count(const RenderJob& job) {
-  const double frames = std::floor(job.seconds * job.fps + 1e-9) + 1.0;
+  const double frames = std::floor(job.seconds * job.fps / job.speed + 1e-9) + 1.0;
   // Saturates instead of overflowing: the render command refuses anything past kMaxFrames.
   return frames < 9.0e18 ? static_cast<long long>(frames) : 9'000'000'000'000'000'000LL;
+}
+
+double frame_time(const RenderJob& job, long long k) {
+  return static_cast<double>(k) * job.speed / job.fps;
+}
+
+std::string frame_spacing_note(const RenderJob& job, double dt) {
+  const double spacing = job.speed / job.fps;
+  const double steps = spacing / dt;
+  if (std::abs(steps - std::round(steps)) <= 1e-9 * std::max(1.0, steps) && steps >= 0.5) {
+    return {};
+  }
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "frames are %g s apart (--speed %g / --fps %g), %.4g physics steps of %g s: each "
+                "frame shows the step nearest its time%s",
+                spacing, job.speed, job.fps, steps, dt,
+                steps < 1.0 ? ", so some frames repeat the one before" : "");
+  return text;
 }
 
 std::string frame_name(long long k) {
@@ -38,7 +57,7 @@ long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, cons
   const long long frames = frame_count(job);
   std::vector<render::Image> pictures(panels.size());
   for (long long k = 0; k < frames; ++k) {
-    const double t = static_cast<double>(k) / job.fps;
+    const double t = frame_time(job, k);
     for (std::size_t p = 0; p < panels.size(); ++p) {
       panels[p].run->advance_to(t);
       pictures[p] = renderer.draw(draw_list(panels[p].run->world, style));
@@ -67,6 +86,7 @@ struct RenderOptions {
   std::optional<double> seconds;  // s; default: the scene's
   double fps = 30.0;
   std::string size = "1280x720";
+  double speed = 1.0;  // simulated seconds per second of video
   std::string out = "out";
   std::string compare;
   bool force = false;
@@ -113,7 +133,12 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
   }
   const int panel_width = size.width / static_cast<int>(variants.size());
   const float aspect = static_cast<float>(panel_width) / static_cast<float>(size.height);
-  for (Job& job : jobs) job.style = resolve_style(*job.scene, job.runs.front().world, o.view, aspect);
+  for (Job& job : jobs) {
+    std::vector<const World*> worlds;
+    for (const scenes::Run& run : job.runs) worlds.push_back(&run.world);
+    job.style = resolve_style(*job.scene, worlds, o.view, aspect,
+                              o.seconds.value_or(job.scene->default_seconds));
+  }
   // Every output folder is checked (foreign files, see output.h) before any is written.
   std::vector<RenderJob> specs;
   std::vector<OutputPlan> plans;
@@ -121,6 +146,7 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     RenderJob spec;
     spec.seconds = o.seconds.value_or(job.scene->default_seconds);
     spec.fps = o.fps;
+    spec.speed = o.speed;
     spec.folder = fs::path(o.out) /
                   (std::string(job.scene->name) + (o.compare.empty() ? "" : "-compare-" + o.compare));
     // The work is bounded before anything is drawn or written: steps, frames and pixels.
@@ -130,7 +156,7 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     const long long frames = frame_count(spec);
     if (static_cast<double>(frames) > kMaxFrames) {
       throw UsageError(std::string(job.scene->name) + ": " + std::to_string(frames) +
-                       " frames (--seconds x --fps) is more than the " +
+                       " frames (--seconds x --fps / --speed) is more than the " +
                        std::to_string(static_cast<long long>(kMaxFrames)) +
                        " frames a render may write; give fewer --seconds or a lower --fps");
     }
@@ -183,17 +209,34 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
                        {"overrides", overrides_json(variants[v].overrides)},
                        {"parameters", parameters_json(job.runs[v].world.def())}});
     }
+    nlohmann::json spacing_notes = nlohmann::json::array();
+    for (const scenes::Run& run : job.runs) {
+      const std::string note = frame_spacing_note(spec, run.world.def().dt);
+      if (note.empty()) continue;
+      std::fprintf(stderr, "cps: note: %s: %s\n", job.scene->name.data(), note.c_str());
+      spacing_notes.push_back(note);
+    }
     const Overlays& overlays = o.view.overlays;
     const nlohmann::json info = run_info(
         "render", argc, argv,
         {{"scene", job.scene->name},
          {"seconds", spec.seconds},
          {"fps", spec.fps},
+         {"speed", spec.speed},
+         {"frame_spacing_s", spec.speed / spec.fps},
+         {"frame_times", spacing_notes.empty() ? nlohmann::json("exact multiples of the physics step")
+                                               : nlohmann::json(spacing_notes)},
          {"frames", frame_count(spec)},
          {"size", {{"width", size.width}, {"height", size.height}}},
          {"compare", o.compare.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.compare)},
          {"backend", o.backend},
          {"camera", o.view.camera},
+         {"camera_resolved", camera_json(job.style.camera)},
+         {"eye_m", o.view.eye ? nlohmann::json{o.view.eye->x(), o.view.eye->y(), o.view.eye->z()}
+                              : nlohmann::json(nullptr)},
+         {"target_m", o.view.target ? nlohmann::json{o.view.target->x(), o.view.target->y(), o.view.target->z()}
+                                    : nlohmann::json(nullptr)},
+         {"fov_y_deg", o.view.fov_y_deg ? nlohmann::json(*o.view.fov_y_deg) : nlohmann::json(nullptr)},
          {"orbit_deg_per_s", overlays.orbit_deg_per_s},
          {"contacts", overlays.contacts},
          {"rods", overlays.rods},
@@ -246,9 +289,17 @@ Command add_render(CLI::App& app, int argc, char** argv) {
   sub->add_option("scene", o->scene, "scene name or 'all'")->required();
   add_seconds_option(*sub, o->seconds,
                      "at most 1e7 physics steps, 1e5 frames and 64 GiB of pixels a render");
-  sub->add_option("--fps", o->fps, "frames per simulated second, in (0, 1000]")
+  sub->add_option("--fps", o->fps,
+                  "frames per second of video, in (0, 1000]; frames are --speed / --fps "
+                  "simulated seconds apart (so with --speed 1, frames per simulated second)")
       ->capture_default_str()
       ->check(decimal_in(0.0, kMaxFps, true, "frames/s"));
+  sub->add_option("--speed", o->speed,
+                  "simulated seconds per second of video, in (0, 100] (0.25: slow motion, 4: "
+                  "fast); frame k shows the physics step nearest to k x speed / fps s, and the "
+                  "label the simulated time")
+      ->capture_default_str()
+      ->check(decimal_in(0.0, 100.0, true, "s/s"));
   sub->add_option("--size", o->size, "frame size WxH in pixels, each in [16, 8192]")->capture_default_str();
   sub->add_option("--out", o->out, "output folder; frames go to OUT/SCENE/")
       ->capture_default_str()

@@ -14,17 +14,29 @@
 
 namespace cps::cli {
 
-/// What to render: duration (s, > 0), frames per second of simulated time (> 0), and the folder
-/// that receives frame_000000.png, frame_000001.png, ...
+/// What to render: duration (simulated s, > 0), frames per second of video (> 0), simulated
+/// seconds per second of video (speed, > 0; typical 1, 0.25 for slow motion), and the folder
+/// that receives frame_000000.png, frame_000001.png, ... Frames are speed / fps simulated
+/// seconds apart.
 struct RenderJob {
   double seconds = 10.0;
   double fps = 30.0;
+  double speed = 1.0;
   std::filesystem::path folder;
 };
 
-/// Number of frames of a job: floor(seconds * fps) + 1 (frame 0 at t = 0), in 64-bit
+/// Number of frames of a job: floor(seconds * fps / speed) + 1 (frame 0 at t = 0), in 64-bit
 /// arithmetic (a count beyond kMaxFrames is refused by the render command before any work).
 long long frame_count(const RenderJob& job);
+
+/// The simulated time (s) frame k (>= 0) is meant for: k * speed / fps. The frame shows the
+/// physics step nearest to it (scenes::Run::advance_to).
+double frame_time(const RenderJob& job, long long k);
+
+/// "" if frames speed / fps apart fall on exact multiples of the physics step dt (s, > 0; to
+/// 1e-9 relative), else a note saying how far apart they are in steps and that each shows
+/// the nearest step (and that some repeat when they are less than a step apart).
+std::string frame_spacing_note(const RenderJob& job, double dt);
 
 /// The file name of frame k (>= 0): "frame_%06lld.png".
 std::string frame_name(long long k);
@@ -35,7 +47,7 @@ struct Panel {
   std::string label;
 };
 
-/// Renders frame k at simulated time k / fps for k = 0 .. frame_count(job) - 1 into job.folder
+/// Renders frame k at simulated time frame_time(job, k) for k = 0 .. frame_count(job) - 1 into job.folder
 /// (which must exist); every panel's physics steps at its world's own dt in between. The panels
 /// are drawn side by side, each at the renderer's size, so a frame is (panels x renderer width)
 /// by renderer height pixels, all drawn with `style` (resolve_style: camera, plane opacity,

@@ -7,6 +7,8 @@
 #include <array>
 #include <cmath>
 #include <deque>
+#include <initializer_list>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -96,21 +98,79 @@ void populate_pendulum_grid_n(World& world, int side) {
   }
 }
 
+// The camera preset of a scaled scene: the bodies and rod ends of `world` as built, with the
+// points `also` (m), framed from `direction` (any length > 0) with a vertical field of view of
+// 45 degrees, so that their bounding sphere (radius r) fits a 16:9 picture with 10 % margin:
+// distance 1.1 r / sin(22.5 deg). The views grow with N, so every size shows its bodies.
+CameraPreset framed_preset(const World& world, const Vec3& direction,
+                           std::initializer_list<Vec3> also = {}) {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max());
+  Vec3 hi = Vec3::Constant(std::numeric_limits<double>::lowest());
+  const auto grow = [&](const Vec3& a, const Vec3& b) {
+    lo = lo.cwiseMin(a);
+    hi = hi.cwiseMax(b);
+  };
+  for (const Body& b : world.bodies()) {
+    if (b.shape.kind == ShapeKind::box) {
+      const Vec3 e = b.rotation().cwiseAbs() * b.shape.half_extents;
+      grow(b.x - e, b.x + e);
+    } else if (b.shape.kind == ShapeKind::sphere) {
+      grow(b.x - Vec3::Constant(b.shape.radius), b.x + Vec3::Constant(b.shape.radius));
+    }
+  }
+  for (const DistanceConstraint& d : world.distances()) {
+    Vec3 p_a;
+    Vec3 p_b;
+    distance_endpoints(d, world.bodies(), p_a, p_b);
+    grow(p_a, p_a);
+    grow(p_b, p_b);
+  }
+  for (const Vec3& p : also) grow(p, p);
+  constexpr double kPi = 3.14159265358979323846;
+  constexpr double kFovDeg = 45.0;
+  const double radius = std::max(0.5 * (hi - lo).norm(), 0.5);
+  const double distance = 1.1 * radius / std::sin(0.5 * kFovDeg * kPi / 180.0);
+  CameraPreset preset;
+  preset.target = 0.5 * (lo + hi);
+  preset.eye = preset.target + distance * direction.normalized();
+  preset.fov_y_deg = kFovDeg;
+  return preset;
+}
+
 struct Family {
   std::string_view name;
   int max_size;
   std::function<WorldDef()> world_def;
   std::function<void(World&, int)> populate;
+  // The camera of a scene of this family, from its world as built.
+  std::function<CameraPreset(const World&)> camera;
 };
 
 const std::array<Family, 5>& families() {
   static const std::array<Family, 5> table = {{
+      // The column from the front, a little above its middle and to the side; with the
+      // ground under it.
       {"stack", 40, &stack_world_def,
-       [](World& w, int n) { add_ground_and_cube_column(w, 2.0, 3.0, n); }},
-      {"pyramid", 20000, &stack_world_def, &populate_pyramid},
-      {"funnel", 20000, &funnel_world_def, &populate_funnel_n},
-      {"pendulum_wave", 20000, &pendulum_wave_world_def, &add_pendulum_wave_rows},
-      {"pendulum_grid", 100, &pendulum_grid_world_def, &populate_pendulum_grid_n},
+       [](World& w, int n) { add_ground_and_cube_column(w, 2.0, 3.0, n); },
+       [](const World& w) { return framed_preset(w, Vec3(0.45, 0.25, 1.0), {Vec3::Zero()}); }},
+      {"pyramid", 20000, &stack_world_def, &populate_pyramid,
+       [](const World& w) { return framed_preset(w, Vec3(0.35, 0.3, 1.0), {Vec3::Zero()}); }},
+      // From above the funnel's rim, the paper scene's direction (eye above all four walls,
+      // y > |x| and y > |z|, so no wall hides the balls); the apex stays in view.
+      {"funnel", 20000, &funnel_world_def, &populate_funnel_n,
+       [](const World& w) { return framed_preset(w, Vec3(9.0, 13.5, 15.0), {Vec3::Zero()}); }},
+      // From above, tilted 4.6 degrees as the paper's Fig. 10 counterpart: the rods are seen short
+      // (the balls are 4 cm across) and the balls as lines of dots.
+      // The longer side of the rows (x: 50 pendulums, 2.45 m; z: 0.3 m per row) runs across
+      // the picture.
+      {"pendulum_wave", 20000, &pendulum_wave_world_def, &add_pendulum_wave_rows,
+       [](const World& w) {
+         const double rows = std::ceil(static_cast<double>(w.bodies().size()) / 50.0);
+         const bool rows_wider = 0.3 * (rows - 1.0) > 2.45;
+         return framed_preset(w, rows_wider ? Vec3(0.08, 1.0, 0.0) : Vec3(0.0, 1.0, 0.08));
+       }},
+      {"pendulum_grid", 100, &pendulum_grid_world_def, &populate_pendulum_grid_n,
+       [](const World& w) { return framed_preset(w, Vec3(8.0, 8.0, 14.0)); }},
   }};
   return table;
 }
@@ -143,6 +203,11 @@ Scene scaled_scene(std::string_view family, int n) {
     s.world_def = f.world_def;
     s.populate = [populate = f.populate, n](World& w) { populate(w, n); };
     s.make_metrics = &scaled_metrics;
+    // The camera scales with N: framed on the world as built (building it costs what one run's
+    // set-up costs).
+    World world(f.world_def());
+    f.populate(world, n);
+    s.camera = f.camera(world);
     return s;
   }
   throw std::invalid_argument("unknown scene family '" + std::string(family) + "'");

@@ -159,15 +159,27 @@ const std::array<Family, 5>& families() {
       // y > |x| and y > |z|, so no wall hides the balls); the apex stays in view.
       {"funnel", 20000, &funnel_world_def, &populate_funnel_n,
        [](const World& w) { return framed_preset(w, Vec3(9.0, 13.5, 15.0), {Vec3::Zero()}); }},
-      // From above, tilted 4.6 degrees as the paper's Fig. 10 counterpart: the rods are seen short
-      // (the balls are 4 cm across) and the balls as lines of dots.
-      // The longer side of the rows (x: 50 pendulums, 2.45 m; z: 0.3 m per row) runs across
-      // the picture.
+      // One row (N <= 50): from above, tilted 4.6 degrees as the paper's Fig. 10 counterpart,
+      // so the rods are seen short and the line of balls (4 cm across) runs across the
+      // picture. More rows: from in front of the first row, just above the balls, looking
+      // down the rows (along +z), so the near rows show their balls large and the far ones
+      // recede; a view of the whole field (0.3 m per row, 120 m at N = 20000) would shrink
+      // the balls below a pixel.
       {"pendulum_wave", 20000, &pendulum_wave_world_def, &add_pendulum_wave_rows,
        [](const World& w) {
-         const double rows = std::ceil(static_cast<double>(w.bodies().size()) / 50.0);
-         const bool rows_wider = 0.3 * (rows - 1.0) > 2.45;
-         return framed_preset(w, rows_wider ? Vec3(0.08, 1.0, 0.0) : Vec3(0.0, 1.0, 0.08));
+         if (w.bodies().size() <= 50) return framed_preset(w, Vec3(0.0, 1.0, 0.08));
+         Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max());
+         Vec3 hi = Vec3::Constant(std::numeric_limits<double>::lowest());
+         for (const Body& b : w.bodies()) {
+           lo = lo.cwiseMin(b.x);
+           hi = hi.cwiseMax(b.x);
+         }
+         const double mid_x = 0.5 * (lo.x() + hi.x());
+         CameraPreset preset;
+         preset.eye = Vec3(mid_x, hi.y() + 0.5, lo.z() - 1.9);
+         preset.target = Vec3(mid_x, 0.5 * (lo.y() + hi.y()), lo.z() + 1.2);
+         preset.fov_y_deg = 45.0;
+         return preset;
        }},
       {"pendulum_grid", 100, &pendulum_grid_world_def, &populate_pendulum_grid_n,
        [](const World& w) { return framed_preset(w, Vec3(8.0, 8.0, 14.0)); }},

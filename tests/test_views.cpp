@@ -1,0 +1,252 @@
+// The views of `cps render` and `cps figure` (demos/cps/draw.h): --camera fit keeps every body
+// in the picture over the whole run, the planes keep one extent for the whole run, --eye,
+// --target and --fov replace the camera's, and every scene's default view shows its bodies.
+#include "draw.h"
+#include "options.h"
+
+#include "cps/render/renderer.h"
+
+#include <catch2/catch.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <algorithm>
+#include <array>
+#include <string>
+#include <vector>
+
+using namespace cps;
+using cps::cli::DrawStyle;
+using cps::cli::View;
+
+namespace {
+
+constexpr float kAspect = 16.0f / 9.0f;
+
+// The largest |NDC x| and |NDC y| (1 = the picture's edge) of the corners of every body's
+// axis-aligned box, seen with `camera` in a picture of aspect kAspect, as the renderer projects
+// (glm::perspective, glm::lookAt); 1e9 if a corner lies behind the eye.
+double widest_ndc(const World& world, const render::Camera& camera) {
+  const glm::mat4 proj = glm::perspective(glm::radians(camera.fov_y_deg), kAspect, camera.near_m,
+                                          camera.far_m);
+  const glm::mat4 view = glm::lookAt(camera.eye, camera.target, camera.up);
+  double widest = 0.0;
+  for (const Body& b : world.bodies()) {
+    if (b.is_static()) continue;
+    const Vec3 e = b.shape.kind == ShapeKind::box ? Vec3(b.rotation().cwiseAbs() * b.shape.half_extents)
+                                                  : Vec3::Constant(b.shape.radius);
+    for (int i = 0; i < 8; ++i) {
+      const Vec3 c = b.x + Vec3((i & 1) ? e.x() : -e.x(), (i & 2) ? e.y() : -e.y(),
+                                (i & 4) ? e.z() : -e.z());
+      const glm::vec4 clip = proj * view * glm::vec4(c.x(), c.y(), c.z(), 1.0f);
+      if (!(clip.w > 0.0f)) return 1e9;  // behind the eye: out of the picture
+      widest = std::max({widest, static_cast<double>(std::abs(clip.x / clip.w)),
+                         static_cast<double>(std::abs(clip.y / clip.w))});
+    }
+  }
+  return widest;
+}
+
+// The largest widest_ndc over every step of `run` from its start to `seconds` (s): every frame
+// of a render shows the world after a whole step.
+double widest_over_run(scenes::Run run, const render::Camera& camera, double seconds) {
+  double widest = widest_ndc(run.world, camera);
+  while (run.world.time() + 0.5 * run.world.def().dt < seconds) {
+    run.step();
+    widest = std::max(widest, widest_ndc(run.world, camera));
+  }
+  return widest;
+}
+
+DrawStyle style_for(const scenes::Scene& scene, const std::vector<const World*>& worlds,
+                    const View& view, double seconds) {
+  return cli::resolve_style(scene, worlds, view, kAspect, seconds);
+}
+
+}  // namespace
+
+TEST_CASE("--camera fit keeps every cube of the intersecting stack in every frame", "[views]") {
+  const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
+  const double seconds = 4.0;
+  const scenes::Run run = scenes::make_run(scene);
+  View view;
+  view.camera = "fit";
+  const DrawStyle fit = style_for(scene, {&run.world}, view, seconds);
+  // Inside the picture at every step of the 4 s, with the 10 % margin of the fit (the bounding
+  // sphere touches the frame at 1 / 1.1 of its half width; boxes inside the sphere stay within).
+  CHECK(widest_over_run(scenes::make_run(scene), fit.camera, seconds) < 1.0);
+  // The framing as built (--camera auto) loses the cubes the push throws up: the check can fail.
+  view.camera = "auto";
+  const DrawStyle as_built = style_for(scene, {&run.world}, view, seconds);
+  CHECK(widest_over_run(scenes::make_run(scene), as_built.camera, seconds) > 1.0);
+  // The scene's own view (the default) keeps them in too.
+  view.camera = "preset";
+  const DrawStyle preset = style_for(scene, {&run.world}, view, seconds);
+  CHECK(widest_over_run(scenes::make_run(scene), preset.camera, seconds) < 1.0);
+}
+
+TEST_CASE("--camera fit frames every run of a comparison", "[views]") {
+  const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
+  const double seconds = 2.0;
+  scenes::Overrides split;
+  split.set("push", PushMode::split);
+  const scenes::Run a = scenes::make_run(scene);
+  const scenes::Run b = scenes::make_run(scene, split);
+  View view;
+  view.camera = "fit";
+  const DrawStyle both = style_for(scene, {&a.world, &b.world}, view, seconds);
+  CHECK(widest_over_run(scenes::make_run(scene), both.camera, seconds) < 1.0);
+  CHECK(widest_over_run(scenes::make_run(scene, split), both.camera, seconds) < 1.0);
+  // Framed on the split run alone (the cubes barely move), the Baumgarte run leaves the picture.
+  const DrawStyle split_only = style_for(scene, {&b.world}, view, seconds);
+  CHECK(widest_over_run(scenes::make_run(scene), split_only.camera, seconds) > 1.0);
+}
+
+TEST_CASE("run_bounds holds every body at every step and leaves the worlds unchanged", "[views]") {
+  const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
+  scenes::Run run = scenes::make_run(scene);
+  const World* worlds[] = {&run.world};
+  const cli::Bounds bounds = cli::run_bounds(worlds, 1.0);
+  CHECK(run.world.time() == 0.0);
+  REQUIRE(bounds.any);
+  const cli::Bounds start = cli::world_bounds(run.world);
+  while (run.world.time() + 0.5 * run.world.def().dt < 1.0) {
+    run.step();
+    const cli::Bounds now = cli::world_bounds(run.world);
+    CHECK((now.lo.array() >= bounds.lo.array()).all());
+    CHECK((now.hi.array() <= bounds.hi.array()).all());
+  }
+  // The cubes rise: the run's bounds reach far above the column as built (its top at 11.6 m).
+  CHECK(bounds.hi.y() > start.hi.y() + 5.0);
+}
+
+TEST_CASE("the planes keep one square for the whole run", "[views]") {
+  const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
+  scenes::Run run = scenes::make_run(scene);
+  const DrawStyle style = cli::resolve_style(scene, run.world, View{}, kAspect);
+  const render::DrawList first = cli::draw_list(run.world, style);
+  run.advance_to(2.0);  // the cubes have flown apart
+  const render::DrawList later = cli::draw_list(run.world, style);
+  REQUIRE(first.planes.size() == 1);
+  REQUIRE(later.planes.size() == 1);
+  CHECK(later.planes[0].center_hint == first.planes[0].center_hint);
+  CHECK(later.planes[0].half_size == first.planes[0].half_size);
+  // Around the bodies as built: 3 x the diagonal of the column, at least 30 m.
+  const cli::Bounds b = cli::world_bounds(scenes::make_run(scene).world);
+  CHECK(first.planes[0].half_size ==
+        Approx(std::max(30.0, 3.0 * (b.hi - b.lo).norm())).epsilon(1e-5));
+}
+
+TEST_CASE("--eye, --target and --fov replace the camera's; an eye on the target is refused",
+          "[views]") {
+  const scenes::Scene& scene = *scenes::find_scene("stack");
+  const scenes::Run run = scenes::make_run(scene);
+  View view;
+  view.eye = Vec3(10.0, 8.0, 20.0);
+  view.target = Vec3(0.0, 3.0, 0.0);
+  view.fov_y_deg = 30.0;
+  const DrawStyle style = cli::resolve_style(scene, run.world, view, kAspect);
+  CHECK(style.camera.eye == glm::vec3(10.0f, 8.0f, 20.0f));
+  CHECK(style.camera.target == glm::vec3(0.0f, 3.0f, 0.0f));
+  CHECK(style.camera.fov_y_deg == 30.0f);
+  const float d = glm::length(style.camera.eye - style.camera.target);
+  CHECK(style.camera.near_m < d);
+  CHECK(style.camera.far_m > d);
+  // Only --target: the preset's eye stays.
+  View target_only;
+  target_only.target = Vec3(1.0, 2.0, 3.0);
+  const DrawStyle preset = cli::resolve_style(scene, run.world, View{}, kAspect);
+  const DrawStyle moved = cli::resolve_style(scene, run.world, target_only, kAspect);
+  CHECK(moved.camera.eye == preset.camera.eye);
+  CHECK(moved.camera.target == glm::vec3(1.0f, 2.0f, 3.0f));
+  // With fit, a narrower field of view puts the eye farther away.
+  View wide;
+  wide.camera = "fit";
+  View narrow = wide;
+  narrow.fov_y_deg = 20.0;
+  const DrawStyle w = cli::resolve_style(scene, run.world, wide, kAspect);
+  const DrawStyle n = cli::resolve_style(scene, run.world, narrow, kAspect);
+  CHECK(glm::length(n.camera.eye - n.camera.target) >
+        1.5f * glm::length(w.camera.eye - w.camera.target));
+  View same;
+  same.eye = Vec3(1.0, 2.0, 3.0);
+  same.target = Vec3(1.0, 2.0, 3.0);
+  CHECK_THROWS_AS(cli::resolve_style(scene, run.world, same, kAspect), cli::UsageError);
+}
+
+#ifndef CPS_VIEW_TESTS_NO_GL
+namespace {
+
+// The share of the picture (0..1) the bodies of `world` cover in `style`'s view: the world is
+// drawn with every box and sphere in pure magenta and without rods, and the pixels whose red
+// and blue both exceed green by 40 (of 255) are counted: the ground (grey, r = g = b), its
+// shadows (darker grey) and the sky (0.86, 0.90, 0.95: green above red) never pass, shaded
+// magenta always does (green stays 0), also seen through the funnel's translucent walls.
+double body_share(render::Renderer& renderer, const World& world, const DrawStyle& style) {
+  render::DrawList list = cli::draw_list(world, style);
+  list.lines.clear();
+  for (render::BoxItem& b : list.boxes) b.color = glm::vec3(1.0f, 0.0f, 1.0f);
+  for (render::SphereItem& s : list.spheres) s.color = glm::vec3(1.0f, 0.0f, 1.0f);
+  const render::Image image = renderer.draw(list);
+  long long covered = 0;
+  for (std::size_t i = 0; i + 2 < image.pixels.size(); i += 3) {
+    const int r = image.pixels[i];
+    const int g = image.pixels[i + 1];
+    const int b = image.pixels[i + 2];
+    if (r - g > 40 && b - g > 40) ++covered;
+  }
+  return static_cast<double>(covered) / (image.width * image.height);
+}
+
+}  // namespace
+
+// Every listed scene's default view (--camera preset, 16:9) at 64x36 pixels shows its bodies:
+// they cover at least 1 % of the picture (23 of 2304 pixels: a subject seen clearly, not a
+// speck; a picture that shows only a wall, the underside of the funnel or empty sky gives 0).
+// The scaled scenes are checked at N = 1, 100 and the family's largest size (40, 20000, 20000,
+// 20000, 100) as built (t = 0); the paper and stress scenes as built and at the end of their
+// default run. Exceptions, by geometry, each with its own bound:
+// - stack_N: the column is 2.4 m wide and about 3 N m tall, so a 16:9 view that holds it covers
+//   at most 2.4 / (3 N x 16 / 9) of the picture (0.9 % at N = 40): at least half that bound.
+// - intersecting_stack: its default view holds the cubes' whole 4 s flight (up to about 55 m
+//   high, checked above), so five 2.4 m cubes cover little of it: at least 0.2 %.
+// - lines of small balls: chain_20 (a 20-ball chain seen whole while it swings) and
+//   pendulum_wave_1 (one 4 cm ball on a 0.35 m rod): at least 0.05 % (two pixels: seen).
+// - random at the end of its run: bodies thrown at up to 50 m/s have left any view that shows
+//   them at a readable size (--camera fit frames them); checked as built only.
+TEST_CASE("every scene's default view shows its bodies", "[views][render]") {
+  render::Renderer renderer(64, 36);
+  std::vector<std::pair<std::string, double>> cases;  // scene name, time (s)
+  for (const scenes::Scene& s : scenes::all_scenes()) {
+    cases.emplace_back(std::string(s.name), 0.0);
+    cases.emplace_back(std::string(s.name), s.default_seconds);
+  }
+  const std::array<std::pair<const char*, int>, 5> families = {
+      {{"stack", 40}, {"pyramid", 20000}, {"funnel", 20000}, {"pendulum_wave", 20000},
+       {"pendulum_grid", 100}}};
+  for (const auto& [family, largest] : families) {
+    for (int n : {1, 100, largest}) {
+      if (n > largest) continue;
+      cases.emplace_back(std::string(family) + "_" + std::to_string(n), 0.0);
+    }
+  }
+  for (const auto& [name, t] : cases) {
+    const scenes::Scene* scene = scenes::find_scene(name);
+    REQUIRE(scene != nullptr);
+    scenes::Run run = scenes::make_run(*scene);
+    const DrawStyle style = cli::resolve_style(*scene, run.world, View{}, kAspect);
+    run.advance_to(t);
+    const double share = body_share(renderer, run.world, style);
+    if (name == "random" && t > 0.0) continue;
+    double least = 0.01;
+    if (name.rfind("stack_", 0) == 0 && name.find("dt") == std::string::npos) {
+      const int n = std::stoi(name.substr(6));
+      least = std::min(least, 0.5 * 2.4 / (3.0 * n * 16.0 / 9.0));
+    }
+    if (name == "intersecting_stack") least = 0.002;
+    if (name == "chain_20" || name == "pendulum_wave_1") least = 0.0005;
+    INFO(name << " at t = " << t << " s: bodies cover " << 100.0 * share << " % (at least "
+              << 100.0 * least << " %)");
+    CHECK(share >= least);
+  }
+}
+#endif

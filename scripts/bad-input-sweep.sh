@@ -50,7 +50,8 @@ declare -A KIND=(
   ['*:--help']=skip ['top:--version']=skip
   ['*:--json']=flag ['*:--force']=flag ['*:--quick']=flag ['*:--list-runs']=flag
   ['*:--rendering']=flag ['*:--contacts']=flag ['*:--rods']=flag ['*:--label']=flag
-  ['*:--seconds']=seconds ['*:--fps']=fps ['*:--orbit']=orbit
+  ['*:--seconds']=seconds ['*:--fps']=fps ['*:--orbit']=orbit ['*:--speed']=speed
+  ['*:--eye']=point ['*:--target']=point ['*:--fov']=fov
   ['*:--dt']=dt ['*:--iterations']=iterations
   ['*:--beta']=unit_interval ['*:--restitution']=unit_interval ['*:--warm-start']=unit_interval
   ['*:--friction']=nonneg_1e6 ['*:--restitution-threshold']=nonneg_1e6
@@ -93,6 +94,11 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     seconds) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 100001 1/2 ;;  # (0, 1e5], no fraction
     fps) printf '%s\n' "$NUM_COMMON" -1 0 1e-400 1001 1/2 ;;           # (0, 1000]
     orbit) printf '%s\n' "$NUM_COMMON" -36001 36001 -1e5 1/2 ;;        # [-36000, 36000]
+    speed) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 100.5 101 1/2 ;;  # (0, 100] s/s
+    fov) printf '%s\n' "$NUM_COMMON" -1 0 1 170 180 1e-400 1/2 ;;       # (1, 170) deg
+    point)  # X,Y,Z in m, each finite with |value| <= 1e6
+      printf '%s\n' "" 1 1,2 1,2,3,4 , ,, 1,,3 1,2, ,1,2 a,b,c nan,0,0 0,inf,0 0,0,-inf \
+        1e7,0,0 0,-1000001,0 0x10,0,0 1/2,0,0 "1;2;3" 1e400,0,0 ;;
     dt)  # [1e-6, 1] s, a fraction allowed
       printf '%s\n' "$NUM_COMMON" -1 0 1e-7 1e-320 5e-324 1e-400 2 1/0 0/1 1/-60 -1/60 1/60x \
         1//60 /60 1/ 1/inf nan/1 1/1e-7 ;;
@@ -157,6 +163,9 @@ EXTRA=(
   "GiB/--size|render stack --seconds 1e5 --fps 0.5 --size 8192x8192 --out out"
   "--size/--compare|render stack --size 16x16 --compare push --seconds 0.1 --fps 10 --out out"
   "--compare|render stack --compare push --push split --seconds 0.1 --fps 10 --size 64x16 --out out"
+  "--eye/--target|render stack --eye 1,2,3 --target 1,2,3 --seconds 0.1 --fps 10 --size 16x16 --out out"
+  "--eye/--target|figure stack --eye 0,1,0 --target 0,1,0 --times 0 --size 16x16 --out out/f.png"
+  "frames/--speed|render stack --seconds 10 --fps 1000 --speed 0.01 --size 16x16 --out out"
   "--times|figure paper --times 0,1"
   "--compare|figure paper --compare push"
   "--out/file|figure paper --size 16x16 --out file"
@@ -182,6 +191,9 @@ CONTROLS=(
   "render stack --seconds 0.1 --fps 10 --size 16x16 --out out"
   "render stack --seconds 0.1 --fps 5e-324 --size 16x16 --out out --orbit -36000"
   "figure stack --times 0,0.1 --size 16x16 --out out/f.png"
+  "render stack --seconds 0.1 --fps 10 --size 16x16 --out out --camera fit --speed 100"
+  "render stack --seconds 0.1 --fps 10 --size 16x16 --out out --eye 1e6,0,-1e6 --target 0,0,0 --fov 169.9 --speed 1e-3"
+  "figure stack --times 0,0.1 --size 16x16 --out out/f.png --camera fit --fov 1.01 --target 0,1,0"
 )
 
 # ---------------------------------------------------------------------------------------------

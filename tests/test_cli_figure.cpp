@@ -213,6 +213,48 @@ TEST_CASE("cps render takes the overlay and camera flags", "[cli][figure]") {
   CHECK(nan.err.find("--orbit") != std::string::npos);
   CHECK(!fs::exists(dir / "o/stack"));
 }
+
+TEST_CASE("cps render --speed spaces frames speed / fps simulated seconds apart", "[cli][figure]") {
+  const fs::path dir = fresh_dir("render_speed");
+  // 0.25 s/s at 10 fps: frames 0.025 s apart over 0.5 s = 21 frames; 1.5 steps of 1/60 s, so
+  // each frame shows the nearest step and run.json says so.
+  const Result slow = cps("render stack --seconds 0.5 --fps 10 --speed 0.25 --size 16x16 --label "
+                          "--out o",
+                          dir);
+  INFO(slow.err);
+  REQUIRE(slow.exit_code == 0);
+  CHECK(fs::exists(dir / "o/stack/frame_000020.png"));
+  CHECK(!fs::exists(dir / "o/stack/frame_000021.png"));
+  const nlohmann::json p = nlohmann::json::parse(slurp(dir / "o/stack/run.json"))["parameters"];
+  CHECK(p["speed"] == 0.25);
+  CHECK(p["frames"] == 21);
+  CHECK(p["frame_spacing_s"].get<double>() == Approx(0.025).epsilon(1e-12));
+  REQUIRE(p["frame_times"].is_array());
+  CHECK(p["frame_times"][0].get<std::string>().find("nearest") != std::string::npos);
+  CHECK(slow.err.find("nearest") != std::string::npos);
+  // 2 s/s at 30 fps: frames 1/15 s = 4 steps apart, exact; 1 s gives 16 frames.
+  const Result fast = cps("render stack --seconds 1 --fps 30 --speed 2 --size 16x16 --out f", dir);
+  REQUIRE(fast.exit_code == 0);
+  const nlohmann::json q = nlohmann::json::parse(slurp(dir / "f/stack/run.json"))["parameters"];
+  CHECK(q["frames"] == 16);
+  CHECK(q["frame_times"] == "exact multiples of the physics step");
+  const std::string quick = "render stack --seconds 0.1 --fps 10 --size 16x16 --out b ";
+  for (const std::string bad : {"--speed 0", "--speed 101", "--speed nan", "--fov 170",
+                                "--fov 1", "--eye 1,2", "--target a,b,c", "--eye 1e7,0,0",
+                                "--eye 1,2,3 --target 1,2,3"}) {
+    INFO(bad);
+    const Result r = cps(quick + bad, dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);
+  }
+  CHECK(!fs::exists(dir / "b"));
+  // Eye, target and field of view are recorded with the camera actually used.
+  REQUIRE(cps(quick + "--eye 10,8,20 --target 0,2,0 --fov 30", dir).exit_code == 0);
+  const nlohmann::json c = nlohmann::json::parse(slurp(dir / "b/stack/run.json"))["parameters"];
+  CHECK(c["camera_resolved"]["eye_m"][0] == 10.0);
+  CHECK(c["camera_resolved"]["target_m"][1] == 2.0);
+  CHECK(c["camera_resolved"]["fov_y_deg"] == 30.0);
+}
 #endif
 
 TEST_CASE("cps simulate --trace writes every body per step and obeys free fall", "[cli][trace]") {
@@ -319,9 +361,11 @@ TEST_CASE("every command's --help states the units of its options", "[cli][help]
   for (const std::string c : {"render", "figure"}) {
     cases.push_back({c,
                      {"(s)", "pixels", "degrees per", "--contacts", "--no-rods", "--label",
-                      "--camera TEXT:{preset,auto,front,side,top}=preset", "--orbit", "=0"}});
+                      "--camera TEXT:{preset,auto,fit,front,side,top}=preset", "--orbit", "=0",
+                      "--eye", "--target", "--fov"}});
   }
   cases[cases.size() - 2].says.push_back("never removed or changed");  // render --force
+  cases[cases.size() - 2].says.push_back("--speed");
   cases.back().says.push_back("never touched");                         // figure --force
   cases.back().says.push_back("--size TEXT=640x360");
   cases.back().says.push_back("--times");

@@ -301,6 +301,10 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
     for (const Variant& v : p.spec.variants) {
       const scenes::Run run = make_run_or_usage_error(*p.spec.scene, v.overrides);
       check_steps(std::string(p.spec.scene->name), p.spec.times.back(), run.world.def().dt);
+      // The view is checked (an --eye on the target) before anything is written; "fit" frames
+      // as built here, so this costs no pre-run.
+      resolve_style(*p.spec.scene, run.world, p.spec.view,
+                    static_cast<float>(size.width) / static_cast<float>(size.height));
     }
     const long long w = static_cast<long long>(p.spec.times.size()) * size.width;
     const long long h = static_cast<long long>(p.spec.variants.size()) * size.height;

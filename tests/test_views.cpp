@@ -64,7 +64,7 @@ DrawStyle style_for(const scenes::Scene& scene, const std::vector<const World*>&
 
 }  // namespace
 
-TEST_CASE("--camera fit keeps every cube of the intersecting stack in every frame", "[views]") {
+TEST_CASE("camera fit keeps every cube of the intersecting stack in every frame", "[views]") {
   const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
   const double seconds = 4.0;
   const scenes::Run run = scenes::make_run(scene);
@@ -84,7 +84,7 @@ TEST_CASE("--camera fit keeps every cube of the intersecting stack in every fram
   CHECK(widest_over_run(scenes::make_run(scene), preset.camera, seconds) < 1.0);
 }
 
-TEST_CASE("--camera fit frames every run of a comparison", "[views]") {
+TEST_CASE("camera fit frames every run of a comparison", "[views]") {
   const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
   const double seconds = 2.0;
   scenes::Overrides split;
@@ -136,7 +136,7 @@ TEST_CASE("the planes keep one square for the whole run", "[views]") {
         Approx(std::max(30.0, 3.0 * (b.hi - b.lo).norm())).epsilon(1e-5));
 }
 
-TEST_CASE("--eye, --target and --fov replace the camera's; an eye on the target is refused",
+TEST_CASE("eye and target and fov replace the camera's and an eye on the target is refused",
           "[views]") {
   const scenes::Scene& scene = *scenes::find_scene("stack");
   const scenes::Run run = scenes::make_run(scene);

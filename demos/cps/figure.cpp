@@ -200,9 +200,9 @@ const std::vector<PaperFigure>& paper_figures() {
       {"fig7_intersecting_stack.png", "paper Fig. 7", "intersecting_stack", "push",
        {0.0, 0.5, 1.0},
        {{"(a)", "(b)", ""}, {"(a)", "(c)", ""}},
-       // The --camera fit framing of both runs over the figure's 1 s (rounded): the cubes the
-       // original push factor throws up stay in view in every panel (from the earlier
-       // (15, 17, 36) the top cube left the 1 s panel).
+       // The --camera fit framing of the original push factor's run over the figure's 1 s
+       // (rounded; the single frame run stays inside it): the cubes it throws up stay in view
+       // in every panel (from the earlier (15, 17, 36) the top cube left the 1 s panel).
        scenes::CameraPreset{Vec3(22.5, 25.0, 49.0), Vec3(0.6, 17.3, 0.3), 45.0},
        "(a) the intersecting start; (b) the original push factor at 0.5 s: the cubes fly apart; "
        "(c) the single frame push factor at 0.5 s: the cubes stop once the overlap is gone"},

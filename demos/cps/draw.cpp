@@ -306,6 +306,11 @@ DrawStyle resolve_style(const scenes::Scene& scene, std::span<const World* const
     if (std::abs(d.y) > 0.999f) style.camera.up = glm::vec3(0.0f, 0.0f, -1.0f);
   }
   plane_extent(bounds, style.plane_centre, style.plane_half_size_m);
+  // Far enough that the planes' edges lie near the far clip plane (50 eye-target distances),
+  // so the ground reaches the horizon instead of ending as a visible square.
+  const float view_distance = glm::length(style.camera.eye - style.camera.target);
+  style.plane_half_size_m = std::max(style.plane_half_size_m,
+                                     40.0f * view_distance + glm::length(style.camera.target - style.plane_centre));
   return style;
 }
 

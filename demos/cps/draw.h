@@ -129,7 +129,9 @@ DrawStyle resolve_style(const scenes::Scene& scene, const World& as_built, const
 /// of view)), so it fits the picture with 10 % margin, for any orbit. Then view.fov_y_deg,
 /// view.eye and view.target replace the camera's (with "fit", the field of view is set before
 /// the distance is computed). The planes are drawn on the square plane_extent gives for the
-/// pre-run bounds with "fit", else for the bounds as built (of all runs). Throws UsageError if
+/// pre-run bounds with "fit", else for the bounds as built (of all runs), widened to at least 40
+/// eye-target distances (plus the target's offset from its centre) so that the ground reaches
+/// the horizon, short of the far clip plane at 50 distances. Throws UsageError if
 /// the eye equals the target.
 DrawStyle resolve_style(const scenes::Scene& scene, std::span<const World* const> as_built,
                         const View& view, float aspect, double seconds);

@@ -54,7 +54,7 @@ declare -A KIND=(
   ['*:--dt']=dt ['*:--iterations']=iterations
   ['*:--beta']=unit_interval ['*:--restitution']=unit_interval ['*:--warm-start']=unit_interval
   ['*:--friction']=nonneg_1e6 ['*:--restitution-threshold']=nonneg_1e6
-  ['*:--contact-margin']=nonneg_1e6
+  ['*:--contact-margin']=nonneg_1e6 ['*:--penetration-slop']=nonneg_1e6
   ['*:--size']=size ['*:--times']=times
   ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png
   ['*:--trace']=trace ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge

@@ -231,7 +231,8 @@ static void check_round_trip(const Scene& scene, double seconds) {
   INFO(scene.name);
   const Run built = make_run(scene);
   const std::string text = scene_file_json(scene, built.world).dump(2);
-  const Scene file = scene_of(parse_scene_file(text, "round_trip.json"), "round_trip.json");
+  const SceneFile parsed = parse_scene_file(text, "round_trip.json");  // outlives the Scene
+  const Scene file = scene_of(parsed, "round_trip.json");
   Run a = make_run(scene);
   Run b = make_run(file);
   CHECK(state_hash(a.world) == state_hash(b.world));

@@ -139,6 +139,7 @@ const Scene* find_scene(std::string_view name) {
       std::find_if(all.begin(), all.end(), [name](const Scene& s) { return s.name == name; });
   if (it != all.end()) return &*it;
   if (const Scene* example = find_example_scene(name)) return example;
+  if (name.size() > 5 && name.substr(name.size() - 5) == ".json") return load_scene_file(name);
   constexpr std::string_view kRandom = "random_";
   if (name.substr(0, kRandom.size()) == kRandom && name.size() > kRandom.size()) {
     const std::string_view digits = name.substr(kRandom.size());
@@ -150,7 +151,6 @@ const Scene* find_scene(std::string_view name) {
     }
     return nullptr;
   }
-  if (name.size() > 5 && name.substr(name.size() - 5) == ".json") return load_scene_file(name);
   // A scaled scene: FAMILY_N with N in the family's range. Made once per name and kept.
   const std::size_t cut = name.rfind('_');
   if (cut == std::string_view::npos || cut + 1 >= name.size()) return nullptr;

@@ -88,7 +88,7 @@ TEST_CASE("a bad scene file exits 2 naming the file and the pointer, and writes 
   }
 }
 
-TEST_CASE("--seed N makes the random scene random_N; cps list shows examples and families",
+TEST_CASE("the seed option makes the random scene random_N, and cps list shows examples and families",
           "[cli][scene_file]") {
   const fs::path dir = cli_test::fresh_dir("cps_cli_scene_files_seed");
   CHECK(hash_of("random --seed 7", dir) == hash_of("random_7", dir));

@@ -454,6 +454,7 @@ Command add_bench(CLI::App& app) {
                   "time only these scenes (a name, a scaled scene such as funnel_500, 'all' or 'stress'; "
                   "repeatable): the physics table alone, each scene over its window")
       ->check(kNotEmpty);
+  add_seed_option(*sub, o->scenes);
   return {sub, [o] { return run_bench(*o); }};
 }
 

@@ -1,5 +1,7 @@
 #include "draw.h"
 
+#include "scene_file.h"
+
 #include "options.h"
 
 #include <algorithm>
@@ -28,7 +30,14 @@ constexpr std::array<glm::vec3, 6> kPalette = {{{0.85f, 0.33f, 0.20f},
                                                 {0.60f, 0.35f, 0.70f},
                                                 {0.15f, 0.65f, 0.70f}}};
 
-glm::vec3 colour_of(std::size_t body) { return kPalette[body % kPalette.size()]; }
+// The colour of body `body`: the scene's own (style.body_colours) if it has one, else the palette's.
+glm::vec3 colour_of(std::size_t body, const DrawStyle& style) {
+  if (body < style.body_colours.size() && style.body_colours[body]) {
+    const Vec3& c = *style.body_colours[body];
+    return {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};
+  }
+  return kPalette[body % kPalette.size()];
+}
 
 // A length (m) that says how big a movable body is: its largest half extent or its radius;
 // 0 for planes and static bodies.
@@ -80,10 +89,10 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
     if (b.shape.kind == ShapeKind::box) {
-      list.boxes.push_back({to_glm(b.x), to_glm(b.o), to_glm(b.shape.half_extents), colour_of(i)});
+      list.boxes.push_back({to_glm(b.x), to_glm(b.o), to_glm(b.shape.half_extents), colour_of(i, style)});
     } else if (b.shape.kind == ShapeKind::sphere) {
       list.spheres.push_back({to_glm(b.x), to_glm(b.o), static_cast<float>(b.shape.radius),
-                              colour_of(i)});
+                              colour_of(i, style)});
     }
   }
   for (const DistanceConstraint& d : world.distances()) {
@@ -192,7 +201,7 @@ DrawStyle resolve_style(const scenes::Scene& scene, const World& as_built, const
   const std::optional<scenes::CameraPreset> preset =
       camera_preset(view.preset ? view.preset : scene.camera, as_built, view.camera, aspect);
   return {preset ? camera_from_preset(*preset) : frame_world(as_built, aspect),
-          static_cast<float>(scene.plane_opacity), view.overlays};
+          static_cast<float>(scene.plane_opacity), view.overlays, scenes::body_colours(scene)};
 }
 
 }  // namespace cps::cli

@@ -36,6 +36,9 @@ struct DrawStyle {
   render::Camera camera;
   float plane_opacity = 1.0f;
   Overlays overlays;
+  /// The scene's colours by body index (scenes::body_colours, linear RGB); a body beyond the end
+  /// or without one takes the palette.
+  std::span<const std::optional<Vec3>> body_colours;
 };
 
 /// The view a command asks for (`cps render`, `cps figure`, `cps bench`): the camera by name,
@@ -51,8 +54,8 @@ struct View {
 
 /// A snapshot of `world` for the renderer: every box and sphere, every distance constraint as a
 /// rod (unless style.overlays.rods is false), every plane (checkered, sized around the movable
-/// bodies), the contact overlay if asked. Colours come from the body index, so a body keeps its
-/// colour from frame to frame. With an orbit, the camera eye is turned about the vertical axis
+/// bodies), the contact overlay if asked. Colours come from style.body_colours, else from the body
+/// index, so a body keeps its colour from frame to frame. With an orbit, the camera eye is turned about the vertical axis
 /// through the target by orbit_deg_per_s * world.time() degrees.
 render::DrawList draw_list(const World& world, const DrawStyle& style);
 

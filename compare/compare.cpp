@@ -82,7 +82,7 @@ Check sanity(const std::string& name, const World& initial, const std::vector<Bo
   const std::string family = family_of(name);
   if (family == "stack") {
     // Top cube within 5 cm of its rest height h (2n - 1), no cube off the axis by 0.5 m (the
-    // scene's own topple threshold).
+    // scene's own slide-off threshold).
     int n = 0;
     double h = 0.0, top = -1e300, drift = 0.0;
     for (std::size_t i = 0; i < bodies.size(); ++i) {

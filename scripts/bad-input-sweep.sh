@@ -11,7 +11,8 @@
 #
 # Each command line (nproc of them at a time, or SWEEP_JOBS; SWEEP_TIMEOUT, SWEEP_VERBOSE=1 to
 # list every verdict) runs in a fresh temporary folder (its cwd, with a few fixture files:
-# `file` and `file.png` regular files, `adir` and `dir.png` folders) under `timeout 20` and a
+# `file` and `file.png` regular files, `adir`, `adir.json` and `dir.png` folders, scene files
+# `bad.json` (a box without half_extents_m) and `notjson.json`) under `timeout 20` and a
 # 1 GiB address-space cap (prlimit --as; see choose_cap below), stdout and stderr captured.
 # A bad command line PASSES when cps exits 2 with a message on stderr that names the option or
 # the value, and wrote nothing (no new file in the cwd or in its TMPDIR, fixture files
@@ -55,12 +56,13 @@ declare -A KIND=(
   ['*:--dt']=dt ['*:--iterations']=iterations
   ['*:--beta']=unit_interval ['*:--restitution']=unit_interval ['*:--warm-start']=unit_interval
   ['*:--friction']=nonneg_1e6 ['*:--restitution-threshold']=nonneg_1e6
-  ['*:--contact-margin']=nonneg_1e6
+  ['*:--contact-margin']=nonneg_1e6 ['*:--penetration-slop']=nonneg_1e6
   ['*:--size']=size ['*:--times']=times
   ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png
   ['*:--trace']=trace ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
   ['simulate:scene']=scene_one ['render:scene']=scene_many ['figure:scene']=scene_figure
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
+  ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
 )
 
 # The commands, each with the valid command line an option under test is added to (a short,
@@ -74,6 +76,7 @@ declare -A BASE=(
   [figure]='figure stack --times 0,0.1 --size 16x16 --out out/f.png'
   [report]='report intersecting_stack --list-runs --out out'
   [bench]='bench --quick --scene intersecting_stack'
+  [scene]='scene stack --out out/s.json'
 )
 RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
 MERGE_SRC=$root/merge-src                              # a complete sweep, made below
@@ -133,12 +136,18 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         "$good.it1x.ss1" "$good.it0x10.ss1" "$good.it1e3.ss1" "$good.it.ss1" "$good.it 1.ss1" \
         "$good.x1.ss1" "$good.it1.ss0" "$good.ss1.it1" "$good.it1.ss1001" "$good.it1.ss-1" \
         "$good.it1.ss1.5" ..... "$good.IT1.SS1" ;;
+    out_json)  # cannot be written as a new scene file
+      printf '%s\n' "" file file/s.json adir /dev/null . ;;
+    seed)  # a decimal integer in [0, 2^64 - 1] (and only for the random scene)
+      printf '%s\n' "" x -1 1.5 1e3 0x10 " 1" "1 " 18446744073709551616 99999999999999999999999 ;;
     merge)  # folders holding report CSVs
       printf '%s\n' "" nosuch file file/sub adir /dev/null ;;
     scene_one | scene_many | scene_figure | scene_report | scene_bench)
       printf '%s\n' "" nosuch STACK "stack " " stack" stack,funnel stack_0 stack_41 stack_ \
         _1 stack_1x stack_0x10 stack_-1 pyramid_20001 pyramid_0000001 pyramid_4294967297 \
-        pendulum_grid_101 funnel_1e3 -
+        pendulum_grid_101 funnel_1e3 - \
+        nosuch.json adir.json bad.json notjson.json file random_x random_-1 random_07 \
+        random_18446744073709551616
       case $kind in
         scene_one) printf '%s\n' all stress paper ;;
         scene_many) printf '%s\n' paper ;;
@@ -242,7 +251,9 @@ CASE_DIR=$root/case
 run_cps() {
   local d=$CASE_DIR
   rm -rf "$d"
-  mkdir -p "$d/cwd/adir" "$d/cwd/dir.png" "$d/tmp"
+  mkdir -p "$d/cwd/adir" "$d/cwd/dir.png" "$d/cwd/adir.json" "$d/tmp"
+  printf '{"bodies": [{"shape": "box", "mass_kg": 1}]}\n' > "$d/cwd/bad.json"  # no half_extents_m
+  printf 'not json\n' > "$d/cwd/notjson.json"
   printf 'not written by cps\n' > "$d/cwd/file"
   printf 'not a png, not written by cps\n' > "$d/cwd/file.png"
   local before

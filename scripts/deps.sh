@@ -5,6 +5,8 @@ cps_packages=(
   libeigen3-dev libglm-dev libstb-dev libpng-dev catch2 libcli11-dev nlohmann-json3-dev
   # The state hash of `cps simulate --json`: xxHash.
   libxxhash-dev
+  # Scene files: validated against assets/schemas/scene.schema.json by valijson.
+  libvalijson-dev
   # PNG frames: deflate by Intel ISA-L, CRCs by zlib.
   libisal-dev zlib1g-dev
   # The two GL backends (both loaded at run time): OSMesa, and EGL with Mesa's driver.

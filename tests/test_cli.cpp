@@ -246,7 +246,7 @@ TEST_CASE("cps simulate --json reports parameters, metrics and the final bodies"
   CHECK(j["steps"] == 100);
   CHECK(j["simulated_s"].get<double>() == Approx(1.0));
   for (const char* key : {"wall_s", "us_per_step"}) CHECK(j[key].get<double>() > 0.0);
-  for (const char* key : {"topple_time_s", "max_drift_m", "max_tilt_deg", "max_penetration_m"}) {
+  for (const char* key : {"slide_off_time_s", "max_drift_m", "creep_m", "max_tilt_deg", "max_penetration_m"}) {
     CHECK(j["metrics"].contains(key));
   }
   for (const char* key : {"pairs_tested", "contacts", "rows", "solves"}) {

@@ -30,14 +30,14 @@ TEST_CASE("a box dropped on the ground comes to rest with penetration under 1 cm
   CHECK(std::abs((b.rotation().transpose() * Vec3::UnitY()).cwiseAbs().maxCoeff() - 1.0) < 1e-3);
 }
 
-TEST_CASE("the stack settles and does not topple within 60 s", "[world][stack]") {
+TEST_CASE("the stack settles and does not slide off within 60 s", "[world][stack]") {
   const scenes::Scene* scene = scenes::find_scene("stack");
   REQUIRE(scene != nullptr);
   scenes::Run run = scenes::make_run(*scene);
   run.advance_to(60.0);
   const nlohmann::json m = run.metrics->report();
   INFO(m.dump());
-  CHECK(m["topple_time_s"].is_null());
+  CHECK(m["slide_off_time_s"].is_null());
   CHECK(m["max_tilt_deg"].get<double>() < 10.0);
   // Resting heights: half an edge (1.2 m) plus an edge (2.4 m) per cube below, within 2 cm
   // (the push factor leaves a few millimetres of penetration per contact).
@@ -66,8 +66,94 @@ TEST_CASE("the stack stays on its base for 600 s with either friction model", "[
     run.advance_to(600.0);
     const nlohmann::json m = run.metrics->report();
     INFO(name_of(model) << ": " << m.dump());
-    CHECK(m["topple_time_s"].is_null());
+    CHECK(m["slide_off_time_s"].is_null());
     CHECK(m["max_drift_m"].get<double>() < 0.5);
+  }
+}
+
+TEST_CASE("a penetration slop leaves a resting box that deep; the push alone breaks contact",
+          "[world][slop]") {
+  // The push (Eq. 5.3.1) with a slop s corrects beta (d - s) / dt of a depth d > s each step and
+  // nothing below s, so once the box rests the excess shrinks by the factor (1 - beta) a step
+  // (0.8^240 ~ 5e-24 after 4 s): the depth converges to s, from above when the landing went
+  // deeper than s. Dropped from 1 m, the box lands about |v| dt = 7.5 cm deep, so the depth
+  // ends at s for every slop tried, and the four corners never lose their contact once landed.
+  // With s = 0 (the paper's push at the paper's margin 0) the push drives the depth to 0, a
+  // corner then has no contact for a step, the box falls back and the contact is made again:
+  // it never comes to rest (the cause of the stack's creep, README "Why the paper's stack
+  // drifts").
+  for (const double slop : {0.0, 0.001, 0.005, 0.02}) {
+    WorldDef def;
+    def.penetration_slop = slop;
+    World world(def);
+    world.add_body({Shape::plane(Vec3::UnitY(), 0.0), true});
+    BodyDef box;
+    box.shape = Shape::box(Vec3::Constant(0.5));
+    box.mass = 1.0;
+    box.position = Vec3(0.0, 1.5, 0.0);
+    world.add_body(box);
+    int fewest_points = 4;  // contact points a step, from 2 s (landed at 0.45 s) to 6 s
+    for (int k = 0; k < 360; ++k) {
+      world.step();
+      if (k >= 120) {
+        const int n = world.manifolds().empty() ? 0 : world.manifolds()[0].count;
+        fewest_points = std::min(fewest_points, n);
+      }
+    }
+    INFO("slop " << slop);
+    const Body& b = world.body(1);
+    if (slop == 0.0) {
+      CHECK(fewest_points < 4);  // a corner lost its contact at least once
+      continue;
+    }
+    CHECK(fewest_points == 4);
+    // The centre rests half an edge up, less the depth: 0.5 - s, to 1e-9 m.
+    CHECK(b.x.y() == Approx(0.5 - slop).margin(1e-9));
+    CHECK(scenes::deepest_contact(world) == Approx(slop).margin(1e-9));
+    // The solve cancels g dt = 0.17 m/s a step; 25 sweeps leave under 1e-5 of it (measured
+    // 6e-8 m/s).
+    CHECK(b.velocity().norm() < 1e-6);
+  }
+}
+
+TEST_CASE("with a penetration slop and warm starting at 1 the stack stands for 600 s",
+          "[world][stack][warm_start][slop]") {
+  // Without a slop the push drives resting depths to 0, corners lose their contact for a step,
+  // their rows restart from 0 and the column rocks and creeps (README, "Why the paper's stack
+  // drifts"). With a 5 mm slop every point persists, a warm start at 1 starts each solve at
+  // last step's answer and the cubes stand still once landed. Measured: creep 0.3 mm after the
+  // landing (0.3 m without a slop). Bound: 1 cm, the target set for a standing column.
+  scenes::Overrides o;
+  o.set("penetration_slop", 0.005);
+  o.set("warm_start", 1.0);
+  scenes::Run run = scenes::make_run(*scenes::find_scene("stack"), o);
+  run.advance_to(600.0);
+  const nlohmann::json m = run.metrics->report();
+  INFO(m.dump());
+  CHECK(m["slide_off_time_s"].is_null());
+  CHECK(m["creep_m"].get<double>() < 0.01);
+  // Every point of the last step persisted from the step before.
+  std::size_t points = 0;
+  for (const Manifold& mf : run.world.manifolds()) points += static_cast<std::size_t>(mf.count);
+  CHECK(points >= 20);  // 5 faces, at least 4 points each
+  CHECK(run.world.persisting_contacts() == points);
+}
+
+TEST_CASE("with a penetration slop the funnel at contact margin 0 comes to rest",
+          "[world][funnel][warm_start][slop]") {
+  // At margin 0 without a slop the balls the push lifts clear lose their contact for a step and
+  // fall back: 9e-3 J of kinetic energy at 10 s cold, 4e-4 J warm started at 0.8. A 1 mm slop
+  // keeps their contacts (measured 3e-7 J at 0.8). Bound: 1e-4 J, the target for a pile at rest
+  // (a ball of the funnel moving at 1 cm/s carries 5e-5 J).
+  for (const double factor : {0.8, 1.0}) {
+    scenes::Overrides o;
+    o.set("contact_margin", 0.0);
+    o.set("penetration_slop", 0.001);
+    o.set("warm_start", factor);
+    scenes::Run run = scenes::make_run(*scenes::find_scene("funnel"), o);
+    run.advance_to(10.0);
+    INFO("warm start " << factor);
+    CHECK(scenes::kinetic_energy(run.world) < 1e-4);
   }
 }
 

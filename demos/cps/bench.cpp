@@ -1,5 +1,5 @@
 // `cps bench`: microseconds per physics step (explicit and matrix-free side by side), the cost
-// growth with body count, and milliseconds per rendered frame.
+// of warm starting, the cost growth with body count, and milliseconds per rendered frame.
 #include "command.h"
 #include "options.h"
 #include "output.h"
@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -56,12 +57,14 @@ struct StepCost {
 // The world is advanced, untimed, to `start_s`; a copy of it is then stepped `steps` times once
 // untimed (the copy's buffers grow to their working size) and `repeats` times timed, each from
 // a fresh copy of the same state, so every repeat times the same window. The median repeat's
-// thread CPU time per step counts. start_s >= 0 (s); steps >= 1; repeats >= 1.
+// thread CPU time per step counts. start_s >= 0 (s); steps >= 1; repeats >= 1. warm_start, if
+// set, replaces the scene's warm starting factor (dimensionless, [0, 1]) from the start.
 StepCost step_cost(const scenes::Scene& scene, Assembly assembly, double start_s, int steps,
-                   int repeats) {
+                   int repeats, std::optional<double> warm_start = std::nullopt) {
   scenes::Run run = scenes::make_run(scene);
   WorldDef def = run.world.def();
   def.assembly = assembly;
+  if (warm_start) def.warm_start = *warm_start;
   run.world.set_def(def);
   while (run.world.time() + 0.5 * def.dt < start_s) run.world.step();
   StepCost cost;
@@ -301,6 +304,49 @@ nlohmann::json physics_table(const std::vector<std::string>& names, bool quick, 
   return rows;
 }
 
+// The cost of warm starting (matrix-free, each scene over its bench window from the same state
+// at its start, at the scene's sweeps): cold (factor 0, the paper), the matching alone (factor
+// 1e-100: the contacts are matched, the cache kept and every guess computed, but the guesses are
+// 1e-100 of a lambda, so the run does the physics of the cold run to round-off; 1e-300 would
+// make subnormal numbers, which are slow), and warm started at 0.8 (its own physics: other
+// contacts, other rows).
+nlohmann::json warm_start_table(const std::vector<std::string>& names, bool quick, bool markdown) {
+  const int timed_steps = quick ? 60 : 180;
+  if (markdown) {
+    std::printf("\n## Warm starting: microseconds per step (matrix-free; the scene's window and "
+                "sweeps; cold = factor 0, the paper; matching = factor 1e-100, the same physics "
+                "with the cache kept and every guess computed)\n\n"
+                "| scene | cold (us/step) | matching (us/step) | cost of matching | warm 0.8 "
+                "(us/step) | rows/step cold | rows/step warm 0.8 |\n"
+                "|---|---|---|---|---|---|---|\n");
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  for (const std::string& name : names) {
+    const scenes::Scene& scene = *scenes::find_scene(name);
+    const int steps = window_steps(scene, quick);
+    const int repeats = std::max(5, (timed_steps + steps - 1) / steps);
+    const double start = scene.bench.start_s;
+    std::fprintf(stderr, "bench: %s warm starting\n", name.c_str());
+    const StepCost cold = step_cost(scene, Assembly::matrix_free, start, steps, repeats, 0.0);
+    const StepCost match = step_cost(scene, Assembly::matrix_free, start, steps, repeats, 1e-100);
+    const StepCost warm = step_cost(scene, Assembly::matrix_free, start, steps, repeats, 0.8);
+    const double cost = match.us / cold.us - 1.0;
+    rows.push_back({{"scene", name},
+                    {"cold_us_per_step", cold.us},
+                    {"matching_us_per_step", match.us},
+                    {"matching_cost_fraction", cost},
+                    {"warm_0.8_us_per_step", warm.us},
+                    {"rows_per_step_cold", cold.rows},
+                    {"rows_per_step_warm_0.8", warm.rows}});
+    if (markdown) {
+      std::printf("| %s | %.1f | %.1f | %+.1f %% | %.1f | %.1f | %.1f |\n", name.c_str(), cold.us,
+                  match.us, 100.0 * cost, warm.us, cold.rows, warm.rows);
+      std::fflush(stdout);
+    }
+  }
+  return rows;
+}
+
 // The cost growth table (matrix-free): log-log slopes of time per step against bodies and rows.
 nlohmann::json growth_table(bool quick, bool markdown) {
   constexpr int k_repeats = 5;
@@ -380,6 +426,7 @@ int run_bench(const BenchOptions& o) {
   } else {
     if (!o.rendering) {
       out["physics"] = physics_table(physics_scenes(o.quick), o.quick, markdown);
+      out["warm_start"] = warm_start_table({"stack", "funnel"}, o.quick, markdown);
       out["growth"] = growth_table(o.quick, markdown);
     }
 #ifdef CPS_HAVE_RENDERER
@@ -395,7 +442,8 @@ int run_bench(const BenchOptions& o) {
 Command add_bench(CLI::App& app) {
   auto o = std::make_shared<BenchOptions>();
   CLI::App* sub = app.add_subcommand(
-      "bench", "microseconds per step (explicit and matrix-free), cost growth, ms per frame");
+      "bench", "microseconds per step (explicit and matrix-free), the cost of warm starting, cost "
+             "growth, ms per frame");
   sub->add_flag("--quick", o->quick, "smaller scenes and fewer steps (results in us/step, ms/frame)");
   sub->add_flag("--rendering", o->rendering,
                 "only the rendering table (ms per frame at 1280x720: draw, PNG, end to end)");
@@ -406,6 +454,7 @@ Command add_bench(CLI::App& app) {
                   "time only these scenes (a name, a scaled scene such as funnel_500, 'all' or 'stress'; "
                   "repeatable): the physics table alone, each scene over its window")
       ->check(kNotEmpty);
+  add_seed_option(*sub, o->scenes);
   return {sub, [o] { return run_bench(*o); }};
 }
 

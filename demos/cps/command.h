@@ -34,6 +34,11 @@ Command add_simulate(CLI::App& app, int argc, char** argv);
 /// argv (the whole command line) are recorded in the folder's run.json.
 Command add_report(CLI::App& app, int argc, char** argv);
 
+/// `cps scene NAME`: writes a scene as a scene file (JSON) to stdout or --out FILE (the output
+/// rule: never a foreign file without --force, atomically). argc and argv are recorded in the
+/// folder's run.json.
+Command add_scene(CLI::App& app, int argc, char** argv);
+
 /// `cps bench`: microseconds per physics step, cost growth with body count and, with the
 /// renderer, milliseconds per rendered frame, as Markdown on stdout.
 Command add_bench(CLI::App& app);

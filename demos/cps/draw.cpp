@@ -1,5 +1,7 @@
 #include "draw.h"
 
+#include "scene_file.h"
+
 #include "options.h"
 
 #include <algorithm>
@@ -29,7 +31,14 @@ constexpr std::array<glm::vec3, 6> kPalette = {{{0.85f, 0.33f, 0.20f},
                                                 {0.60f, 0.35f, 0.70f},
                                                 {0.15f, 0.65f, 0.70f}}};
 
-glm::vec3 colour_of(std::size_t body) { return kPalette[body % kPalette.size()]; }
+// The colour of body `body`: the scene's own (style.body_colours) if it has one, else the palette's.
+glm::vec3 colour_of(std::size_t body, const DrawStyle& style) {
+  if (body < style.body_colours.size() && style.body_colours[body]) {
+    const Vec3& c = *style.body_colours[body];
+    return {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};
+  }
+  return kPalette[body % kPalette.size()];
+}
 
 // A length (m) that says how big a movable body is: its largest half extent or its radius;
 // 0 for planes and static bodies.
@@ -88,10 +97,10 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
     if (b.shape.kind == ShapeKind::box) {
-      list.boxes.push_back({to_glm(b.x), to_glm(b.o), to_glm(b.shape.half_extents), colour_of(i)});
+      list.boxes.push_back({to_glm(b.x), to_glm(b.o), to_glm(b.shape.half_extents), colour_of(i, style)});
     } else if (b.shape.kind == ShapeKind::sphere) {
       list.spheres.push_back({to_glm(b.x), to_glm(b.o), static_cast<float>(b.shape.radius),
-                              colour_of(i)});
+                              colour_of(i, style)});
     }
   }
   for (const DistanceConstraint& d : world.distances()) {
@@ -270,6 +279,7 @@ DrawStyle resolve_style(const scenes::Scene& scene, std::span<const World* const
   style.camera = preset ? camera_from_preset(*preset) : frame_world(first, aspect);
   style.plane_opacity = static_cast<float>(scene.plane_opacity);
   style.overlays = view.overlays;
+  style.body_colours = scenes::body_colours(scene);
   if (view.fov_y_deg) style.camera.fov_y_deg = static_cast<float>(*view.fov_y_deg);
   Bounds bounds;
   if (view.camera == "fit") {

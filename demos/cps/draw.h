@@ -38,6 +38,9 @@ struct DrawStyle {
   render::Camera camera;
   float plane_opacity = 1.0f;
   Overlays overlays;
+  /// The scene's colours by body index (scenes::body_colours, linear RGB); a body beyond the end
+  /// or without one takes the palette.
+  std::span<const std::optional<Vec3>> body_colours;
   /// Every plane is drawn as a square of half side plane_half_size_m (m, > 0) centred on its
   /// point nearest to plane_centre (m). Fixed for the whole run, so a plane's edge never moves
   /// from frame to frame (resolve_style: around the bodies' bounds, see plane_extent).
@@ -93,8 +96,9 @@ struct View {
 
 /// A snapshot of `world` for the renderer: every box and sphere, every distance constraint as a
 /// rod (unless style.overlays.rods is false), every plane (checkered, on the square of
-/// style.plane_centre and style.plane_half_size_m), the contact overlay if asked. Colours come from the body index, so a body keeps its
-/// colour from frame to frame. With an orbit, the camera eye is turned about the vertical axis
+/// style.plane_centre and style.plane_half_size_m), the contact overlay if asked. Colours come
+/// from style.body_colours, else from the body index, so a body keeps its colour from frame to
+/// frame. With an orbit, the camera eye is turned about the vertical axis
 /// through the target by orbit_deg_per_s * world.time() degrees.
 render::DrawList draw_list(const World& world, const DrawStyle& style);
 

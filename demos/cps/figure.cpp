@@ -348,7 +348,8 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
       "figure",
       "one labelled PNG of a scene: a panel per time (columns) and per variant (rows); "
       "'cps figure paper' writes the counterparts of the paper's Figs. 6-10");
-  sub->add_option("scene", o->scene, "scene name (see 'cps list') or 'paper'")->required();
+  sub->add_option("scene", o->scene, "scene name (see 'cps list'), the path of a scene file (.json), or 'paper'")->required();
+  add_seed_option(*sub, o->scene);
   sub->add_option("--times", o->times,
                   "simulated times of the columns (s), comma separated, finite, >= 0, "
                   "increasing, e.g. 0,0.5,2; required except for 'paper'");

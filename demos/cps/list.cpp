@@ -2,6 +2,7 @@
 #include "command.h"
 
 #include "scene.h"
+#include "scene_file.h"
 
 #include <cstdio>
 #include <span>
@@ -23,14 +24,25 @@ void print_table(const char* title, std::span<const scenes::Scene> table) {
 
 Command add_list(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
-      "list", "print the scenes with their default duration (s) and a summary");
+      "list", "print the scenes, example scene files and scaled families with their default duration (s) and a summary");
   return {sub, [] {
             print_table("The paper's scenes (Sec. 10; 'all'):", scenes::paper_scenes());
             print_table("Stress scenes ('stress'):", scenes::stress_scenes());
+            std::printf("  %-22s %5s    the random scene with that seed (random is random_1; or "
+                        "random --seed N)\n", "random_SEED", "");
+            std::printf("Example scene files (assets/scenes, built into cps; type the name, or "
+                        "'cps scene NAME' to get the file):\n");
+            for (const std::string_view name : scenes::example_scene_names()) {
+              const scenes::Scene* s = scenes::find_scene(name);
+              std::printf("  %-22s %5.0f s  %s\n", std::string(name).c_str(), s->default_seconds,
+                          std::string(s->summary).c_str());
+            }
             std::printf("Scaled scenes for benchmarks, made on demand as FAMILY_N (e.g. pyramid_1000):\n");
             for (const std::string_view family : scenes::scaled_families()) {
               std::printf("  %s\n", std::string(family).c_str());
             }
+            std::printf("Scene files: any PATH.json in the format of "
+                        "assets/schemas/scene.schema.json (README, \"Scene files\").\n");
             return 0;
           }};
 }

@@ -22,6 +22,7 @@ int run(int argc, char** argv) {
       cli::add_simulate(app, argc, argv),
       cli::add_report(app, argc, argv),
       cli::add_bench(app),
+      cli::add_scene(app, argc, argv),
 #ifdef CPS_HAVE_RENDERER
       cli::add_render(app, argc, argv),
       cli::add_figure(app, argc, argv),

@@ -1,6 +1,11 @@
 #include "options.h"
 
+#include "scene_file.h"
+
+#include <charconv>
 #include <cmath>
+#include <functional>
+#include <memory>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -111,16 +116,85 @@ std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
     }
     return selected;
   }
-  if (const scenes::Scene* s = scenes::find_scene(name)) return {s};
+  try {
+    if (const scenes::Scene* s = scenes::find_scene(name)) return {s};
+  } catch (const scenes::SceneFileError& e) {
+    throw UsageError(e.what());
+  }
   std::string known;
   for (const scenes::Scene& s : scenes::all_scenes()) known += std::string(known.empty() ? "" : ", ") + std::string(s.name);
+  std::string examples;
+  for (const std::string_view e : scenes::example_scene_names()) {
+    examples += (examples.empty() ? "" : ", ") + std::string(e);
+  }
   std::string families;
   for (const std::string_view f : scenes::scaled_families()) {
     families += (families.empty() ? "" : ", ") + std::string(f);
   }
   throw UsageError("unknown scene '" + name + "'; the scenes are: " + known +
-                   " (or 'all' for the paper's scenes, 'stress' for the stress scenes), and the "
-                   "scaled scenes " + families + "; 'cps list' describes them");
+                   " (or 'all' for the paper's scenes, 'stress' for the stress scenes); the "
+                   "example scene files " + examples + "; random_SEED (the random scene with "
+                   "that seed); the scaled scenes " + families +
+                   "; or the path of a scene file ending in .json; 'cps list' describes them");
+}
+
+std::string with_seed(const std::string& scene, std::uint64_t seed) {
+  const std::string seeded = "random_" + std::to_string(seed);
+  if (scene == "random" || scene == seeded) return seeded;
+  if (scene.rfind("random_", 0) == 0) {
+    throw UsageError("--seed " + std::to_string(seed) + ": the scene " + scene +
+                     " already names its seed; give the seed once (random --seed N, or random_N)");
+  }
+  throw UsageError("--seed " + std::to_string(seed) + ": the scene " + scene +
+                   " is not random; --seed applies to the random scene only (random, random_N)");
+}
+
+namespace {
+
+// Adds --seed to `cmd`; `apply` turns the seed into scene names once the command line is parsed.
+void add_seed(CLI::App& cmd, std::function<void(std::uint64_t)> apply) {
+  auto seed = std::make_shared<std::optional<std::uint64_t>>();
+  cmd.add_option_function<std::string>(
+         "--seed",
+         [seed](const std::string& text) { *seed = std::stoull(text); },
+         "seed of the random scene (an integer in [0, 18446744073709551615]): 'random --seed 7' "
+         "is random_7; refused for any other scene")
+      ->type_name("INT")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            std::uint64_t v = 0;
+            const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+            if (text.empty() || ec != std::errc() || end != text.data() + text.size()) {
+              return text + ": not allowed; give a decimal integer in [0, 18446744073709551615]";
+            }
+            return {};
+          },
+          ""));
+  cmd.parse_complete_callback([seed, apply = std::move(apply)] {
+    if (!seed->has_value()) return;
+    try {
+      apply(**seed);
+    } catch (const UsageError& e) {
+      // A CLI11 parse error: main reports it and exits 2.
+      throw CLI::ValidationError(e.what());
+    }
+  });
+}
+
+}  // namespace
+
+void add_seed_option(CLI::App& cmd, std::string& scene) {
+  add_seed(cmd, [&scene](std::uint64_t seed) { scene = with_seed(scene, seed); });
+}
+
+void add_seed_option(CLI::App& cmd, std::vector<std::string>& scenes) {
+  add_seed(cmd, [&scenes](std::uint64_t seed) {
+    if (scenes.empty()) {
+      throw UsageError("--seed " + std::to_string(seed) + ": no scene is random; --seed applies "
+                       "to the random scene (--scene random)");
+    }
+    for (std::string& s : scenes) s = with_seed(s, seed);
+  });
 }
 
 std::vector<std::string> comparable_options() {

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -49,9 +50,23 @@ extern const CLI::Validator kNotEmpty;
 /// (s / s) exceeds kMaxSteps.
 void check_steps(const std::string& what, double seconds, double dt);
 
-/// Scenes named on the command line: "all" or one scene name. Throws UsageError listing the
-/// scenes for an unknown name.
+/// Scenes named on the command line: "all", "stress", one scene name (see scenes::find_scene:
+/// the tables, the example scene files, random_SEED, the scaled families) or the path of a scene
+/// file (ending in ".json"). Throws UsageError listing the scenes, the example files and the
+/// scaled families for an unknown name, and with the file's own message (file, JSON pointer,
+/// value, what is allowed) for a scene file that cannot be read or is not valid.
 std::vector<const scenes::Scene*> select_scenes(const std::string& name);
+
+/// Adds --seed N (the random scene's seed, a decimal integer in [0, 2^64 - 1]) to a command that
+/// takes the scene `scene` (or the scenes `scenes`): once the command line is parsed, it turns
+/// "random" (or random_N with the same N) into random_N. A scene that is not random is refused
+/// (exit 2, naming the scene), as is a random_M with another seed.
+void add_seed_option(CLI::App& cmd, std::string& scene);
+void add_seed_option(CLI::App& cmd, std::vector<std::string>& scenes);
+
+/// The scene name `scene` with the seed applied (see add_seed_option). Throws UsageError for a
+/// scene that is not random, or random_M with M != seed.
+std::string with_seed(const std::string& scene, std::uint64_t seed);
 
 /// One variant of a comparison: the overrides it runs with and its label ("push = split").
 struct Variant {

@@ -286,7 +286,8 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
 Command add_render(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* sub = app.add_subcommand("render", "render scenes into PNG frame sequences");
-  sub->add_option("scene", o->scene, "scene name or 'all'")->required();
+  sub->add_option("scene", o->scene, "scene name, the path of a scene file (.json), or 'all'")->required();
+  add_seed_option(*sub, o->scene);
   add_seconds_option(*sub, o->seconds,
                      "at most 1e7 physics steps, 1e5 frames and 64 GiB of pixels a render");
   sub->add_option("--fps", o->fps,

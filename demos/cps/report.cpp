@@ -1431,9 +1431,10 @@ Command add_report(CLI::App& app, int argc, char** argv) {
   CLI::App* sub = app.add_subcommand(
       "report", "error against run time: sweep solver settings, write CSV, plots, report.md");
   sub->add_option("scene", o->scene,
-                  "scene name, 'all' (the paper's) or 'stress'; with --run, the sweep the run "
-                  "belongs to")
+                  "scene name, the path of a scene file (.json), 'all' (the paper's) or "
+                  "'stress'; with --run, the sweep the run belongs to")
       ->capture_default_str();
+  add_seed_option(*sub, o->scene);
   sub->add_option("--out", o->out, "output folder")->capture_default_str()->check(kNotEmpty);
   sub->add_flag("--quick", o->quick,
                 "a reduced sweep: iterations 1, 4, 16, 25, 64 and 4 substeps, fixed friction "

@@ -193,7 +193,8 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
 Command add_simulate(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<SimulateOptions>();
   CLI::App* sub = app.add_subcommand("simulate", "run a scene headless and report metrics");
-  sub->add_option("scene", o->scene, "scene name (see 'cps list')")->required();
+  sub->add_option("scene", o->scene, "scene name (see 'cps list') or the path of a scene file (.json)")->required();
+  add_seed_option(*sub, o->scene);
   add_seconds_option(*sub, o->seconds, "at most 1e7 steps (--seconds / --dt) a run");
   sub->add_flag("--json", o->json, "print one JSON object (keys carry their unit: _s, _m, ...)");
   sub->add_option("--trace", o->trace,

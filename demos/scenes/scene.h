@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -115,12 +116,21 @@ std::span<const Scene> stress_scenes();
 /// Paper scenes, then stress scenes.
 std::span<const Scene> all_scenes();
 
-/// The scene called `name`, or nullptr. Besides the tables, scaled scenes for benchmarks are
-/// made on demand from a family name and a size: stack_N (N cubes, 1..40), pyramid_N (a
-/// pyramid of about N boxes, 1..20000), funnel_N (N balls, 1..20000), pendulum_wave_N (N
-/// pendulums, 1..20000), pendulum_grid_N (an N x N grid, 1..100). The returned pointer stays
-/// valid for the whole program.
+/// The scene called `name`, or nullptr. Besides the tables: the example scene files by name
+/// (assets/scenes, embedded: "dominoes"); random_SEED, the random scene (populate_random) with
+/// that seed (a decimal integer in [0, 2^64 - 1]; random_1 is "random"); scaled scenes for
+/// benchmarks, made on demand from a family name and a size: stack_N (N cubes, 1..40),
+/// pyramid_N (a pyramid of about N boxes, 1..20000), funnel_N (N balls, 1..20000),
+/// pendulum_wave_N (N pendulums, 1..20000), pendulum_grid_N (an N x N grid, 1..100); and a name
+/// ending in ".json", a scene file loaded from that path (scene_file.h; the scene is called by
+/// the path as given). The returned pointer stays valid for the whole program. Throws
+/// SceneFileError (scene_file.h, a std::invalid_argument) for a scene file that cannot be read
+/// or is not valid.
 const Scene* find_scene(std::string_view name);
+
+/// The random scene with this seed, named random_SEED (see find_scene); kept for the program's
+/// life.
+const Scene* random_scene(std::uint64_t seed);
 
 /// The scaled scene families, with the size range each takes ("stack_N 1..40", ...).
 std::span<const std::string_view> scaled_families();

@@ -1,7 +1,10 @@
 #include "scene.h"
+#include "scene_file.h"
+#include "stress/stress.h"
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <deque>
 #include <mutex>
@@ -138,6 +141,19 @@ const Scene* find_scene(std::string_view name) {
   const auto it =
       std::find_if(all.begin(), all.end(), [name](const Scene& s) { return s.name == name; });
   if (it != all.end()) return &*it;
+  if (const Scene* example = find_example_scene(name)) return example;
+  if (name.size() > 5 && name.substr(name.size() - 5) == ".json") return load_scene_file(name);
+  constexpr std::string_view kRandom = "random_";
+  if (name.substr(0, kRandom.size()) == kRandom && name.size() > kRandom.size()) {
+    const std::string_view digits = name.substr(kRandom.size());
+    std::uint64_t seed = 0;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), seed);
+    if (ec == std::errc() && end == digits.data() + digits.size() &&
+        std::string(kRandom) + std::to_string(seed) == name) {
+      return random_scene(seed);
+    }
+    return nullptr;
+  }
   // A scaled scene: FAMILY_N with N in the family's range. Made once per name and kept.
   const std::size_t cut = name.rfind('_');
   if (cut == std::string_view::npos || cut + 1 >= name.size()) return nullptr;
@@ -156,6 +172,29 @@ const Scene* find_scene(std::string_view name) {
   } catch (const std::invalid_argument&) {
     return nullptr;
   }
+  return &made.back();
+}
+
+const Scene* random_scene(std::uint64_t seed) {
+  static std::mutex mutex;
+  static std::deque<std::string> names;
+  static std::deque<std::string> summaries;
+  static std::deque<Scene> made;
+  const std::string name = "random_" + std::to_string(seed);
+  const std::lock_guard<std::mutex> lock(mutex);
+  for (const Scene& s : made) {
+    if (s.name == name) return &s;
+  }
+  const std::span<const Scene> all = all_scenes();
+  const auto base = std::find_if(all.begin(), all.end(), [](const Scene& s) { return s.name == "random"; });
+  Scene s = *base;
+  names.push_back(name);
+  summaries.push_back("a random pile (seed " + std::to_string(seed) +
+                      "): 4-12 boxes and balls, 0.05-5 m, 0.01-1000 kg, up to 50 m/s");
+  s.name = names.back();
+  s.summary = summaries.back();
+  s.populate = [seed](World& world) { populate_random(world, seed); };
+  made.push_back(std::move(s));
   return &made.back();
 }
 

@@ -1,11 +1,14 @@
 // The stack test, paper Sec. 10.1: five cubes of edge 2.4 m and mass 1.2 kg, centres 3 m apart
 // (0.6 m gaps), the bottom centre 2 m above the ground; g = -10 m/s^2, 60 Hz, 25 iterations,
-// beta = 0.2, no contact caching. The paper reports that the stack topples after about 85 s.
+// beta = 0.2, no contact caching. The paper reports that the stack topples after about 85 s;
+// ours slides rather than falls (README, "Why the paper's stack drifts"), so its metric is the
+// time a cube slides off the column's axis.
 #include "scene.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 namespace cps::scenes {
 namespace {
@@ -13,10 +16,14 @@ namespace {
 constexpr int kCubes = 5;
 constexpr double kHalfEdge = 1.2;   // m
 constexpr double kMass = 1.2;       // kg
-// A cube counts as toppled once its centre leaves this radius around the column's axis (m) ...
-constexpr double kToppleDrift = 0.5;
+// A cube has slid off the column once its centre leaves this radius around the column's axis
+// (m, a fifth of the edge) ...
+constexpr double kSlideOffDrift = 0.5;
 // ... or it tilts further than this (degrees).
-constexpr double kToppleTilt = 10.0;
+constexpr double kSlideOffTilt = 10.0;
+// The landing is over by this time (s): the fifth cube touches down at about 0.8 s and the
+// column is still from about 1.5 s. creep_m is measured from the cubes' positions here.
+constexpr double kLandedTime = 3.0;
 
 // Angle (degrees) between world up and the cube axis closest to it.
 double tilt_deg(const Body& b) {
@@ -28,26 +35,41 @@ double tilt_deg(const Body& b) {
 class StackMetrics final : public Metrics {
  public:
   void observe(const World& world) override {
-    for (const Body& b : world.bodies()) {
+    const bool landed = world.time() + 0.5 * world.def().dt >= kLandedTime;
+    if (landed && landed_at_.empty()) {
+      for (const Body& b : world.bodies()) landed_at_.push_back(b.x);
+    }
+    for (std::size_t i = 0; i < world.bodies().size(); ++i) {
+      const Body& b = world.bodies()[i];
       if (b.is_static()) continue;
       const double drift = std::hypot(b.x.x(), b.x.z());
       const double tilt = tilt_deg(b);
       max_drift_ = std::max(max_drift_, drift);
       max_tilt_ = std::max(max_tilt_, tilt);
-      if (!topple_time_ && (drift > kToppleDrift || tilt > kToppleTilt)) topple_time_ = world.time();
+      if (!slide_off_time_ && (drift > kSlideOffDrift || tilt > kSlideOffTilt)) {
+        slide_off_time_ = world.time();
+      }
+      if (landed && i < landed_at_.size()) {
+        const Vec3 d = b.x - landed_at_[i];
+        creep_ = std::max(creep_, std::hypot(d.x(), d.z()));
+      }
     }
     max_penetration_ = std::max(max_penetration_, deepest_contact(world));
   }
 
   nlohmann::json report() const override {
-    return {{"topple_time_s", topple_time_ ? nlohmann::json(*topple_time_) : nlohmann::json()},
+    return {{"slide_off_time_s",
+             slide_off_time_ ? nlohmann::json(*slide_off_time_) : nlohmann::json()},
             {"max_drift_m", max_drift_},
+            {"creep_m", landed_at_.empty() ? nlohmann::json() : nlohmann::json(creep_)},
             {"max_tilt_deg", max_tilt_},
             {"max_penetration_m", max_penetration_}};
   }
 
  private:
-  std::optional<double> topple_time_;
+  std::optional<double> slide_off_time_;  // s: first time a cube slid off (kSlideOff*)
+  std::vector<Vec3> landed_at_;            // m: every body's centre at kLandedTime
+  double creep_ = 0.0;                     // m: largest horizontal move since kLandedTime
   double max_drift_ = 0.0;
   double max_tilt_ = 0.0;
   double max_penetration_ = 0.0;

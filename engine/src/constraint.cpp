@@ -70,8 +70,9 @@ void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
     // j . v1 (m/s)
     const double approach = relative_velocity(contact.j, vel_a.v, vel_a.w, vel_b.v, vel_b.w);
     if (c.depth >= 0.0) {
-      // Eq. 5.3.1 (docs/conventions.md, Sec. 3): C = -d, v = -beta C / dt = beta d / dt > 0 opens it.
-      contact.push = params.beta * c.depth / params.dt;
+      // Eq. 5.3.1 (docs/conventions.md, Sec. 3): C = -d, v = -beta C / dt = beta d / dt > 0 opens
+      // it; with a penetration slop s, C = -max(d - s, 0) (s = 0: the paper's push).
+      contact.push = params.beta * std::max(c.depth - params.penetration_slop, 0.0) / params.dt;
     } else {
       // Speculative contact (gap -d within the margin): the points may approach by the gap in this
       // step, no further. This is a limit on the velocity, not a correction, so it stays in both

@@ -185,6 +185,18 @@ const std::array kParameters = {
                       "paper; typical 0.001 for bodies of 0.5 to 3 m",
               .get = &get_member<&WorldDef::contact_margin>,
               .set = &set_member<&WorldDef::contact_margin>},
+    Parameter{.name = "penetration_slop",
+              .flag = "penetration-slop",
+              .json_key = "penetration_slop_m",
+              .unit = "m",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0e6,
+              .help = "penetration slop: the push corrects only the depth beyond it, so resting "
+                      "contacts settle this deep instead of being pushed apart and re-made each "
+                      "step; 0 = the paper's push; typical 0.005 for bodies of 0.5 to 3 m",
+              .get = &get_member<&WorldDef::penetration_slop>,
+              .set = &set_member<&WorldDef::penetration_slop>},
     Parameter{.name = "warm_start",
               .flag = "warm-start",
               .json_key = "warm_start",

@@ -170,8 +170,10 @@ void World::build_rows() {
   for (const Manifold& m : manifolds_) contact_points += static_cast<std::size_t>(m.count);
   detail::reserve_with_headroom(
       rows_, contact_points * (def_.friction > 0.0 ? 3 : 1) + distances_.size());
-  const RowParams params{def_.beta,    def_.dt,          def_.friction,
-                         def_.gravity, def_.restitution, def_.restitution_threshold};
+  const RowParams params{def_.beta,        def_.dt,
+                         def_.friction,    def_.gravity,
+                         def_.restitution, def_.restitution_threshold,
+                         def_.penetration_slop};
   // Each body's v and w (w needs I^-1 = R I_body^-1 R^T) once, for the bodies in a manifold;
   // a body typically sits in several.
   velocity_known_.assign(bodies_.size(), 0);  // n bytes: no allocation once grown

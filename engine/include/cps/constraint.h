@@ -66,6 +66,7 @@ struct RowParams {
   Vec3 gravity = Vec3(0.0, -10.0, 0.0);
   double restitution = 0.0;
   double restitution_threshold = 1.0;
+  double penetration_slop = 0.0;  ///< m, >= 0: depth the push leaves (WorldDef::penetration_slop)
 };
 
 /// Appends the rows of one manifold to `rows`: first its contact rows, one per point in point

@@ -1,0 +1,267 @@
+// Scene files (demos/scenes/scene_file.h): every class of mistake is refused with a message that
+// names the file and the JSON pointer; a built-in scene written as a file runs to the same state.
+#include "scene_file.h"
+#include "state_hash.h"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
+using namespace cps;
+using namespace cps::scenes;
+using nlohmann::json;
+
+namespace {
+
+// A valid scene written by hand: ground, a box, a ball hanging from a fixed point by a rod and a
+// named static box.
+const char* kValid = R"({
+  // comments are allowed
+  "name": "hand", "description": "written by hand", "seconds": 2,
+  "world": {"dt_s": 0.01, "iterations": 30, "push": "split", "gravity_mps2": [0, -9.81, 0]},
+  "bodies": [
+    {"shape": "plane", "normal": [0, 1, 0], "offset_m": 0},
+    {"shape": "box", "name": "crate", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 2,
+     "position_m": [0, 2, 0], "color": "#ff8000"},
+    {"shape": "sphere", "name": "bob", "radius_m": 0.2, "mass_kg": 1, "position_m": [3, 3, 0]},
+    {"shape": "box", "name": "wall", "static": true, "half_extents_m": [0.1, 1, 1],
+     "position_m": [-2, 1, 0], "orientation_wxyz": [1, 0, 0, 0]}
+  ],
+  "rods": [{"body_a": "bob", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [3, 5, 0],
+            "length_m": 2}],
+  "camera": {"eye_m": [0, 4, 12], "target_m": [0, 1, 0], "fov_deg": 40}
+})";
+
+// The message of the error parse_scene_file raises for `doc` (with `edit` applied), or "".
+std::string error_of(const std::string& text) {
+  try {
+    parse_scene_file(text, "test.json");
+  } catch (const SceneFileError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string error_with(const std::function<void(json&)>& edit) {
+  json doc = json::parse(kValid, nullptr, true, true);
+  edit(doc);
+  return error_of(doc.dump());
+}
+
+}  // namespace
+
+TEST_CASE("a scene file written by hand is read as written", "[scene_file]") {
+  const SceneFile f = parse_scene_file(kValid, "test.json");
+  CHECK(f.name == "hand");
+  CHECK(f.seconds == 2.0);
+  CHECK(f.world.dt == 0.01);
+  CHECK(f.world.iterations == 30);
+  CHECK(f.world.push == PushMode::split);
+  CHECK(f.world.gravity.y() == -9.81);
+  CHECK(f.world.beta == WorldDef{}.beta);  // omitted: the table's default
+  REQUIRE(f.bodies.size() == 4);
+  CHECK(f.bodies[0].def.is_static);
+  CHECK(f.bodies[1].def.mass == 2.0);
+  CHECK(f.bodies[1].def.orientation.w() == 1.0);  // omitted: the identity
+  REQUIRE(f.bodies[1].colour.has_value());
+  CHECK(f.bodies[1].colour->x() == Approx(1.0));
+  CHECK(f.bodies[1].colour->y() == Approx(0.2158605).margin(1e-6));  // sRGB 0x80 in linear
+  CHECK(f.bodies[3].def.is_static);
+  REQUIRE(f.rods.size() == 1);
+  CHECK(f.rods[0].body_a == 2);
+  CHECK(f.rods[0].body_b == kWorldBody);
+  REQUIRE(f.camera.has_value());
+  CHECK(f.camera->fov_y_deg == 40.0);
+
+  // It runs: the bob swings on its rod and the crate lands on the ground.
+  const Scene s = scene_of(f, "test.json");
+  Run run = make_run(s);
+  run.advance_to(2.0);
+  const json m = run.metrics->report();
+  CHECK(m["nan"] == false);
+  CHECK(m["max_rod_error_m"].get<double>() < 0.01);
+  CHECK(m["final_penetration_m"].get<double>() < 0.01);
+  CHECK(run.world.body(1).x.y() == Approx(0.5).margin(0.02));
+  CHECK(m["energy_drift_J"].get<double>() < 1e-6);  // nothing gains energy
+}
+
+TEST_CASE("each class of mistake names the file, the pointer, the value and what is allowed",
+          "[scene_file]") {
+  SECTION("a syntax error names the line and column") {
+    const std::string e = error_of("{\n  \"name\": \"x\",\n  \"seconds\": 2,,\n}");
+    CHECK(e.rfind("test.json:3:", 0) == 0);
+    CHECK(e.find("not valid JSON") != std::string::npos);
+  }
+  SECTION("a wrong type") {
+    const std::string e = error_with([](json& d) { d["bodies"][1]["mass_kg"] = "heavy"; });
+    CHECK(e.find("test.json: /bodies/1/mass_kg: \"heavy\" is not allowed: mass (kg)") == 0);
+  }
+  SECTION("a value out of the schema's range") {
+    const std::string e = error_with([](json& d) { d["bodies"][2]["radius_m"] = -1; });
+    CHECK(e.find("/bodies/2/radius_m: -1 is not allowed") != std::string::npos);
+    CHECK(e.find("[1e-4, 1e5]") != std::string::npos);
+  }
+  SECTION("a world parameter out of the table's range") {
+    const std::string e = error_with([](json& d) { d["world"]["beta"] = 2; });
+    CHECK(e.find("test.json: /world/beta: 2 is not allowed: it must be in [0, 1]") == 0);
+  }
+  SECTION("an unknown choice") {
+    const std::string e = error_with([](json& d) { d["world"]["push"] = "splat"; });
+    CHECK(e.find("/world/push: \"splat\" is not allowed: one of: baumgarte, split") != std::string::npos);
+  }
+  SECTION("an unknown key names the nearest known key") {
+    const std::string e = error_with([](json& d) {
+      d["bodies"][1].erase("mass_kg");
+      d["bodies"][1]["mas_kg"] = 2;
+    });
+    CHECK(e.find("/bodies/1/mas_kg: unknown key \"mas_kg\"; did you mean \"mass_kg\"?") != std::string::npos);
+    const std::string w = error_with([](json& d) { d["world"]["dt"] = 0.01; });
+    CHECK(w.find("/world/dt: unknown key \"dt\"; did you mean \"dt_s\"?") != std::string::npos);
+    const std::string top = error_with([](json& d) { d["camra"] = d["camera"]; });
+    CHECK(top.find("/camra: unknown key \"camra\"; did you mean \"camera\"?") != std::string::npos);
+  }
+  SECTION("a missing required key") {
+    const std::string box = error_with([](json& d) { d["bodies"][1].erase("half_extents_m"); });
+    CHECK(box.find("/bodies/1: the key \"half_extents_m\" is missing") != std::string::npos);
+    const std::string shape = error_with([](json& d) { d["bodies"][1].erase("shape"); });
+    CHECK(shape.find("/bodies/1: the key \"shape\" is missing") != std::string::npos);
+    const std::string mass = error_with([](json& d) { d["bodies"][2].erase("mass_kg"); });
+    CHECK(mass.find("/bodies/2: the key \"mass_kg\" is missing") != std::string::npos);
+    const std::string rod = error_with([](json& d) { d["rods"][0].erase("length_m"); });
+    CHECK(rod.find("/rods/0: the key \"length_m\" is missing") != std::string::npos);
+  }
+  SECTION("a bad rod reference by index and by name") {
+    const std::string index = error_with([](json& d) { d["rods"][0]["body_a"] = 9; });
+    CHECK(index.find("/rods/0/body_a: 9: no body has this index; the file has 4 bodies, indices 0..3") !=
+          std::string::npos);
+    const std::string name = error_with([](json& d) { d["rods"][0]["body_b"] = "crat"; });
+    CHECK(name.find("/rods/0/body_b: \"crat\": no body has this name; did you mean \"crate\"?") !=
+          std::string::npos);
+    const std::string fixed = error_with([](json& d) { d["rods"][0]["body_a"] = "wall"; });
+    CHECK(fixed.find("/rods/0/body_a: \"wall\" is not allowed: body_a must be a movable body") !=
+          std::string::npos);
+    const std::string same = error_with([](json& d) { d["rods"][0]["body_b"] = "bob"; });
+    CHECK(same.find("test.json: /rods/0: ") == 0);
+  }
+  SECTION("a bad colour") {
+    const std::string e = error_with([](json& d) { d["bodies"][1]["color"] = "orange"; });
+    CHECK(e.find("/bodies/1/color: \"orange\" is not allowed: a colour \"#rrggbb\"") != std::string::npos);
+  }
+  SECTION("a quaternion that is not unit, and a zero normal") {
+    const std::string q = error_with([](json& d) { d["bodies"][1]["orientation_wxyz"] = {1, 1, 0, 0}; });
+    CHECK(q.find("/bodies/1/orientation_wxyz: [1,1,0,0] is not allowed: its norm is 1.41421356") !=
+          std::string::npos);
+    const std::string zero = error_with([](json& d) { d["bodies"][1]["orientation_wxyz"] = {0, 0, 0, 0}; });
+    CHECK(zero.find("its norm is 0") != std::string::npos);
+    const std::string n = error_with([](json& d) { d["bodies"][0]["normal"] = {0, 0, 0}; });
+    CHECK(n.find("/bodies/0/normal: [0,0,0] is not allowed: plane normal") != std::string::npos);
+    // A quaternion written with 7 digits is normalised; a non-unit normal too.
+    CHECK(error_with([](json& d) { d["bodies"][1]["orientation_wxyz"] = {0.9238795, 0, 0.3826834, 0}; }) == "");
+    CHECK(error_with([](json& d) { d["bodies"][0]["normal"] = {0, 2, 0}; }) == "");
+  }
+  SECTION("a duplicate body name") {
+    const std::string e = error_with([](json& d) { d["bodies"][3]["name"] = "crate"; });
+    CHECK(e.find("/bodies/3/name: \"crate\" is not allowed: it is already the name of body 1") !=
+          std::string::npos);
+  }
+  SECTION("keys of another shape, a moving static body, a plane with a mass") {
+    CHECK(error_with([](json& d) { d["bodies"][1]["radius_m"] = 1; })
+              .find("/bodies/1/radius_m: a box takes half_extents_m, not radius_m") != std::string::npos);
+    CHECK(error_with([](json& d) { d["bodies"][3]["velocity_mps"] = {1, 0, 0}; })
+              .find("/bodies/3/velocity_mps: [1,0,0] is not allowed: a static body never moves") !=
+          std::string::npos);
+    CHECK(error_with([](json& d) { d["bodies"][0]["mass_kg"] = 1; })
+              .find("/bodies/0/mass_kg: 1 is not allowed: a static body has no mass") != std::string::npos);
+  }
+  SECTION("a value the engine refuses (make_body) names the key") {
+    const std::string e = error_with([](json& d) { d["bodies"][1]["mass_kg"] = 1e-9; });
+    CHECK(e.find("/bodies/1/mass_kg: 1e-09 is not allowed: body mass") != std::string::npos);
+  }
+  SECTION("the camera looks somewhere") {
+    const std::string e = error_with([](json& d) { d["camera"]["target_m"] = d["camera"]["eye_m"]; });
+    CHECK(e.find("/camera/target_m") != std::string::npos);
+  }
+}
+
+TEST_CASE("the schema's world keys are the parameter table's, and its body ranges body.h's",
+          "[scene_file]") {
+  const json schema = json::parse(scene_schema_text());
+  std::vector<std::string> keys;
+  for (const auto& [k, v] : schema["definitions"]["world"]["properties"].items()) keys.push_back(k);
+  std::vector<std::string> table;
+  for (const Parameter& p : world_parameters()) table.emplace_back(p.json_key);
+  std::sort(keys.begin(), keys.end());
+  std::sort(table.begin(), table.end());
+  CHECK(keys == table);
+  const json& body = schema["definitions"]["body"]["properties"];
+  CHECK(body["radius_m"]["minimum"] == kMinSize);
+  CHECK(body["radius_m"]["maximum"] == kMaxSize);
+  CHECK(body["half_extents_m"]["items"]["minimum"] == kMinSize);
+  CHECK(body["mass_kg"]["maximum"] == kMaxMass);
+  CHECK(body["velocity_mps"]["items"]["maximum"] == kMaxSpeed);
+  CHECK(body["angular_velocity_radps"]["items"]["maximum"] == kMaxSpin);
+  CHECK(schema["definitions"]["position"]["items"]["maximum"] == kMaxCoordinate);
+}
+
+TEST_CASE("every example scene file is valid and runs without diverging", "[scene_file]") {
+  REQUIRE(example_scene_names().size() >= 3);
+  for (const std::string_view name : example_scene_names()) {
+    INFO(name);
+    const Scene* s = find_scene(name);
+    REQUIRE(s != nullptr);
+    CHECK(s->camera.has_value());
+    CHECK(!s->summary.empty());
+    Run run = make_run(*s);
+    run.advance_to(s->default_seconds);
+    const json m = run.metrics->report();
+    CHECK(m["nan"] == false);
+    CHECK(m["max_penetration_m"].get<double>() < 0.05);
+    CHECK(m["max_rod_error_m"].get<double>() < 0.05);
+    CHECK(m["energy_drift_J"].get<double>() < 1e-6 * std::max(1.0, std::abs(m["initial_kinetic_energy_J"].get<double>() + m["initial_potential_energy_J"].get<double>())));
+  }
+}
+
+// Writes the scene as a file, reads it back and runs both: the same state at the end.
+static void check_round_trip(const Scene& scene, double seconds) {
+  INFO(scene.name);
+  const Run built = make_run(scene);
+  const std::string text = scene_file_json(scene, built.world).dump(2);
+  const SceneFile parsed = parse_scene_file(text, "round_trip.json");  // outlives the Scene
+  const Scene file = scene_of(parsed, "round_trip.json");
+  Run a = make_run(scene);
+  Run b = make_run(file);
+  CHECK(state_hash(a.world) == state_hash(b.world));
+  a.advance_to(seconds);
+  b.advance_to(seconds);
+  CHECK(format_hash(state_hash(a.world)) == format_hash(state_hash(b.world)));
+}
+
+TEST_CASE("a paper scene written as a scene file runs to the same state_hash", "[scene_file]") {
+  for (const Scene& s : paper_scenes()) check_round_trip(s, 1.0);
+}
+
+TEST_CASE("a stress scene written as a scene file runs to the same state_hash", "[scene_file]") {
+  for (const Scene& s : stress_scenes()) check_round_trip(s, 0.5);
+  check_round_trip(*find_scene("random_7"), 0.5);
+  check_round_trip(*find_scene("pyramid_30"), 0.5);
+}
+
+TEST_CASE("random_SEED is the random scene with that seed", "[scene_file]") {
+  const Scene* one = find_scene("random_1");
+  const Scene* base = find_scene("random");
+  REQUIRE(one != nullptr);
+  CHECK(state_hash(make_run(*one).world) == state_hash(make_run(*base).world));
+  const Scene* seven = find_scene("random_7");
+  REQUIRE(seven != nullptr);
+  CHECK(seven->name == "random_7");
+  CHECK(state_hash(make_run(*seven).world) != state_hash(make_run(*base).world));
+  CHECK(find_scene("random_07") == nullptr);
+  CHECK(find_scene("random_x") == nullptr);
+  CHECK(find_scene("random_18446744073709551616") == nullptr);  // 2^64
+  CHECK(find_scene("random_18446744073709551615") != nullptr);
+}

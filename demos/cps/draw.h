@@ -36,6 +36,11 @@ struct DrawStyle {
   render::Camera camera;
   float plane_opacity = 1.0f;
   Overlays overlays;
+  /// Set for a variant of --overlay: every body in this colour (linear RGB, each in [0, 1]) at
+  /// opacity body_alpha (in (0, 1]), its rods in the colour at half brightness. Unset: each body
+  /// in its palette colour, opaque.
+  std::optional<glm::vec3> body_colour = std::nullopt;
+  float body_alpha = 1.0f;
 };
 
 /// The view a command asks for (`cps render`, `cps figure`, `cps bench`): the camera by name,

@@ -278,8 +278,8 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
   };
   if (o.scene == "paper") {
     if (!o.times.empty() || !o.compare.empty() || o.overlay) {
-      throw UsageError("cps figure paper chooses its own --times, --compare and layout for each "
-                       "figure; drop them, or name a scene (e.g. cps figure "
+      throw UsageError("cps figure paper chooses its own --times, --compare and --overlay for "
+                       "each figure; drop them, or name a scene (e.g. cps figure "
                        "intersecting_stack --times 0,0.5 --compare push)");
     }
     const fs::path folder = o.out.empty() ? fs::path("out/figures") : fs::path(o.out);

@@ -76,7 +76,7 @@ constexpr double kOrangeHue = 28.0;   // overlay_colour(1), #ff7f0e
 
 }  // namespace
 
-TEST_CASE("cps render --compare beta=0.05,0.2,0.5 lays out 3 labelled panels that differ",
+TEST_CASE("cps render --compare with three values of beta lays out 3 labelled panels that differ",
           "[cli][compare]") {
   const fs::path dir = fresh_dir("cps_compare_grid");
   const Result r = run("render intersecting_stack --compare beta=0.05,0.2,0.5 --seconds 1 --fps 1 "

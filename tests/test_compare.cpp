@@ -29,7 +29,7 @@ bool contains(const std::string& text, const std::string& part) {
 
 }  // namespace
 
-TEST_CASE("--compare takes every world parameter with an option, from the table", "[compare]") {
+TEST_CASE("compare takes every world parameter that has an option, from the table", "[compare]") {
   const std::vector<std::string> names = comparable_options();
   const std::set<std::string> set(names.begin(), names.end());
   for (const Parameter& p : world_parameters()) {
@@ -42,7 +42,7 @@ TEST_CASE("--compare takes every world parameter with an option, from the table"
   }
 }
 
-TEST_CASE("--compare beta=... gives one variant per value, in order, labelled with the paper's name",
+TEST_CASE("compare beta=V1,V2,V3 gives one variant per value in order, labelled with the paper's name",
           "[compare]") {
   const std::vector<Variant> v = compare_variants("beta=0.05,0.2,0.5", {});
   REQUIRE(v.size() == 3);
@@ -70,7 +70,7 @@ TEST_CASE("--compare beta=... gives one variant per value, in order, labelled wi
   CHECK(close[0].legend != close[1].legend);
 }
 
-TEST_CASE("--compare push gives every choice; push=... the ones listed, with the paper's names",
+TEST_CASE("compare push gives every choice and push=V1,V2 the ones listed, with the paper's names",
           "[compare]") {
   scenes::Overrides base;
   base.set("beta", 0.3);
@@ -93,7 +93,7 @@ TEST_CASE("--compare push gives every choice; push=... the ones listed, with the
   CHECK(none[0].overrides.values.size() == 1);
 }
 
-TEST_CASE("a bad --compare is a usage error naming the parameter, the value and what is allowed",
+TEST_CASE("a bad compare spec is a usage error naming the parameter, the value and what is allowed",
           "[compare]") {
   scenes::Overrides beta;
   beta.set("beta", 0.3);

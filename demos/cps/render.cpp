@@ -217,7 +217,8 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     std::vector<Panel> panels;
     nlohmann::json world = nlohmann::json::array();
     for (std::size_t v = 0; v < variants.size(); ++v) {
-      std::string label = variants[v].label;
+      // --overlay: the legend names the variants; the label, the scene (with --label).
+      std::string label = o.overlay ? "" : variants[v].label;
       if (o.label) label = std::string(job.scene->name) + (label.empty() ? "" : "\n" + label);
       panels.push_back({&job.runs[v], label});
       world.push_back({{"label", variants[v].label},

@@ -51,6 +51,7 @@ declare -A KIND=(
   ['*:--help']=skip ['top:--version']=skip
   ['*:--json']=flag ['*:--force']=flag ['*:--quick']=flag ['*:--list-runs']=flag
   ['*:--rendering']=flag ['*:--contacts']=flag ['*:--rods']=flag ['*:--label']=flag
+  ['*:--overlay']=flag ['*:--compare']=compare
   ['*:--seconds']=seconds ['*:--fps']=fps ['*:--orbit']=orbit ['*:--speed']=speed
   ['*:--eye']=point ['*:--target']=point ['*:--fov']=fov
   ['*:--dt']=dt ['*:--iterations']=iterations
@@ -118,6 +119,13 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     times)  # comma separated, finite, >= 0, increasing, at most 1e5 s, at most 64 of them
       printf '%s\n' "" , 0, ,0 0,,1 nan inf -inf -1 0,-1 1,0 0,0 0x10 1x 10s 1/2 1e308 1e12 \
         100001 4294967297 0,1e-400x "0;1" "$(seq_csv 65)" ;;
+    compare)  # PARAM=V1,...,Vn (2 to 6 distinct values the table accepts) or a choice alone
+      printf '%s\n' "" nosuch nosuch=1,2 gravity=0,0,-10 collision=true,false PUSH "push " " push" \
+        beta beta= =0.1,0.2 beta=2,3 beta=0.1,2 beta=nan,0.1 beta=0.1,inf beta=0x10,0.1 \
+        beta=0.1 push=split beta=0.1,0.2,0.3,0.4,0.5,0.6,0.7 beta=0.1,0.1 beta=0.5,0.50 \
+        push=split,split push=sideways,split "beta=0.1,,0.2" beta=0.1,0.2, "beta=0.1, 0.2" \
+        beta==0.1,0.2 iterations=1,0 iterations=1,1.5 dt=0,1/60 dt=1/0,1/60 \
+        "beta=0.1;0.2" iterations=1,2,3,4,5,6,7 ;;
     out_folder)  # cannot be a folder: an existing file, a path under a file, a device
       printf '%s\n' "" file file/sub /dev/null ;;
     out_png)  # not a PNG path that can be written
@@ -183,6 +191,11 @@ EXTRA=(
   "--out/dir.png|figure stack --times 0,0.1 --size 16x16 --out dir.png --force"
   "--times/--size/16384|figure stack --times 0,1,2 --size 8192x16 --out out/f.png"
   "--compare|figure stack --compare push --push split --times 0 --size 16x16 --out out/f.png"
+  "--compare/--beta|render stack --compare beta=0.1,0.2 --beta 0.3 --seconds 0.1 --fps 10 --size 64x16 --out out"
+  "--size/--compare|render stack --compare beta=0,0.2,0.4,0.6 --seconds 0.1 --fps 10 --size 16x64 --out out"
+  "--overlay|render stack --overlay --seconds 0.1 --fps 10 --size 16x16 --out out"
+  "--overlay|figure stack --overlay --times 0 --size 16x16 --out out/f.png"
+  "--overlay|figure paper --overlay"
   "steps/--times/--dt|figure stack --times 0,1e5 --dt 1e-6 --size 16x16 --out out/f.png"
   "--trace/adir|simulate stack --seconds 0.1 --trace adir --force"
   "--run/--merge|report --merge $MERGE_SRC --run $RUN_ID --out out"
@@ -200,9 +213,9 @@ CONTROLS=(
   "render stack --seconds 0.1 --fps 10 --size 16x16 --out out"
   "render stack --seconds 0.1 --fps 5e-324 --size 16x16 --out out --orbit -36000"
   "figure stack --times 0,0.1 --size 16x16 --out out/f.png"
-  "render stack --seconds 0.1 --fps 10 --size 16x16 --out out --camera fit --speed 100"
-  "render stack --seconds 0.1 --fps 10 --size 16x16 --out out --eye 1e6,0,-1e6 --target 0,0,0 --fov 169.9 --speed 1e-3"
-  "figure stack --times 0,0.1 --size 16x16 --out out/f.png --camera fit --fov 1.01 --target 0,1,0"
+  "render stack --seconds 0.1 --fps 10 --size 96x32 --compare beta=0,0.5,1 --out out"
+  "render stack --seconds 0.1 --fps 10 --size 16x16 --compare dt=1/60,1/120 --overlay --out out"
+  "figure stack --times 0 --size 16x16 --compare push --overlay --out out/f.png"
 )
 
 # ---------------------------------------------------------------------------------------------

@@ -7,6 +7,7 @@ in vec3 v_normal;
 in vec3 v_local;
 flat in vec3 v_half_extents;
 flat in vec3 v_color;
+flat in float v_alpha;
 
 uniform int u_kind;
 
@@ -29,5 +30,5 @@ void main() {
     vec3 s = clamp(u / max(fwidth(u), vec3(1e-5)), -1.0, 1.0);  // antialiased sign
     albedo *= mix(0.68, 1.0, 0.5 + 0.5 * s.x * s.y * s.z);
   }
-  o_color = finish(shade(albedo, n, v_world, 48.0, 0.12), v_world, 1.0);
+  o_color = finish(shade(albedo, n, v_world, 48.0, 0.12), v_world, v_alpha);
 }

@@ -96,11 +96,13 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
   const auto& bodies = world.bodies();
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
+    const glm::vec3 colour = style.body_colour.value_or(colour_of(i, style));
     if (b.shape.kind == ShapeKind::box) {
-      list.boxes.push_back({to_glm(b.x), to_glm(b.o), to_glm(b.shape.half_extents), colour_of(i, style)});
+      list.boxes.push_back({to_glm(b.x), to_glm(b.o), to_glm(b.shape.half_extents), colour,
+                            style.body_alpha});
     } else if (b.shape.kind == ShapeKind::sphere) {
       list.spheres.push_back({to_glm(b.x), to_glm(b.o), static_cast<float>(b.shape.radius),
-                              colour_of(i, style)});
+                              colour, style.body_alpha});
     }
   }
   for (const DistanceConstraint& d : world.distances()) {
@@ -108,7 +110,8 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
     Vec3 p_a;
     Vec3 p_b;
     distance_endpoints(d, bodies, p_a, p_b);
-    list.lines.push_back({to_glm(p_a), to_glm(p_b), glm::vec3(0.15f), 2.0f});
+    list.lines.push_back(
+        {to_glm(p_a), to_glm(p_b), style.body_colour ? 0.5f * *style.body_colour : glm::vec3(0.15f), 2.0f});
   }
   if (style.overlays.contacts) add_contacts(world, list);
   for (const Body& b : bodies) {

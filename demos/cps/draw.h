@@ -41,6 +41,11 @@ struct DrawStyle {
   /// The scene's colours by body index (scenes::body_colours, linear RGB); a body beyond the end
   /// or without one takes the palette.
   std::span<const std::optional<Vec3>> body_colours;
+  /// Set for a variant of --overlay: every body in this colour (linear RGB, each in [0, 1]) at
+  /// opacity body_alpha (in (0, 1]), its rods in the colour at half brightness. Unset: each body
+  /// in its palette colour, opaque.
+  std::optional<glm::vec3> body_colour = std::nullopt;
+  float body_alpha = 1.0f;
   /// Every plane is drawn as a square of half side plane_half_size_m (m, > 0) centred on its
   /// point nearest to plane_centre (m). Fixed for the whole run, so a plane's edge never moves
   /// from frame to frame (resolve_style: around the bodies' bounds, see plane_extent).

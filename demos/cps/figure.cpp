@@ -2,6 +2,7 @@
 
 #include "command.h"
 #include "output.h"
+#include "overlay.h"
 #include "view_options.h"
 
 #include "cps/render/image_ops.h"
@@ -118,6 +119,26 @@ render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer) 
   const int label_scale = std::max(1, renderer.height() / 360);
 
   std::vector<render::Image> rows;
+  if (spec.overlay) {
+    std::vector<render::Image> row;
+    for (std::size_t c = 0; c < spec.times.size(); ++c) {
+      for (scenes::Run& run : runs) run.advance_to(spec.times[c]);
+      render::Image panel = renderer.draw(overlay_draw_list(worlds, style));
+      draw_border(panel);
+      if (spec.label) {
+        std::string text;
+        if (!spec.caption.empty()) text += spec.caption + "\n";
+        const std::string tag = !spec.tags.empty() && c < spec.tags[0].size() ? spec.tags[0][c] : "";
+        text += (tag.empty() ? "" : tag + " ") + std::string(scene.name) + "\n";
+        text += format_time(runs.front().world.time());
+        render::draw_label(panel, 4 * label_scale, 4 * label_scale, text, label_scale);
+      }
+      // The legend even without labels: without it the colours mean nothing.
+      draw_overlay_legend(panel, spec.comparison, spec.variants, label_scale);
+      row.push_back(std::move(panel));
+    }
+    return row.size() == 1 ? std::move(row.front()) : render::side_by_side(row);
+  }
   for (std::size_t r = 0; r < runs.size(); ++r) {
     std::vector<render::Image> row;
     for (std::size_t c = 0; c < spec.times.size(); ++c) {
@@ -132,7 +153,9 @@ render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer) 
         text += (tag.empty() ? "" : tag + " ") + std::string(scene.name) + "\n";
         if (!spec.variants[r].label.empty()) text += spec.variants[r].label + "\n";
         text += format_time(runs[r].world.time());
-        render::draw_label(panel, 4 * label_scale, 4 * label_scale, text, label_scale);
+        render::draw_label(panel, 4 * label_scale, 4 * label_scale,
+                           render::wrap_text(text, panel.width - 8 * label_scale, label_scale),
+                           label_scale);
       }
       row.push_back(std::move(panel));
     }
@@ -149,20 +172,25 @@ fs::path sidecar_path(const fs::path& png) {
 
 nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
   nlohmann::json variants = nlohmann::json::array();
-  for (const Variant& v : spec.variants) {
+  for (std::size_t k = 0; k < spec.variants.size(); ++k) {
+    const Variant& v = spec.variants[k];
     variants.push_back({{"label", v.label},
+                        {"overlay_colour_srgb", spec.overlay ? nlohmann::json(overlay_colour(k))
+                                                             : nlohmann::json(nullptr)},
                         {"parameters", parameters_json(scenes::world_def_with(*spec.scene, v.overrides))}});
   }
   const int columns = static_cast<int>(spec.times.size());
-  const int rows = static_cast<int>(spec.variants.size());
+  const int rows = spec.overlay ? 1 : static_cast<int>(spec.variants.size());
   const std::optional<scenes::CameraPreset>& preset = spec.view.preset;
   const nlohmann::json parameters = {
           {"scene", spec.scene->name},
           {"compare", spec.compare},
+          {"comparison", comparison_json(spec.comparison, spec.overlay)},
           {"caption", spec.caption},
           {"shows", spec.what},
           {"times_s", spec.times},
-          {"layout", "rows = variants, columns = times"},
+          {"layout", spec.overlay ? "one row, every variant as a ghost in each panel, columns = times"
+                                  : "rows = variants, columns = times"},
           {"panel_size_px", {spec.panel_width, spec.panel_height}},
           {"image_size_px", {columns * spec.panel_width, rows * spec.panel_height}},
           {"camera", spec.view.camera},
@@ -229,6 +257,7 @@ struct FigureOptions {
   std::string scene;
   std::string times;  // "t1,t2,..." (s)
   std::string compare;
+  bool overlay = false;
   std::string size = "640x360";
   std::string out;
   bool force = false;
@@ -257,9 +286,9 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
     return spec;
   };
   if (o.scene == "paper") {
-    if (!o.times.empty() || !o.compare.empty()) {
-      throw UsageError("cps figure paper chooses its own --times and --compare for each "
-                       "figure; drop them, or name a scene (e.g. cps figure "
+    if (!o.times.empty() || !o.compare.empty() || o.overlay) {
+      throw UsageError("cps figure paper chooses its own --times, --compare and --overlay for "
+                       "each figure; drop them, or name a scene (e.g. cps figure "
                        "intersecting_stack --times 0,0.5 --compare push)");
     }
     const fs::path folder = o.out.empty() ? fs::path("out/figures") : fs::path(o.out);
@@ -267,7 +296,8 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
       FigureSpec spec = base_spec(select_scenes(f.scene).front());
       spec.times = f.times;
       spec.compare = f.compare;
-      spec.variants = compare_variants(f.compare, o.overrides);
+      spec.comparison = parse_comparison(f.compare, o.overrides);
+      spec.variants = comparison_variants(spec.comparison, o.overrides);
       spec.caption = f.caption + " counterpart";
       spec.tags = f.tags;
       spec.view.preset = f.preset;
@@ -283,14 +313,19 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
       throw UsageError("--times is required: the simulated times (s) of the columns, e.g. "
                        "--times 0,0.5,2");
     }
+    if (o.overlay && o.compare.empty()) {
+      throw UsageError("--overlay draws the variants of --compare in one view; give --compare "
+                       "too (e.g. --compare push --overlay)");
+    }
     FigureSpec spec = base_spec(chosen.front());
     spec.times = parse_times(o.times);
     spec.compare = o.compare;
-    spec.variants = compare_variants(o.compare, o.overrides);
+    spec.comparison = parse_comparison(o.compare, o.overrides);
+    spec.variants = comparison_variants(spec.comparison, o.overrides);
+    spec.overlay = o.overlay;
     const fs::path png =
         o.out.empty()
-            ? fs::path("out/figures") /
-                  (o.scene + (o.compare.empty() ? "" : "-compare-" + o.compare) + ".png")
+            ? fs::path("out/figures") / (o.scene + comparison_suffix(spec.comparison, o.overlay) + ".png")
             : fs::path(o.out);
     if (png.extension() != ".png") {
       throw UsageError("--out " + png.string() + ": the figure is a PNG; give a name ending in .png");
@@ -307,7 +342,8 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
                     static_cast<float>(size.width) / static_cast<float>(size.height));
     }
     const long long w = static_cast<long long>(p.spec.times.size()) * size.width;
-    const long long h = static_cast<long long>(p.spec.variants.size()) * size.height;
+    const long long h =
+        static_cast<long long>(p.spec.overlay ? 1 : p.spec.variants.size()) * size.height;
     if (w > 16384 || h > 16384) {
       throw UsageError("the figure would be " + std::to_string(w) + "x" + std::to_string(h) +
                        " pixels (more than 16384 on a side); give fewer --times or a "
@@ -354,12 +390,19 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
                   "simulated times of the columns (s), comma separated, finite, >= 0, "
                   "increasing, e.g. 0,0.5,2; required except for 'paper'");
   sub->add_option("--compare", o->compare,
-                  "one row per value of this option (default: one row, the scene's settings)")
-      ->check(CLI::IsMember(comparable_options()));
+                  "PARAM=V1,V2,...: one row per value, 2 to 6 values of a world parameter (" +
+                      comparable_list() + "), each checked as its own option is; a choice alone "
+                      "(e.g. push) compares all its values (default: one row, the scene's "
+                      "settings)")
+      ->check(kNotEmpty);
+  sub->add_flag("--overlay", o->overlay,
+                "with --compare: one row, every variant drawn in each panel as a translucent "
+                "ghost in its own colour, with a legend");
   sub->add_option("--size", o->size, "size of ONE panel, WxH in pixels, each in [16, 8192]")
       ->capture_default_str();
   sub->add_option("--out", o->out,
-                  "output PNG (default out/figures/SCENE[-compare-OPTION].png); for 'paper', "
+                  "output PNG (default out/figures/SCENE[-compare-PARAM[-VALUES]][-overlay].png); for "
+                  "'paper', "
                   "the folder (default out/figures); a FILE.json sidecar records the run, and the "
                   "folder's run.json lists the files cps wrote there")
       ->check(kNotEmpty);

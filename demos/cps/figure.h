@@ -25,6 +25,12 @@ struct FigureSpec {
   std::vector<double> times;
   /// The rows: one run of the scene per variant (compare_variants gives them).
   std::vector<Variant> variants;
+  /// The parsed --compare the variants come from (its legend heading, and the sidecar's
+  /// "comparison"); no parameter for one row.
+  Comparison comparison;
+  /// --overlay: one row, every variant drawn in each panel as a ghost (overlay_draw_list) with
+  /// a legend in the bottom-left corner, instead of a row per variant.
+  bool overlay = false;
   /// Size of one panel in pixels (each in [16, 8192]); the figure is
   /// (times.size() * panel_width) x (variants.size() * panel_height).
   int panel_width = 640;
@@ -50,7 +56,8 @@ struct FigureSpec {
 std::vector<double> parse_times(const std::string& text);
 
 /// Steps one run per variant through the times and draws every panel. Returns the composed
-/// figure: row r, column c is the variant r at times[c]; labelled if spec.label. The panels
+/// figure: row r, column c is the variant r at times[c] (with spec.overlay, one row whose panel c
+/// holds every variant at times[c], with the legend); labelled if spec.label. The panels
 /// have a 1-pixel dark border (inside the panel, so the size is exact). Throws UsageError for
 /// a bad parameter or camera name, std::runtime_error from the renderer.
 /// `renderer` must be spec.panel_width x spec.panel_height.
@@ -65,8 +72,9 @@ std::filesystem::path sidecar_path(const std::filesystem::path& png);
 
 /// The sidecar's content: run_info("figure", argc, argv, parameters) (command line, engine
 /// version, UTC date; see output.h) with "written_by": "cps figure", where the parameters are
-/// scene, compare, caption, times_s, panel_size_px, image_size_px, camera, overlays and the
-/// variants (label and world parameters with units).
+/// scene, compare, comparison (comparison_json), caption, times_s, layout, panel_size_px,
+/// image_size_px, camera, overlays and the variants (label, overlay colour and world parameters
+/// with units).
 nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv);
 
 /// Writes the sidecar and then the PNG (render::encode_png), each atomically (write_json_atomic,

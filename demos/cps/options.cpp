@@ -197,39 +197,6 @@ void add_seed_option(CLI::App& cmd, std::vector<std::string>& scenes) {
   });
 }
 
-std::vector<std::string> comparable_options() {
-  std::vector<std::string> names;
-  for (const Parameter& p : world_parameters()) {
-    if (p.type == ParameterType::choice && !p.flag.empty()) names.emplace_back(p.flag);
-  }
-  return names;
-}
-
-std::vector<Variant> compare_variants(const std::string& option, const scenes::Overrides& base) {
-  if (option.empty()) return {{base, ""}};
-  const Parameter* p = find_parameter(option);
-  if (p == nullptr || p->type != ParameterType::choice || p->flag != option) {
-    std::string allowed;
-    for (const std::string& n : comparable_options()) allowed += (allowed.empty() ? "" : ", ") + n;
-    throw UsageError("--compare " + option + ": allowed are " + allowed);
-  }
-  if (base.find(p->name) != nullptr) {
-    throw UsageError("--compare " + option + " renders every value of --" + option +
-                     "; do not set --" + option + " as well");
-  }
-  std::vector<Variant> v;
-  for (const Choice& c : p->choices) {
-    Variant variant{base, std::string(p->name) + " = " + std::string(c.name)};
-    for (char& ch : variant.label) {
-      if (ch == '_') ch = ' ';
-    }
-    if (!c.source.empty()) variant.label += " (" + std::string(c.source) + ")";
-    variant.overrides.set(*p, c.value);
-    v.push_back(std::move(variant));
-  }
-  return v;
-}
-
 scenes::Run make_run_or_usage_error(const scenes::Scene& scene, const scenes::Overrides& o) {
   try {
     return scenes::make_run(scene, o);

@@ -1,6 +1,7 @@
 #pragma once
 // Command-line options shared by the cps subcommands, and their validation.
 
+#include "compare.h"
 #include "scene.h"
 
 #include <CLI/CLI.hpp>
@@ -68,20 +69,7 @@ void add_seed_option(CLI::App& cmd, std::vector<std::string>& scenes);
 /// scene that is not random, or random_M with M != seed.
 std::string with_seed(const std::string& scene, std::uint64_t seed);
 
-/// One variant of a comparison: the overrides it runs with and its label ("push = split").
-struct Variant {
-  scenes::Overrides overrides;
-  std::string label;
-};
-
-/// The flags of the parameters --compare takes: every choice parameter of the table.
-std::vector<std::string> comparable_options();
-
-/// The variants of `option` (a flag of comparable_options()), one per value in the table's
-/// order, each on top of `base` and labelled "push = split (Sec. 8.1)"; with an empty option,
-/// the single variant `base` with no label. Throws UsageError for another option, or if base
-/// already sets the compared option.
-std::vector<Variant> compare_variants(const std::string& option, const scenes::Overrides& base);
+// Variant, comparable_options and compare_variants (--compare): compare.h.
 
 /// Builds a run and turns a bad parameter (std::invalid_argument) into a UsageError.
 scenes::Run make_run_or_usage_error(const scenes::Scene& scene, const scenes::Overrides& o);

@@ -4,6 +4,7 @@
 #include "draw.h"
 #include "options.h"
 #include "output.h"
+#include "overlay.h"
 #include "video.h"
 #include "view_options.h"
 
@@ -55,22 +56,41 @@ long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, cons
   const int label_scale = std::max(1, renderer.height() / 360);
 
   const long long frames = frame_count(job);
-  std::vector<render::Image> pictures(panels.size());
+  std::vector<render::Image> pictures(job.overlay ? 1 : panels.size());
+  std::vector<const World*> worlds;
+  for (const Panel& panel : panels) worlds.push_back(&panel.run->world);
+  const auto time_text = [](double t) {
+    char time[32];
+    std::snprintf(time, sizeof time, "t = %.2f s", t);
+    return std::string(time);
+  };
   for (long long k = 0; k < frames; ++k) {
     const double t = frame_time(job, k);
-    for (std::size_t p = 0; p < panels.size(); ++p) {
-      panels[p].run->advance_to(t);
+    for (Panel& panel : panels) panel.run->advance_to(t);
+    if (job.overlay) {
+      pictures[0] = renderer.draw(overlay_draw_list(worlds, style));
+      const std::string& label = panels.front().label;
+      render::draw_label(pictures[0], 4 * label_scale, 4 * label_scale,
+                         (label.empty() ? "" : label + "\n") + time_text(worlds.front()->time()),
+                         label_scale);
+      const int legend_height = render::legend_size(job.legend_heading, job.legend, label_scale).second;
+      render::draw_legend(pictures[0], 4 * label_scale, pictures[0].height - legend_height - 4 * label_scale,
+                          job.legend_heading, job.legend, label_scale);
+    }
+    for (std::size_t p = 0; p < panels.size() && !job.overlay; ++p) {
       pictures[p] = renderer.draw(draw_list(panels[p].run->world, style));
       if (!panels[p].label.empty()) {
-        char time[32];
-        std::snprintf(time, sizeof time, "\nt = %.2f s", panels[p].run->world.time());
-        render::draw_label(pictures[p], 4 * label_scale, 4 * label_scale, panels[p].label + time,
+        const std::string text = panels[p].label + "\n" + time_text(panels[p].run->world.time());
+        render::draw_label(pictures[p], 4 * label_scale, 4 * label_scale,
+                           render::wrap_text(text, pictures[p].width - 8 * label_scale, label_scale),
                            label_scale);
       }
     }
-    writer.write(job.folder / frame_name(k), pictures.size() == 1
-                                                 ? std::move(pictures.front())
-                                                 : render::side_by_side(pictures));
+    writer.write(job.folder / frame_name(k),
+                 pictures.size() == 1 ? std::move(pictures.front())
+                                      : render::grid(pictures, job.columns > 0
+                                                                   ? job.columns
+                                                                   : static_cast<int>(pictures.size())));
     if (progress != nullptr) progress->update(k + 1);
   }
   writer.finish();
@@ -89,6 +109,7 @@ struct RenderOptions {
   double speed = 1.0;  // simulated seconds per second of video
   std::string out = "out";
   std::string compare;
+  bool overlay = false;
   bool force = false;
   scenes::Overrides overrides;
   std::string backend = "osmesa";
@@ -103,9 +124,24 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
   namespace fs = std::filesystem;
   const PixelSize size = parse_size(o.size);
   const std::vector<const scenes::Scene*> selected = select_scenes(o.scene);
-  const std::vector<Variant> variants = compare_variants(o.compare, o.overrides);
-  if (!o.compare.empty() && size.width < 32) {
-    throw UsageError("--size " + o.size + ": --compare needs a width of at least 32");
+  const Comparison comparison = parse_comparison(o.compare, o.overrides);
+  const std::vector<Variant> variants = comparison_variants(comparison, o.overrides);
+  if (o.overlay && o.compare.empty()) {
+    throw UsageError("--overlay draws the variants of --compare in one view; give --compare too "
+                     "(e.g. --compare push --overlay)");
+  }
+  // The variants' panels in a grid of rows x columns that fills --size (one panel for
+  // --overlay); each panel at least 16x16 pixels.
+  const Grid grid = o.overlay ? Grid{1, 1}
+                              : grid_layout(variants.size(), static_cast<double>(size.width) / size.height);
+  const int panel_width = size.width / grid.columns;
+  const int panel_height = size.height / grid.rows;
+  if (panel_width < 16 || panel_height < 16) {
+    throw UsageError("--size " + o.size + ": --compare " + o.compare + " lays " +
+                     std::to_string(variants.size()) + " panels out as " +
+                     std::to_string(grid.rows) + " x " + std::to_string(grid.columns) + ", each " +
+                     std::to_string(panel_width) + "x" + std::to_string(panel_height) +
+                     " pixels; a panel needs at least 16x16: give a larger --size");
   }
   struct Job {
     const scenes::Scene* scene;
@@ -131,8 +167,7 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
                    o.video.c_str());
     }
   }
-  const int panel_width = size.width / static_cast<int>(variants.size());
-  const float aspect = static_cast<float>(panel_width) / static_cast<float>(size.height);
+  const float aspect = static_cast<float>(panel_width) / static_cast<float>(panel_height);
   for (Job& job : jobs) {
     std::vector<const World*> worlds;
     for (const scenes::Run& run : job.runs) worlds.push_back(&run.world);
@@ -148,7 +183,13 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     spec.fps = o.fps;
     spec.speed = o.speed;
     spec.folder = fs::path(o.out) /
-                  (std::string(job.scene->name) + (o.compare.empty() ? "" : "-compare-" + o.compare));
+                  (std::string(job.scene->name) + comparison_suffix(comparison, o.overlay));
+    spec.columns = grid.columns;
+    spec.overlay = o.overlay;
+    if (o.overlay) {
+      spec.legend_heading = legend_heading(comparison);
+      spec.legend = overlay_legend(variants);
+    }
     // The work is bounded before anything is drawn or written: steps, frames and pixels.
     for (const scenes::Run& run : job.runs) {
       check_steps(std::string(job.scene->name), spec.seconds, run.world.def().dt);
@@ -188,7 +229,7 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     video_info = run_info("render", argc, argv,
                           {{"video", o.video}, {"fps", o.fps}, {"frames_folders", folders}});
   }
-  render::Renderer renderer(panel_width, size.height, *render::parse_backend(o.backend));
+  render::Renderer renderer(panel_width, panel_height, *render::parse_backend(o.backend));
   std::fprintf(stderr, "render: %s\n", renderer.context_description().c_str());
   // Encoding overlaps drawing: one encoder thread keeps up with llvmpipe (see cps bench). Each
   // frame is written atomically under the output rule (output.h).
@@ -202,10 +243,13 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     std::vector<Panel> panels;
     nlohmann::json world = nlohmann::json::array();
     for (std::size_t v = 0; v < variants.size(); ++v) {
-      std::string label = variants[v].label;
+      // --overlay: the legend names the variants; the label, the scene (with --label).
+      std::string label = o.overlay ? "" : variants[v].label;
       if (o.label) label = std::string(job.scene->name) + (label.empty() ? "" : "\n" + label);
       panels.push_back({&job.runs[v], label});
       world.push_back({{"label", variants[v].label},
+                       {"overlay_colour_srgb", o.overlay ? nlohmann::json(overlay_colour(v))
+                                                         : nlohmann::json(nullptr)},
                        {"overrides", overrides_json(variants[v].overrides)},
                        {"parameters", parameters_json(job.runs[v].world.def())}});
     }
@@ -228,7 +272,11 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
                                                : nlohmann::json(spacing_notes)},
          {"frames", frame_count(spec)},
          {"size", {{"width", size.width}, {"height", size.height}}},
-         {"compare", o.compare.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.compare)},
+         {"compare", comparison_json(comparison, o.overlay)},
+         {"layout", o.overlay ? nlohmann::json{{"overlay", true}, {"panel_px", {panel_width, panel_height}}}
+                              : nlohmann::json{{"rows", grid.rows},
+                                               {"columns", grid.columns},
+                                               {"panel_px", {panel_width, panel_height}}}},
          {"backend", o.backend},
          {"camera", o.view.camera},
          {"camera_resolved", camera_json(job.style.camera)},
@@ -255,8 +303,8 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
       video.frames_folder = spec.folder;
       video.frames = static_cast<int>(frames);  // at most kMaxFrames
       video.fps = o.fps;
-      video.width = panel_width * static_cast<int>(variants.size());
-      video.height = size.height;
+      video.width = o.overlay ? panel_width : panel_width * grid.columns;
+      video.height = o.overlay ? panel_height : panel_height * grid.rows;
       video.output = fs::path(o.out) / (folder + "." + o.video);
       if (!ffmpeg) {
         videos_left.push_back(video);
@@ -306,9 +354,15 @@ Command add_render(CLI::App& app, int argc, char** argv) {
       ->capture_default_str()
       ->check(kNotEmpty);
   sub->add_option("--compare", o->compare,
-                  "render the two variants of this option side by side, labelled, into "
-                  "OUT/SCENE-compare-OPTION/")
-      ->check(CLI::IsMember(comparable_options()));
+                  "PARAM=V1,V2,...: render 2 to 6 values of a world parameter (" + comparable_list() +
+                      "), each checked as its own option is, in a grid of labelled panels that "
+                      "fills --size (2: 1x2 or 2x1 by aspect, 3: 1x3, 4: 2x2, 5-6: 2x3), into "
+                      "OUT/SCENE-compare-PARAM-V1_V2_.../; a choice alone (e.g. push) compares "
+                      "all its values, into OUT/SCENE-compare-PARAM/")
+      ->check(kNotEmpty);
+  sub->add_flag("--overlay", o->overlay,
+                "with --compare: draw every variant in ONE view of --size as a translucent ghost "
+                "in its own colour, with a legend, into OUT/SCENE-compare-...-overlay/");
   sub->add_flag("--force", o->force,
                 "write into an output folder that holds files no earlier cps run wrote there: "
                 "those files are kept, never removed or changed, except that a file with exactly "

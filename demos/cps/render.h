@@ -6,6 +6,7 @@
 #include "progress.h"
 #include "scene.h"
 
+#include "cps/render/image_ops.h"
 #include "cps/render/renderer.h"
 
 #include <filesystem>
@@ -23,6 +24,14 @@ struct RenderJob {
   double fps = 30.0;
   double speed = 1.0;
   std::filesystem::path folder;
+  /// Panels per row of a frame's grid (grid_layout); 0: all panels in one row.
+  int columns = 0;
+  /// --overlay: every panel's run drawn in one picture as ghosts (overlay_draw_list), with the
+  /// first panel's label (if any) and the time at the top left and this legend (heading and
+  /// one entry per panel) at the bottom left.
+  bool overlay = false;
+  std::string legend_heading;
+  std::vector<render::LegendEntry> legend;
 };
 
 /// Number of frames of a job: floor(seconds * fps / speed) + 1 (frame 0 at t = 0), in 64-bit
@@ -49,9 +58,10 @@ struct Panel {
 
 /// Renders frame k at simulated time frame_time(job, k) for k = 0 .. frame_count(job) - 1 into job.folder
 /// (which must exist); every panel's physics steps at its world's own dt in between. The panels
-/// are drawn side by side, each at the renderer's size, so a frame is (panels x renderer width)
-/// by renderer height pixels, all drawn with `style` (resolve_style: camera, plane opacity,
-/// overlays). Drawing stays on the calling thread (it owns the GL context); each finished frame
+/// are drawn in a grid of job.columns per row (render::grid; 0: one row), each at the renderer's
+/// size, so a frame is (columns x renderer width) by (rows x renderer height) pixels, all drawn
+/// with `style` (resolve_style: camera, plane opacity, overlays); with job.overlay, one picture
+/// of the renderer's size holds every panel's run as a ghost. Drawing stays on the calling thread (it owns the GL context); each finished frame
 /// goes to `writer`, which encodes it on its threads while the next frame is drawn; this returns
 /// after every frame is written. `progress` (may be null) is updated once per frame. Returns the
 /// number of frames (at most kMaxFrames: the caller checks frame_count first). Throws std::runtime_error if a frame cannot be drawn or written (frames

@@ -38,24 +38,24 @@ void set_member(WorldDef& d, const ParameterValue& v) {
 }
 
 constexpr std::array kPushChoices = {
-    Choice{"baumgarte", static_cast<int>(PushMode::baumgarte), "Sec. 5.3"},
-    Choice{"split", static_cast<int>(PushMode::split), "Sec. 8.1"},
+    Choice{"baumgarte", static_cast<int>(PushMode::baumgarte), "Sec. 5.3", "push factor"},
+    Choice{"split", static_cast<int>(PushMode::split), "Sec. 8.1", "single frame push factor"},
 };
 constexpr std::array kSolverChoices = {
-    Choice{"pgs", static_cast<int>(SolverKind::pgs), "Sec. 7.2"},
-    Choice{"jacobi", static_cast<int>(SolverKind::jacobi), "Sec. 7.1"},
+    Choice{"pgs", static_cast<int>(SolverKind::pgs), "Sec. 7.2", "projected Gauss-Seidel"},
+    Choice{"jacobi", static_cast<int>(SolverKind::jacobi), "Sec. 7.1", "projected Jacobi"},
 };
 constexpr std::array kFrictionModelChoices = {
-    Choice{"fixed", static_cast<int>(FrictionModel::fixed), "Sec. 5.4"},
-    Choice{"coupled", static_cast<int>(FrictionModel::coupled), ""},
+    Choice{"fixed", static_cast<int>(FrictionModel::fixed), "Sec. 5.4", "friction limit mu m |g.n|"},
+    Choice{"coupled", static_cast<int>(FrictionModel::coupled), "", "friction limit mu lambda_n"},
 };
 constexpr std::array kRotationChoices = {
-    Choice{"linear", static_cast<int>(RotationUpdate::linear), "Eq. 3.2.4"},
-    Choice{"exact", static_cast<int>(RotationUpdate::exact), "Eq. 12.4.1"},
+    Choice{"linear", static_cast<int>(RotationUpdate::linear), "Eq. 3.2.4", "linear orientation update"},
+    Choice{"exact", static_cast<int>(RotationUpdate::exact), "Eq. 12.4.1", "axis-angle orientation update"},
 };
 constexpr std::array kAssemblyChoices = {
-    Choice{"matrix-free", static_cast<int>(Assembly::matrix_free), ""},
-    Choice{"explicit", static_cast<int>(Assembly::explicit_matrices), "Sec. 6"},
+    Choice{"matrix-free", static_cast<int>(Assembly::matrix_free), "", "matrix-free"},
+    Choice{"explicit", static_cast<int>(Assembly::explicit_matrices), "Sec. 6", "explicit J, M^-1 and A"},
 };
 
 // Every WorldDef member, in its order. Reals and integers are finite and in [min, max].
@@ -78,6 +78,7 @@ const std::array kParameters = {
               .min = 1.0e-6,
               .max = 1.0,
               .help = "time step; the paper uses 1/60",
+              .title = "time step dt",
               .get = &get_member<&WorldDef::dt>,
               .set = &set_member<&WorldDef::dt>},
     Parameter{.name = "iterations",
@@ -88,6 +89,7 @@ const std::array kParameters = {
               .min = 1.0,
               .max = 10000.0,
               .help = "solver sweeps per solve of A lambda = b; the paper uses 25",
+              .title = "solver iterations (Sec. 7)",
               .get = &get_member<&WorldDef::iterations>,
               .set = &set_member<&WorldDef::iterations>},
     Parameter{.name = "beta",
@@ -98,6 +100,7 @@ const std::array kParameters = {
               .min = 0.0,
               .max = 1.0,
               .help = "push factor constant beta (Eq. 5.2.3); the paper uses 0.2",
+              .title = "push factor constant beta (Eq. 5.2.3)",
               .get = &get_member<&WorldDef::beta>,
               .set = &set_member<&WorldDef::beta>},
     Parameter{.name = "friction",
@@ -108,6 +111,7 @@ const std::array kParameters = {
               .min = 0.0,
               .max = 1.0e6,
               .help = "friction coefficient mu (Sec. 5.4); 0 builds no friction rows; scenes use 0.5",
+              .title = "friction coefficient mu (Sec. 5.4)",
               .get = &get_member<&WorldDef::friction>,
               .set = &set_member<&WorldDef::friction>},
     Parameter{.name = "restitution",
@@ -118,6 +122,7 @@ const std::array kParameters = {
               .min = 0.0,
               .max = 1.0,
               .help = "coefficient of restitution eps (Eq. 8.2.1); scenes use 0",
+              .title = "coefficient of restitution eps (Eq. 8.2.1)",
               .get = &get_member<&WorldDef::restitution>,
               .set = &set_member<&WorldDef::restitution>},
     Parameter{.name = "restitution_threshold",
@@ -138,6 +143,7 @@ const std::array kParameters = {
               .choices = kPushChoices,
               .help = "baumgarte: the push factor kept in the velocity (Sec. 5); split: the single "
                       "frame push factor, two solves (Sec. 8.1)",
+              .title = "constraint correction (Sec. 5, Sec. 8.1)",
               .get = &get_member<&WorldDef::push>,
               .set = &set_member<&WorldDef::push>},
     Parameter{.name = "solver",
@@ -146,6 +152,7 @@ const std::array kParameters = {
               .type = ParameterType::choice,
               .choices = kSolverChoices,
               .help = "pgs: projected Gauss-Seidel (Sec. 7.2); jacobi: projected Jacobi (Sec. 7.1)",
+              .title = "solver",
               .get = &get_member<&WorldDef::solver>,
               .set = &set_member<&WorldDef::solver>},
     Parameter{.name = "friction_model",
@@ -155,6 +162,7 @@ const std::array kParameters = {
               .choices = kFrictionModelChoices,
               .help = "fixed: the paper's limit mu m |g.n| (Sec. 5.4); coupled: mu times the "
                       "contact row's lambda",
+              .title = "friction model",
               .get = &get_member<&WorldDef::friction_model>,
               .set = &set_member<&WorldDef::friction_model>},
     Parameter{.name = "rotation",
@@ -163,6 +171,7 @@ const std::array kParameters = {
               .type = ParameterType::choice,
               .choices = kRotationChoices,
               .help = "linear: Eq. 3.2.4 then normalise; exact: the axis-angle step of Eq. 12.4.1",
+              .title = "orientation update",
               .get = &get_member<&WorldDef::rotation>,
               .set = &set_member<&WorldDef::rotation>},
     Parameter{.name = "assembly",
@@ -208,6 +217,7 @@ const std::array kParameters = {
                       "its lambda of the previous steps when its contact or rod persists; 0 = the "
                       "paper's initial guess 0; typical 0.8 (1 can feed energy into stiff piles "
                       "and chains)",
+              .title = "warm start factor (Sec. 6.2.3)",
               .get = &get_member<&WorldDef::warm_start>,
               .set = &set_member<&WorldDef::warm_start>},
     Parameter{.name = "collision",
@@ -413,6 +423,13 @@ const Choice* Parameter::find_choice(std::string_view choice) const {
     if (c.name == choice) return &c;
   }
   return nullptr;
+}
+
+std::string Parameter::label() const {
+  if (!title.empty()) return std::string(title);
+  std::string s(name);
+  std::replace(s.begin(), s.end(), '_', ' ');
+  return s;
 }
 
 std::span<const Parameter> world_parameters() { return kParameters; }

@@ -5,7 +5,8 @@
 //   1. shadow pass: boxes and spheres into a 2048^2 depth texture from the sun, orthographic
 //      projection fitted to the bodies and to the part of each plane their shadows can reach;
 //   2. main pass into a 4x multisampled framebuffer: bodies, opaque planes, lines, then planes
-//      with alpha < 1 back to front, blended, without depth writes;
+//      with alpha < 1 back to front, blended, without depth writes, then the ghosts (bodies with
+//      alpha < 1) back to front, blended, depth tested but without depth writes;
 //   3. resolve (blit) into the context's framebuffer, glFinish, read back top row first.
 
 #include "cps/render/renderer.h"
@@ -52,9 +53,9 @@ struct BodyInstance {
   float center[3];
   float orientation[4];  // x, y, z, w
   float half_extents[3];
-  float color[3];
+  float color[4];  // linear RGB, alpha
 };
-static_assert(sizeof(BodyInstance) == 13 * sizeof(float));
+static_assert(sizeof(BodyInstance) == 14 * sizeof(float));
 
 struct LineInstance {
   float a[3];
@@ -167,7 +168,7 @@ struct InstancedMesh {
     float_attrib(2, 3, stride, offsetof(BodyInstance, center), true);
     float_attrib(3, 4, stride, offsetof(BodyInstance, orientation), true);
     float_attrib(4, 3, stride, offsetof(BodyInstance, half_extents), true);
-    float_attrib(5, 3, stride, offsetof(BodyInstance, color), true);
+    float_attrib(5, 4, stride, offsetof(BodyInstance, color), true);
     glBindVertexArray(0);
   }
 
@@ -185,7 +186,7 @@ void put(float* dst, const glm::vec3& v) {
 }
 
 BodyInstance make_instance(const glm::vec3& center, const glm::quat& q, const glm::vec3& half,
-                           const glm::vec3& color) {
+                           const glm::vec3& color, float alpha) {
   BodyInstance b{};
   put(b.center, center);
   b.orientation[0] = q.x;
@@ -194,6 +195,7 @@ BodyInstance make_instance(const glm::vec3& center, const glm::quat& q, const gl
   b.orientation[3] = q.w;
   put(b.half_extents, half);
   put(b.color, glm::clamp(color, 0.0f, 1.0f));
+  b.color[3] = std::clamp(alpha, 0.0f, 1.0f);
   return b;
 }
 
@@ -250,6 +252,9 @@ struct Renderer::Impl {
   // CPU staging reused across frames.
   std::vector<BodyInstance> box_data;
   std::array<std::vector<BodyInstance>, k_sphere_lods> sphere_data;  // per level of detail
+  // Ghosts (alpha < 1), each list sorted far to near from the eye.
+  std::vector<BodyInstance> ghost_box_data;
+  std::array<std::vector<BodyInstance>, k_sphere_lods> ghost_sphere_data;
   std::vector<LineInstance> line_data;
   std::vector<PlaneDraw> planes;
 
@@ -360,21 +365,38 @@ struct Renderer::Impl {
   void gather(const DrawList& list, const glm::vec3& eye, const glm::vec3& forward,
               float focal_px) {
     box_data.clear();
+    ghost_box_data.clear();
     for (const BoxItem& b : list.boxes) {
       const glm::vec3 h = glm::abs(b.half_extents);
       if (!finite(b.center) || !finite(h) || !finite(b.color) || !(std::min({h.x, h.y, h.z}) > 0.0f)) continue;
-      box_data.push_back(make_instance(b.center, safe_normalize(b.orientation), h, b.color));
+      if (!finite(b.alpha) || !(b.alpha > 0.0f)) continue;
+      (b.alpha < 1.0f ? ghost_box_data : box_data)
+          .push_back(make_instance(b.center, safe_normalize(b.orientation), h, b.color, b.alpha));
     }
     for (std::vector<BodyInstance>& v : sphere_data) v.clear();
+    for (std::vector<BodyInstance>& v : ghost_sphere_data) v.clear();
     for (const SphereItem& s : list.spheres) {
       const float r = std::abs(s.radius);
       if (!finite(s.center) || !finite(r) || !finite(s.color) || !(r > 0.0f)) continue;
+      if (!finite(s.alpha) || !(s.alpha > 0.0f)) continue;
       const float depth = glm::dot(s.center - eye, forward);
       const float radius_px = depth > r ? r * focal_px / depth : std::numeric_limits<float>::max();
       std::size_t lod = 0;
       while (lod + 1 < sphere_limits_px.size() && radius_px > sphere_limits_px[lod]) ++lod;
-      sphere_data[lod].push_back(
-          make_instance(s.center, safe_normalize(s.orientation), glm::vec3(r), s.color));
+      (s.alpha < 1.0f ? ghost_sphere_data : sphere_data)[lod].push_back(
+          make_instance(s.center, safe_normalize(s.orientation), glm::vec3(r), s.color, s.alpha));
+    }
+    // Far to near, so that where ghosts overlap the nearer one is blended last.
+    const auto far_first = [&eye](const BodyInstance& x, const BodyInstance& y) {
+      const auto d2 = [&eye](const BodyInstance& b) {
+        const glm::vec3 c(b.center[0], b.center[1], b.center[2]);
+        return glm::dot(c - eye, c - eye);
+      };
+      return d2(x) > d2(y);
+    };
+    std::stable_sort(ghost_box_data.begin(), ghost_box_data.end(), far_first);
+    for (std::vector<BodyInstance>& v : ghost_sphere_data) {
+      std::stable_sort(v.begin(), v.end(), far_first);
     }
     line_data.clear();
     for (const LineItem& l : list.lines) {
@@ -698,6 +720,37 @@ struct Renderer::Impl {
       glDepthMask(GL_TRUE);
       glDisable(GL_BLEND);
     }
+
+    // Ghosts last: depth tested against everything opaque (the ground hides what is below it),
+    // but without depth writes, so every ghost shows through every other, whichever variant it
+    // belongs to, even where two coincide exactly; back faces culled, so each convex body adds
+    // one layer. They cast no shadow: a translucent body would cast a full one, and the shadows
+    // of several variants would merge into one dark patch.
+    const bool ghosts = !ghost_box_data.empty() ||
+                        std::any_of(ghost_sphere_data.begin(), ghost_sphere_data.end(),
+                                    [](const std::vector<BodyInstance>& v) { return !v.empty(); });
+    if (ghosts) {
+      glEnable(GL_BLEND);
+      glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+      glDepthMask(GL_FALSE);
+      glEnable(GL_CULL_FACE);
+      glCullFace(GL_BACK);
+      body_program.use();
+      // The opaque bodies' instances were drawn: their buffers now take the ghosts'.
+      upload(cube.instances, cube.capacity, ghost_box_data.data(),
+             ghost_box_data.size() * sizeof(BodyInstance));
+      body_program.set("u_kind", 0);
+      cube.draw(static_cast<GLsizei>(ghost_box_data.size()));
+      body_program.set("u_kind", 1);
+      for (std::size_t i = 0; i < spheres.size(); ++i) {
+        upload(spheres[i].instances, spheres[i].capacity, ghost_sphere_data[i].data(),
+               ghost_sphere_data[i].size() * sizeof(BodyInstance));
+        spheres[i].draw(static_cast<GLsizei>(ghost_sphere_data[i].size()));
+      }
+      glDisable(GL_CULL_FACE);
+      glDepthMask(GL_TRUE);
+      glDisable(GL_BLEND);
+    }
     glBindVertexArray(0);
 
     // 3. Resolve the multisampled image into the context's framebuffer.
@@ -746,7 +799,7 @@ std::optional<Backend> parse_backend(std::string_view name) {
 
 // draw(list): renders one frame (lengths in metres, camera field of view in degrees) and returns
 // it as width x height RGB8, rows top to bottom. Items with non-finite values or non-positive sizes
-// are skipped. Throws std::runtime_error naming the GL error code if glGetError reports one, or if
+// (or alpha <= 0) are skipped; bodies with alpha < 1 are ghosts (see the frame outline above). Throws std::runtime_error naming the GL error code if glGetError reports one, or if
 // the context cannot be made current. Lighting: Lambert + Blinn-Phong (Blinn 1977) under a sun
 // with PCF-filtered shadow mapping (Williams 1978; Reeves et al. 1987; LearnOpenGL "Shadow
 // Mapping"), hemisphere ambient and a weak camera-relative fill light.

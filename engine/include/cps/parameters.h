@@ -109,6 +109,9 @@ struct Choice {
   std::string_view name;    ///< as typed and written: "baumgarte"
   int value;                ///< the enum's value, static_cast<int>(PushMode::baumgarte)
   std::string_view source;  ///< where it is defined, for labels ("Sec. 5.3"); may be empty
+  /// The paper's name for it (or the field's, where the paper has none), for labels:
+  /// "single frame push factor"; may be empty.
+  std::string_view title{};
 };
 
 /// A parameter's value: double (real), int (integer, and choice: the enum's value), bool
@@ -127,6 +130,9 @@ struct Parameter {
   bool min_exclusive = false;  ///< real: min itself is not allowed (dt > 0)
   std::span<const Choice> choices{};  ///< choice: the allowed names, the default first
   std::string_view help{};     ///< what it means and a typical value, for --help
+  /// The paper's name for it with its source, for labels ("push factor constant beta
+  /// (Eq. 5.2.3)"); empty: the name with spaces for underscores ("contact margin").
+  std::string_view title{};
   ParameterValue (*get)(const WorldDef&) = nullptr;
   void (*set)(WorldDef&, const ParameterValue&) = nullptr;
 
@@ -146,6 +152,8 @@ struct Parameter {
   std::string_view choice_name(int value) const;
   /// The Choice called `name`, or nullptr.
   const Choice* find_choice(std::string_view name) const;
+  /// `title`, or the name with spaces for underscores when it has none.
+  std::string label() const;
 };
 
 /// Parses the whole of `text` as a decimal number ("0.01", "1e-3", "-2"): no hex, no leading

@@ -13,21 +13,24 @@
 namespace cps::render {
 
 /// A box: centre (m), orientation (unit quaternion, body to world), half extents (m, all > 0),
-/// linear RGB colour in [0, 1].
+/// linear RGB colour in [0, 1], opacity alpha in [0, 1] (1: opaque, the default; below 1: a
+/// ghost, see Renderer::draw; 0: not drawn).
 struct BoxItem {
   glm::vec3 center{0.0f};
   glm::quat orientation{1.0f, 0.0f, 0.0f, 0.0f};
   glm::vec3 half_extents{0.5f};
   glm::vec3 color{0.8f};
+  float alpha = 1.0f;
 };
 
 /// A sphere: centre (m), orientation (unit quaternion, so that its spin can be seen on its
-/// shading pattern), radius (m, > 0), colour in [0, 1].
+/// shading pattern), radius (m, > 0), colour in [0, 1], opacity alpha in [0, 1] as for a box.
 struct SphereItem {
   glm::vec3 center{0.0f};
   glm::quat orientation{1.0f, 0.0f, 0.0f, 0.0f};
   float radius = 0.5f;
   glm::vec3 color{0.8f};
+  float alpha = 1.0f;
 };
 
 /// An infinite plane {x : dot(normal, x) = offset}, drawn as a square of side 2 * half_size (m)

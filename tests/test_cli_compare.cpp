@@ -1,0 +1,197 @@
+// `cps render` and `cps figure` with --compare PARAM=V1,... and --overlay, run as a user runs
+// them: the grid of panels, the ghosts of the overlay (pixel checks), run.json, bad input.
+#include "cli_support.h"
+
+#include "cps/render/renderer.h"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+namespace fs = std::filesystem;
+using cli_test::fresh_dir;
+using cli_test::Result;
+using cli_test::slurp;
+
+namespace {
+
+Result run(const std::string& args, const fs::path& dir) { return cli_test::run_cps(args, dir); }
+
+// Mean absolute difference (0-255) over rows [y0, y1) of two panels of width w placed at x = a
+// and x = b in `image`.
+double panel_difference(const cps::render::Image& image, int a, int b, int w, int y0, int y1) {
+  double sum = 0.0;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const auto at = [&](int x0) {
+          return image.pixels[3 * (static_cast<std::size_t>(y) * image.width + x0 + x) + c];
+        };
+        sum += std::abs(static_cast<int>(at(a)) - static_cast<int>(at(b)));
+      }
+    }
+  }
+  return sum / (3.0 * w * (y1 - y0));
+}
+
+// Hue (degrees) and saturation of an RGB8 pixel.
+std::pair<double, double> hue_saturation(const std::uint8_t* p) {
+  const double r = p[0] / 255.0, g = p[1] / 255.0, b = p[2] / 255.0;
+  const double mx = std::max({r, g, b}), mn = std::min({r, g, b}), d = mx - mn;
+  if (d <= 0.0) return {0.0, 0.0};
+  double h = mx == r ? 60.0 * std::fmod((g - b) / d, 6.0) : mx == g ? 60.0 * ((b - r) / d + 2.0)
+                                                                     : 60.0 * ((r - g) / d + 4.0);
+  if (h < 0.0) h += 360.0;
+  return {h, d / mx};
+}
+
+// Pixels in rows [y0, y1) whose hue is within tol degrees of `hue` with saturation above 0.25
+// (the sky, 0.10, and the grey ground, 0.02, are below it).
+int pixels_of_hue(const cps::render::Image& image, double hue, double tol, int y0, int y1,
+                  double* mean_y = nullptr) {
+  int n = 0;
+  double sum_y = 0.0;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const auto [h, s] = hue_saturation(&image.pixels[3 * (static_cast<std::size_t>(y) * image.width + x)]);
+      double d = std::abs(h - hue);
+      d = std::min(d, 360.0 - d);
+      if (s > 0.25 && d < tol) {
+        ++n;
+        sum_y += y;
+      }
+    }
+  }
+  if (mean_y != nullptr) *mean_y = n > 0 ? sum_y / n : 0.0;
+  return n;
+}
+
+constexpr double kBlueHue = 205.0;    // overlay_colour(0), #1f77b4
+constexpr double kOrangeHue = 28.0;   // overlay_colour(1), #ff7f0e
+
+}  // namespace
+
+TEST_CASE("cps render --compare with three values of beta lays out 3 labelled panels that differ",
+          "[cli][compare]") {
+  const fs::path dir = fresh_dir("cps_compare_grid");
+  const Result r = run("render intersecting_stack --compare beta=0.05,0.2,0.5 --seconds 1 --fps 1 "
+                       "--size 480x240 --out out",
+                       dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const fs::path folder = dir / "out" / "intersecting_stack-compare-beta-0.05_0.2_0.5";
+  const cps::render::Image last = cps::render::read_png(folder / "frame_000001.png");
+  CHECK(last.width == 480);  // 1 x 3 panels of 160 x 240
+  CHECK(last.height == 240);
+  // Below the labels (the top 100 rows), at t = 1 s: beta = 0.05 still pushes the cubes apart
+  // slowly, 0.5 has thrown them out; a few grey levels on average is a different picture (the
+  // same picture differs by 0).
+  for (const auto& [a, b] : {std::pair{0, 1}, std::pair{0, 2}, std::pair{1, 2}}) {
+    INFO("panels " << a << " and " << b);
+    CHECK(panel_difference(last, 160 * a, 160 * b, 160, 100, 240) > 1.0);
+  }
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(folder / "run.json"));
+  const nlohmann::json& p = manifest["parameters"];
+  CHECK(p["compare"]["parameter"] == "beta");
+  CHECK(p["compare"]["values"] == nlohmann::json({0.05, 0.2, 0.5}));
+  CHECK(p["layout"]["rows"] == 1);
+  CHECK(p["layout"]["columns"] == 3);
+  REQUIRE(p["world"].size() == 3);
+  CHECK(p["world"][2]["parameters"]["beta"] == 0.5);
+  CHECK(p["world"][0]["label"].get<std::string>().find("beta = 0.05") != std::string::npos);
+
+  // Another list of the same parameter goes to its own folder; the first stays whole.
+  REQUIRE(run("render intersecting_stack --compare beta=0.05,0.2,0.5,0.8 --seconds 0.1 --fps 1 "
+              "--size 480x240 --out out",
+              dir)
+              .exit_code == 0);
+  CHECK(fs::exists(folder / "frame_000001.png"));
+  const cps::render::Image four = cps::render::read_png(
+      dir / "out" / "intersecting_stack-compare-beta-0.05_0.2_0.5_0.8" / "frame_000000.png");
+  CHECK(four.width == 480);  // 2 x 2 panels of 240 x 120
+  CHECK(four.height == 240);
+}
+
+TEST_CASE("cps render --overlay draws every variant in one view in its colour, with a legend",
+          "[cli][compare]") {
+  const fs::path dir = fresh_dir("cps_compare_overlay");
+  const Result r = run("render intersecting_stack --compare push --overlay --seconds 0.5 --fps 2 "
+                       "--size 320x240 --out out",
+                       dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const fs::path folder = dir / "out" / "intersecting_stack-compare-push-overlay";
+  const cps::render::Image frame = cps::render::read_png(folder / "frame_000001.png");
+  CHECK(frame.width == 320);  // one view of --size
+  CHECK(frame.height == 240);
+  // Above the legend (bottom 50 rows) and below the label (top 30): at 0.5 s the baumgarte cubes
+  // have flown up (blue ghosts) while the split ones stand (orange ghosts). Hue within 15
+  // degrees; each ghost cube covers hundreds of pixels, so 100 is a safe floor.
+  double blue_y = 0.0;
+  double orange_y = 0.0;
+  const int blue = pixels_of_hue(frame, kBlueHue, 15.0, 30, 240 - 50, &blue_y);
+  const int orange = pixels_of_hue(frame, kOrangeHue, 15.0, 30, 240 - 50, &orange_y);
+  CHECK(blue > 100);
+  CHECK(orange > 100);
+  // Each colour is one variant: the blue (baumgarte) cubes are higher up the picture than the
+  // orange (split) stack, by more than a cube's height on average (at this size a cube is
+  // about 10 pixels). Bodies in their own palette colours would mix both hues in both stacks.
+  CHECK(blue_y < orange_y - 10.0);
+  // The legend's swatches: both colours in the bottom-left corner.
+  CHECK(pixels_of_hue(frame, kBlueHue, 5.0, 240 - 50, 240) > 20);
+  CHECK(pixels_of_hue(frame, kOrangeHue, 5.0, 240 - 50, 240) > 20);
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(folder / "run.json"));
+  CHECK(manifest["parameters"]["compare"]["layout"] == "overlay");
+  CHECK(manifest["parameters"]["compare"]["values"] == nlohmann::json({"baumgarte", "split"}));
+
+  // cps figure --overlay: one row, one panel per time, each with both colours.
+  const Result f = run("figure intersecting_stack --overlay --compare push=baumgarte,split "
+                       "--times 0.5,1 --size 200x150 --out f.png",
+                       dir);
+  INFO(f.err);
+  REQUIRE(f.exit_code == 0);
+  const cps::render::Image fig = cps::render::read_png(dir / "f.png");
+  CHECK(fig.width == 2 * 200);
+  CHECK(fig.height == 150);  // one row: the variants share each panel
+  CHECK(pixels_of_hue(fig, kBlueHue, 15.0, 40, 150 - 45) > 50);
+  CHECK(pixels_of_hue(fig, kOrangeHue, 15.0, 40, 150 - 45) > 50);
+  const nlohmann::json side = nlohmann::json::parse(slurp(dir / "f.png.json"));
+  CHECK(side["parameters"]["comparison"]["layout"] == "overlay");
+  CHECK(side["parameters"]["image_size_px"] == nlohmann::json({400, 150}));
+}
+
+TEST_CASE("a bad --compare or --overlay exits 2 naming the problem and writes nothing",
+          "[cli][compare]") {
+  const fs::path dir = fresh_dir("cps_compare_bad");
+  struct Case {
+    std::string args;
+    std::string says;
+  };
+  const Case cases[] = {
+      {"render stack --compare nosuch=1,2", "'nosuch'"},
+      {"render stack --compare beta=0.1,2", "--beta 2"},
+      {"render stack --compare beta=0.1", "1 value"},
+      {"render stack --compare beta=0.1,0.2,0.3,0.4,0.5,0.6,0.7", "more than 6"},
+      {"render stack --compare beta=0.2,0.20", "same value"},
+      {"render stack --compare beta=0.1,0.2 --beta 0.3", "--beta is given too"},
+      {"render stack --compare push --push split", "--push is given too"},
+      {"render stack --overlay", "--overlay"},
+      {"render stack --compare beta=0.1,0.2,0.3,0.4 --size 30x30", "16x16"},
+      {"figure stack --times 0 --compare iterations=1,0", "--iterations 0"},
+      {"figure stack --times 0 --overlay", "--overlay"},
+      {"figure paper --overlay", "--overlay"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.args);
+    const bool render = c.args.rfind("render", 0) == 0;
+    const Result r = run(c.args + (render ? " --seconds 0.1 --fps 10 --out out" : " --out out/x.png"), dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find(c.says) != std::string::npos);
+    CHECK(!fs::exists(dir / "out"));
+  }
+}

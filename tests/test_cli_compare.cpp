@@ -149,9 +149,11 @@ TEST_CASE("cps render --overlay draws every variant in one view in its colour, w
   CHECK(manifest["parameters"]["compare"]["layout"] == "overlay");
   CHECK(manifest["parameters"]["compare"]["values"] == nlohmann::json({"baumgarte", "split"}));
 
-  // cps figure --overlay: one row, one panel per time, each with both colours.
+  // cps figure --overlay: one row, one panel per time, each with both colours. The camera is
+  // the scene's earlier, closer preset (its default now holds the cubes' whole 4 s flight, so
+  // the split stack would sit below the rows counted here).
   const Result f = run("figure intersecting_stack --overlay --compare push=baumgarte,split "
-                       "--times 0.5,1 --size 200x150 --out f.png",
+                       "--times 0.5,1 --size 200x150 --eye 18,16,40 --target 0,10,0 --out f.png",
                        dir);
   INFO(f.err);
   REQUIRE(f.exit_code == 0);

@@ -110,3 +110,26 @@ TEST_CASE("a scene file renders", "[cli][scene_file]") {
   CHECK(fs::exists(dir / "out" / "chain.json" / "frame_000000.png"));
 }
 #endif
+
+TEST_CASE("cps report takes a scene file in a folder and writes its files in --out",
+          "[cli][scene_file][report]") {
+  // A box dropped for 0.25 s: the quick sweep's runs and their reference take a moment.
+  const fs::path dir = cli_test::fresh_dir("cps_cli_scene_files_report");
+  fs::create_directories(dir / "scenes");
+  write(dir / "scenes" / "drop.json",
+        R"({"seconds": 0.25, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0},
+            {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1,
+             "position_m": [0, 0.6, 0]}]})");
+  // One run, as --list-runs prints it: its CSV is named after the file, not the folder.
+  const Result one = run_cps("report scenes/drop.json --run scenes/drop.json.pgs.baumgarte.fixed.it4.ss1 --out one", dir);
+  INFO(one.err);
+  REQUIRE(one.exit_code == 0);
+  CHECK(fs::exists(dir / "one" / "drop.json.pgs.baumgarte.fixed.it4.ss1.csv"));
+  // The whole quick sweep: report.md links the CSV that is there.
+  const Result all = run_cps("report scenes/drop.json --quick --out all", dir);
+  INFO(all.err);
+  REQUIRE(all.exit_code == 0);
+  CHECK(fs::exists(dir / "all" / "drop.json.csv"));
+  CHECK(slurp(dir / "all" / "report.md").find("(drop.json.csv)") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "all" / "scenes"));
+}

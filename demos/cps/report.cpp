@@ -38,6 +38,13 @@ std::optional<Enum> choice_of(const char* parameter_name, const std::string& tex
   return static_cast<Enum>(c->value);
 }
 
+// The name a scene's files start with: the scene's name, or for a scene file given by a path
+// with folders ("runs/drop.json") its file name ("drop.json"), so that no file lands in another
+// folder. One report holds one scene file, so file names stay distinct within it.
+std::string file_stem(const std::string& scene) {
+  return scene.find('/') == std::string::npos ? scene : fs::path(scene).filename().string();
+}
+
 std::string number(double v) {
   if (!std::isfinite(v)) return "";
   char text[32];
@@ -656,7 +663,7 @@ bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& 
                   const std::vector<const Row*>& rows, const std::string& title_note) {
   const std::optional<Diagram> diagram = make_diagram(m, floor_of(m, scene), rows);
   if (!diagram) return false;
-  const std::string stem = scene + "_" + m.column;
+  const std::string stem = file_stem(scene) + "_" + m.column;
   const fs::path data = dir / "plots" / (stem + ".dat");
   const fs::path script = dir / "plots" / (stem + ".gp");
   {
@@ -1194,7 +1201,7 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows,
   for (const std::string& scene : order) {
     std::vector<Row> scene_rows;
     for (const Row* r : by_scene[scene]) scene_rows.push_back(*r);
-    write_csv(dir / (scene + ".csv"), scene_rows);
+    write_csv(dir / (file_stem(scene) + ".csv"), scene_rows);
     md << "## " << scene << "\n\n";
     if (const scenes::Scene* s = scenes::find_scene(scene)) {
       md << "- **Horizon** " << number(s->report_horizon_s()) << " s: " << s->report.horizon_reason
@@ -1222,10 +1229,10 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows,
       }
       md << ".\n";
     }
-    md << "\nAll runs: [" << scene << ".csv](" << scene << ".csv).\n\n";
+    md << "\nAll runs: [" << file_stem(scene) << ".csv](" << file_stem(scene) << ".csv).\n\n";
     for (const Measure& m : kMeasures) {
       if (plot_measure(dir, scene, m, by_scene[scene], title_note)) {
-        md << "![" << scene << " " << m.column << "](" << scene << "_" << m.column << ".png)\n\n";
+        md << "![" << scene << " " << m.column << "](" << file_stem(scene) << "_" << m.column << ".png)\n\n";
       }
     }
     const std::string measure = primary_measure(scene);
@@ -1274,9 +1281,9 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows,
 std::vector<std::string> report_files(const std::vector<std::string>& scenes) {
   std::vector<std::string> files = {"report.md", "mass_ratio.csv"};
   for (const std::string& scene : scenes) {
-    files.push_back(scene + ".csv");
+    files.push_back(file_stem(scene) + ".csv");
     for (const Measure& m : kMeasures) {
-      for (const char* ext : {".png", ".svg"}) files.push_back(scene + "_" + m.column + ext);
+      for (const char* ext : {".png", ".svg"}) files.push_back(file_stem(scene) + "_" + m.column + ext);
     }
   }
   return files;
@@ -1286,7 +1293,7 @@ std::vector<std::string> plot_files(const std::vector<std::string>& scenes) {
   std::vector<std::string> files;
   for (const std::string& scene : scenes) {
     for (const Measure& m : kMeasures) {
-      for (const char* ext : {".dat", ".gp"}) files.push_back(scene + "_" + m.column + ext);
+      for (const char* ext : {".dat", ".gp"}) files.push_back(file_stem(scene) + "_" + m.column + ext);
     }
   }
   return files;
@@ -1390,7 +1397,8 @@ int run_report(const ReportOptions& o, int argc, char** argv) {
   if (!o.run.empty()) {
     const RunSpec spec = RunSpec::parse(o.run);
     select_scenes(o.scene);  // the sweep it belongs to must be one
-    const std::string file = spec.id() + ".csv";
+    // The run id with the scene part as file_stem: a scene file path keeps its folders out.
+    const std::string file = file_stem(spec.scene) + spec.id().substr(spec.scene.size()) + ".csv";
     const OutputPlan plan = plan_output(o.out, {file}, o.force, FolderUse::shared);
     Row row = execute_run(spec, repeats);
     mark_sweep(row);

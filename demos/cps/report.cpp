@@ -52,6 +52,14 @@ std::string number(double v) {
   return text;
 }
 
+// A warm start factor (dimensionless) as the shortest decimal text that reads back exactly
+// ("0.8", "1"), for run ids and the CSV column.
+std::string factor_text(double v) {
+  char text[32];
+  const auto [end, ec] = std::to_chars(text, text + sizeof text, v);
+  return ec == std::errc() ? std::string(text, end) : number(v);
+}
+
 bool has_friction(const scenes::Scene& scene) { return scene.world_def().friction > 0.0; }
 
 // True if `scene` is one of the paper's scenes (its table, scenes::paper_scenes()).
@@ -91,6 +99,7 @@ scenes::Overrides overrides_of(const RunSpec& spec) {
   o.set("push", spec.push);
   o.set("friction_model", spec.friction_model);
   o.set("iterations", spec.iterations);
+  o.set("warm_start", spec.warm_start);
   o.set("dt", is_paper_scene(scene) ? 1.0 / (60.0 * spec.substeps)
                                     : scene.world_def().dt / spec.substeps);
   return o;
@@ -161,6 +170,7 @@ const Reference& reference_of(const RunSpec& spec) {
   ref.solver = SolverKind::pgs;
   ref.iterations = kReferenceIterations;
   ref.substeps = kReferenceSubsteps;
+  ref.warm_start = 0.0;  // one reference for the cold and the warm runs: the paper's start
   const std::lock_guard<std::mutex> lock(mutex);
   const auto it = cache.find(ref.id());
   if (it != cache.end()) return it->second;
@@ -192,7 +202,7 @@ double to_double(const Row& row, const std::string& column) {
 // Columns in the order a reader wants them: the settings, then the measures, then metrics.
 std::vector<std::string> ordered_columns(const std::vector<Row>& rows) {
   static const std::vector<std::string> first = {
-      "scene", "solver", "push", "friction_model", "iterations", "substeps", "dt_s", "horizon_s",
+      "scene", "solver", "push", "friction_model", "iterations", "substeps", "warm_start", "dt_s", "horizon_s",
       "diverged", "diverged_at_s", "wall_s_per_sim_s", "us_per_step", "timing_repeats",
       "trajectory_time_s", "trajectory_error_m", "reference_check_m", "phase_error_deg",
       "residual_max_N", "residual_rms_N", "penetration_max_m", "penetration_rms_m",
@@ -280,9 +290,19 @@ std::string variant_of(const Row& r) {
   return r.at("solver") + " " + r.at("push") + " " + r.at("friction_model");
 }
 
+// The warm start factor of a row (dimensionless); 0 (cold) where the column is missing or
+// empty (a CSV of a build before warm starting).
+double warm_of(const Row& r) {
+  const double w = to_double(r, "warm_start");
+  return std::isnan(w) ? 0.0 : w;
+}
+
+// The paper's settings: PGS, Baumgarte push, fixed friction, 25 iterations, 1 substep (60 Hz),
+// cold start.
 bool is_paper_setting(const Row& r) {
   return r.at("solver") == "pgs" && r.at("push") == "baumgarte" &&
-         r.at("friction_model") == "fixed" && r.at("iterations") == "25" && r.at("substeps") == "1";
+         r.at("friction_model") == "fixed" && r.at("iterations") == "25" &&
+         r.at("substeps") == "1" && warm_of(r) == 0.0;
 }
 
 void run_gnuplot(const fs::path& script) {
@@ -329,6 +349,9 @@ struct PlotPoint {
 struct Panel {
   std::string title;
   std::vector<PlotPoint> iterations;  // 1 substep, by iteration count (solid line)
+  // The warm-started iteration lines (1 substep, by iteration count), by warm start factor (one
+  // per factor of the whole diagram, Diagram::warm_factors; empty where the panel has none).
+  std::vector<std::vector<PlotPoint>> warm;
   std::vector<PlotPoint> substeps;    // 25 iterations, by substep count (dashed line)
   std::vector<PlotPoint> paper;       // the paper's settings (25 iterations, 1 substep)
   std::vector<PlotPoint> clamped;     // values under the floor, drawn on it
@@ -350,6 +373,7 @@ struct Diagram {
   bool any_clamped = false;
   bool any_diverged = false;
   bool any_reference = false;
+  std::vector<double> warm_factors;  // the warm start factors (> 0) of any run, ascending
   double x_lo = 0.0, x_hi = 0.0, y_lo = 0.0, y_hi = 0.0;  // y_hi: the top edge
 };
 
@@ -377,6 +401,13 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
   for (const Row* r : rows) by_panel[key_of(*r)].push_back(r);
   Diagram d;
   d.floor = floor;
+  for (const Row* r : rows) {
+    const double w = warm_of(*r);
+    if (w != 0.0 && std::find(d.warm_factors.begin(), d.warm_factors.end(), w) == d.warm_factors.end()) {
+      d.warm_factors.push_back(w);
+    }
+  }
+  std::sort(d.warm_factors.begin(), d.warm_factors.end());
   double raw_min = kInfinity, y_max = 0.0, x_min = kInfinity, x_max = 0.0;
   bool any_value = false;
   for (auto& [key, panel_rows] : by_panel) {
@@ -391,12 +422,15 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
              std::make_pair(count(*b, "substeps"), count(*b, "iterations"));
     });
     std::vector<std::pair<int, PlotPoint>> it_line, ss_line;
+    std::vector<std::vector<std::pair<int, PlotPoint>>> warm_lines(d.warm_factors.size());
     for (const Row* r : sorted) {
       const double t = to_double(*r, "wall_s_per_sim_s");
       if (!(t > 0.0)) continue;
       const int it = count(*r, "iterations");
       const int ss = count(*r, "substeps");
-      const std::string label = ss == 1 ? std::to_string(it) + " it" : std::to_string(ss) + " ss";
+      const double w = warm_of(*r);
+      const std::string label = (ss == 1 ? std::to_string(it) + " it" : std::to_string(ss) + " ss") +
+                                (w != 0.0 ? ", ws " + factor_text(w) : std::string());
       if (r->at("diverged") == "1") {
         p.diverged.push_back({t, 0.0, label});
         d.any_diverged = true;
@@ -416,9 +450,21 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
       y_max = std::max(y_max, point.y);
       x_min = std::min(x_min, t);
       x_max = std::max(x_max, t);
+      if (w != 0.0) {
+        // Warm runs: the iteration line of their factor only (the sweep has no warm substeps).
+        const auto k = std::find(d.warm_factors.begin(), d.warm_factors.end(), w);
+        if (ss == 1) warm_lines[static_cast<std::size_t>(k - d.warm_factors.begin())].emplace_back(it, point);
+        continue;
+      }
       if (ss == 1) it_line.emplace_back(it, point);
       if (it == 25) ss_line.emplace_back(ss, point);
       if (ss == 1 && it == 25) p.paper.push_back(point);
+    }
+    for (auto& line : warm_lines) {
+      std::sort(line.begin(), line.end(),
+                [](const auto& a, const auto& b) { return a.first < b.first; });
+      p.warm.emplace_back();
+      for (const auto& [n, point] : line) p.warm.back().push_back(point);
     }
     std::sort(it_line.begin(), it_line.end(),
               [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -450,6 +496,9 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
     for (const auto* line : {&p.iterations, &p.substeps}) {
       for (const PlotPoint& q : *line) y_min = std::min(y_min, q.y);
     }
+    for (const auto& line : p.warm) {
+      for (const PlotPoint& q : line) y_min = std::min(y_min, q.y);
+    }
     if (p.reference > 0.0) y_min = std::min(y_min, p.reference);
   }
   if (d.show_floor) y_min = std::min(y_min, floor / 3.0);  // room for the floor's label
@@ -478,6 +527,12 @@ void place_labels(Panel& p, const Diagram& d) {
     for (const PlotPoint& q : *list) {
       const double u = u_of(q.x), v = v_of(q.y);
       taken.push_back({u - grow * kPointU, u + grow * kPointU, v - grow * kPointV, v + grow * kPointV});
+    }
+  }
+  for (const auto& line : p.warm) {
+    for (const PlotPoint& q : line) {
+      const double u = u_of(q.x), v = v_of(q.y);
+      taken.push_back({u - kPointU, u + kPointU, v - kPointV, v + kPointV});
     }
   }
   // The floor's and the reference's lines, as thin boxes across the frame.
@@ -531,8 +586,13 @@ void place_labels(Panel& p, const Diagram& d) {
 // centre goes).
 void write_plot_data(std::ostream& out, const Diagram& d) {
   for (const Panel& p : d.panels) {
-    for (const auto* list : {&p.iterations, &p.substeps, &p.paper, &p.clamped, &p.diverged,
-                             &p.labels_it, &p.labels_ss, &p.labels_div}) {
+    std::vector<const std::vector<PlotPoint>*> lists = {&p.iterations};
+    for (const auto& line : p.warm) lists.push_back(&line);
+    for (const auto* list : {&p.substeps, &p.paper, &p.clamped, &p.diverged, &p.labels_it,
+                             &p.labels_ss, &p.labels_div}) {
+      lists.push_back(list);
+    }
+    for (const auto* list : lists) {
       if (list->empty()) continue;
       for (const PlotPoint& q : *list) out << q.x << " " << q.y << " \"" << q.label << "\"\n";
       out << "\n\n";
@@ -550,8 +610,35 @@ bool label_under_reference(const Panel& p, const Diagram& d) {
   for (const auto* line : {&p.iterations, &p.substeps}) {
     for (const PlotPoint& q : *line) (q.y > p.reference ? above : below) += 1;
   }
+  for (const auto& line : p.warm) {
+    for (const PlotPoint& q : line) (q.y > p.reference ? above : below) += 1;
+  }
   return above > below;
 }
+
+// The style of the warm-started iteration line of the k-th warm start factor: its own colour,
+// dash and point, so that it stays apart from the cold line (blue, solid, discs) and the
+// substep line (pink, dashed, squares) in the same panel.
+struct WarmStyle {
+  const char* colour;
+  int dash;
+  int point;
+};
+constexpr WarmStyle kWarmStyles[] = {
+    {"#2ca02c", 4, 9}, {"#ff7f0e", 5, 13}, {"#9467bd", 6, 11}, {"#8c564b", 3, 3}};
+const WarmStyle& warm_style(std::size_t k) {
+  return kWarmStyles[k % (sizeof kWarmStyles / sizeof kWarmStyles[0])];
+}
+std::string warm_line_style(std::size_t k) {
+  const WarmStyle& w = warm_style(k);
+  return "lw 1.5 dt " + std::to_string(w.dash) + " pt " + std::to_string(w.point) +
+         " ps 0.8 lc rgb '" + w.colour + "'";
+}
+
+// The rows of the key under the panels (the warm lines' entries take a third) and its height
+// (pixels).
+int key_rows(const Diagram& d) { return d.warm_factors.empty() ? 2 : 3; }
+double key_height(const Diagram& d) { return 10.0 + 30.0 * key_rows(d); }
 
 // The gnuplot commands that draw the diagram from `data` (written by write_plot_data) into the
 // current terminal: a grid of panels (pgs left, jacobi right, a row per push and friction
@@ -562,7 +649,7 @@ std::string plot_script(const Diagram& d, const fs::path& data, const std::strin
   const int n = static_cast<int>(d.panels.size());
   const int cols = n > 1 ? 2 : 1;
   const int rows = (n + cols - 1) / cols;
-  const double title_h = 40.0 / height, key_h = 70.0 / height;
+  const double title_h = 40.0 / height, key_h = key_height(d) / height;
   const double panel_w = 1.0 / cols, panel_h = (1.0 - title_h - key_h) / rows;
   // x tics at 1, 2 and 5 per decade: the time axis spans one or two decades.
   std::string xtics;
@@ -615,6 +702,9 @@ std::string plot_script(const Diagram& d, const fs::path& data, const std::strin
                       std::to_string(index++) + " " + style);
     };
     block(p.iterations, "using 1:2 with linespoints lw 1.5 pt 7 ps 0.7 lc rgb '#1f77b4'");
+    for (std::size_t k = 0; k < p.warm.size(); ++k) {
+      block(p.warm[k], "using 1:2 with linespoints " + warm_line_style(k));
+    }
     block(p.substeps, "using 1:2 with linespoints lw 1.5 dt 2 pt 5 ps 0.7 lc rgb '#e377c2'");
     block(p.paper, "using 1:2 with points pt 6 ps 2.2 lw 1.5 lc rgb 'black'");
     block(p.clamped, "using 1:2 with points pt 10 ps 1.6 lw 1.5 lc rgb 'black'");
@@ -632,9 +722,14 @@ std::string plot_script(const Diagram& d, const fs::path& data, const std::strin
      << "unset border\nunset tics\nunset grid\nset origin 0, 0\nset size 1, " << key_h << "\n"
      << "set lmargin 0\nset rmargin 0\nset tmargin 0\nset bmargin 0\n"
      << "set xrange [0:1]\nset yrange [0:1]\n"
-     << "set key center center horizontal maxrows 2 width 1 samplen 3 font ',9'\nplot "
-     << "NaN with linespoints lw 1.5 pt 7 lc rgb '#1f77b4' title 'iterations, 1 substep (60 Hz)'"
-     << ", NaN with linespoints lw 1.5 dt 2 pt 5 lc rgb '#e377c2' title "
+     << "set key center center horizontal maxrows " << key_rows(d)
+     << " width 1 samplen 3 font ',9'\nplot "
+     << "NaN with linespoints lw 1.5 pt 7 lc rgb '#1f77b4' title 'iterations, 1 substep (60 Hz)'";
+  for (std::size_t k = 0; k < d.warm_factors.size(); ++k) {
+    gp << ", NaN with linespoints " << warm_line_style(k) << " title "
+       << gp_text("iterations, warm start " + factor_text(d.warm_factors[k]));
+  }
+  gp << ", NaN with linespoints lw 1.5 dt 2 pt 5 lc rgb '#e377c2' title "
         "'substeps per 1/60 s frame, 25 iterations'"
      << ", NaN with points pt 6 ps 2 lw 1.5 lc rgb 'black' title 'the paper''s settings'";
   if (d.any_diverged) {
@@ -672,7 +767,8 @@ bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& 
     write_text_atomic(data, out.str());
   }
   const int rows_of_panels = (static_cast<int>(diagram->panels.size()) + 1) / 2;
-  const int width = 1100, height = 110 + 300 * rows_of_panels;
+  const int width = 1100,
+            height = 40 + static_cast<int>(key_height(*diagram)) + 300 * rows_of_panels;
   const std::string title = scene + ": " + m.label + title_note;
   const std::string body = plot_script(*diagram, data, title, m, height);
   // gnuplot writes the pictures into temporaries of this run, renamed once it has succeeded.
@@ -783,8 +879,10 @@ std::vector<Row> mass_ratio_rows() {
 
 // The id (RunSpec::id) of the run a CSV row holds.
 std::string id_of(const Row& r) {
+  const double w = warm_of(r);
   return r.at("scene") + "." + r.at("solver") + "." + r.at("push") + "." +
-         r.at("friction_model") + ".it" + r.at("iterations") + ".ss" + r.at("substeps");
+         r.at("friction_model") + ".it" + r.at("iterations") + ".ss" + r.at("substeps") +
+         (w != 0.0 ? ".ws" + factor_text(w) : std::string());
 }
 
 // A human label of a CSV column: the diagram's label of a measure, else the column's name.
@@ -795,23 +893,120 @@ std::string label_of(const std::string& column) {
   return column;
 }
 
+// The iteration count of the paper's settings (PGS, Baumgarte, fixed friction, 1 substep).
+constexpr int kPaperIterations = 25;
+
+// The table "Warm starting: what PGS needs to reach the paper's error" of one scene, from its
+// rows: for the cold start 0 and each warm start factor (kReportWarmStarts and any other in the
+// rows), the fewest iterations at the paper's other settings (PGS, Baumgarte, fixed friction,
+// 1 substep) whose value of the scene's primary measure (primary_measure) is at most the
+// paper's run's (25 iterations, cold); that run's wall time per simulated second and its ratio
+// to the paper's run's; and the iterations saved, 25 minus that count. Diverged runs and runs
+// without a value never count; "none in this sweep" where no run of the factor reaches it.
+void write_warm_table(std::ostream& md, const std::string& scene, const std::vector<const Row*>& rows) {
+  const std::string measure = primary_measure(scene);
+  md << "### Warm starting: what PGS needs to reach the paper's error\n\n";
+  const Row* base = nullptr;
+  for (const Row* r : rows) {
+    if (is_paper_setting(*r)) base = r;
+  }
+  if (!base || base->at("diverged") == "1" || std::isnan(to_double(*base, measure)) ||
+      !(to_double(*base, "wall_s_per_sim_s") > 0.0)) {
+    md << "The paper's run (PGS, Baumgarte, fixed friction, " << kPaperIterations
+       << " it, 1 substep, warm start 0) is "
+       << (base ? "diverged or without a value of " + label_of(measure) : std::string("not in this sweep"))
+       << ": nothing to compare with.\n\n";
+    return;
+  }
+  const double e0 = to_double(*base, measure);
+  const double t0 = to_double(*base, "wall_s_per_sim_s");
+  md << "The fewest iterations at the paper's other settings (PGS, Baumgarte, fixed friction, "
+        "1 substep) with which a run's " << label_of(measure) << " is at most the paper's run's ("
+     << kPaperIterations << " it, warm start 0): " << number(e0) << ", in " << number(t0)
+     << " s/s. Iterations saved: " << kPaperIterations
+     << " minus that count. Diverged runs never count.";
+  if (measure == "trajectory_error_m" && e0 < to_double(*base, "reference_check_m")) {
+    md << " The paper's value is under its reference's own error ("
+       << number(to_double(*base, "reference_check_m"))
+       << " m): the counts compare differences the reference does not resolve.";
+  }
+  md << "\n\n| warm start factor | fewest iterations | its " << label_of(measure)
+     << " | its time (s/s) | time ratio to the paper's run | iterations saved |\n"
+        "|---|---|---|---|---|---|\n";
+  std::vector<double> factors = {0.0};
+  for (const double w : kReportWarmStarts) factors.push_back(w);
+  for (const Row* r : rows) {
+    if (std::find(factors.begin(), factors.end(), warm_of(*r)) == factors.end()) {
+      factors.push_back(warm_of(*r));
+    }
+  }
+  std::sort(factors.begin(), factors.end());
+  for (const double w : factors) {
+    const Row* fewest = nullptr;
+    for (const Row* r : rows) {
+      if (r->at("solver") != "pgs" || r->at("push") != "baumgarte" ||
+          r->at("friction_model") != "fixed" || r->at("substeps") != "1" || warm_of(*r) != w ||
+          r->at("diverged") == "1") {
+        continue;
+      }
+      const double e = to_double(*r, measure);
+      if (!(e <= e0)) continue;
+      if (!fewest || std::atoi(r->at("iterations").c_str()) < std::atoi(fewest->at("iterations").c_str())) {
+        fewest = r;
+      }
+    }
+    md << "| " << factor_text(w) << (w == 0.0 ? " (cold, the paper's)" : "") << " | ";
+    if (!fewest) {
+      md << "none in this sweep | | | | |\n";
+      continue;
+    }
+    const int n = std::atoi(fewest->at("iterations").c_str());
+    const double t = to_double(*fewest, "wall_s_per_sim_s");
+    md << n << " | " << number(to_double(*fewest, measure)) << " | " << number(t) << " | "
+       << number(t / t0) << " | " << kPaperIterations - n << " |\n";
+  }
+  md << "\n";
+}
+
 }  // namespace
 
 std::string RunSpec::id() const {
   return scene + "." + name(solver) + "." + name(push) + "." + name(friction_model) +
-         ".it" + std::to_string(iterations) + ".ss" + std::to_string(substeps);
+         ".it" + std::to_string(iterations) + ".ss" + std::to_string(substeps) +
+         (warm_start != 0.0 ? ".ws" + factor_text(warm_start) : std::string());
 }
 
 RunSpec RunSpec::parse(const std::string& id) {
+  const auto bad = [&id](const std::string& why) {
+    return UsageError("run id '" + id + "': " + why +
+                      "; expected scene.pgs|jacobi.baumgarte|split.fixed|coupled.itN.ssM, "
+                      "optionally followed by .wsF, a warm start factor F in [0, 1]");
+  };
+  // The warm start factor, if any: ".wsF" right after the ".ssM" part (F may hold a dot).
+  std::string rest = id;
+  double warm_start = 0.0;
+  const std::size_t ws = id.rfind(".ws");
+  if (ws != std::string::npos) {
+    const std::size_t ss = id.rfind(".ss", ws);
+    const bool after_ss = ss != std::string::npos && ss + 3 < ws &&
+                          id.find_first_not_of("0123456789", ss + 3) == ws;
+    if (after_ss) {
+      const std::string f = id.substr(ws + 3);
+      const char* first = f.c_str();
+      const char* last = first + f.size();
+      const auto [end, ec] = std::from_chars(first, last, warm_start, std::chars_format::fixed);
+      if (first == last || ec != std::errc() || end != last || !(warm_start >= 0.0) ||
+          !(warm_start <= 1.0)) {
+        throw bad("'ws" + f + "' is not a warm start factor in [0, 1]");
+      }
+      rest = id.substr(0, ws);
+    }
+  }
   // The last five parts are the settings; the scene is what comes before them (scene names may
   // hold a dot: pendulum_wave_dt_0.1).
   std::vector<std::string> parts;
-  std::stringstream s(id);
+  std::stringstream s(rest);
   for (std::string part; std::getline(s, part, '.');) parts.push_back(part);
-  const auto bad = [&id](const std::string& why) {
-    return UsageError("run id '" + id + "': " + why +
-                      "; expected scene.pgs|jacobi.baumgarte|split.fixed|coupled.itN.ssM");
-  };
   if (parts.size() < 6) throw bad("it has " + std::to_string(parts.size()) + " parts, not 6");
   while (parts.size() > 6) {
     parts[0] += "." + parts[1];
@@ -843,6 +1038,7 @@ RunSpec RunSpec::parse(const std::string& id) {
   };
   r.iterations = count(parts[4], "it", static_cast<int>(parameter("iterations").max));
   r.substeps = count(parts[5], "ss", kMaxSubsteps);
+  r.warm_start = warm_start;
   const scenes::Scene& scene = scene_of(r);
   check_steps("run " + id, scene.report_horizon_s(), std::get<double>(*overrides_of(r).find("dt")));
   return r;
@@ -861,6 +1057,19 @@ std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, 
         for (const SolverKind s : {SolverKind::pgs, SolverKind::jacobi}) {
           for (const int it : iterations) runs.push_back({std::string(scene->name), s, p, f, it, 1});
           for (const int ss : substeps) runs.push_back({std::string(scene->name), s, p, f, 25, ss});
+        }
+        // Warm starting, PGS only (see the declaration); the quick sweep at the paper's push.
+        if (quick && p != PushMode::baumgarte) continue;
+        for (const double w : kReportWarmStarts) {
+          if (quick) {
+            for (const int it : kQuickWarmIterations) {
+              runs.push_back({std::string(scene->name), SolverKind::pgs, p, f, it, 1, w});
+            }
+          } else {
+            for (const int it : iterations) {
+              runs.push_back({std::string(scene->name), SolverKind::pgs, p, f, it, 1, w});
+            }
+          }
         }
       }
     }
@@ -882,6 +1091,7 @@ Row execute_run(const RunSpec& spec, int repeats) {
   row[std::string(parameter("friction_model").json_key)] = name(spec.friction_model);
   row[std::string(parameter("iterations").json_key)] = std::to_string(spec.iterations);
   row["substeps"] = std::to_string(spec.substeps);
+  row[std::string(parameter("warm_start").json_key)] = factor_text(spec.warm_start);
   row[std::string(parameter("dt").json_key)] = number(std::get<double>(*o.find("dt")));
   row["horizon_s"] = number(horizon);
 
@@ -1149,6 +1359,12 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows,
         "b) / A_jj, c_min, c_max)| over every row of every solve.\n"
      << "- **Substeps**: steps per 1/60 s frame (dt = 1 / (60 substeps) s); the iteration sweep "
         "runs at 1 substep, the substep sweep at 25 iterations.\n"
+     << "- **Warm start** (column warm_start, dimensionless): each PGS row's lambda starts from "
+        "this factor times its lambda of the previous step where its contact or rod persists "
+        "(Sec. 6.2.3); 0 is the paper's cold start from 0. Every run above starts cold but the "
+        "warm-started PGS iteration lines (1 substep), drawn in the same panels in their own "
+        "colours; each scene's table \"Warm starting\" gives the fewest iterations with which "
+        "PGS reaches the paper's error cold and warm, and the iterations saved.\n"
      << "- **Round-off floors** (diagrams only; tables and CSVs keep every value): " << kFloorNotes
      << "\n\n"
      << "## Headline: the paper's settings and the cheapest run with at most half their error\n\n"
@@ -1191,6 +1407,7 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows,
       md << best->at("solver") << ", " << best->at("push") << ", " << best->at("friction_model")
          << ", " << best->at("iterations") << " it, " << best->at("substeps")
          << (best->at("substeps") == "1" ? " substep" : " substeps")
+         << (warm_of(*best) != 0.0 ? ", warm start " + factor_text(warm_of(*best)) : std::string())
          << ": " << number(to_double(*best, measure)) << " | " << number(t1) << " | "
          << number(t1 / t0) << " |\n";
     } else {
@@ -1230,19 +1447,21 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows,
       md << ".\n";
     }
     md << "\nAll runs: [" << file_stem(scene) << ".csv](" << file_stem(scene) << ".csv).\n\n";
+    write_warm_table(md, scene, by_scene[scene]);
     for (const Measure& m : kMeasures) {
       if (plot_measure(dir, scene, m, by_scene[scene], title_note)) {
         md << "![" << scene << " " << m.column << "](" << file_stem(scene) << "_" << m.column << ".png)\n\n";
       }
     }
     const std::string measure = primary_measure(scene);
-    md << "| solver | push | friction | iterations | substeps | time (s/s) | " << label_of(measure)
+    md << "| solver | push | friction | iterations | substeps | warm start | time (s/s) | "
+       << label_of(measure)
        << " | residual RMS (N) | penetration max (m) | rod error max (m) | diverged at (s) |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const Row* r : by_scene[scene]) {
       md << "| " << cell(*r, "solver") << " | " << cell(*r, "push") << " | "
          << cell(*r, "friction_model") << " | " << cell(*r, "iterations") << " | "
-         << cell(*r, "substeps") << " | " << cell(*r, "wall_s_per_sim_s") << " | "
+         << cell(*r, "substeps") << " | " << factor_text(warm_of(*r)) << " | " << cell(*r, "wall_s_per_sim_s") << " | "
          << cell(*r, measure) << " | " << cell(*r, "residual_rms_N") << " | "
          << cell(*r, "penetration_max_m") << " | " << cell(*r, "rod_error_max_m") << " | "
          << (cell(*r, "diverged") == "1" ? cell(*r, "diverged_at_s") : "no") << " |\n";

@@ -13,7 +13,9 @@
 namespace cps::cli {
 
 /// One run of the sweep: a scene and the settings it runs with. iterations >= 1; substeps >= 1
-/// steps per 1/60 s frame, so dt = 1 / (60 substeps) s.
+/// steps per 1/60 s frame, so dt = 1 / (60 substeps) s; warm_start is the warm start factor
+/// (dimensionless, in [0, 1]; the world parameter warm_start, Sec. 6.2.3): 0, the default, is
+/// the paper's cold start from lambda = 0, typical warm values 0.8 and 1.
 struct RunSpec {
   std::string scene;
   SolverKind solver = SolverKind::pgs;
@@ -21,10 +23,16 @@ struct RunSpec {
   FrictionModel friction_model = FrictionModel::fixed;
   int iterations = 25;
   int substeps = 1;
+  double warm_start = 0.0;
 
-  /// "scene.solver.push.friction.itN.ssM", e.g. "stack.pgs.baumgarte.fixed.it25.ss1".
+  /// "scene.solver.push.friction.itN.ssM", e.g. "stack.pgs.baumgarte.fixed.it25.ss1", with
+  /// ".wsF" after it only when warm_start is not 0 (F its shortest decimal form that reads back
+  /// exactly: "stack.pgs.baumgarte.fixed.it4.ss1.ws0.8", ".ws1"), so that the ids of cold runs
+  /// are those of builds before warm starting.
   std::string id() const;
-  /// The inverse of id(). Throws UsageError naming the id if it is malformed or the scene unknown.
+  /// The inverse of id(); ".ws0" is taken as a cold run too. Throws UsageError naming the id if
+  /// it is malformed, the scene unknown, a count out of range or the warm start factor not a
+  /// number in [0, 1].
   static RunSpec parse(const std::string& id);
 };
 
@@ -34,7 +42,19 @@ using Row = std::map<std::string, std::string>;
 /// The runs of the sweep for these scenes. Full: iterations 1, 2, 4, 8, 16, 25, 32, 64, 128, 256
 /// at 1 substep and substeps 2, 4, 8, 16 at 25 iterations, for solver pgs and jacobi, push baumgarte and split,
 /// friction model fixed and coupled where the scene has friction. Quick: iterations 1, 4, 16, 25,
-/// 64 at 1 substep and 4 substeps at 25 iterations, friction model fixed only.
+/// 64 at 1 substep and 4 substeps at 25 iterations, friction model fixed only. All of these
+/// start cold (warm start 0, the paper's). Warm starting (kReportWarmStarts: factors 0.8 and 1)
+/// is swept for PGS only, where it matters most: PGS's Gauss-Seidel sweeps carry a good initial
+/// guess forward row by row, while Jacobi's simultaneous updates overshoot from any guess (its
+/// runs diverge at the paper's settings in the funnel already). Full: the whole iteration line
+/// at 1 substep for each warm factor, push baumgarte and split and the friction models as
+/// above (20 runs per push and friction model). Quick: iterations 1, 4, 16, 25 at 1 substep for
+/// each warm factor, push baumgarte and fixed friction only (8 runs per scene, 24 + 8 = 32).
+/// The warm start factors (dimensionless) the sweep runs beside the cold start 0.
+inline constexpr double kReportWarmStarts[] = {0.8, 1.0};
+
+/// The iteration counts of the quick sweep's warm lines (1 substep).
+inline constexpr int kQuickWarmIterations[] = {1, 4, 16, 25};
 std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, bool quick);
 
 /// Runs one spec: the error run (residuals measured) and `repeats` timing runs of the physics

@@ -73,6 +73,98 @@ double value(const std::map<std::string, std::string>& row, const std::string& c
   return it == row.end() || it->second.empty() ? std::nan("") : std::stod(it->second);
 }
 
+// The quick sweep of one scene, as `cps report --quick` defines it: cold runs at iterations 1,
+// 4, 16, 25, 64 (1 substep) and 4 substeps (25 iterations) for each solver (pgs, jacobi) and
+// push (baumgarte, split), fixed friction; and PGS warm-started at factors 0.8 and 1 at
+// iterations 1, 4, 16, 25 (1 substep), Baumgarte push, fixed friction.
+constexpr int kQuickCold = (5 + 1) * 2 * 2;
+constexpr int kQuickWarm = 2 * 4;
+constexpr int kQuickRuns = kQuickCold + kQuickWarm;
+
+// The warm start factor of a report CSV row; 0 where the column is empty.
+double warm_of(const std::map<std::string, std::string>& row) {
+  const double w = value(row, "warm_start");
+  return std::isnan(w) ? 0.0 : w;
+}
+
+// Checks report.md's table "Warm starting: what PGS needs to reach the paper's error" of
+// `scene` against the scene's CSV rows: for each warm start factor of the table, the fewest
+// iterations is the smallest count among the runs at PGS, Baumgarte, fixed friction, 1 substep
+// and that factor whose `measure` is at most the paper's run's (25 it, cold), not diverged;
+// every smaller count of that line does not reach it; the saved iterations are 25 minus the
+// count, the time ratio that run's time over the paper's. Returns the fewest count per factor
+// (-1 for "none in this sweep").
+std::map<double, int> check_warm_table(const std::string& md, const std::string& scene,
+                                       const std::vector<std::map<std::string, std::string>>& rows,
+                                       const std::string& measure) {
+  const auto line_of = [](const auto& r) {
+    return r.at("solver") == "pgs" && r.at("push") == "baumgarte" &&
+           r.at("friction_model") == "fixed" && r.at("substeps") == "1";
+  };
+  const std::map<std::string, std::string>* paper = nullptr;
+  for (const auto& r : rows) {
+    if (line_of(r) && r.at("iterations") == "25" && warm_of(r) == 0.0) paper = &r;
+  }
+  REQUIRE(paper != nullptr);
+  REQUIRE(paper->at("diverged") == "0");
+  const double e0 = value(*paper, measure);
+  const double t0 = value(*paper, "wall_s_per_sim_s");
+  const std::size_t section = md.find("## " + scene + "\n");
+  REQUIRE(section != std::string::npos);
+  const std::size_t table = md.find("### Warm starting: what PGS needs to reach the paper's error", section);
+  REQUIRE(table != std::string::npos);
+  std::stringstream lines(md.substr(md.find("|---", table)));
+  std::string line;
+  std::getline(lines, line);  // the separator
+  std::map<double, int> fewest;
+  while (std::getline(lines, line) && line.rfind("| ", 0) == 0) {
+    std::vector<std::string> cells;
+    std::stringstream cs(line.substr(2));
+    for (std::string c; std::getline(cs, c, '|');) {
+      c.erase(0, c.find_first_not_of(' '));
+      c.erase(c.find_last_not_of(' ') + 1);
+      cells.push_back(c);
+    }
+    REQUIRE(cells.size() >= 6);
+    const double w = std::stod(cells[0]);
+    INFO(scene << " warm start " << w);
+    int expected = -1;
+    for (const auto& r : rows) {
+      if (!line_of(r) || warm_of(r) != w || r.at("diverged") == "1") continue;
+      const int n = std::stoi(r.at("iterations"));
+      if (value(r, measure) <= e0 && (expected < 0 || n < expected)) expected = n;
+    }
+    if (cells[1] == "none in this sweep") {
+      CHECK(expected == -1);
+      fewest[w] = -1;
+      continue;
+    }
+    const int n = std::stoi(cells[1]);
+    CHECK(n == expected);
+    fewest[w] = n;
+    for (const auto& r : rows) {
+      if (!line_of(r) || warm_of(r) != w) continue;
+      const int it = std::stoi(r.at("iterations"));
+      if (it == n) {
+        CHECK(r.at("diverged") == "0");
+        CHECK(value(r, measure) <= e0);
+        CHECK(std::stod(cells[2]) == Approx(value(r, measure)).epsilon(1e-5));
+        CHECK(std::stod(cells[4]) == Approx(value(r, "wall_s_per_sim_s") / t0).epsilon(1e-4));
+      }
+      if (it < n) CHECK((r.at("diverged") == "1" || !(value(r, measure) <= e0)));
+    }
+    CHECK(std::stoi(cells[5]) == 25 - n);
+  }
+  // The cold start and the two warm factors of the sweep.
+  CHECK(fewest.count(0.0) == 1);
+  CHECK(fewest.count(0.8) == 1);
+  CHECK(fewest.count(1.0) == 1);
+  // The paper's run itself reaches the paper's error.
+  CHECK(fewest[0.0] >= 1);
+  CHECK(fewest[0.0] <= 25);
+  return fewest;
+}
+
 }  // namespace
 
 TEST_CASE("bad arguments exit with 2, name the problem and write nothing", "[cli]") {
@@ -124,6 +216,12 @@ TEST_CASE("work that would not end and malformed numbers are refused before any 
       {"simulate stack --dt 1/0", "--dt"},
       {"report --run stack.pgs.baumgarte.fixed.it4294967297.ss1 --out out", "it4294967297"},
       {"report --run stack.pgs.baumgarte.fixed.it1x.ss1 --out out", "it1x"},
+      // Warm start factors: decimal, in [0, 1], nothing after.
+      {"report --run stack.pgs.baumgarte.fixed.it1.ss1.ws2 --out out", "'ws2' is not a warm start factor in [0, 1]"},
+      {"report --run stack.pgs.baumgarte.fixed.it1.ss1.ws-0.5 --out out", "'ws-0.5' is not a warm start factor in [0, 1]"},
+      {"report --run stack.pgs.baumgarte.fixed.it1.ss1.wsnan --out out", "'wsnan'"},
+      {"report --run stack.pgs.baumgarte.fixed.it1.ss1.ws0.5x --out out", "'ws0.5x'"},
+      {"report --run stack.pgs.baumgarte.fixed.it1.ss1.ws --out out", "'ws' is not a warm start factor"},
       // Empty names mean nothing: refused.
       {"report --run '' --out out", "--run"},
       {"report stack --out ''", "--out"},
@@ -173,10 +271,10 @@ TEST_CASE("cps report's quick funnel sweep: trajectory errors where the balls ar
   const Result r = cps("report funnel --quick --out q", dir);
   REQUIRE(r.exit_code == 0);
   const auto rows = read_table(dir / "q/funnel.csv");
-  REQUIRE(rows.size() == 24u);
+  REQUIRE(rows.size() == static_cast<std::size_t>(kQuickRuns));
   const auto find = [&](const std::string& solver, const std::string& push, int it, int ss) {
     for (const auto& row : rows) {
-      if (row.at("solver") == solver && row.at("push") == push &&
+      if (row.at("solver") == solver && row.at("push") == push && warm_of(row) == 0.0 &&
           row.at("iterations") == std::to_string(it) && row.at("substeps") == std::to_string(ss)) {
         return row;
       }
@@ -212,6 +310,9 @@ TEST_CASE("cps report's quick funnel sweep: trajectory errors where the balls ar
     CHECK(value(row, "diverged_at_s") <= value(row, "horizon_s"));
   }
   CHECK(diverged >= 1);
+  // Warm-started PGS: the paper's error (trajectory error at 25 it, cold) reached with fewer
+  // iterations or not at all, as report.md's table says and the CSV confirms.
+  check_warm_table(slurp(dir / "q/report.md"), "funnel", rows, "trajectory_error_m");
   // Jacobi with the coupled friction model blows the balls apart within 1.3 s, before the
   // trajectory time: it steps on to it, and the blow-up has carried the balls further from the
   // reference pile than a ball's radius.
@@ -292,6 +393,10 @@ TEST_CASE("cps report never overwrites a foreign report.md, CSV or run.json", "[
   const fs::path dir = fresh_dir("report_foreign");
   // A complete sweep to merge (the intersecting stack's quick one: 24 short runs).
   REQUIRE(cps("report intersecting_stack --quick --out src", dir).exit_code == 0);
+  // Its warm starting table agrees with its CSV (the scene's measure: the largest body speed
+  // at the end; the paper's run flings the boxes apart fastest, so few iterations reach it).
+  check_warm_table(slurp(dir / "src/report.md"), "intersecting_stack",
+                   read_table(dir / "src/intersecting_stack.csv"), "metric.max_speed_mps");
   for (const char* name : {"report.md", "intersecting_stack.csv", "run.json"}) {
     INFO(name);
     const fs::path out = dir / (std::string("out_") + name);
@@ -382,14 +487,19 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
     // 2 s after which a run is timed once).
     CHECK(value(read_table(dir / "runs/stack.pgs.split.fixed.it4.ss1.csv").at(0), "timing_repeats") >= 3);
     const Result merged = cps("report --merge runs --out merged", dir);
-    // 2 of the 24 runs of the quick stack sweep: the other 22 are named (a few, then a count).
+    // 2 of the quick stack sweep's runs: the others are named (a few, then a count).
     CHECK(merged.exit_code == 1);
-    CHECK(merged.err.find("22 of the 24 planned runs are missing") != std::string::npos);
+    CHECK(merged.err.find(std::to_string(kQuickRuns - 2) + " of the " + std::to_string(kQuickRuns) +
+                          " planned runs are missing") != std::string::npos);
     CHECK(merged.err.find("stack.pgs.baumgarte.fixed.it1.ss1") != std::string::npos);
-    CHECK(merged.err.find("and 17 more") != std::string::npos);
+    CHECK(merged.err.find("and " + std::to_string(kQuickRuns - 2 - 5) + " more") != std::string::npos);
     CHECK(merged.err.find("INCOMPLETE") != std::string::npos);
     const std::string md = slurp(dir / "merged/report.md");
     CHECK(md.find("INCOMPLETE") < md.find("## Headline"));
+    // The missing warm-started runs are named too (report.md names the first 20 in plan order:
+    // the Baumgarte runs, cold then warm).
+    CHECK(md.find("`stack.pgs.baumgarte.fixed.it1.ss1.ws0.8`") != std::string::npos);
+    CHECK(md.find("`stack.pgs.baumgarte.fixed.it25.ss1.ws1`") != std::string::npos);
     const std::string csv = slurp(dir / "merged/stack.csv");
     CHECK(csv.find("wall_s_per_sim_s") != std::string::npos);
     CHECK(csv.find("residual_rms_N") != std::string::npos);
@@ -401,8 +511,9 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
   SECTION("--list-runs prints one command per run; all of them merge into a complete report") {
     const Result r = cps("report mass_ratio_10 --quick --list-runs --out o", dir);
     REQUIRE(r.exit_code == 0);
-    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 25);  // 24 runs and the merge line
-    CHECK(r.out.find("--run mass_ratio_10.pgs.baumgarte.fixed.it25.ss1") != std::string::npos);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == kQuickRuns + 1);  // and the merge line
+    CHECK(r.out.find("--run mass_ratio_10.pgs.baumgarte.fixed.it25.ss1 ") != std::string::npos);
+    CHECK(r.out.find("--run mass_ratio_10.pgs.baumgarte.fixed.it16.ss1.ws0.8 ") != std::string::npos);
     CHECK(r.out.find("--merge") != std::string::npos);
     std::stringstream lines(r.out);
     int ran = 0;
@@ -412,7 +523,12 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
       CHECK(std::system(command.c_str()) == 0);
       ++ran;
     }
-    CHECK(ran == 24);
+    CHECK(ran == kQuickRuns);
+    // A warm run's file is named by its id, which reads back to the run: warm_start 0.8.
+    const auto warm = read_table(dir / "o/runs/mass_ratio_10.pgs.baumgarte.fixed.it16.ss1.ws0.8.csv");
+    REQUIRE(warm.size() == 1u);
+    CHECK(warm[0].at("warm_start") == "0.8");
+    CHECK(warm[0].at("iterations") == "16");
     const Result merged = cps("report --merge o/runs --out o", dir);
     CHECK(merged.exit_code == 0);
     CHECK(merged.err.find("missing") == std::string::npos);
@@ -423,6 +539,83 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
     CHECK(r.exit_code == 2);
     CHECK(r.err.find("unknown push 'sideways'") != std::string::npos);
     CHECK(!fs::exists(dir / "o"));
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps report plans warm-started PGS runs beside the cold sweep and their ids read back",
+          "[cli][report]") {
+  const fs::path dir = fresh_dir("warm_plan");
+  // The ids of a sweep's runs, from --list-runs.
+  const auto ids_of = [&](const std::string& args) {
+    const Result r = cps("report " + args + " --list-runs --out o", dir);
+    REQUIRE(r.exit_code == 0);
+    std::vector<std::string> ids;
+    std::stringstream lines(r.out);
+    for (std::string line; std::getline(lines, line);) {
+      const std::size_t at = line.find("--run ");
+      if (at == std::string::npos) continue;
+      ids.push_back(line.substr(at + 6, line.find(' ', at + 6) - at - 6));
+    }
+    return ids;
+  };
+  // The factor of an id (after ".ws"; 0 without) and whether it is PGS at 1 substep.
+  const auto factor = [](const std::string& id) {
+    const std::size_t ws = id.rfind(".ws");
+    return ws == std::string::npos ? 0.0 : std::stod(id.substr(ws + 3));
+  };
+  SECTION("quick: the cold sweep and PGS, Baumgarte, fixed friction at 0.8 and 1, it 1, 4, 16, 25") {
+    const std::vector<std::string> ids = ids_of("funnel --quick");
+    CHECK(ids.size() == static_cast<std::size_t>(kQuickRuns));
+    std::map<double, std::vector<std::string>> by_factor;
+    for (const std::string& id : ids) by_factor[factor(id)].push_back(id);
+    CHECK(by_factor[0.0].size() == static_cast<std::size_t>(kQuickCold));
+    for (const double w : {0.8, 1.0}) {
+      INFO("warm start " << w);
+      std::vector<std::string> expected;
+      for (const int it : {1, 4, 16, 25}) {
+        std::ostringstream id;
+        id << "funnel.pgs.baumgarte.fixed.it" << it << ".ss1.ws" << w;
+        expected.push_back(id.str());
+      }
+      CHECK(by_factor[w] == expected);
+    }
+    CHECK(by_factor.size() == 3u);
+  }
+  SECTION("full: every push and friction model, PGS's whole iteration line at 0.8 and 1") {
+    const std::vector<std::string> ids = ids_of("funnel");
+    // The funnel has friction: friction models fixed and coupled. Cold: 10 iteration counts at
+    // 1 substep and 4 substep counts at 25 iterations, per solver, push and friction model.
+    // Warm: 10 iteration counts per factor, push and friction model, PGS only.
+    const int cold = (10 + 4) * 2 * 2 * 2;
+    const int warm = 2 * 10 * 2 * 2;
+    CHECK(ids.size() == static_cast<std::size_t>(cold + warm));
+    int n_warm = 0;
+    for (const std::string& id : ids) {
+      if (factor(id) == 0.0) continue;
+      ++n_warm;
+      INFO(id);
+      CHECK(id.find(".pgs.") != std::string::npos);
+      CHECK(id.find(".ss1.ws") != std::string::npos);
+      CHECK((factor(id) == 0.8 || factor(id) == 1.0));
+    }
+    CHECK(n_warm == warm);
+    for (const char* id : {"funnel.pgs.split.coupled.it256.ss1.ws1", "funnel.pgs.baumgarte.fixed.it2.ss1.ws0.8"}) {
+      CHECK(std::find(ids.begin(), ids.end(), id) != ids.end());
+    }
+  }
+  SECTION("an id runs the run it names; .ws0 is the cold run, named without it") {
+    const std::string cold = "intersecting_stack.pgs.baumgarte.fixed.it4.ss1";
+    REQUIRE(cps("report intersecting_stack --run " + cold + ".ws0 --out r", dir).exit_code == 0);
+    const auto c = read_table(dir / "r" / (cold + ".csv"));
+    REQUIRE(c.size() == 1u);
+    CHECK(c[0].at("warm_start") == "0");
+    REQUIRE(cps("report intersecting_stack --run " + cold + ".ws1 --out r", dir).exit_code == 0);
+    const auto w = read_table(dir / "r" / (cold + ".ws1.csv"));
+    REQUIRE(w.size() == 1u);
+    CHECK(w[0].at("warm_start") == "1");
+    CHECK(w[0].at("iterations") == "4");
+    CHECK(w[0].at("solver") == "pgs");
   }
   fs::remove_all(dir);
 }

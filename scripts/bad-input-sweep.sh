@@ -135,7 +135,7 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     hash)  # 16 hex digits (0x prefix allowed)
       printf '%s\n' "" xyz 0123456789abcde 0123456789abcdef0 0123456789abcdeg 0x0123456789abcde \
         -123456789abcdef " 0123456789abcdef" "0123456789abcdef " 0x 0xx0123456789abcdef nan ;;
-    run_id)  # scene.solver.push.friction.itN.ssM
+    run_id)  # scene.solver.push.friction.itN.ssM, then optionally .wsF (warm start F in [0, 1])
       local good=intersecting_stack.pgs.baumgarte.fixed
       printf '%s\n' "" garbage intersecting_stack "$good.it25" "$good.it25.ss1.extra" \
         nosuch.pgs.baumgarte.fixed.it1.ss1 intersecting_stack.sor.baumgarte.fixed.it1.ss1 \
@@ -143,7 +143,10 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         "$good.it0.ss1" "$good.it-1.ss1" "$good.it10001.ss1" "$good.it4294967297.ss1" \
         "$good.it1x.ss1" "$good.it0x10.ss1" "$good.it1e3.ss1" "$good.it.ss1" "$good.it 1.ss1" \
         "$good.x1.ss1" "$good.it1.ss0" "$good.ss1.it1" "$good.it1.ss1001" "$good.it1.ss-1" \
-        "$good.it1.ss1.5" ..... "$good.IT1.SS1" ;;
+        "$good.it1.ss1.5" ..... "$good.IT1.SS1" \
+        "$good.it1.ss1.ws2" "$good.it1.ss1.ws-0.1" "$good.it1.ss1.wsnan" "$good.it1.ss1.wsinf" \
+        "$good.it1.ss1.ws1e-1" "$good.it1.ss1.ws0x1" "$good.it1.ss1.ws" "$good.it1.ss1.ws0.5.5" \
+        "$good.it1.ss1.ws 0.5" "$good.it1.ss1.WS0.5" "$good.it1.ws0.5" "$good.it1.ss1.ws1.0001" ;;
     out_json)  # cannot be written as a new scene file
       printf '%s\n' "" file file/s.json adir /dev/null . ;;
     seed)  # a decimal integer in [0, 2^64 - 1] (and only for the random scene)
@@ -210,6 +213,7 @@ CONTROLS=(
   "simulate stack --seconds 5e-324"
   "simulate stack --seconds 0.1 --dt 1/60 --beta 1e-320 --friction 0 --iterations 10000"
   "report --list-runs --out out"
+  "report intersecting_stack --run intersecting_stack.pgs.baumgarte.fixed.it1.ss1.ws0.8 --out out"
   "render stack --seconds 0.1 --fps 10 --size 16x16 --out out"
   "render stack --seconds 0.1 --fps 5e-324 --size 16x16 --out out --orbit -36000"
   "figure stack --times 0,0.1 --size 16x16 --out out/f.png"
@@ -493,7 +497,7 @@ control() {  # ARGS...: must exit 0
     echo "CONTROL FAILED (valid, must exit 0): $(show "$@") -> exit $RC: ${ERR:0:300}"
   fi
 }
-# The --merge source: a complete sweep (the intersecting stack's quick one, 24 runs, a few
+# The --merge source: a complete sweep (the intersecting stack's quick one, 32 runs, a few
 # seconds; RUN_ID is one of them), so that merging it is valid (a merge with runs missing exits 1).
 timeout "$TIMEOUT" "$CPS" report intersecting_stack --quick --out "$MERGE_SRC" > /dev/null 2>&1
 if ! compgen -G "$MERGE_SRC/*.csv" > /dev/null; then

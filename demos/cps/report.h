@@ -75,9 +75,14 @@ std::vector<std::string> missing_runs(const std::vector<Row>& rows, std::size_t&
 
 /// Writes DIR/SCENE.csv (one per scene present in rows, columns sorted with the settings first),
 /// the work-precision diagrams DIR/SCENE_<measure>.png and .svg through gnuplot (a panel per
-/// solver, push and friction model on shared axes; diverged runs on the top edge; values under
+/// solver, push and friction model on shared axes, the warm-started iteration lines in the cold
+/// run's panel; diverged runs on the top edge; values under
 /// the measure's round-off floor drawn on it), DIR/mass_ratio.csv (the mass ratio pair: held or
-/// not per ratio, solver and push) and DIR/report.md. If `missing` (run ids, of `planned`) is
+/// not per ratio, solver and push) and DIR/report.md, whose section per scene opens with the
+/// table "Warm starting: what PGS needs to reach the paper's error" (per warm start factor, 0
+/// included: the fewest iterations at PGS, Baumgarte, fixed friction, 1 substep whose primary
+/// measure is at most the paper's run's, that run's time, its ratio to the paper run's, and
+/// the iterations saved, 25 minus the count). If `missing` (run ids, of `planned`) is
 /// not empty, report.md opens with INCOMPLETE and names them, and every diagram's title says
 /// so. Throws std::runtime_error if a file cannot be written or gnuplot fails (the message says
 /// to install gnuplot-nox when it is missing; the CSVs are kept).

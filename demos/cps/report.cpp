@@ -202,8 +202,8 @@ double to_double(const Row& row, const std::string& column) {
 // Columns in the order a reader wants them: the settings, then the measures, then metrics.
 std::vector<std::string> ordered_columns(const std::vector<Row>& rows) {
   static const std::vector<std::string> first = {
-      "scene", "solver", "push", "friction_model", "iterations", "substeps", "warm_start", "dt_s", "horizon_s",
-      "diverged", "diverged_at_s", "wall_s_per_sim_s", "us_per_step", "timing_repeats",
+      "scene", "solver", "push", "friction_model", "iterations", "substeps", "warm_start", "dt_s",
+      "horizon_s", "diverged", "diverged_at_s", "wall_s_per_sim_s", "us_per_step", "timing_repeats",
       "trajectory_time_s", "trajectory_error_m", "reference_check_m", "phase_error_deg",
       "residual_max_N", "residual_rms_N", "penetration_max_m", "penetration_rms_m",
       "rod_error_max_m", "rod_error_rms_m", "energy_drift_rel", "sweep", "quick", "mass_ratio",
@@ -403,7 +403,8 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
   d.floor = floor;
   for (const Row* r : rows) {
     const double w = warm_of(*r);
-    if (w != 0.0 && std::find(d.warm_factors.begin(), d.warm_factors.end(), w) == d.warm_factors.end()) {
+    if (w != 0.0 &&
+        std::find(d.warm_factors.begin(), d.warm_factors.end(), w) == d.warm_factors.end()) {
       d.warm_factors.push_back(w);
     }
   }
@@ -429,8 +430,9 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
       const int it = count(*r, "iterations");
       const int ss = count(*r, "substeps");
       const double w = warm_of(*r);
-      const std::string label = (ss == 1 ? std::to_string(it) + " it" : std::to_string(ss) + " ss") +
-                                (w != 0.0 ? ", ws " + factor_text(w) : std::string());
+      const std::string label =
+          (ss == 1 ? std::to_string(it) + " it" : std::to_string(ss) + " ss") +
+          (w != 0.0 ? ", ws " + factor_text(w) : std::string());
       if (r->at("diverged") == "1") {
         p.diverged.push_back({t, 0.0, label});
         d.any_diverged = true;
@@ -453,7 +455,8 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
       if (w != 0.0) {
         // Warm runs: the iteration line of their factor only (the sweep has no warm substeps).
         const auto k = std::find(d.warm_factors.begin(), d.warm_factors.end(), w);
-        if (ss == 1) warm_lines[static_cast<std::size_t>(k - d.warm_factors.begin())].emplace_back(it, point);
+        const auto line = static_cast<std::size_t>(k - d.warm_factors.begin());
+        if (ss == 1) warm_lines[line].emplace_back(it, point);
         continue;
       }
       if (ss == 1) it_line.emplace_back(it, point);
@@ -903,7 +906,8 @@ constexpr int kPaperIterations = 25;
 // paper's run's (25 iterations, cold); that run's wall time per simulated second and its ratio
 // to the paper's run's; and the iterations saved, 25 minus that count. Diverged runs and runs
 // without a value never count; "none in this sweep" where no run of the factor reaches it.
-void write_warm_table(std::ostream& md, const std::string& scene, const std::vector<const Row*>& rows) {
+void write_warm_table(std::ostream& md, const std::string& scene,
+                      const std::vector<const Row*>& rows) {
   const std::string measure = primary_measure(scene);
   md << "### Warm starting: what PGS needs to reach the paper's error\n\n";
   const Row* base = nullptr;
@@ -914,7 +918,8 @@ void write_warm_table(std::ostream& md, const std::string& scene, const std::vec
       !(to_double(*base, "wall_s_per_sim_s") > 0.0)) {
     md << "The paper's run (PGS, Baumgarte, fixed friction, " << kPaperIterations
        << " it, 1 substep, warm start 0) is "
-       << (base ? "diverged or without a value of " + label_of(measure) : std::string("not in this sweep"))
+       << (base ? "diverged or without a value of " + label_of(measure)
+                : std::string("not in this sweep"))
        << ": nothing to compare with.\n\n";
     return;
   }
@@ -951,9 +956,8 @@ void write_warm_table(std::ostream& md, const std::string& scene, const std::vec
       }
       const double e = to_double(*r, measure);
       if (!(e <= e0)) continue;
-      if (!fewest || std::atoi(r->at("iterations").c_str()) < std::atoi(fewest->at("iterations").c_str())) {
-        fewest = r;
-      }
+      const int n = std::atoi(r->at("iterations").c_str());
+      if (!fewest || n < std::atoi(fewest->at("iterations").c_str())) fewest = r;
     }
     md << "| " << factor_text(w) << (w == 0.0 ? " (cold, the paper's)" : "") << " | ";
     if (!fewest) {
@@ -1461,7 +1465,8 @@ void write_report(const fs::path& dir, const std::vector<Row>& rows,
     for (const Row* r : by_scene[scene]) {
       md << "| " << cell(*r, "solver") << " | " << cell(*r, "push") << " | "
          << cell(*r, "friction_model") << " | " << cell(*r, "iterations") << " | "
-         << cell(*r, "substeps") << " | " << factor_text(warm_of(*r)) << " | " << cell(*r, "wall_s_per_sim_s") << " | "
+         << cell(*r, "substeps") << " | " << factor_text(warm_of(*r)) << " | "
+         << cell(*r, "wall_s_per_sim_s") << " | "
          << cell(*r, measure) << " | " << cell(*r, "residual_rms_N") << " | "
          << cell(*r, "penetration_max_m") << " | " << cell(*r, "rod_error_max_m") << " | "
          << (cell(*r, "diverged") == "1" ? cell(*r, "diverged_at_s") : "no") << " |\n";

@@ -84,6 +84,12 @@ void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
     if (params.restitution > 0.0 && approach < -params.restitution_threshold &&
         approach * params.dt <= std::min(c.depth, 0.0)) {
       contact.bias = -params.restitution * approach;
+      contact.restitution = contact.bias;
+    }
+    // Split impulse (split_impulse.h): a shallow contact's push stays in the velocity solve.
+    if (c.depth <= params.velocity_push_depth) {
+      contact.bias += contact.push;
+      contact.push = 0.0;
     }
     contact.c_min = 0.0;
     contact.c_max = kInfinity;

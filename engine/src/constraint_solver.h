@@ -18,13 +18,18 @@
 
 namespace cps {
 
-/// What one solve needs besides the rows and bodies: dt (s, > 0), the number of sweeps (>= 1),
-/// PGS or Jacobi, and the friction model of the force limits.
+/// What one solve needs besides the rows and bodies: dt (s, > 0; a substep's length for the soft
+/// step), the number of sweeps (>= 1), PGS or Jacobi, the friction model of the force limits,
+/// and the rows' softness.
 struct SolveSettings {
   double dt = 1.0 / 60.0;
   int iterations = 25;
   SolverKind kind = SolverKind::pgs;
   FrictionModel friction = FrictionModel::fixed;
+  /// nullptr: rigid rows (the paper's A lambda = b). Else c values gamma_j >= 0 (dimensionless):
+  /// the solve is of (A + diag(gamma_j A_jj)) lambda = b, soft rows as Box2D v3 makes them
+  /// (soft_step.h: gamma = 1 / (h omega (2 zeta + h omega))); gamma_j = 0 leaves row j rigid.
+  const std::vector<double>* softness = nullptr;
 };
 
 /// A way to solve the step's bounded system A lambda = b.
@@ -38,7 +43,8 @@ class ConstraintSolver {
   virtual void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies) = 0;
 
   /// Solves A lambda = b with settings.iterations sweeps, b of Eq. 6.2.9 from the bodies'
-  /// momenta, f_ext (6n: force and torque per body, N and N m) and each row's target velocity
+  /// momenta as they are now (read with the world inverse inertia of prepare(), so that the
+  /// substeps of one step share one A), f_ext (6n: force and torque per body, N and N m) and each row's target velocity
   /// (push and bias, or bias only: `terms`, Sec. 8.1), from `initial` (c values, N: the warm
   /// start of Sec. 6.2.3) when given, else from lambda = 0. lambda: resized to c (N). The rows
   /// and bodies must be those given to prepare().

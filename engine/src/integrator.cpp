@@ -39,4 +39,14 @@ void integrate(std::vector<Body>& bodies, const Eigen::VectorXd& f_position,
   }
 }
 
+void add_momenta(std::vector<Body>& bodies, const Eigen::VectorXd& f, double dt) {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    Body& body = bodies[i];
+    if (body.is_static()) continue;
+    const auto k = 6 * static_cast<Eigen::Index>(i);
+    body.p += f.segment<3>(k) * dt;
+    body.l += f.segment<3>(k + 3) * dt;
+  }
+}
+
 }  // namespace cps

@@ -158,6 +158,46 @@ void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lam
   }
 }
 
+// Soft rows (SolveSettings::softness): PGS or Jacobi row by row on (A + diag(gamma_j A_jj)),
+// lambda_j <- clamp(lambda_j + ((b_j - (A lambda)_j) / A_jj - gamma_j lambda_j) / (1 + gamma_j)),
+// which is Box2D v3's soft update with mass scale 1 / (1 + gamma) and impulse scale
+// gamma / (1 + gamma) (soft_step.h). With gamma_j = 0 it is Eq. 7.1.1.
+template <bool kCoupled>
+void soft_sweeps(MatrixFreeSystem& s, const std::vector<double>& softness, bool jacobi,
+                 int iterations, std::vector<double>& lambda) {
+  const std::size_t c = s.rows.size();
+  const PackedRow* rows = s.rows.data();
+  const double* b = s.b.data();
+  double* l = lambda.data();
+  const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+  for (int k = 0; k < iterations; ++k) {
+    for (std::size_t j = 0; j < c; ++j) {
+      const PackedRow& row = rows[j];
+      if (row.inv_diagonal == 0.0) continue;  // the row touches no movable body: lambda_j stays 0
+      double lo;
+      double hi;
+      bounds<kCoupled>(row, lambda, lo, hi);
+      const double gamma = softness[j];
+      const double value = std::clamp(
+          l[j] + ((b[j] - row_times_w(row, s.w, fixed_slot)) * row.inv_diagonal - gamma * l[j]) /
+                     (1.0 + gamma),
+          lo, hi);
+      if (jacobi) {
+        s.next[j] = value;
+      } else {
+        add_to_w(row, value - l[j], s.w, fixed_slot);
+        l[j] = value;
+      }
+    }
+    if (!jacobi) continue;
+    for (std::size_t j = 0; j < c; ++j) {
+      if (rows[j].inv_diagonal == 0.0) continue;
+      add_to_w(rows[j], s.next[j] - l[j], s.w, fixed_slot);
+      l[j] = s.next[j];
+    }
+  }
+}
+
 }  // namespace
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
@@ -231,8 +271,12 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     }
   }
   s.w.back().setZero();
+  if (terms == TargetTerms::push_from_rest) {  // the bodies at rest, no external force: b = v / dt
+    for (std::size_t r = 0; r < rows.size(); ++r) s.b[r] = target_velocity(rows[r], terms) / dt;
+    return;
+  }
   for (std::size_t r = 0; r < rows.size(); ++r) {
-    const double v = rows[r].bias + (terms == TargetTerms::push_and_bias ? rows[r].push : 0.0);
+    const double v = target_velocity(rows[r], terms);
     s.b[r] = v / dt - row_times_w(s.rows[r], s.w, static_cast<int>(bodies.size()));
   }
 }
@@ -286,7 +330,7 @@ void build_runs(MatrixFreeSystem& s) {
 
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
            SolverKind kind, int iterations, std::vector<double>& lambda,
-           const std::vector<double>* initial) {
+           const std::vector<double>* initial, const std::vector<double>* softness) {
   detail::assign_with_headroom(lambda, rows.size(), 0.0);  // initial guess 0 (Sec. 7.2) ...
   for (Vec6& w : s.w) w.setZero();
   if (initial != nullptr) {  // ... or the one given, with w = M^-1 J^T lambda to match
@@ -319,6 +363,14 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
     flush();
   }
   const bool coupled = friction == FrictionModel::coupled;
+  s.softness = softness;
+  if (softness != nullptr) {
+    const bool jacobi = kind == SolverKind::jacobi;
+    if (jacobi) detail::assign_with_headroom(s.next, rows.size(), 0.0);
+    coupled ? soft_sweeps<true>(s, *softness, jacobi, iterations, lambda)
+            : soft_sweeps<false>(s, *softness, jacobi, iterations, lambda);
+    return;
+  }
   if (kind == SolverKind::jacobi) {
     detail::assign_with_headroom(s.next, rows.size(), 0.0);
     coupled ? jacobi_sweeps<true>(s, iterations, lambda) : jacobi_sweeps<false>(s, iterations, lambda);
@@ -343,8 +395,14 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     } else {
       bounds<false>(s.rows[j], lambda, lo, hi);
     }
-    const double Ax = row_times_w(s.rows[j], s.w, static_cast<int>(s.w.size()) - 1);
-    const double r = detail::natural_map_residual(lambda[j], Ax - s.b[j], diagonal, lo, hi);
+    double Ax = row_times_w(s.rows[j], s.w, static_cast<int>(s.w.size()) - 1);
+    double d = diagonal;
+    if (s.softness != nullptr) {  // the soft system's row: A_jj (1 + gamma_j)
+      const double gamma = (*s.softness)[j];
+      Ax += gamma * diagonal * lambda[j];
+      d *= 1.0 + gamma;
+    }
+    const double r = detail::natural_map_residual(lambda[j], Ax - s.b[j], d, lo, hi);
     max = std::max(max, r);
     sum_squares += r * r;
   }

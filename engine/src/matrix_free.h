@@ -60,6 +60,9 @@ struct MatrixFreeSystem {
   std::vector<double> next;      ///< Jacobi: the sweep's new values (N)
   std::vector<Vec6> w;           ///< per body, and one zero slot: M^-1 J^T lambda
   std::vector<Mat3> inv_inertia; ///< per body: world inverse inertia this step (1/(kg m^2))
+  /// The softness of the last solve (c values, dimensionless; SolveSettings::softness), or
+  /// nullptr for rigid rows; the residual reads it. Not owned.
+  const std::vector<double>* softness = nullptr;
 };
 
 /// Packs the rows (c) for bodies (n): j, minv_jt, diagonal, 1 / A_jj and the bounds, and the
@@ -69,8 +72,9 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
              const std::vector<Body>& bodies);
 
 /// Fills s.b (c): b_j = v_j / dt - j_j . (v1 / dt + M^-1 f_ext) (Eq. 6.2.9) with f_ext (6n:
-/// force and torque per body, N and N m; the explicit path reads the same vector) and v_j the
-/// row's push and bias (TargetTerms as in assemble_rhs). dt in s, > 0.
+/// force and torque per body, N and N m; the explicit path reads the same vector), v1 from the
+/// bodies' momenta now and the inverse inertia of prepare(), and v_j the row's push and bias
+/// (TargetTerms as in assemble_rhs; push_from_rest: b_j = push_j / dt). dt in s, > 0.
 void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
          const std::vector<Body>& bodies, const Eigen::VectorXd& f_ext, double dt,
          TargetTerms terms);
@@ -80,10 +84,13 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
 /// It starts from `initial` (c values, N; warm starting, Sec. 6.2.3) when given, with
 /// w = M^-1 J^T initial, else from lambda = 0 and w = 0; a row that touches no movable body
 /// starts at 0 whatever the guess (as solve_lcp). s must be prepared for these rows and s.b
-/// filled.
+/// filled. softness: nullptr (rigid rows), or c values gamma_j >= 0: the system is then
+/// (A + diag(gamma_j A_jj)) lambda = b (SolveSettings::softness), swept row by row; the vector
+/// must outlive the next residual() call.
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
            SolverKind kind, int iterations, std::vector<double>& lambda,
-           const std::vector<double>* initial = nullptr);
+           const std::vector<double>* initial = nullptr,
+           const std::vector<double>* softness = nullptr);
 
 /// The natural-map residual of lcp_residual for the lambda that solve() left (using its w),
 /// per row: the largest value and the sum of squares (N, N^2).

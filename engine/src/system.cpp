@@ -41,9 +41,9 @@ Eigen::VectorXd assemble_rhs(const std::vector<ConstraintRow>& rows, const Spars
   // b = v / dt - J (v1 / dt + M^-1 f_ext)   (Eq. 6.2.9)
   Eigen::VectorXd v(static_cast<Eigen::Index>(rows.size()));
   for (std::size_t r = 0; r < rows.size(); ++r) {
-    v[static_cast<Eigen::Index>(r)] =
-        rows[r].bias + (terms == TargetTerms::push_and_bias ? rows[r].push : 0.0);
+    v[static_cast<Eigen::Index>(r)] = target_velocity(rows[r], terms);
   }
+  if (terms == TargetTerms::push_from_rest) return v / dt;  // v1 = 0, f_ext = 0
   const Eigen::VectorXd accel = v1 / dt + M_inv * f_ext;
   return v / dt - J * accel;
 }

@@ -22,9 +22,21 @@ namespace cps {
 using SparseRowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
 /// Which parts of each row's target velocity enter v: the full push + bias (the ordinary solve,
-/// and the first solve of Sec. 8.1), or bias only (the second solve of Sec. 8.1, v without the
-/// constraint-correcting push factor).
-enum class TargetTerms : int { push_and_bias, bias_only };
+/// and the first solve of Sec. 8.1), bias only (the second solve of Sec. 8.1, v without the
+/// constraint-correcting push factor), or the push alone with the bodies taken at rest and no
+/// external force, b = push / dt (the pseudo-velocity solve of the split impulse,
+/// split_impulse.h).
+enum class TargetTerms : int { push_and_bias, bias_only, push_from_rest };
+
+/// The target velocity v_j (m/s) of a row in a solve of these terms: push + bias, bias, or push.
+inline double target_velocity(const ConstraintRow& row, TargetTerms terms) {
+  switch (terms) {
+    case TargetTerms::push_and_bias: return row.bias + row.push;
+    case TargetTerms::bias_only: return row.bias;
+    case TargetTerms::push_from_rest: return row.push;
+  }
+  return 0.0;
+}
 
 
 /// The bounds on lambda, per row (c each): c_min, c_max (N); for friction rows also the index

@@ -30,6 +30,9 @@ inline constexpr int kWorldBody = -1;
 /// - normal_row: for a friction row, the index of its contact row (for the coupled friction
 ///   limit mu lambda_n); -1 otherwise.
 /// - mu: for a friction row, the friction coefficient (dimensionless).
+/// - restitution: for a contact row that bounces (Eq. 8.2.1), its target -eps j . v1 (m/s), also
+///   in bias; 0 otherwise. The soft step (soft_step.h) recomputes every target each substep and
+///   applies this one at the end of the step, as Box2D v3 does.
 /// body_a or body_b may be kWorldBody (a fixed world point): that half of j then acts on nothing.
 struct ConstraintRow {
   RowKind kind = RowKind::contact;
@@ -38,6 +41,7 @@ struct ConstraintRow {
   Vec12 j = Vec12::Zero();
   double push = 0.0;
   double bias = 0.0;
+  double restitution = 0.0;
   double c_min = -kInfinity;
   double c_max = kInfinity;
   int normal_row = -1;
@@ -67,6 +71,10 @@ struct RowParams {
   double restitution = 0.0;
   double restitution_threshold = 1.0;
   double penetration_slop = 0.0;  ///< m, >= 0: depth the push leaves (WorldDef::penetration_slop)
+  /// m: contacts no deeper than this keep their push in the velocity solve (it is moved into
+  /// bias). The split impulse (split_impulse.h) sets it to WorldDef::split_impulse_threshold;
+  /// -inf (the default) moves nothing.
+  double velocity_push_depth = -kInfinity;
 };
 
 /// Appends the rows of one manifold to `rows`: first its contact rows, one per point in point

@@ -5,6 +5,9 @@
 #include "buffers.h"
 #include "constraint_solver.h"
 #include "integrator.h"
+#include "ngs.h"
+#include "soft_step.h"
+#include "split_impulse.h"
 #include "system.h"
 #include "warm_start.h"
 
@@ -99,23 +102,99 @@ void World::step() {
   collide();                                          // Sec. 4: manifolds
   build_rows();                                       // Sec. 5: rows of J, targets, limits
   prepare();                                          // Sec. 6: A or the packed rows
-  // Sec. 7: lambda, f_cv. With the single frame push factor (Sec. 8.1) both solves are warm
-  // started, each from its own lambda of the previous step: they solve for different targets
-  // (with and without the push), and a persisting contact's lambda of one solve is the guess
-  // closest to that solve's answer. Starting the second from the first's lambda would begin
-  // from the push's correction, which Sec. 8.1 keeps out of the stored momenta; with a fixed
-  // number of sweeps some of it would stay there.
-  solve(TargetTerms::push_and_bias, lambda_, f_cv_, warm ? &initial_ : nullptr);
-  if (def_.push == PushMode::split) {
-    // Sec. 8.1: lambda_0, f_c0
-    solve(TargetTerms::bias_only, lambda0_, f_c0_,
-          warm && !initial_second_.empty() ? &initial_second_ : nullptr);
-  } else {
-    lambda0_.clear();
+  switch (def_.push) {
+    case PushMode::baumgarte:
+    case PushMode::split:
+      // Sec. 7: lambda, f_cv. With the single frame push factor (Sec. 8.1) both solves are warm
+      // started, each from its own lambda of the previous step: they solve for different
+      // targets (with and without the push), and a persisting contact's lambda of one solve is
+      // the guess closest to that solve's answer. Starting the second from the first's lambda
+      // would begin from the push's correction, which Sec. 8.1 keeps out of the stored momenta;
+      // with a fixed number of sweeps some of it would stay there.
+      solve(TargetTerms::push_and_bias, lambda_, f_cv_, warm ? &initial_ : nullptr);
+      if (def_.push == PushMode::split) {
+        // Sec. 8.1: lambda_0, f_c0
+        solve(TargetTerms::bias_only, lambda0_, f_c0_,
+              warm && !initial_second_.empty() ? &initial_second_ : nullptr);
+      } else {
+        lambda0_.clear();
+      }
+      if (warm) warm_start_->store(manifolds_, rows_, distances_.size(), lambda_, lambda0_);
+      integrate();                                    // Sec. 3.2
+      break;
+    case PushMode::split_impulse:
+      step_split_impulse(warm);
+      break;
+    case PushMode::soft:
+      step_soft(warm);
+      break;
+    case PushMode::ngs:
+      step_ngs(warm);
+      break;
   }
-  if (warm) warm_start_->store(manifolds_, rows_, distances_.size(), lambda_, lambda0_);
-  integrate();                                        // Sec. 3.2
   ++counters_.steps;
+}
+
+// Split impulse (split_impulse.h): the velocity solve without the push (f_c0 for the momenta),
+// then the push on pseudo-velocities from rest; positions move with both.
+void World::step_split_impulse(bool warm) {
+  lambda0_.clear();
+  solve(TargetTerms::bias_only, lambda_, f_c0_, warm ? &initial_ : nullptr);
+  if (warm) warm_start_->store(manifolds_, rows_, distances_.size(), lambda_, lambda0_);
+  if (!split_impulse_) split_impulse_ = std::make_unique<SplitImpulse>();
+  if (!rows_.empty()) {
+    split_impulse_->solve(rows_, bodies_, def_.assembly, settings(def_.dt), f_c0_, f_cv_);
+    ++counters_.solves;
+  } else {
+    f_cv_ = f_c0_;
+  }
+  cps::integrate(bodies_, f_cv_, f_c0_, def_.dt, def_.rotation);
+}
+
+// Non-linear Gauss-Seidel (ngs.h): the velocity solve without the push moves positions and
+// momenta; then the positions are projected.
+void World::step_ngs(bool warm) {
+  lambda0_.clear();
+  solve(TargetTerms::bias_only, lambda_, f_cv_, warm ? &initial_ : nullptr);
+  if (warm) warm_start_->store(manifolds_, rows_, distances_.size(), lambda_, lambda0_);
+  if (!ngs_) ngs_ = std::make_unique<NgsProjection>();
+  ngs_->capture(manifolds_, bodies_);  // the contact points where the step found them
+  cps::integrate(bodies_, f_cv_, f_cv_, def_.dt, def_.rotation);
+  ngs_->project(distances_, def_, bodies_);
+}
+
+// The soft step (soft_step.h): per substep a soft solve that moves the positions, then a relax
+// solve that sets the momenta; lambda carried from each solve to the next.
+void World::step_soft(bool warm) {
+  if (rows_.empty()) {  // nothing to solve: substeps of free flight under f_ext
+    const double h = def_.dt / static_cast<double>(def_.soft_substeps);
+    for (int k = 0; k < def_.soft_substeps; ++k) cps::integrate(bodies_, f_ext_, f_ext_, h, def_.rotation);
+    lambda_.clear();
+    lambda0_.clear();
+    return;
+  }
+  if (!soft_) soft_ = std::make_unique<SoftStep>();
+  soft_->begin(rows_, manifolds_, bodies_, def_);
+  const double h = soft_->substep();
+  zero_force_.setZero(f_ext_.size());  // no allocation once it has the size
+  const std::vector<double>* start = warm ? &initial_ : nullptr;
+  for (int k = 0; k < def_.soft_substeps; ++k) {
+    // 1. soft solve (lambda0_) from the last relaxed lambda
+    soft_->set_targets(rows_, distances_, bodies_, /*soft=*/true, /*last=*/false);
+    SolveSettings soft_settings = settings(h);
+    soft_settings.softness = &soft_->softness();
+    solve_with(soft_settings, TargetTerms::push_and_bias, lambda0_, f_cv_, start);
+    // 2. positions with f_s; momenta kept
+    cps::integrate(bodies_, f_cv_, zero_force_, h, def_.rotation);
+    // 3. relax solve (lambda_) from lambda_s, rigid, without the push; it sets the momenta
+    soft_->set_targets(rows_, distances_, bodies_, /*soft=*/false,
+                       /*last=*/k + 1 == def_.soft_substeps);
+    solve_with(settings(h), TargetTerms::bias_only, lambda_, f_c0_, &lambda0_);
+    add_momenta(bodies_, f_c0_, h);
+    start = &lambda_;
+  }
+  lambda0_.clear();
+  if (warm) warm_start_->store(manifolds_, rows_, distances_.size(), lambda_, lambda0_);
 }
 
 // Stage 0, Sec. 6.1: f_ext (6n) = [m g, 0] per movable body, into a buffer that keeps its size.
@@ -170,10 +249,12 @@ void World::build_rows() {
   for (const Manifold& m : manifolds_) contact_points += static_cast<std::size_t>(m.count);
   detail::reserve_with_headroom(
       rows_, contact_points * (def_.friction > 0.0 ? 3 : 1) + distances_.size());
-  const RowParams params{def_.beta,        def_.dt,
-                         def_.friction,    def_.gravity,
-                         def_.restitution, def_.restitution_threshold,
-                         def_.penetration_slop};
+  RowParams params{def_.beta,        def_.dt,
+                   def_.friction,    def_.gravity,
+                   def_.restitution, def_.restitution_threshold,
+                   def_.penetration_slop};
+  // Split impulse: shallow contacts keep their push in the velocity (split_impulse.h).
+  if (def_.push == PushMode::split_impulse) params.velocity_push_depth = def_.split_impulse_threshold;
   // Each body's v and w (w needs I^-1 = R I_body^-1 R^T) once, for the bodies in a manifold;
   // a body typically sits in several.
   velocity_known_.assign(bodies_.size(), 0);  // n bytes: no allocation once grown
@@ -237,16 +318,25 @@ void World::prepare() {
   solver_->prepare(rows_, bodies_);
 }
 
+SolveSettings World::settings(double dt) const {
+  return SolveSettings{dt, def_.iterations, def_.solver, def_.friction_model};
+}
+
 // Stage 4, Sec. 7 (and the second solve of Sec. 8.1): lambda from `initial` (warm starting) or
 // from 0, then f = f_ext + J^T lambda (Eq. 6.2.1). A step without rows solves nothing: f = f_ext.
 void World::solve(TargetTerms terms, std::vector<double>& lambda, Eigen::VectorXd& f,
                   const std::vector<double>* initial) {
+  solve_with(settings(def_.dt), terms, lambda, f, initial);
+}
+
+void World::solve_with(const SolveSettings& settings, TargetTerms terms,
+                       std::vector<double>& lambda, Eigen::VectorXd& f,
+                       const std::vector<double>* initial) {
   if (rows_.empty()) {
     lambda.clear();
     f = f_ext_;
     return;
   }
-  const SolveSettings settings{def_.dt, def_.iterations, def_.solver, def_.friction_model};
   solver_->solve(rows_, bodies_, f_ext_, terms, settings, lambda, initial);
   ++counters_.solves;
   if (def_.measure_residual) {

@@ -21,6 +21,12 @@ enum class PushMode {
   baumgarte,  ///< the push factor stays in the velocity (Eq. 5.2.3, 5.3.1): one solve a step
   split,      ///< the single frame push factor (Sec. 8.1): positions move with f_cv, the stored
               ///< momenta with f_c0 from a second solve without the push
+  split_impulse,  ///< Bullet's split impulse (engine/src/split_impulse.h): the push solved on
+                  ///< pseudo-velocities from rest, added to the positions' motion only
+  soft,       ///< Box2D v3's soft step (engine/src/soft_step.h): substeps, soft rows with a
+              ///< stiffness (Hz) and damping ratio, then a relax solve without the push
+  ngs,        ///< non-linear Gauss-Seidel (engine/src/ngs.h): a velocity solve without the push,
+              ///< then positions moved directly to reduce the overlaps and rod errors
 };
 
 /// The iteration used for A lambda = b.
@@ -84,6 +90,36 @@ struct WorldDef {
   /// paper's initial guess 0 everywhere. Typical 0.8; 1 can feed energy into stiff piles and
   /// chains (README, "Warm starting").
   double warm_start = 0.0;
+  /// Split impulse (push split-impulse) only: contacts no deeper than this (m, >= 0) keep their
+  /// push in the velocity solve, as Baumgarte; deeper ones are pushed out on pseudo-velocities.
+  /// 0 (the default) sends every overlap to the pseudo-velocities. Bullet's
+  /// m_splitImpulsePenetrationThreshold is 0.04 m.
+  double split_impulse_threshold = 0.0;
+  /// Soft step (push soft) only: substeps per step (count, >= 1); each solves with the soft
+  /// push, moves the positions, then relaxes. Box2D v3's default: 4.
+  int soft_substeps = 4;
+  /// Soft step only: the contact rows' stiffness (Hz, >= 0; 0 = rigid rows without push), capped
+  /// at a quarter of the substep rate; contacts with a static body get twice it. Box2D v3's
+  /// default: 30.
+  double contact_hertz = 30.0;
+  /// Soft step only: the contact rows' damping ratio (dimensionless, >= 0). Box2D v3's default:
+  /// 10 (strongly overdamped: an overlap is pushed out without bouncing).
+  double contact_damping_ratio = 10.0;
+  /// Soft step only: the rods' stiffness (Hz, >= 0; 0 = rigid rods without push). Box2D v3's
+  /// default for joints: 60.
+  double rod_hertz = 60.0;
+  /// Soft step only: the rods' damping ratio (dimensionless, >= 0). Box2D v3's default for
+  /// joints: 2.
+  double rod_damping_ratio = 2.0;
+  /// Soft step only: the fastest an overlap is pushed out (m/s, > 0). Box2D v3's default
+  /// (contactPushMaxSpeed, called contactPushoutVelocity in v3.0): 3.
+  double contact_push_max_speed = 3.0;
+  /// Non-linear Gauss-Seidel (push ngs) only: position iterations per step (count, >= 1). Box2D
+  /// v2.4's default: 3 (Jolt's: 2).
+  int position_iterations = 3;
+  /// Non-linear Gauss-Seidel only: the largest correction of one contact point or rod in one
+  /// position iteration (m, > 0). Box2D v2.4's b2_maxLinearCorrection: 0.2.
+  double max_correction = 0.2;
   bool collision = true;  ///< false: the bodies never collide and the collide stage is skipped
   /// true: after every solve, measure the LCP residual into World::residual(); it costs one pass
   /// over the rows per solve, so it is off unless a report asks for it.

@@ -34,6 +34,10 @@ namespace cps {
 class BroadPhase;
 class ConstraintSolver;
 class WarmStartCache;
+class SplitImpulse;
+class SoftStep;
+class NgsProjection;
+struct SolveSettings;
 enum class TargetTerms : int;
 
 /// The most candidate pairs the broad phase may list in one step (count). A pair costs 8 bytes;
@@ -127,7 +131,15 @@ class World {
   void prepare();
   void solve(TargetTerms terms, std::vector<double>& lambda, Eigen::VectorXd& f,
              const std::vector<double>* initial);
+  void solve_with(const SolveSettings& settings, TargetTerms terms, std::vector<double>& lambda,
+                  Eigen::VectorXd& f, const std::vector<double>* initial);
+  SolveSettings settings(double dt) const;
   void integrate();
+  // The push methods beyond the paper's, each in its own file (engine/src/split_impulse.h,
+  // soft_step.h, ngs.h): they replace the solve and integrate stages.
+  void step_split_impulse(bool warm);
+  void step_soft(bool warm);
+  void step_ngs(bool warm);
   void count_residual(double max, double sum_squares, std::int64_t rows);
 
   WorldDef def_;
@@ -154,6 +166,11 @@ class World {
   std::unique_ptr<WarmStartCache> warm_start_;
   std::vector<double> initial_;
   std::vector<double> initial_second_;
+  // The push methods' per-step state (made when first needed; nothing in them outlives a step).
+  std::unique_ptr<SplitImpulse> split_impulse_;
+  std::unique_ptr<SoftStep> soft_;
+  std::unique_ptr<NgsProjection> ngs_;
+  Eigen::VectorXd zero_force_;  // 6n zeros: the soft step's positions-only integration
   Assembly solver_assembly_ = Assembly::matrix_free;
   StepCounters counters_;
   ResidualStats residual_;

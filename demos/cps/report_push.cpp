@@ -472,10 +472,12 @@ std::string legend(bool quick, double stack_seconds, const scenes::Scene& is,
         "the heavy cube within a quarter edge of its stacked height); \"none\": none held.\n"
      << "- **grid rod error (m)**: the pendulum grid's metric max_rod_error_m over "
      << number(grid_seconds) << " s (its default " << number(grid.default_seconds)
-     << " s): the largest |rod length - its length|. **wave rod error**, **wave phase error "
-        "(deg)**: the pendulum wave's metrics max_rod_error_rel (the same, over the rod's "
-        "length) and max_phase_error_deg (the largest phase error against the reduced-coordinate "
-        "reference), over " << number(wave_seconds) << " s"
+     << " s): the largest |rod length - its length| over the run. **wave rod error**, **wave phase error "
+        "(deg)**: the pendulum wave's metrics max_rod_error_rel (the largest |rod length - "
+        "its length| / its length over the run) and max_phase_error_deg (at the end of the run, "
+        "the largest difference over its 50 pendulums between a ball's swing angle and that of "
+        "the reduced-coordinate reference, wrapped to [-180, 180] deg), run "
+     << number(wave_seconds) << " s"
      << (wave_seconds < wave.default_seconds
              ? " (--quick; its default is " + number(wave.default_seconds) + " s)"
              : std::string(" (its default)"))

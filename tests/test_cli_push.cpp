@@ -1,8 +1,7 @@
 // `cps report push` as a user runs it: every push method of the table side by side, its files,
 // its physics (the paper's Fig. 7 point), and its refusals.
 #include "cli_support.h"
-
-#include "cps/parameters.h"
+#include "push_methods.h"
 
 #include <catch2/catch.hpp>
 
@@ -49,13 +48,6 @@ Table read_csv(const fs::path& file, std::vector<std::string>& header) {
   return rows;
 }
 
-// The push methods of the table, in its order.
-std::vector<std::string> push_methods() {
-  std::vector<std::string> names;
-  for (const cps::Choice& c : cps::parameter("push").choices) names.emplace_back(c.name);
-  return names;
-}
-
 // True if `text` is a finite number, as a whole.
 bool is_finite_number(const std::string& text) {
   if (text.empty()) return false;
@@ -85,7 +77,7 @@ TEST_CASE("cps report push --quick compares every push method of the table: file
           "and split brings the intersecting stack to rest where baumgarte throws it",
           "[cli][report][push]") {
   const fs::path dir = fresh_dir("quick");
-  const std::vector<std::string> methods = push_methods();
+  const std::vector<std::string> methods = cli_test::push_method_names();
   REQUIRE(methods.size() >= 2);
   // A foreign push.md is refused (exit 2, named, kept), then replaced with --force.
   fs::create_directories(dir / "q");

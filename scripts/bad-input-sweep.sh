@@ -81,7 +81,7 @@ declare -A BASE=(
 )
 RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
 MERGE_SRC=$root/merge-src                              # a complete sweep, made below
-BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick"
+BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick;report push --quick"
 BASE['report:--run']='report --out out'
 BASE['report:--merge']='report --out out'
 

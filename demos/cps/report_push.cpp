@@ -16,7 +16,6 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
-#include <numeric>
 #include <optional>
 #include <sstream>
 #include <stdexcept>

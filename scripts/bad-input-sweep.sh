@@ -81,7 +81,7 @@ declare -A BASE=(
 )
 RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
 MERGE_SRC=$root/merge-src                              # a complete sweep, made below
-BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick"
+BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick;report push --quick"
 BASE['report:--run']='report --out out'
 BASE['report:--merge']='report --out out'
 
@@ -163,7 +163,7 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         scene_one) printf '%s\n' all stress paper ;;
         scene_many) printf '%s\n' paper ;;
         scene_figure) printf '%s\n' all stress ;;
-        scene_report) printf '%s\n' paper ;;
+        scene_report) printf '%s\n' paper PUSH pushes 'push ' ;;
       esac ;;
     *) echo "bad-input-sweep: no bad values for kind '$kind'" >&2; exit 3 ;;
   esac
@@ -203,6 +203,10 @@ EXTRA=(
   "--trace/adir|simulate stack --seconds 0.1 --trace adir --force"
   "--run/--merge|report --merge $MERGE_SRC --run $RUN_ID --out out"
   "--run/--list-runs|report --list-runs --run $RUN_ID --out out"
+  "push/--run|report push --run $RUN_ID --out out"
+  "push/--merge|report push --merge $MERGE_SRC --out out"
+  "push/--list-runs|report push --list-runs --out out"
+  "push/--seed|report push --seed 3 --out out"
   "--rendering/--quick|bench --rendering=false --quick=junk"
 )
 
@@ -214,6 +218,7 @@ CONTROLS=(
   "simulate stack --seconds 0.1 --dt 1/60 --beta 1e-320 --friction 0 --iterations 10000"
   "report --list-runs --out out"
   "report intersecting_stack --run intersecting_stack.pgs.baumgarte.fixed.it1.ss1.ws0.8 --out out"
+  "report push --quick --out out"
   "render stack --seconds 0.1 --fps 10 --size 16x16 --out out"
   "render stack --seconds 0.1 --fps 5e-324 --size 16x16 --out out --orbit -36000"
   "figure stack --times 0,0.1 --size 16x16 --out out/f.png"

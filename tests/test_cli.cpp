@@ -1,5 +1,6 @@
 // The cps command as a user runs it: exit codes, messages, and that bad input writes nothing.
 #include "cli_support.h"
+#include "push_methods.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -73,13 +74,17 @@ double value(const std::map<std::string, std::string>& row, const std::string& c
   return it == row.end() || it->second.empty() ? std::nan("") : std::stod(it->second);
 }
 
+using cli_test::paper_push_methods;
+using cli_test::push_methods;
+
 // The quick sweep of one scene, as `cps report --quick` defines it: cold runs at iterations 1,
-// 4, 16, 25, 64 (1 substep) and 4 substeps (25 iterations) for each solver (pgs, jacobi) and
-// push (baumgarte, split), fixed friction; and PGS warm-started at factors 0.8 and 1 at
-// iterations 1, 4, 16, 25 (1 substep), Baumgarte push, fixed friction.
-constexpr int kQuickCold = (5 + 1) * 2 * 2;
-constexpr int kQuickWarm = 2 * 4;
-constexpr int kQuickRuns = kQuickCold + kQuickWarm;
+// 4, 16, 25, 64 (1 substep) and 4 substeps (25 iterations) for each push method of the table,
+// with solver pgs, and jacobi too for the paper's push methods, fixed friction; and PGS
+// warm-started at factors 0.8 and 1 at iterations 1, 4, 16, 25 (1 substep), Baumgarte push,
+// fixed friction. With baumgarte and split: (5 + 1) x 2 x 2 + 8 = 32.
+const int kQuickCold = (5 + 1) * (2 * paper_push_methods() + (push_methods() - paper_push_methods()));
+const int kQuickWarm = 2 * 4;
+const int kQuickRuns = kQuickCold + kQuickWarm;
 
 // The warm start factor of a report CSV row; 0 where the column is empty.
 double warm_of(const std::map<std::string, std::string>& row) {
@@ -587,8 +592,8 @@ TEST_CASE("cps report plans warm-started PGS runs beside the cold sweep and thei
     // The funnel has friction: friction models fixed and coupled. Cold: 10 iteration counts at
     // 1 substep and 4 substep counts at 25 iterations, per solver, push and friction model.
     // Warm: 10 iteration counts per factor, push and friction model, PGS only.
-    const int cold = (10 + 4) * 2 * 2 * 2;
-    const int warm = 2 * 10 * 2 * 2;
+    const int cold = (10 + 4) * 2 * push_methods() * 2;
+    const int warm = 2 * 10 * push_methods() * 2;
     CHECK(ids.size() == static_cast<std::size_t>(cold + warm));
     int n_warm = 0;
     for (const std::string& id : ids) {
@@ -600,6 +605,18 @@ TEST_CASE("cps report plans warm-started PGS runs beside the cold sweep and thei
       CHECK((factor(id) == 0.8 || factor(id) == 1.0));
     }
     CHECK(n_warm == warm);
+    // Every push method of the table enters the sweep, in the table's order (its first run of
+    // each method comes after the first run of the method before it).
+    std::size_t last = 0;
+    for (const std::string& method : cli_test::push_method_names()) {
+      const std::string part = "." + method + ".";
+      const auto at = std::find_if(ids.begin(), ids.end(),
+                                   [&](const std::string& id) { return id.find(part) != std::string::npos; });
+      INFO(method);
+      REQUIRE(at != ids.end());
+      CHECK(static_cast<std::size_t>(at - ids.begin()) >= last);
+      last = static_cast<std::size_t>(at - ids.begin());
+    }
     for (const char* id : {"funnel.pgs.split.coupled.it256.ss1.ws1", "funnel.pgs.baumgarte.fixed.it2.ss1.ws0.8"}) {
       CHECK(std::find(ids.begin(), ids.end(), id) != ids.end());
     }
@@ -625,7 +642,8 @@ TEST_CASE("cps report's mass ratio table says whether each stack held", "[cli][r
   REQUIRE(cps("report --run stack.pgs.split.fixed.it4.ss1 --out runs", dir).exit_code == 0);
   cps("report --merge runs --out r", dir);  // incomplete (exit 1), but with the mass ratio table
   const auto rows = read_table(dir / "r/mass_ratio.csv");
-  REQUIRE(rows.size() == 12u);  // ratios 10, 100, 1000 x solvers x pushes
+  // ratios 10, 100, 1000 x solvers x every push method of the table
+  REQUIRE(rows.size() == static_cast<std::size_t>(3 * 2 * push_methods()));
   // Cubes of edge 1 m: stacked, the heavy one's centre is at 1.5 m; squeezed out, at 0.5 m.
   const double h = 0.5;
   for (const auto& row : rows) {

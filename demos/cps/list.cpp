@@ -43,6 +43,14 @@ Command add_list(CLI::App& app) {
             }
             std::printf("Scene files: any PATH.json in the format of "
                         "assets/schemas/scene.schema.json (README, \"Scene files\").\n");
+            std::string pushes;
+            for (const Choice& c : parameter("push").choices) {
+              pushes += (pushes.empty() ? "" : ", ") + std::string(c.name);
+            }
+            std::printf("Reports: 'cps report SCENE|all|stress' sweeps solver settings (error "
+                        "against run time); 'cps report push' runs every push method (--push: "
+                        "%s) on the same cases side by side.\n",
+                        pushes.c_str());
             return 0;
           }};
 }

@@ -4,6 +4,7 @@
 #include "options.h"
 #include "output.h"
 #include "progress.h"
+#include "report_push.h"
 #include "stress/mass_ratio.h"
 
 #include <unistd.h>
@@ -45,12 +46,16 @@ std::string file_stem(const std::string& scene) {
   return scene.find('/') == std::string::npos ? scene : fs::path(scene).filename().string();
 }
 
+}  // namespace
+
 std::string number(double v) {
   if (!std::isfinite(v)) return "";
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", v);
   return text;
 }
+
+namespace {
 
 // A warm start factor (dimensionless) as the shortest decimal text that reads back exactly
 // ("0.8", "1"), for run ids and the CSV column.
@@ -113,8 +118,8 @@ std::vector<Vec3> positions(const World& world) {
   return x;
 }
 
-// False once the state is not finite, or a body is further than 1e6 m away or faster than
-// 1e6 m/s: the run has blown up and goes no further.
+}  // namespace
+
 bool sane_state(const World& world) {
   for (const Body& b : world.bodies()) {
     if (!b.x.allFinite() || !b.p.allFinite() || !b.l.allFinite() || !b.o.coeffs().allFinite()) {
@@ -124,6 +129,8 @@ bool sane_state(const World& world) {
   }
   return true;
 }
+
+namespace {
 
 // The reference of the trajectory error: PGS with this many iterations and substeps per 1/60 s
 // frame, and the run's own push and friction model.
@@ -305,6 +312,8 @@ bool is_paper_setting(const Row& r) {
          r.at("substeps") == "1" && warm_of(r) == 0.0;
 }
 
+}  // namespace
+
 void run_gnuplot(const fs::path& script) {
   const std::string command = "gnuplot '" + script.string() + "' 2>&1";
   std::FILE* pipe = popen(command.c_str(), "r");
@@ -321,18 +330,32 @@ void run_gnuplot(const fs::path& script) {
   }
 }
 
-// A gnuplot string: single quotes, a quote inside doubled.
 std::string gp_text(const std::string& s) {
   std::string q = "'";
   for (const char c : s) q += c == '\'' ? std::string("''") : std::string(1, c);
   return q + "'";
 }
 
+namespace {
+
 // The place of a setting's name in the order the diagrams' panels take (unknown names last).
 int rank_of(const std::string& value, std::initializer_list<const char*> order) {
   int i = 0;
   for (const char* o : order) {
     if (value == o) return i;
+    ++i;
+  }
+  return i;
+}
+
+// The place of a push method's name in the table's order of the parameter push (the order of
+// the diagrams' panels and of the tables); names the table does not have (a CSV of another
+// build) after them.
+int push_rank(const std::string& value) {
+  const auto choices = parameter("push").choices;
+  int i = 0;
+  for (const Choice& c : choices) {
+    if (value == c.name) return i;
     ++i;
   }
   return i;
@@ -394,7 +417,7 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
                                     const std::vector<const Row*>& rows) {
   const auto key_of = [](const Row& r) {
     return std::make_tuple(rank_of(r.at("friction_model"), {"fixed", "coupled"}),
-                           rank_of(r.at("push"), {"baumgarte", "split"}),
+                           push_rank(r.at("push")),
                            rank_of(r.at("solver"), {"pgs", "jacobi"}), variant_of(r));
   };
   std::map<std::tuple<int, int, int, std::string>, std::vector<const Row*>> by_panel;
@@ -791,15 +814,6 @@ bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& 
   return true;
 }
 
-// The mass ratio pair (stress scenes mass_ratio_R: a heavy cube of R kg resting on a light cube
-// of 1 kg on the ground, both of half edge h = scenes::kMassRatioHalfEdge) at the end of a run.
-struct PairOutcome {
-  bool finite = false;                    // false: the run blew up (nothing below is measured)
-  double light_offset_m = std::nan("");   // light cube centre to the heavy cube's vertical axis
-  double heavy_height_m = std::nan("");   // heavy cube centre height; 3 h = 1.5 m when stacked
-  double overlap_m = std::nan("");        // deepest overlap between any two bodies now
-  bool held = false;                      // see pair_outcome
-};
 
 // How far the heavy cube's centre may be from its stacked height 3 h and the pair still count
 // as held (m): h / 2, a light cube crushed by under a quarter of its edge. Squeezed out from
@@ -827,9 +841,8 @@ PairOutcome pair_outcome(const World& world) {
   return o;
 }
 
-// Runs the pair of mass ratio `ratio` (> 0) from rest for `seconds` (s) at the paper's settings
-// (scenes::mass_ratio_world_def(): 60 Hz, beta 0.2, mu 0.5) with this solver, push and
-// iteration count.
+}  // namespace
+
 PairOutcome run_pair(double ratio, SolverKind solver, PushMode push, int iterations,
                      double seconds) {
   WorldDef def = scenes::mass_ratio_world_def();
@@ -845,16 +858,19 @@ PairOutcome run_pair(double ratio, SolverKind solver, PushMode push, int iterati
   return pair_outcome(world);
 }
 
-// The mass ratio table: for ratios 10, 100, 1000 and each solver and push, the pair after
+namespace {
+
+// The mass ratio table: for each ratio of kMassRatios and each solver and push, the pair after
 // kPairSeconds at 25 iterations, and the iteration counts of 1, 2, 4, ..., 256 with which it
 // holds with under 1 cm of overlap (space-separated; holding need not be monotone in the count).
 // One row each (columns mass_ratio, solver, push, iterations, seconds, held, heavy_height_m,
-// light_offset_m, overlap_m, iterations_holding).
-constexpr double kPairSeconds = 5.0;
+// light_offset_m, overlap_m, iterations_holding). The pushes are every choice of the world
+// parameter push, in the table's order.
 std::vector<Row> mass_ratio_rows() {
   std::vector<Row> rows;
-  for (const double ratio : {10.0, 100.0, 1000.0}) {
-    for (const PushMode push : {PushMode::baumgarte, PushMode::split}) {
+  for (const double ratio : kMassRatios) {
+    for (const Choice& c : parameter("push").choices) {
+      const auto push = static_cast<PushMode>(c.value);
       for (const SolverKind solver : {SolverKind::pgs, SolverKind::jacobi}) {
         const PairOutcome o = run_pair(ratio, solver, push, 25, kPairSeconds);
         std::string holding;
@@ -982,9 +998,16 @@ std::string RunSpec::id() const {
 
 RunSpec RunSpec::parse(const std::string& id) {
   const auto bad = [&id](const std::string& why) {
-    return UsageError("run id '" + id + "': " + why +
-                      "; expected scene.pgs|jacobi.baumgarte|split.fixed|coupled.itN.ssM, "
-                      "optionally followed by .wsF, a warm start factor F in [0, 1]");
+    const auto names = [](const char* parameter_name) {
+      std::string list;
+      for (const Choice& c : parameter(parameter_name).choices) {
+        list += (list.empty() ? "" : "|") + std::string(c.name);
+      }
+      return list;
+    };
+    return UsageError("run id '" + id + "': " + why + "; expected scene." + names("solver") + "." +
+                      names("push") + "." + names("friction_model") +
+                      ".itN.ssM, optionally followed by .wsF, a warm start factor F in [0, 1]");
   };
   // The warm start factor, if any: ".wsF" right after the ".ssM" part (F may hold a dot).
   std::string rest = id;
@@ -1048,6 +1071,8 @@ RunSpec RunSpec::parse(const std::string& id) {
   return r;
 }
 
+bool is_paper_push(const Choice& push) { return push.source.rfind("Sec. ", 0) == 0; }
+
 std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, bool quick) {
   const std::vector<int> iterations =
       quick ? std::vector<int>{1, 4, 16, 25, 64} : std::vector<int>{1, 2, 4, 8, 16, 25, 32, 64, 128, 256};
@@ -1057,8 +1082,11 @@ std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, 
     std::vector<FrictionModel> frictions = {FrictionModel::fixed};
     if (!quick && has_friction(*scene)) frictions.push_back(FrictionModel::coupled);
     for (const FrictionModel f : frictions) {
-      for (const PushMode p : {PushMode::baumgarte, PushMode::split}) {
+      for (const Choice& c : parameter("push").choices) {
+        const auto p = static_cast<PushMode>(c.value);
         for (const SolverKind s : {SolverKind::pgs, SolverKind::jacobi}) {
+          // The quick sweep runs Jacobi for the paper's push methods only (see the declaration).
+          if (quick && s != SolverKind::pgs && !is_paper_push(c)) continue;
           for (const int it : iterations) runs.push_back({std::string(scene->name), s, p, f, it, 1});
           for (const int ss : substeps) runs.push_back({std::string(scene->name), s, p, f, 25, ss});
         }
@@ -1578,6 +1606,19 @@ std::vector<std::string> scene_names(const std::vector<const scenes::Scene*>& sc
   return names;
 }
 
+// The scene argument that runs `cps report push` instead of a sweep.
+constexpr const char* kPushReport = "push";
+
+// select_scenes for the report's scene argument: its error also names 'push'.
+std::vector<const scenes::Scene*> report_scenes(const std::string& name) {
+  try {
+    return select_scenes(name);
+  } catch (const UsageError& e) {
+    throw UsageError(std::string(e.what()) + "; cps report also takes '" + kPushReport +
+                     "' (every push method side by side: cps report push [--quick] [--out DIR])");
+  }
+}
+
 int run_report(const ReportOptions& o, int argc, char** argv) {
   nlohmann::json merged = nlohmann::json::array();
   for (const std::string& m : o.merge) merged.push_back(m);
@@ -1585,6 +1626,16 @@ int run_report(const ReportOptions& o, int argc, char** argv) {
       "report", argc, argv,
       {{"scene", o.scene}, {"quick", o.quick}, {"repeats", kTimingRepeats}, {"merge", merged},
        {"run", o.run.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.run)}});
+  if (o.scene == kPushReport) {
+    const char* sweep_only = !o.run.empty() ? "--run" : !o.merge.empty() ? "--merge"
+                             : o.list        ? "--list-runs" : nullptr;
+    if (sweep_only) {
+      throw UsageError(std::string("report push: ") + sweep_only +
+                       " applies to the sweeps (a scene, 'all' or 'stress'), not to the push "
+                       "methods side by side; cps report push takes --out, --quick and --force");
+    }
+    return run_push_report(o.out, o.quick, o.force, info);
+  }
   const int repeats = kTimingRepeats;
   // The sweep a run belongs to, recorded in its row so that --merge can tell what is missing.
   const auto mark_sweep = [&o](Row& row) {
@@ -1620,7 +1671,7 @@ int run_report(const ReportOptions& o, int argc, char** argv) {
   }
   if (!o.run.empty()) {
     const RunSpec spec = RunSpec::parse(o.run);
-    select_scenes(o.scene);  // the sweep it belongs to must be one
+    report_scenes(o.scene);  // the sweep it belongs to must be one
     // The run id with the scene part as file_stem: a scene file path keeps its folders out.
     const std::string file = file_stem(spec.scene) + spec.id().substr(spec.scene.size()) + ".csv";
     const OutputPlan plan = plan_output(o.out, {file}, o.force, FolderUse::shared);
@@ -1631,7 +1682,7 @@ int run_report(const ReportOptions& o, int argc, char** argv) {
     end_output(plan, info);
     return 0;
   }
-  const std::vector<RunSpec> runs = plan_runs(select_scenes(o.scene), o.quick);
+  const std::vector<RunSpec> runs = plan_runs(report_scenes(o.scene), o.quick);
   if (o.list) {
     const std::string exe = self_path();
     for (const RunSpec& r : runs) {
@@ -1642,7 +1693,7 @@ int run_report(const ReportOptions& o, int argc, char** argv) {
                 exe.c_str(), o.out.c_str(), o.out.c_str());
     return 0;
   }
-  ReportOutput output(o.out, scene_names(select_scenes(o.scene)), o.force, info);
+  ReportOutput output(o.out, scene_names(report_scenes(o.scene)), o.force, info);
   std::vector<Row> rows;
   Progress progress("report " + o.scene, static_cast<long long>(runs.size()), "runs");
   for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -1661,19 +1712,28 @@ int run_report(const ReportOptions& o, int argc, char** argv) {
 Command add_report(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<ReportOptions>();
   CLI::App* sub = app.add_subcommand(
-      "report", "error against run time: sweep solver settings, write CSV, plots, report.md");
+      "report", "error against run time: sweep solver settings, write CSV, plots, report.md; "
+                "'cps report push': every push method side by side (push.csv, push.md, plots)");
   sub->add_option("scene", o->scene,
                   "scene name, the path of a scene file (.json), 'all' (the paper's) or "
-                  "'stress'; with --run, the sweep the run belongs to")
+                  "'stress'; with --run, the sweep the run belongs to; 'push': instead of a "
+                  "sweep, every push method (the choices of --push) on the same cases: the "
+                  "intersecting stack and sphere_in_box (overlaps resolved, energy injected, "
+                  "final heights), the stack over 600 s (60 s with --quick), the mass ratios "
+                  "that hold, the pendulums' rod and phase errors and the cost per step, into "
+                  "push.csv, push.md, push_overlap.png and push_speed.png in --out")
       ->capture_default_str();
   add_seed_option(*sub, o->scene);
   sub->add_option("--out", o->out, "output folder")->capture_default_str()->check(kNotEmpty);
+  const std::size_t quick_runs = plan_runs(select_scenes("all"), true).size();
   sub->add_flag("--quick", o->quick,
                 "a reduced sweep: iterations 1, 4, 16, 25, 64 and 4 substeps, fixed friction "
-                "only, and warm-started PGS (warm start 0.8 and 1) at iterations 1, 4, 16, 25 "
-                "with Baumgarte push; each run timed by the median of 3 timing runs as in the "
-                "full sweep (the paper's five scenes: 160 runs, measured 63 s on 2 cores shared "
-                "with other jobs)");
+                "only, Jacobi for the paper's push methods only, and warm-started PGS (warm "
+                "start 0.8 and 1) at iterations 1, 4, 16, 25 with Baumgarte push; each run "
+                "timed by the median of 3 timing runs as in the full sweep (the paper's five "
+                "scenes: " + std::to_string(quick_runs) + " runs; with the two push methods "
+                "baumgarte and split, 160 runs measured 63 s on 2 cores shared with other "
+                "jobs); with 'push': the stack over 60 s and the pendulum wave over 10 s");
   CLI::Option* list = sub->add_flag("--list-runs", o->list,
                 "print one self-contained command per run, to spread the sweep over machines");
   CLI::Option* merge = sub->add_option("--merge", o->merge,

@@ -5,6 +5,7 @@
 
 #include "scene.h"
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -39,17 +40,25 @@ struct RunSpec {
 /// One CSV row: column name (with its unit) -> value as text ("" where it does not apply).
 using Row = std::map<std::string, std::string>;
 
+/// True if `push` (a choice of the world parameter push) is one of the paper's push methods: its
+/// source names a section of the paper ("Sec. 5.3": baumgarte, "Sec. 8.1": split).
+bool is_paper_push(const Choice& push);
+
 /// The runs of the sweep for these scenes. Full: iterations 1, 2, 4, 8, 16, 25, 32, 64, 128, 256
-/// at 1 substep and substeps 2, 4, 8, 16 at 25 iterations, for solver pgs and jacobi, push baumgarte and split,
-/// friction model fixed and coupled where the scene has friction. Quick: iterations 1, 4, 16, 25,
-/// 64 at 1 substep and 4 substeps at 25 iterations, friction model fixed only. All of these
+/// at 1 substep and substeps 2, 4, 8, 16 at 25 iterations, for solver pgs and jacobi, every push
+/// method of the table (parameter("push").choices, in its order), friction model fixed and
+/// coupled where the scene has friction. Quick: iterations 1, 4, 16, 25, 64 at 1 substep and 4
+/// substeps at 25 iterations, friction model fixed only, Jacobi only for the paper's push
+/// methods (is_paper_push; the others at PGS only, which keeps the quick sweep near 2 minutes
+/// with five methods: 250 runs for the paper's five scenes, 160 with two). All of these
 /// start cold (warm start 0, the paper's). Warm starting (kReportWarmStarts: factors 0.8 and 1)
 /// is swept for PGS only, where it matters most: PGS's Gauss-Seidel sweeps carry a good initial
 /// guess forward row by row, while Jacobi's simultaneous updates overshoot from any guess (its
 /// runs diverge at the paper's settings in the funnel already). Full: the whole iteration line
-/// at 1 substep for each warm factor, push baumgarte and split and the friction models as
-/// above (20 runs per push and friction model). Quick: iterations 1, 4, 16, 25 at 1 substep for
-/// each warm factor, push baumgarte and fixed friction only (8 runs per scene, 24 + 8 = 32).
+/// at 1 substep for each warm factor, every push method and the friction models as above (20
+/// runs per push and friction model). Quick: iterations 1, 4, 16, 25 at 1 substep for
+/// each warm factor, push baumgarte and fixed friction only (8 runs per scene; with the two
+/// paper methods, 24 + 8 = 32 runs per scene).
 /// The warm start factors (dimensionless) the sweep runs beside the cold start 0.
 inline constexpr double kReportWarmStarts[] = {0.8, 1.0};
 
@@ -106,5 +115,47 @@ std::vector<Row> read_rows(const std::vector<std::filesystem::path>& dirs);
 /// Writes rows as one CSV file (header, then one line per row), atomically (atomic_file.h).
 /// Throws std::runtime_error "cannot write FILE: REASON" on failure.
 void write_csv(const std::filesystem::path& file, const std::vector<Row>& rows);
+
+/// A number as the report's CSVs and tables write it: 6 significant digits (printf "%.6g"), ""
+/// for a value that is not finite.
+std::string number(double v);
+
+/// False once the state is not finite, or a body is further than 1e6 m away or faster than
+/// 1e6 m/s: the run has blown up and goes no further.
+bool sane_state(const World& world);
+
+/// Runs gnuplot on `script` (a file). Throws std::runtime_error naming the script, gnuplot's exit
+/// status and the first 400 characters of its output if it fails (saying to install
+/// gnuplot-nox when it is missing).
+void run_gnuplot(const std::filesystem::path& script);
+
+/// `s` as a gnuplot string: in single quotes, a quote inside doubled.
+std::string gp_text(const std::string& s);
+
+/// The mass ratios R (heavy cube mass / light cube mass, dimensionless) of the report's mass
+/// ratio table (stress scenes mass_ratio_R), ascending.
+inline constexpr double kMassRatios[] = {10.0, 100.0, 1000.0};
+
+/// How long each run of the mass ratio table lasts (s of simulated time).
+inline constexpr double kPairSeconds = 5.0;
+
+/// The mass ratio pair (stress scenes mass_ratio_R: a heavy cube of R kg resting on a light cube
+/// of 1 kg on the ground, both of half edge h = scenes::kMassRatioHalfEdge) at the end of a run.
+struct PairOutcome {
+  bool finite = false;                    ///< false: the run blew up (nothing below is measured)
+  double light_offset_m = std::nan("");   ///< light cube centre to the heavy cube's vertical axis
+  double heavy_height_m = std::nan("");   ///< heavy cube centre height; 3 h = 1.5 m when stacked
+  double overlap_m = std::nan("");        ///< deepest overlap between any two bodies now (m)
+  /// Held: the light cube is still between the heavy cube and the ground, its centre within h
+  /// of the heavy cube's vertical axis and the heavy cube's centre within h / 2 of its stacked
+  /// height 3 h.
+  bool held = false;
+};
+
+/// Runs the pair of mass ratio `ratio` (> 0) from rest for `seconds` (s) at the paper's settings
+/// (scenes::mass_ratio_world_def(): 60 Hz, beta 0.2, mu 0.5) with this solver, push and
+/// iteration count (>= 1). A run that blows up (sane_state) stops and returns finite = false.
+PairOutcome run_pair(double ratio, SolverKind solver, PushMode push, int iterations,
+                     double seconds);
 
 }  // namespace cps::cli

@@ -1,0 +1,35 @@
+#pragma once
+// `cps report push`: every push method (every choice of the world parameter push, in the
+// table's order: cps::parameter("push").choices) on the same cases, each at the scene's own
+// settings with only push changed: the intersecting stack and sphere_in_box (overlaps resolved,
+// energy injected, final heights), the stack's drift, the mass ratios that hold, the pendulums'
+// rod and phase errors and the cost per step. Writes push.csv, push.md and two diagrams.
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace cps::cli {
+
+/// The files `cps report push` writes into its output folder (plain names): push.csv, push.md,
+/// push_overlap.png (the largest overlap against time) and push_speed.png (the largest body
+/// speed against time).
+std::vector<std::string> push_report_files();
+
+/// The files it writes into OUT/plots: the gnuplot data and script of each diagram
+/// (push_overlap.dat, .gp, push_speed.dat, .gp).
+std::vector<std::string> push_plot_files();
+
+/// Runs every push method on the cases (the full run; quick: the stack over 60 s instead of
+/// 600 s and the pendulum wave over 10 s instead of its 62 s) and writes push_report_files()
+/// into `out` and push_plot_files() into out/plots, both shared folders (output.h), with `info`
+/// (run_info) in their run.json. Every target is checked before any work: throws UsageError
+/// (exit 2) naming a foreign file it would replace (without `force`) or an unusable folder.
+/// Throws std::runtime_error if a file cannot be written or gnuplot fails (the CSV and the
+/// table are written first and kept). Returns the exit code, 0.
+int run_push_report(const std::filesystem::path& out, bool quick, bool force,
+                    const nlohmann::json& info);
+
+}  // namespace cps::cli

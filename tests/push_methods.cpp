@@ -1,0 +1,21 @@
+#include "push_methods.h"
+
+#include "cps/parameters.h"
+
+namespace cli_test {
+
+std::vector<std::string> push_method_names() {
+  std::vector<std::string> names;
+  for (const cps::Choice& c : cps::parameter("push").choices) names.emplace_back(c.name);
+  return names;
+}
+
+int push_methods() { return static_cast<int>(cps::parameter("push").choices.size()); }
+
+int paper_push_methods() {
+  int n = 0;
+  for (const cps::Choice& c : cps::parameter("push").choices) n += c.source.rfind("Sec. ", 0) == 0;
+  return n;
+}
+
+}  // namespace cli_test

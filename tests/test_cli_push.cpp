@@ -1,0 +1,233 @@
+// `cps report push` as a user runs it: every push method of the table side by side, its files,
+// its physics (the paper's Fig. 7 point), and its refusals.
+#include "cli_support.h"
+#include "push_methods.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using cli_test::Result;
+using cli_test::run_cps;
+using cli_test::slurp;
+
+fs::path fresh_dir(const std::string& name) { return cli_test::fresh_dir("cps_cli_push_test_" + name); }
+
+using Table = std::vector<std::map<std::string, std::string>>;
+
+// The rows of a CSV file with a header line, each as column name -> cell.
+Table read_csv(const fs::path& file, std::vector<std::string>& header) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  std::stringstream hs(line);
+  header.clear();
+  for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
+  Table rows;
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::map<std::string, std::string> row;
+    for (const std::string& c : header) {
+      std::string cell;
+      std::getline(ls, cell, ',');
+      row[c] = cell;
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// True if `text` is a finite number, as a whole.
+bool is_finite_number(const std::string& text) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size() && std::isfinite(v);
+}
+
+// The cell of the row of `push` and `kase`.
+const std::map<std::string, std::string>& row_of(const Table& rows, const std::string& push,
+                                                 const std::string& kase) {
+  for (const auto& r : rows) {
+    if (r.at("push") == push && r.at("case") == kase) return r;
+  }
+  FAIL("no row for " << push << " " << kase);
+  return rows.front();
+}
+
+double number_in(const std::map<std::string, std::string>& row, const std::string& column) {
+  REQUIRE(is_finite_number(row.at(column)));
+  return std::stod(row.at(column));
+}
+
+}  // namespace
+
+TEST_CASE("cps report push --quick compares every push method of the table: files, measures, "
+          "and split brings the intersecting stack to rest where baumgarte throws it",
+          "[cli][report][push]") {
+  const fs::path dir = fresh_dir("quick");
+  const std::vector<std::string> methods = cli_test::push_method_names();
+  REQUIRE(methods.size() >= 2);
+  // A foreign push.md is refused (exit 2, named, kept), then replaced with --force.
+  fs::create_directories(dir / "q");
+  { std::ofstream(dir / "q" / "push.md") << "mine\n"; }
+  const Result refused = run_cps("report push --quick --out q", dir);
+  CHECK(refused.exit_code == 2);
+  CHECK(refused.err.find("push.md") != std::string::npos);
+  CHECK(slurp(dir / "q" / "push.md") == "mine\n");
+  CHECK(!fs::exists(dir / "q" / "push.csv"));
+  const Result r = run_cps("report push --quick --out q --force", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  for (const char* f : {"push.csv", "push.md", "push_overlap.png", "push_speed.png", "run.json",
+                        "plots/push_overlap.gp", "plots/push_speed.dat"}) {
+    INFO(f);
+    CHECK(fs::is_regular_file(dir / "q" / f));
+  }
+  for (const char* png : {"push_overlap.png", "push_speed.png"}) {
+    CHECK(slurp(dir / "q" / png).substr(0, 8) == std::string("\x89PNG\r\n\x1a\n", 8));
+  }
+
+  // push.csv: one row per method per case, every column with its unit (or a name, not a
+  // quantity), every measure a finite number or the documented "never" / "none".
+  std::vector<std::string> header;
+  const Table rows = read_csv(dir / "q" / "push.csv", header);
+  const std::vector<std::string> cases = {"intersecting_stack", "sphere_in_box", "stack",
+                                          "mass_ratio", "pendulum_grid", "pendulum_wave"};
+  CHECK(rows.size() == methods.size() * cases.size());
+  std::set<std::pair<std::string, std::string>> seen;
+  for (const auto& row : rows) seen.emplace(row.at("push"), row.at("case"));
+  CHECK(seen.size() == rows.size());
+  const std::set<std::string> unitless = {"push", "case", "mass_ratios_held",
+                                          "largest_mass_ratio_held"};
+  for (const std::string& c : header) {
+    INFO(c);
+    const bool has_unit = c.size() > 2 && (c.ends_with("_s") || c.ends_with("_m") ||
+                                           c.ends_with("_mps") || c.ends_with("_J") ||
+                                           c.ends_with("_rel") || c.ends_with("_deg") ||
+                                           c == "us_per_step");
+    CHECK((has_unit || unitless.count(c)));
+  }
+  for (const auto& row : rows) {
+    for (const auto& [column, cell] : row) {
+      if (cell.empty() || column == "push" || column == "case") continue;
+      INFO(row.at("push") << " " << row.at("case") << " " << column << " = " << cell);
+      if (column == "final_heights_m" || column == "rest_heights_m" || column == "mass_ratios_held") {
+        std::stringstream s(cell);
+        for (std::string v; s >> v;) CHECK((is_finite_number(v) || v == "none"));
+        continue;
+      }
+      CHECK((is_finite_number(cell) || cell == "never" || cell == "none"));
+    }
+  }
+  for (const std::string& m : methods) {
+    INFO(m);
+    // The resting column, from the cubes' half extent 1.2 m: centres at 1.2 (2 i + 1) m.
+    std::stringstream rest(row_of(rows, m, "intersecting_stack").at("rest_heights_m"));
+    int i = 0;
+    for (double y; rest >> y; ++i) CHECK(y == Approx(1.2 * (2 * i + 1)).margin(1e-9));
+    CHECK(i == 5);
+    CHECK(row_of(rows, m, "sphere_in_box").at("rest_heights_m") == "1 2.4");
+    CHECK(number_in(row_of(rows, m, "stack"), "seconds_s") == Approx(60.0));
+    CHECK(number_in(row_of(rows, m, "stack"), "us_per_step") > 0.0);
+    CHECK(number_in(row_of(rows, m, "intersecting_stack"), "us_per_step") > 0.0);
+  }
+
+  // Fig. 7 of the paper: with the push kept in the velocity (baumgarte) the overlapping cubes
+  // fly apart, with the single frame push factor (split) they are moved apart and come to rest.
+  // A cube pushed out of 0.4 m of overlap at beta d / dt = 0.2 x 0.4 x 60 = 4.8 m/s per contact
+  // keeps that speed under baumgarte; under split it keeps none of it.
+  const auto& baumgarte = row_of(rows, "baumgarte", "intersecting_stack");
+  const auto& split = row_of(rows, "split", "intersecting_stack");
+  CHECK(number_in(split, "peak_speed_mps") < number_in(baumgarte, "peak_speed_mps"));
+  CHECK(number_in(baumgarte, "peak_speed_mps") > 4.8);
+  CHECK(number_in(split, "peak_speed_mps") < 1.0);
+  // Split ends near the resting column (within 1 cm); baumgarte has thrown it metres off.
+  CHECK(number_in(split, "final_height_error_m") < 0.01);
+  CHECK(number_in(baumgarte, "final_height_error_m") > 1.0);
+  // The energy injected above rest: 5 cubes of 1.2 kg, 10 m/s^2: a metre of height is 12 J per
+  // cube. Split stays within 1 J, baumgarte throws the cubes tens of metres up.
+  CHECK(std::abs(number_in(split, "energy_injected_J")) < 1.0);
+  CHECK(number_in(baumgarte, "energy_injected_J") > 100.0);
+
+  // push.md: one table row per method, in the table's order, each with as many cells as the
+  // header, every cell a number or a documented word.
+  const std::string md = slurp(dir / "q" / "push.md");
+  std::stringstream lines(md);
+  std::vector<std::string> table;
+  bool in_table = false;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("| method |", 0) == 0) {
+      in_table = true;
+      table.push_back(line);
+    } else if (in_table && line.rfind("|", 0) == 0) {
+      table.push_back(line);
+    } else if (in_table) {
+      break;
+    }
+  }
+  REQUIRE(table.size() == methods.size() + 2);  // header, separator, a row per method
+  const auto cells = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream s(line.substr(1));
+    for (std::string c; std::getline(s, c, '|');) out.push_back(c.substr(1, c.size() - 2));
+    return out;
+  };
+  const std::size_t columns = cells(table[0]).size();
+  for (std::size_t k = 0; k < methods.size(); ++k) {
+    const std::vector<std::string> row = cells(table[k + 2]);
+    INFO(table[k + 2]);
+    REQUIRE(row.size() == columns);
+    CHECK(row[0].rfind(methods[k], 0) == 0);
+    for (std::size_t c = 1; c < row.size(); ++c) {
+      CHECK((is_finite_number(row[c]) || row[c] == "never" || row[c] == "-" || row[c] == "none"));
+    }
+  }
+  CHECK(md.find("--quick") != std::string::npos);  // the legend says the stack ran 60 s
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps report push refuses sweep options and bad names, naming them, writing nothing",
+          "[cli][report][push]") {
+  const fs::path dir = fresh_dir("refused");
+  fs::create_directories(dir / "runs");
+  struct Case {
+    std::string args;
+    std::vector<std::string> says;
+  };
+  const std::vector<Case> cases = {
+      {"report push --run x --out out", {"push", "--run"}},
+      {"report push --run intersecting_stack.pgs.baumgarte.fixed.it1.ss1 --out out", {"push", "--run"}},
+      {"report push --merge runs --out out", {"push", "--merge"}},
+      {"report push --list-runs --out out", {"push", "--list-runs"}},
+      {"report pushh --out out", {"'pushh'", "'push'"}},
+      {"report PUSH --out out", {"'PUSH'", "'push'"}},
+      {"report push --seed 3 --out out", {"push", "--seed"}},
+      {"report push --out ''", {"--out"}},
+  };
+  for (const Case& c : cases) {
+    INFO("cps " << c.args);
+    const Result r = run_cps(c.args, dir);
+    CHECK(r.exit_code == 2);
+    for (const std::string& s : c.says) {
+      INFO(s << " in: " << r.err);
+      CHECK(r.err.find(s) != std::string::npos);
+    }
+    CHECK(!fs::exists(dir / "out"));
+  }
+  // cps list and report's help name the comparison.
+  CHECK(run_cps("list", dir).out.find("cps report push") != std::string::npos);
+  CHECK(run_cps("report --help", dir).out.find("'push'") != std::string::npos);
+  fs::remove_all(dir);
+}

@@ -118,7 +118,7 @@ TEST_CASE("a file named like a temporary of an own frame is still foreign", "[cl
   fs::remove_all(dir);
 }
 
-TEST_CASE("--out naming a file, or a path below one, is refused before any work", "[cli][output]") {
+TEST_CASE("an --out naming a file, or a path below one, is refused before any work", "[cli][output]") {
   const fs::path dir = fresh_dir("out_file");
   write_text(dir / "somefile", "not a folder");
   for (const std::string out : {"somefile", "somefile/x"}) {

@@ -68,7 +68,9 @@ void SoftStep::set_targets(std::vector<ConstraintRow>& rows,
       const double s =
           -p.depth + p.normal.dot((b.x + b.rotation() * p.local_b) - (a.x + a.rotation() * p.local_a));
       if (s > 0.0) {
-        row.bias = s / h_;  // rigid: close the gap within the substep, no further
+        // Rigid: the points may approach by the gap s within the substep, no further (j . v >=
+        // -s / h; Box2D's bias s / h in its sign convention, as a speculative contact here).
+        row.bias = -s / h_;
       } else if (soft) {
         const Softness& k = p.touches_static ? static_soft_ : contact_soft_;
         row.push = std::min(k.bias_rate * std::max(-s - slop_, 0.0), max_push_);

@@ -20,8 +20,8 @@
 //   1. soft solve: every contact row with current separation s <= 0 (an overlap) targets
 //      min(bias rate x max(-s - slop, 0), contact_push_max_speed) and is soft (contact_hertz,
 //      capped at a quarter of the substep rate as Box2D does, twice it against a static body);
-//      a separated one (s > 0) targets s / h and is rigid (it may close its gap within the
-//      substep, no further). Each rod targets -bias rate x C (C its current length error, m) and
+//      a separated one (s > 0) targets -s / h and is rigid (it may close its gap within the
+//      substep, no further, like a speculative contact). Each rod targets -bias rate x C (C its current length error, m) and
 //      is soft (rod_hertz, rod_damping_ratio: Box2D's joint softness). Friction rows target 0,
 //      rigid. lambda_s starts from the previous substep's relaxed lambda: Box2D's accumulated
 //      impulse, which it re-applies each substep ("warm start"); the first substep starts from
@@ -29,7 +29,7 @@
 //      or from 0.
 //   2. positions move with f_s = f_ext + J^T lambda_s over h (Eqs. 3.2.3-3.2.4); the momenta
 //      stay v0.
-//   3. relax solve: the same rows, rigid, without the push (a contact targets s / h if its
+//   3. relax solve: the same rows, rigid, without the push (a contact targets -s / h if its
 //      points separated in the substep, else 0; rods 0), from the momenta v0 and lambda_s; its
 //      f_r = f_ext + J^T lambda_r sets the momenta (Eqs. 3.2.1-3.2.2). Box2D applies the relax
 //      as a change of velocity from v_soft with its accumulated impulse; solving from v0 for the

@@ -58,6 +58,11 @@ declare -A KIND=(
   ['*:--beta']=unit_interval ['*:--restitution']=unit_interval ['*:--warm-start']=unit_interval
   ['*:--friction']=nonneg_1e6 ['*:--restitution-threshold']=nonneg_1e6
   ['*:--contact-margin']=nonneg_1e6 ['*:--penetration-slop']=nonneg_1e6
+  ['*:--split-impulse-threshold']=nonneg_1e6 ['*:--contact-hertz']=nonneg_1e6
+  ['*:--contact-damping-ratio']=nonneg_1e6 ['*:--rod-hertz']=nonneg_1e6
+  ['*:--rod-damping-ratio']=nonneg_1e6 ['*:--contact-push-max-speed']=pos_1e6
+  ['*:--max-correction']=pos_1e6 ['*:--soft-substeps']=substeps
+  ['*:--position-iterations']=iterations
   ['*:--size']=size ['*:--times']=times
   ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png
   ['*:--trace']=trace ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
@@ -108,6 +113,8 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         1//60 /60 1/ 1/inf nan/1 1/1e-7 ;;
     unit_interval) printf '%s\n' "$NUM_COMMON" -1 -1e-9 1.5 1/2 ;;     # [0, 1]
     nonneg_1e6) printf '%s\n' "$NUM_COMMON" -1 -1e-9 1000001 1/2 ;;    # [0, 1e6]
+    pos_1e6) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 1000001 1/2 ;;  # (0, 1e6]
+    substeps) printf '%s\n' "$NUM_COMMON" -1 0 1001 1.5 1/2 2147483648 ;;  # whole, [1, 1000]
     iterations)  # whole numbers in [1, 1e4]
       printf '%s\n' "$NUM_COMMON" -1 0 10001 1.5 25.0 1e3 1/2 1e-320 5e-324 2147483648 \
         99999999999999999999 ;;

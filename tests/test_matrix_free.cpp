@@ -43,7 +43,8 @@ TEST_CASE("matrix-free lambda equals the explicit path's to round-off", "[solver
   for (const scenes::Scene& scene : scenes::paper_scenes()) {
     for (const Variant& variant : variants) {
       for (const SolverKind solver : {SolverKind::pgs, SolverKind::jacobi}) {
-        for (const PushMode push : {PushMode::baumgarte, PushMode::split}) {
+        for (const Choice& choice : parameter("push").choices) {  // every push method
+          const auto push = static_cast<PushMode>(choice.value);
           scenes::Overrides o;
           o.set("solver", SolverKind::pgs);  // reach a state with contacts the same way every time
           o.set("push", push);               // and a cache of the solves this variant runs
@@ -67,7 +68,7 @@ TEST_CASE("matrix-free lambda equals the explicit path's to round-off", "[solver
           explicit_world.step();
           free_world.step();
           INFO(scene.name << ", " << variant.name << (solver == SolverKind::pgs ? ", pgs" : ", jacobi")
-                          << (push == PushMode::split ? ", split" : ", baumgarte") << ", "
+                          << ", " << choice.name << ", "
                           << explicit_world.rows().size() << " rows");
           REQUIRE(!explicit_world.lambda().empty());
           if (variant.warm_start > 0.0 && scene.name != "pendulum_wave") {

@@ -186,10 +186,13 @@ void World::step_soft(bool warm) {
     solve_with(soft_settings, TargetTerms::push_and_bias, lambda0_, f_cv_, start);
     // 2. positions with f_s; momenta kept
     cps::integrate(bodies_, f_cv_, zero_force_, h, def_.rotation);
-    // 3. relax solve (lambda_) from lambda_s, rigid, without the push; it sets the momenta
+    // 3. relax solve (lambda_), rigid, without the push, from the last relaxed lambda (not
+    //    lambda_s, which carries the push: soft_step.h); it sets the momenta
     soft_->set_targets(rows_, distances_, bodies_, /*soft=*/false,
                        /*last=*/k + 1 == def_.soft_substeps);
-    solve_with(settings(h), TargetTerms::bias_only, lambda_, f_c0_, &lambda0_);
+    relax_start_.assign(lambda_.begin(), lambda_.end());
+    solve_with(settings(h), TargetTerms::bias_only, lambda_, f_c0_,
+               k > 0 ? &relax_start_ : (warm ? &initial_ : nullptr));
     add_momenta(bodies_, f_c0_, h);
     start = &lambda_;
   }

@@ -171,6 +171,7 @@ class World {
   std::unique_ptr<SoftStep> soft_;
   std::unique_ptr<NgsProjection> ngs_;
   Eigen::VectorXd zero_force_;  // 6n zeros: the soft step's positions-only integration
+  std::vector<double> relax_start_;  // the soft step's last relaxed lambda (c, N)
   Assembly solver_assembly_ = Assembly::matrix_free;
   StepCounters counters_;
   ResidualStats residual_;

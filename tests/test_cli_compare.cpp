@@ -120,12 +120,12 @@ TEST_CASE("cps render --compare with three values of beta lays out 3 labelled pa
 TEST_CASE("cps render --overlay draws every variant in one view in its colour, with a legend",
           "[cli][compare]") {
   const fs::path dir = fresh_dir("cps_compare_overlay");
-  const Result r = run("render intersecting_stack --compare push --overlay --seconds 0.5 --fps 2 "
+  const Result r = run("render intersecting_stack --compare push=baumgarte,split --overlay --seconds 0.5 --fps 2 "
                        "--size 320x240 --out out",
                        dir);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
-  const fs::path folder = dir / "out" / "intersecting_stack-compare-push-overlay";
+  const fs::path folder = dir / "out" / "intersecting_stack-compare-push-baumgarte_split-overlay";
   const cps::render::Image frame = cps::render::read_png(folder / "frame_000001.png");
   CHECK(frame.width == 320);  // one view of --size
   CHECK(frame.height == 240);

@@ -70,7 +70,7 @@ std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
 #ifdef CPS_HAVE_RENDERER
 TEST_CASE("cps figure writes one PNG of times x variants panels with a sidecar", "[cli][figure]") {
   const fs::path dir = fresh_dir("size");
-  const Result r = cps("figure intersecting_stack --times 0,0.25,0.5 --compare push --size 48x32 "
+  const Result r = cps("figure intersecting_stack --times 0,0.25,0.5 --compare push=baumgarte,split --size 48x32 "
                        "--out f.png",
                        dir);
   INFO(r.err);

@@ -13,6 +13,11 @@
 //                               f_c0 = f_ext + J^T lambda_0
 //   integrate         Sec. 3.2  semi-implicit Euler: positions with f_cv, stored momenta with
 //                               f_c0 (split) or f_cv (baumgarte)
+// The push methods beyond the paper's replace the two last stages, each in its own file:
+// split-impulse (split_impulse.h: a velocity solve without the push, then the push solved on
+// pseudo-velocities that move the positions only), soft (soft_step.h: substeps, each a soft
+// solve that moves the positions and a relax solve that sets the momenta) and ngs (ngs.h: a
+// velocity solve without the push, the integration, then the positions projected).
 
 #include "cps/body.h"
 #include "cps/collision.h"

@@ -108,7 +108,11 @@ TEST_CASE("after warm-up a step of every paper scene allocates nothing", "[alloc
                              Variant{"jacobi baumgarte", SolverKind::jacobi, PushMode::baumgarte, 0.0},
                              Variant{"pgs baumgarte warm 0.8", SolverKind::pgs, PushMode::baumgarte, 0.8},
                              Variant{"pgs split warm 1", SolverKind::pgs, PushMode::split, 1.0},
-                             Variant{"jacobi split warm 0.8", SolverKind::jacobi, PushMode::split, 0.8}}) {
+                             Variant{"jacobi split warm 0.8", SolverKind::jacobi, PushMode::split, 0.8},
+                             Variant{"pgs split-impulse", SolverKind::pgs, PushMode::split_impulse, 0.0},
+                             Variant{"pgs soft warm 0.8", SolverKind::pgs, PushMode::soft, 0.8},
+                             Variant{"jacobi soft", SolverKind::jacobi, PushMode::soft, 0.0},
+                             Variant{"pgs ngs", SolverKind::pgs, PushMode::ngs, 0.0}}) {
       scenes::Overrides o;
       o.set("solver", v.solver);
       o.set("push", v.push);

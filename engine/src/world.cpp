@@ -190,6 +190,7 @@ void World::step_soft(bool warm) {
     //    lambda_s, which carries the push: soft_step.h); it sets the momenta
     soft_->set_targets(rows_, distances_, bodies_, /*soft=*/false,
                        /*last=*/k + 1 == def_.soft_substeps);
+    detail::reserve_with_headroom(relax_start_, lambda_.size());
     relax_start_.assign(lambda_.begin(), lambda_.end());
     solve_with(settings(h), TargetTerms::bias_only, lambda_, f_c0_,
                k > 0 ? &relax_start_ : (warm ? &initial_ : nullptr));

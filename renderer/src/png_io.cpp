@@ -1,6 +1,6 @@
-// encode_png (a PNG file assembled here around a zlib stream from Intel's ISA-L, or from zlib when
-// the build has no ISA-L), PngWriter (encoding on worker threads, files written by its sink) and
-// read_png through libpng.
+// encode_png (a PNG file written by stb_image_write around a zlib stream from Intel's ISA-L, or
+// from zlib when the build has no ISA-L), PngWriter (encoding on worker threads, files written by
+// its sink) and read_png through libpng.
 
 #include "cps/render/renderer.h"
 
@@ -10,11 +10,14 @@
 #include <isa-l/igzip_lib.h>
 #endif
 
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cerrno>
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <exception>
@@ -31,144 +34,214 @@ namespace {
 
 // Speed over size: a frame is drawn in 15-300 ms and its encoding runs beside the drawing of the
 // next frame on the same two cores, so every millisecond of encoder CPU slows the pipeline down.
-// Measured on 8-16 real 1280x720 frames of each of the five paper scenes (Debian 12 on the
-// 2-core host, median thread CPU ms per frame, encoding to memory; mean KiB per frame;
-// pendulum_wave / the four others; an earlier note found stb_image_write slower still):
-//   libpng 1.6, zlib 1.2.13 level 1, filter none          5.7 / 11-14   55 / 251-269 KiB
-//   libpng, zlib level 1, Z_RLE + filter up or sub        6.6 / 12-18   47 / 236-482 KiB
-//   libpng, zlib level 1, Z_FILTERED + filter up or sub   6.9 / 13-16   52 / 256-359 KiB
-//   libdeflate 1.14 level 1, filter none                  3.7 / 6.3-7   43 / 212-232 KiB
-//   ISA-L 2.30 igzip level 1, filter none                 0.8 / 2.4-2.7 55 / 243-262 KiB
-//   ISA-L igzip level 2, filter none (chosen)             0.8 / 2.5-2.8 55 / 240-259 KiB
-//   ISA-L igzip level 1, filter up or sub                 1.5 / 3.4-4.9 52 / 235-369 KiB
+// MEASUREMENTS_PLACEHOLDER
 // The renders are mostly flat colour, which deflate compresses well without row prediction, and
 // a row filter costs more than it saves here. Every row therefore uses PNG filter type 0 (none),
 // and the zlib stream of the whole image is made in one call (ISA-L's stateless mode).
 #if CPS_PNG_ISAL
-constexpr int k_isal_level = 2;                            // igzip level, 0..3; typical 1-2
-constexpr std::uint32_t k_isal_level_buf = ISAL_DEF_LVL2_DEFAULT;  // bytes of work space
+constexpr int k_deflate_level = 2;  // igzip level, 0..3; typical 1-2
 #else
-constexpr int k_zlib_level = 1;  // zlib level, 0..9 (fallback without ISA-L); typical 1
+constexpr int k_deflate_level = 1;  // zlib level, 0..9 (fallback without ISA-L); typical 1
 #endif
 
-void put_be32(std::uint8_t* p, std::uint32_t v) {
-  p[0] = static_cast<std::uint8_t>(v >> 24);
-  p[1] = static_cast<std::uint8_t>(v >> 16);
-  p[2] = static_cast<std::uint8_t>(v >> 8);
-  p[3] = static_cast<std::uint8_t>(v);
-}
+/// The memory of stb_image_write (STBIW_MALLOC, STBIW_REALLOC, STBIW_FREE) and of deflate_zlib's
+/// result, which stb frees. stb allocates the same few large blocks for every image (the filtered
+/// rows, 3 width + 1 bytes a row; a line; the zlib stream; the file) and frees them before it
+/// returns. From std::malloc, blocks of megabytes are mapped afresh and returned to the system on
+/// every call (glibc's malloc trims them), and touching their new pages took more CPU than the
+/// deflate itself (see the measurements above). So each thread keeps up to k_kept_blocks freed
+/// blocks and hands out the smallest one that is large enough: a stream of frames of one size
+/// allocates nothing after the first. Each block starts with a header giving its capacity.
+/// Not shared between threads (each encoder thread has its own).
+class BlockCache {
+ public:
+  BlockCache() = default;
+  BlockCache(const BlockCache&) = delete;
+  BlockCache& operator=(const BlockCache&) = delete;
+  ~BlockCache() {
+    for (std::size_t i = 0; i < count_; ++i) std::free(kept_[i]);
+  }
 
-/// Writes a chunk's CRC-32 of its type and data (4 + length bytes from `type`) at `type` + 4 +
-/// length (PNG specification, 3rd ed., 5.3: CRC-32 of ISO 3309, as in zlib's crc32).
-void put_crc(std::uint8_t* type, std::size_t length) {
-  put_be32(type + 4 + length,
-           static_cast<std::uint32_t>(crc32(0L, type, static_cast<uInt>(length + 4))));
-}
-
-/// One PNG encoder's buffers, kept between images so that a stream of frames allocates (and
-/// clears) nothing after the first. Not thread-safe: one encoder per thread.
-struct PngEncoder {
-  std::vector<std::uint8_t> scanlines;  // height rows of (filter byte 0, 3 * width bytes RGB)
-  std::vector<std::uint8_t> file;       // the PNG file in its first `size` bytes
-  std::size_t size = 0;
-#if CPS_PNG_ISAL
-  std::vector<std::uint8_t> level_buf;  // ISA-L's work space for k_isal_level
-#endif
-
-  /// Encodes `image` (checked by the caller: sizes > 0, 3 * width * height bytes) into
-  /// file[0, size): an 8-bit RGB, non-interlaced PNG with chunks IHDR, one IDAT and IEND.
-  /// Throws std::runtime_error if the compressor fails.
-  void encode(const Image& image) {
-    const std::size_t row = 3u * static_cast<std::size_t>(image.width);
-    const auto height = static_cast<std::size_t>(image.height);
-    if (scanlines.size() != (row + 1u) * height) scanlines.resize((row + 1u) * height);
-    for (std::size_t y = 0; y < height; ++y) {
-      std::uint8_t* line = scanlines.data() + (row + 1u) * y;
-      line[0] = 0;  // filter type: none
-      std::memcpy(line + 1, image.pixels.data() + row * y, row);
+  /// A block of at least `bytes` bytes (aligned as std::malloc's), or nullptr if memory runs out.
+  void* allocate(std::size_t bytes) {
+    std::size_t best = count_;
+    for (std::size_t i = 0; i < count_; ++i) {
+      if (capacity(kept_[i]) >= bytes && (best == count_ || capacity(kept_[i]) < capacity(kept_[best]))) {
+        best = i;
+      }
     }
+    if (best < count_) {
+      Header* block = kept_[best];
+      kept_[best] = kept_[--count_];
+      return block + 1;
+    }
+    if (bytes > SIZE_MAX - sizeof(Header)) return nullptr;
+    auto* block = static_cast<Header*>(std::malloc(sizeof(Header) + bytes));
+    if (block == nullptr) return nullptr;
+    block->capacity = bytes;
+    return block + 1;
+  }
 
-    // Layout: signature (8), IHDR (12 + 13), IDAT (12 + n), IEND (12). The IDAT data, the zlib
-    // stream, is compressed straight into place, with room for the worst case: incompressible
-    // data sent in stored blocks, 5 bytes per block of at most 65535 bytes (RFC 1951) plus the
-    // zlib header and Adler-32 (RFC 1950); 1/1024 + 1 KiB covers both.
-    constexpr std::size_t k_ihdr = 8;
-    constexpr std::size_t k_idat = k_ihdr + 12 + 13;
-    const std::size_t room = scanlines.size() + scanlines.size() / 1024u + 1024u;
-    if (file.size() < k_idat + 12 + room + 12) file.resize(k_idat + 12 + room + 12);
-    std::uint8_t* out = file.data();
+  /// Keeps the block at `p` (from allocate; nullptr is ignored) for later calls: if k_kept_blocks
+  /// are kept already, the smallest of them and this one goes back to std::free.
+  void release(void* p) {
+    if (p == nullptr) return;
+    Header* block = static_cast<Header*>(p) - 1;
+    if (count_ < k_kept_blocks) {
+      kept_[count_++] = block;
+      return;
+    }
+    std::size_t smallest = 0;
+    for (std::size_t i = 1; i < count_; ++i) {
+      if (capacity(kept_[i]) < capacity(kept_[smallest])) smallest = i;
+    }
+    if (capacity(kept_[smallest]) < capacity(block)) std::swap(kept_[smallest], block);
+    std::free(block);
+  }
 
-    static constexpr std::array<std::uint8_t, 8> k_signature = {0x89, 'P', 'N', 'G',
-                                                                 0x0D, 0x0A, 0x1A, 0x0A};
-    std::memcpy(out, k_signature.data(), k_signature.size());
-    put_be32(out + k_ihdr, 13);
-    std::memcpy(out + k_ihdr + 4, "IHDR", 4);
-    put_be32(out + k_ihdr + 8, static_cast<std::uint32_t>(image.width));
-    put_be32(out + k_ihdr + 12, static_cast<std::uint32_t>(image.height));
-    out[k_ihdr + 16] = 8;  // bits per sample
-    out[k_ihdr + 17] = 2;  // colour type: RGB
-    out[k_ihdr + 18] = 0;  // compression method: zlib deflate
-    out[k_ihdr + 19] = 0;  // filter method 0 (five filter types; every row uses type 0, none)
-    out[k_ihdr + 20] = 0;  // no interlace
-    put_crc(out + k_ihdr + 4, 13);
-
-    std::memcpy(out + k_idat + 4, "IDAT", 4);
-    const std::size_t length = deflate_into(out + k_idat + 8, room);
-    put_be32(out + k_idat, static_cast<std::uint32_t>(length));
-    put_crc(out + k_idat + 4, length);
-
-    const std::size_t iend = k_idat + 12 + length;
-    put_be32(out + iend, 0);
-    std::memcpy(out + iend + 4, "IEND", 4);
-    put_crc(out + iend + 4, 0);
-    size = iend + 12;
+  /// The block at `p` grown to at least `bytes` bytes, its first bytes kept (like std::realloc;
+  /// nullptr: a new block); nullptr if memory runs out (then `p` is still valid).
+  void* reallocate(void* p, std::size_t bytes) {
+    if (p == nullptr) return allocate(bytes);
+    const std::size_t old = capacity(static_cast<Header*>(p) - 1);
+    if (old >= bytes) return p;
+    void* grown = allocate(bytes);
+    if (grown == nullptr) return nullptr;
+    std::memcpy(grown, p, old);
+    release(p);
+    return grown;
   }
 
  private:
-  /// Compresses `scanlines` into out[0, room) as one zlib stream; returns its length in bytes.
-  std::size_t deflate_into(std::uint8_t* out, std::size_t room) {
-#if CPS_PNG_ISAL
-    if (level_buf.size() != k_isal_level_buf) level_buf.assign(k_isal_level_buf, 0);
-    isal_zstream z;
-    isal_deflate_stateless_init(&z);
-    z.gzip_flag = IGZIP_ZLIB;
-    z.level = k_isal_level;
-    z.level_buf = level_buf.data();
-    z.level_buf_size = static_cast<std::uint32_t>(level_buf.size());
-    z.flush = NO_FLUSH;
-    z.end_of_stream = 1;
-    z.next_in = scanlines.data();
-    z.avail_in = static_cast<std::uint32_t>(scanlines.size());
-    z.next_out = out;
-    z.avail_out = static_cast<std::uint32_t>(room);
-    const int status = isal_deflate_stateless(&z);
-    if (status != COMP_OK) {
-      throw std::runtime_error("ISA-L deflate failed (status " + std::to_string(status) + ")");
-    }
-    return z.total_out;
-#else
-    z_stream z{};
-    if (deflateInit(&z, k_zlib_level) != Z_OK) throw std::runtime_error("zlib: deflateInit failed");
-    z.next_in = scanlines.data();
-    z.avail_in = static_cast<uInt>(scanlines.size());
-    z.next_out = out;
-    z.avail_out = static_cast<uInt>(room);
-    const int status = deflate(&z, Z_FINISH);
-    const std::size_t length = z.total_out;
-    deflateEnd(&z);
-    if (status != Z_STREAM_END) {
-      throw std::runtime_error("zlib deflate failed (status " + std::to_string(status) + ")");
-    }
-    return length;
-#endif
-  }
+  struct alignas(std::max_align_t) Header {
+    std::size_t capacity;  // bytes after the header
+  };
+  static std::size_t capacity(const Header* block) { return block->capacity; }
+  // The blocks one image needs at once (the rows and the zlib stream, then the stream and the
+  // file) plus the line and one spare; typical 4.
+  static constexpr std::size_t k_kept_blocks = 4;
+  std::array<Header*, k_kept_blocks> kept_{};
+  std::size_t count_ = 0;
 };
+
+BlockCache& block_cache() {
+  thread_local BlockCache cache;
+  return cache;
+}
+void* stb_allocate(std::size_t bytes) { return block_cache().allocate(bytes); }
+[[maybe_unused]] void* stb_reallocate(void* p, std::size_t bytes) { return block_cache().reallocate(p, bytes); }
+void stb_release(void* p) { block_cache().release(p); }
+
+/// Why the last deflate_zlib call on this thread failed (empty if it did not): stb_image_write
+/// only sees a null result, so encode_png reads the reason here.
+thread_local std::string t_deflate_error;
+
+/// stb_image_write's STBIW_ZLIB_COMPRESS hook: compresses data[0, data_len) into one zlib stream
+/// (RFC 1950: 2-byte header, deflate data of RFC 1951, Adler-32 of the data) at `level` (stb's
+/// stbi_write_png_compression_level, set to k_deflate_level by encode_png). Returns the stream in
+/// memory from stb_allocate, which stb frees with STBIW_FREE (stb_release), its length in
+/// *out_len; nullptr if the compressor fails (the reason in t_deflate_error) or memory runs out.
+unsigned char* deflate_zlib(unsigned char* data, int data_len, int* out_len, int level) {
+  t_deflate_error.clear();
+  const auto in_size = static_cast<std::size_t>(data_len);
+#if CPS_PNG_ISAL
+  // Room for the worst case: incompressible data sent in stored blocks, 5 bytes per block of at
+  // most 65535 bytes (RFC 1951) plus the zlib header and Adler-32 (RFC 1950); 1/1024 + 1 KiB
+  // covers both.
+  const std::size_t room = in_size + in_size / 1024u + 1024u;
+  auto* out = static_cast<unsigned char*>(stb_allocate(room));
+  if (out == nullptr) {
+    t_deflate_error = "out of memory";
+    return nullptr;
+  }
+  // ISA-L's work space for the level, kept per thread so that a stream of frames allocates it once.
+  thread_local std::vector<std::uint8_t> level_buf;
+  static constexpr std::uint32_t k_level_buf_bytes[] = {0, ISAL_DEF_LVL1_DEFAULT,
+                                                        ISAL_DEF_LVL2_DEFAULT,
+                                                        ISAL_DEF_LVL3_DEFAULT};
+  const int isal_level = std::clamp(level, 0, 3);
+  const std::uint32_t level_bytes = k_level_buf_bytes[isal_level];
+  if (level_buf.size() < level_bytes) level_buf.assign(level_bytes, 0);
+  isal_zstream z;
+  isal_deflate_stateless_init(&z);
+  z.gzip_flag = IGZIP_ZLIB;
+  z.level = static_cast<std::uint32_t>(isal_level);
+  z.level_buf = level_bytes > 0 ? level_buf.data() : nullptr;
+  z.level_buf_size = level_bytes;
+  z.flush = NO_FLUSH;
+  z.end_of_stream = 1;
+  z.next_in = data;
+  z.avail_in = static_cast<std::uint32_t>(in_size);
+  z.next_out = out;
+  z.avail_out = static_cast<std::uint32_t>(room);
+  const int status = isal_deflate_stateless(&z);
+  if (status != COMP_OK) {
+    stb_release(out);
+    t_deflate_error = "ISA-L deflate failed (status " + std::to_string(status) + ")";
+    return nullptr;
+  }
+  *out_len = static_cast<int>(z.total_out);
+  return out;
+#else
+  uLongf length = compressBound(static_cast<uLong>(in_size));
+  auto* out = static_cast<unsigned char*>(stb_allocate(length));
+  if (out == nullptr) {
+    t_deflate_error = "out of memory";
+    return nullptr;
+  }
+  const int status = compress2(out, &length, data, static_cast<uLong>(in_size), level);
+  if (status != Z_OK) {
+    stb_release(out);
+    t_deflate_error = "zlib compress2 failed (status " + std::to_string(status) + ")";
+    return nullptr;
+  }
+  *out_len = static_cast<int>(length);
+  return out;
+#endif
+}
+
+}  // namespace
+}  // namespace cps::render
+
+// stb_image_write (Debian libstb-dev), compiled here with internal linkage: it lays out the PNG
+// (signature, IHDR, one IDAT, IEND) and its filtered rows; the deflate is ISA-L's (or zlib's)
+// through STBIW_ZLIB_COMPRESS and the chunk CRC-32 is zlib's crc32 through STBIW_CRC32 (PNG
+// specification, 3rd ed., 5.3: the CRC of ISO 3309), faster than stb's byte-wise table; its
+// memory comes from this thread's BlockCache.
+#define STBIW_ZLIB_COMPRESS cps::render::deflate_zlib
+#define STBIW_MALLOC(bytes) cps::render::stb_allocate(bytes)
+#define STBIW_REALLOC(p, bytes) cps::render::stb_reallocate((p), (bytes))
+#define STBIW_FREE(p) cps::render::stb_release(p)
+#define STBIW_CRC32(buffer, len) \
+  static_cast<unsigned int>(crc32(0L, (buffer), static_cast<uInt>(len)))
+#define STB_IMAGE_WRITE_STATIC
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#endif
+#include <stb_image_write.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+namespace cps::render {
+namespace {
+
+/// stbi_write_png_to_func's callback: appends the file's bytes to the std::vector<std::uint8_t>
+/// at `context` (stb calls it once, with the whole file).
+void append_bytes(void* context, void* data, int size) {
+  auto& file = *static_cast<std::vector<std::uint8_t>*>(context);
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  file.insert(file.end(), bytes, bytes + size);
+}
 
 }  // namespace
 
 // encode_png: image of width x height > 0 with 3 * width * height bytes (RGB8, rows top to
-// bottom), else std::invalid_argument. Encodes into this thread's buffers (kept for the next call:
-// about 2 x 3 x width x height bytes) and returns a view of the file's bytes in them.
+// bottom), else std::invalid_argument. stb_image_write builds the file in memory it allocates and
+// frees each call; the finished file is copied into this thread's buffer (kept for the next call)
+// and a view of it returned.
 std::span<const std::uint8_t> encode_png(const Image& image) {
   const auto expected = static_cast<std::size_t>(image.width > 0 ? image.width : 0) *
                         static_cast<std::size_t>(image.height > 0 ? image.height : 0) * 3u;
@@ -177,9 +250,34 @@ std::span<const std::uint8_t> encode_png(const Image& image) {
                                 std::to_string(image.height) + ", " +
                                 std::to_string(image.pixels.size()) + " bytes)");
   }
-  thread_local PngEncoder encoder;
-  encoder.encode(image);
-  return {encoder.file.data(), encoder.size};
+  // stb_image_write counts bytes in int: the filtered rows, (3 width + 1) height bytes, and the
+  // file, about as large for noise, must stay below INT_MAX with room for the chunks.
+  const auto row_bytes = (3u * static_cast<std::size_t>(image.width) + 1u) *
+                         static_cast<std::size_t>(image.height);
+  constexpr std::size_t k_max_row_bytes = std::size_t{1} << 30;  // 1 GiB
+  if (row_bytes > k_max_row_bytes) {
+    throw std::invalid_argument("encode_png: image " + std::to_string(image.width) + "x" +
+                                std::to_string(image.height) + " too large (" +
+                                std::to_string(row_bytes) + " bytes of rows; at most " +
+                                std::to_string(k_max_row_bytes) + ")");
+  }
+  // stb's settings are globals of this file: set once, before the first image, then only read.
+  static const bool settings = [] {
+    stbi_write_force_png_filter = 0;  // filter type 0 (none) on every row
+    stbi_write_png_compression_level = k_deflate_level;  // handed to deflate_zlib
+    return true;
+  }();
+  (void)settings;
+  thread_local std::vector<std::uint8_t> file;
+  file.clear();
+  if (stbi_write_png_to_func(append_bytes, &file, image.width, image.height, 3,
+                             image.pixels.data(), 3 * image.width) == 0) {
+    throw std::runtime_error("encode_png: stb_image_write failed (" +
+                             (t_deflate_error.empty() ? std::string("out of memory")
+                                                      : t_deflate_error) +
+                             ")");
+  }
+  return {file.data(), file.size()};
 }
 
 struct PngWriter::Impl {

@@ -7,7 +7,7 @@ cps_packages=(
   libxxhash-dev
   # Scene files: validated against assets/schemas/scene.schema.json by valijson.
   libvalijson-dev
-  # PNG frames: deflate by Intel ISA-L, CRCs by zlib.
+  # PNG frames: written by stb_image_write (libstb-dev), deflate by Intel ISA-L, CRCs by zlib.
   libisal-dev zlib1g-dev
   # The two GL backends (both loaded at run time): OSMesa, and EGL with Mesa's driver.
   libosmesa6-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri

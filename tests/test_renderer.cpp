@@ -4,11 +4,14 @@
 #include "cps/render/renderer.h"
 
 #include <catch2/catch.hpp>
+#include <zlib.h>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -18,6 +21,7 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <vector>
 
 namespace fs = std::filesystem;
 using namespace cps::render;
@@ -348,6 +352,84 @@ TEST_CASE("encode_png keeps every pixel of noise, flat and tiny images", "[rende
   write_png(dir.path / "cut.png", img);
   fs::resize_file(dir.path / "cut.png", fs::file_size(dir.path / "cut.png") - 20);
   CHECK_THROWS_WITH(read_png(dir.path / "cut.png"), Catch::Contains("cut.png"));
+}
+
+/// Big-endian 32-bit value at p (PNG's byte order).
+std::uint32_t be32(const std::uint8_t* p) {
+  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) |
+         std::uint32_t{p[3]};
+}
+
+TEST_CASE("encode_png writes RGB rows unfiltered in one zlib stream, every chunk's CRC right",
+          "[renderer]") {
+  // The file is taken apart here, without libpng: signature, chunks (each CRC-32 of its type and
+  // data, PNG spec 5.3), IHDR 8-bit RGB, and the IDAT data inflated by zlib (which checks the
+  // Adler-32): height rows of a filter byte 0 (none) and the image's bytes unchanged. Random
+  // content defeats any row filter a writer might pick by itself; sizes go large, small, then
+  // large again, so that the encoder's kept buffers are reused and regrown.
+  std::mt19937 rng(2017);
+  for (const auto& [w, h] : {std::pair{1280, 720}, std::pair{3, 2}, std::pair{1920, 1081}}) {
+    INFO(w << "x" << h);
+    Image img;
+    img.width = w;
+    img.height = h;
+    img.pixels.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3u);
+    // Half the rows noise, half smooth ramps (which row filters up/sub/paeth would shrink).
+    for (int y = 0; y < h; ++y) {
+      for (int i = 0; i < 3 * w; ++i) {
+        const std::size_t k = static_cast<std::size_t>(y) * static_cast<std::size_t>(3 * w) +
+                              static_cast<std::size_t>(i);
+        img.pixels[k] = (y % 2 == 0) ? static_cast<std::uint8_t>(rng() >> 24)
+                                     : static_cast<std::uint8_t>(i / 3 + y);
+      }
+    }
+    const std::span<const std::uint8_t> file = encode_png(img);
+    REQUIRE(file.size() > 8u + 25u + 12u + 12u);
+    const std::array<std::uint8_t, 8> signature = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
+    CHECK(std::equal(signature.begin(), signature.end(), file.begin()));
+    std::vector<std::uint8_t> zlib_stream;
+    std::vector<std::string> types;
+    std::size_t at = 8;
+    while (at + 12u <= file.size()) {
+      const std::uint32_t length = be32(file.data() + at);
+      REQUIRE(at + 12u + length <= file.size());
+      const std::uint8_t* type = file.data() + at + 4;
+      types.emplace_back(reinterpret_cast<const char*>(type), 4);
+      const auto crc = static_cast<std::uint32_t>(crc32(0L, type, static_cast<uInt>(length + 4)));
+      CHECK(be32(type + 4 + length) == crc);
+      if (types.back() == "IHDR") {
+        REQUIRE(length == 13u);
+        CHECK(be32(type + 4) == static_cast<std::uint32_t>(w));
+        CHECK(be32(type + 8) == static_cast<std::uint32_t>(h));
+        CHECK(type[12] == 8);  // bits per sample
+        CHECK(type[13] == 2);  // colour type RGB
+        CHECK(type[16] == 0);  // no interlace
+      }
+      if (types.back() == "IDAT") zlib_stream.insert(zlib_stream.end(), type + 4, type + 4 + length);
+      at += 12u + length;
+    }
+    CHECK(at == file.size());
+    REQUIRE(types.size() >= 3u);
+    CHECK(types.front() == "IHDR");
+    CHECK(types.back() == "IEND");
+
+    const std::size_t row = 3u * static_cast<std::size_t>(w);
+    std::vector<std::uint8_t> rows((row + 1u) * static_cast<std::size_t>(h) + 1u);  // 1 spare
+    uLongf rows_size = static_cast<uLongf>(rows.size());
+    REQUIRE(uncompress(rows.data(), &rows_size, zlib_stream.data(),
+                       static_cast<uLong>(zlib_stream.size())) == Z_OK);
+    REQUIRE(rows_size == (row + 1u) * static_cast<std::size_t>(h));
+    int filtered_rows = 0;
+    bool same = true;
+    for (std::size_t y = 0; y < static_cast<std::size_t>(h); ++y) {
+      const std::uint8_t* line = rows.data() + (row + 1u) * y;
+      if (line[0] != 0) ++filtered_rows;
+      same = same && std::equal(line + 1, line + 1 + row, img.pixels.begin() +
+                                                               static_cast<std::ptrdiff_t>(row * y));
+    }
+    CHECK(filtered_rows == 0);
+    CHECK(same);
+  }
 }
 
 TEST_CASE("PngWriter writes every queued image and reports a failed write by its path",

@@ -68,14 +68,17 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Encodes `image` as an 8-bit RGB PNG file (no row filter, deflate by Intel's ISA-L at level 2,
-/// or by zlib at level 1 in a build without ISA-L: the fastest of the encoders measured for these
-/// renders, see png_io.cpp). Returns the file's bytes, held in this thread's encoder: valid until
-/// this thread's next encode_png call. Thread-safe: each thread has its own encoder, whose
-/// buffers (about 6 bytes per pixel of the largest image) stay for its next call. Throws
+/// Encodes `image` as an 8-bit RGB PNG file with stb_image_write (no row filter, deflate by
+/// Intel's ISA-L at level 2, or by zlib at level 1 in a build without ISA-L: the fastest of the
+/// encoders measured for these renders, see png_io.cpp). Returns the file's bytes, held in this
+/// thread's encoder: valid until this thread's next encode_png call. Thread-safe: each thread has
+/// its own encoder, whose buffers (about 6 bytes per pixel of the largest image, plus twice its
+/// file) stay for its next call. Throws
 /// std::invalid_argument for an invalid image (width or height <= 0, or pixels.size() !=
-/// 3 * width * height; the message gives the sizes), std::runtime_error if the compressor fails.
-/// Writes no file: the caller decides how (the cps command writes atomically, see FileSink).
+/// 3 * width * height; the message gives the sizes; or more than 2^30 bytes of rows, (3 width + 1)
+/// height, the most stb_image_write's int sizes are kept within), std::runtime_error if the
+/// compressor fails. Writes no file: the caller decides how (the cps command writes atomically,
+/// see FileSink).
 std::span<const std::uint8_t> encode_png(const Image& image);
 
 /// Writes one file: `bytes` as the whole content of `path`. The renderer writes no file itself;

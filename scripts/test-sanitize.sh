@@ -15,9 +15,11 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # Left to the Release build of the test command, which runs them too: the bad-input sweep (label
 # sweep, ~1400 command lines; about 5 minutes here, and it found the same results in both
 # builds) and the two report sweeps (about 5 and 4 minutes here, 1 to 2 minutes of report runs
-# each in the Release build), so that .ci/run stays well under 30 minutes on 2 cores.
+# each in the Release build), and cps report push --quick (35 runs of the five push methods:
+# 98 s here, 6 s in Release; the methods' own tests run here), so that .ci/run stays under 30
+# minutes on 2 cores.
 # The random piles run 200 seeds in the Release tests; 50 here (under the sanitizers the 200 took
 # 189 s of a 27.4-minute .ci/run).
 export CPS_RANDOM_SEEDS=${CPS_RANDOM_SEEDS:-50}
 ctest --test-dir build-asan --output-on-failure --parallel "$(nproc)" -LE sweep \
-  -E "cps report's quick funnel sweep|cps report writes CSVs with units"
+  -E "cps report's quick funnel sweep|cps report writes CSVs with units|cps report push --quick compares"

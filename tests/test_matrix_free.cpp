@@ -48,6 +48,10 @@ TEST_CASE("matrix-free lambda equals the explicit path's to round-off", "[solver
       for (const SolverKind solver : {SolverKind::pgs, SolverKind::jacobi}) {
         for (const Choice& choice : parameter("push").choices) {  // every push method
           const auto push = static_cast<PushMode>(choice.value);
+          // The methods beyond the paper's share its solve paths: cold, and warm with coupled
+          // friction and restitution, cover their own code (warm 0.8 adds only run time).
+          const bool paper_push = push == PushMode::baumgarte || push == PushMode::split;
+          if (!paper_push && variant.warm_start == 0.8) continue;
           scenes::Overrides o;
           o.set("solver", SolverKind::pgs);  // reach a state with contacts the same way every time
           o.set("push", push);               // and a cache of the solves this variant runs

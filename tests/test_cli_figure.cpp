@@ -5,6 +5,10 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#ifdef CPS_HAVE_RENDERER
+#include "cps/render/renderer.h"
+#endif
+
 #include <sys/wait.h>
 
 #include <cmath>
@@ -48,6 +52,47 @@ std::pair<int, int> png_size(const fs::path& p) {
   };
   return {be32(16), be32(20)};
 }
+
+// The page size the figure's sidecar records ({0, 0} without a sidecar).
+std::pair<int, int> sidecar_size(const fs::path& figure) {
+  const fs::path side = figure.string() + ".json";
+  if (!fs::exists(side)) return {0, 0};
+  const nlohmann::json size = nlohmann::json::parse(slurp(side))["parameters"]["image_size_px"];
+  return {size[0].get<int>(), size[1].get<int>()};
+}
+
+// The text of a PDF as pdftotext (poppler-utils) reads it; "" if it cannot.
+std::string pdf_text(const fs::path& pdf) {
+  const fs::path txt = pdf.string() + ".txt";
+  const std::string command = "pdftotext -q '" + pdf.string() + "' '" + txt.string() + "'";
+  if (std::system(command.c_str()) != 0) return "";
+  return slurp(txt);
+}
+
+// The panels' rectangles (x, y, width, height) and letters the sidecar of `figure` records.
+struct PanelRect {
+  int x, y, w, h;
+  std::string letter;
+};
+std::vector<PanelRect> sidecar_panels(const fs::path& figure) {
+  std::vector<PanelRect> out;
+  for (const auto& p : nlohmann::json::parse(slurp(figure.string() + ".json"))["parameters"]["panels_px"]) {
+    out.push_back({p["rect"][0], p["rect"][1], p["rect"][2], p["rect"][3], p["letter"]});
+  }
+  return out;
+}
+
+// (a), (b), ... in reading order: row by row (y increasing), each row left to right.
+void check_reading_order(const std::vector<PanelRect>& panels) {
+  for (std::size_t k = 0; k < panels.size(); ++k) {
+    INFO("panel " << k);
+    CHECK(panels[k].letter == std::string("(") + static_cast<char>('a' + k) + ")");
+    if (k == 0) continue;
+    const PanelRect& a = panels[k - 1];
+    const PanelRect& b = panels[k];
+    CHECK((b.y > a.y || (b.y == a.y && b.x > a.x)));
+  }
+}
 #endif
 
 // The rows of a CSV file, each split at commas.
@@ -75,9 +120,20 @@ TEST_CASE("cps figure writes one PNG of times x variants panels with a sidecar",
                        dir);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
+  // The page holds the 3 x 2 panels (one column per time, one row per variant of --push) and
+  // their caption strips.
   const auto [w, h] = png_size(dir / "f.png");
-  CHECK(w == 3 * 48);  // one column per time
-  CHECK(h == 2 * 32);  // one row per variant of --push
+  CHECK(std::make_pair(w, h) == sidecar_size(dir / "f.png"));
+  CHECK(w > 3 * 48);
+  CHECK(h > 2 * 32);
+  const std::vector<PanelRect> panels = sidecar_panels(dir / "f.png");
+  REQUIRE(panels.size() == 6);
+  for (const PanelRect& p : panels) CHECK((p.w == 48 && p.h == 32));
+  check_reading_order(panels);
+  // Bare (--no-label): the panels alone, abutting.
+  REQUIRE(cps("figure intersecting_stack --times 0,0.25,0.5 --compare push=baumgarte,split "
+              "--size 48x32 --no-label --out bare.png", dir).exit_code == 0);
+  CHECK(png_size(dir / "bare.png") == std::make_pair(3 * 48, 2 * 32));
   const nlohmann::json side = nlohmann::json::parse(slurp(dir / "f.png.json"));
   CHECK(side["written_by"] == "cps figure");
   CHECK(side["parameters"]["times_s"].size() == 3);
@@ -86,9 +142,9 @@ TEST_CASE("cps figure writes one PNG of times x variants panels with a sidecar",
   CHECK(side["command_line"].dump().find("\"--times\",\"0,0.25,0.5\"") != std::string::npos);
 
   // Its own file is replaced without --force; the default name is out/figures/SCENE.png.
-  CHECK(cps("figure intersecting_stack --times 0,0.25 --size 48x32 --out f.png", dir).exit_code == 0);
+  CHECK(cps("figure intersecting_stack --times 0,0.25 --size 48x32 --no-label --out f.png", dir).exit_code == 0);
   CHECK(png_size(dir / "f.png") == std::make_pair(2 * 48, 32));
-  CHECK(cps("figure stack --times 0 --size 40x24", dir).exit_code == 0);
+  CHECK(cps("figure stack --times 0 --size 40x24 --no-label", dir).exit_code == 0);
   CHECK(png_size(dir / "out/figures/stack.png") == std::make_pair(40, 24));
   CHECK(fs::exists(dir / "out/figures/stack.png.json"));
 }
@@ -130,7 +186,8 @@ TEST_CASE("cps figure keeps a file it did not write unless --force", "[cli][figu
   CHECK(slurp(dir / "mine.png") == foreign);
 
   CHECK(cps("figure stack --times 0 --size 32x32 --out mine.png --force", dir).exit_code == 0);
-  CHECK(png_size(dir / "mine.png") == std::make_pair(32, 32));
+  CHECK(png_size(dir / "mine.png") == sidecar_size(dir / "mine.png"));
+  CHECK(png_size(dir / "mine.png").first > 0);
 }
 
 TEST_CASE("cps figure never touches foreign files beside its targets", "[cli][figure][output]") {
@@ -142,7 +199,7 @@ TEST_CASE("cps figure never touches foreign files beside its targets", "[cli][fi
     const Result r = cps("figure stack --times 0 --size 32x32 --out f.png" + force, dir);
     INFO(force << ": " << r.err);
     REQUIRE(r.exit_code == 0);
-    CHECK(png_size(dir / "f.png") == std::make_pair(32, 32));
+    CHECK(png_size(dir / "f.png") == sidecar_size(dir / "f.png"));
     CHECK(slurp(dir / "f.png.tmp") == "notes 1");
     CHECK(slurp(dir / "f.png.json.tmp") == "notes 2");
   }
@@ -183,12 +240,15 @@ TEST_CASE("cps figure paper writes the counterparts of Figs. 6 to 10", "[cli][fi
   for (const auto& [name, number] : figures) {
     INFO(name);
     const fs::path png = dir / "figs" / (name + ".png");
-    const auto [w, h] = png_size(png);
     const nlohmann::json side = nlohmann::json::parse(slurp(fs::path(png.string() + ".json")));
     CHECK(side["parameters"]["caption"].get<std::string>().find("Fig. " + std::to_string(number)) !=
           std::string::npos);
-    CHECK(w == 32 * static_cast<int>(side["parameters"]["times_s"].size()));
-    CHECK(h == 24 * static_cast<int>(side["parameters"]["variants"].size()));
+    CHECK(png_size(png) == sidecar_size(png));
+    // Every panel lettered, (a), (b), ... in reading order, the same way in every figure.
+    const std::vector<PanelRect> panels = sidecar_panels(png);
+    CHECK(panels.size() == side["parameters"]["times_s"].size() * side["parameters"]["variants"].size());
+    for (const PanelRect& p : panels) CHECK((p.w == 32 && p.h == 24));
+    check_reading_order(panels);
   }
   // Fig. 7 compares the original push factor with the single frame push factor at 0.5 s.
   const nlohmann::json fig7 =
@@ -196,6 +256,91 @@ TEST_CASE("cps figure paper writes the counterparts of Figs. 6 to 10", "[cli][fi
   CHECK(fig7["compare"] == "push");
   CHECK(std::find(fig7["times_s"].begin(), fig7["times_s"].end(), 0.5) != fig7["times_s"].end());
   CHECK(cps("figure paper --times 0,1", dir).exit_code == 2);
+}
+
+TEST_CASE("cps figure --format pdf writes its labels as text, svg as glyphs", "[cli][figure][format]") {
+  const fs::path dir = fresh_dir("format");
+  const Result r = cps("figure intersecting_stack --times 0,0.5 --compare push=baumgarte,split "
+                       "--size 160x90 --format pdf --out f.pdf", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(slurp(dir / "f.pdf").substr(0, 5) == "%PDF-");
+  CHECK(fs::exists(dir / "f.pdf.json"));
+  // pdftotext finds every label as text: the letters of the four panels, the times, the
+  // compared parameter and its values, the scene in the title.
+  const std::string text = pdf_text(dir / "f.pdf");
+  INFO(text);
+  for (const char* label : {"(a)", "(b)", "(c)", "(d)", "t = 0.00 s", "t = 0.50 s", "push",
+                            "baumgarte", "split", "intersecting_stack"}) {
+    INFO(label);
+    CHECK(text.find(label) != std::string::npos);
+  }
+  CHECK(text.find("(e)") == std::string::npos);  // four panels, four letters
+
+  // The format follows --out's extension when --format is not given. cairo's SVG writes each
+  // glyph once as a <symbol> and places it with <use>: the labels are glyph outlines, the
+  // panels <image> elements.
+  REQUIRE(cps("figure intersecting_stack --times 0,0.5 --size 64x36 --out f.svg", dir).exit_code == 0);
+  const std::string svg = slurp(dir / "f.svg");
+  CHECK(svg.find("<svg") != std::string::npos);
+  CHECK(svg.find("<symbol overflow=\"visible\" id=\"glyph") != std::string::npos);
+  CHECK(svg.find("xlink:href=\"#glyph") != std::string::npos);
+  CHECK(svg.find("<image") != std::string::npos);
+  CHECK(nlohmann::json::parse(slurp(dir / "f.svg.json"))["parameters"]["format"] == "svg");
+}
+
+TEST_CASE("cps figure's labels lie in strips outside the scene", "[cli][figure][format]") {
+  const fs::path dir = fresh_dir("strips");
+  const std::string args = "figure intersecting_stack --times 0,0.5 --compare push=baumgarte,split "
+                           "--size 96x64 ";
+  REQUIRE(cps(args + "--out labelled.png", dir).exit_code == 0);
+  REQUIRE(cps(args + "--no-label --out bare.png", dir).exit_code == 0);
+  const cps::render::Image labelled = cps::render::read_png(dir / "labelled.png");
+  const cps::render::Image bare = cps::render::read_png(dir / "bare.png");
+  const std::vector<PanelRect> at_l = sidecar_panels(dir / "labelled.png");
+  const std::vector<PanelRect> at_b = sidecar_panels(dir / "bare.png");
+  REQUIRE(at_l.size() == 4);
+  REQUIRE(at_b.size() == 4);
+  const auto pixel = [](const cps::render::Image& im, int x, int y, int ch) {
+    return im.pixels[3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(im.width) +
+                          static_cast<std::size_t>(x)) + static_cast<std::size_t>(ch)];
+  };
+  for (std::size_t k = 0; k < 4; ++k) {
+    INFO("panel " << k);
+    // The scene's pixels with labels are those without: no label covers any of them.
+    int differ = 0;
+    for (int y = 0; y < 64; ++y) {
+      for (int x = 0; x < 96; ++x) {
+        for (int ch = 0; ch < 3; ++ch) {
+          differ += pixel(labelled, at_l[k].x + x, at_l[k].y + y, ch) !=
+                    pixel(bare, at_b[k].x + x, at_b[k].y + y, ch);
+        }
+      }
+    }
+    CHECK(differ == 0);
+    // And the caption strip below the panel holds text: dark pixels on white.
+    int ink = 0;
+    for (int y = at_l[k].y + 64; y < at_l[k].y + 64 + 14; ++y) {
+      for (int x = at_l[k].x; x < at_l[k].x + 96; ++x) ink += pixel(labelled, x, y, 0) < 128;
+    }
+    CHECK(ink > 20);
+  }
+}
+
+TEST_CASE("cps figure rejects a bad --format with exit 2, naming it, and writes nothing",
+          "[cli][figure][format]") {
+  const fs::path dir = fresh_dir("bad_format");
+  const Result r = cps("figure stack --times 0 --size 32x32 --format jpg", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("jpg") != std::string::npos);
+  CHECK(r.err.find("png") != std::string::npos);  // and what is allowed
+  // A name that does not end as the format says.
+  const Result mismatch = cps("figure stack --times 0 --size 32x32 --format pdf --out f.png", dir);
+  CHECK(mismatch.exit_code == 2);
+  CHECK(mismatch.err.find(".pdf") != std::string::npos);
+  const Result unknown = cps("figure stack --times 0 --size 32x32 --out f.jpg", dir);
+  CHECK(unknown.exit_code == 2);
+  CHECK(fs::is_empty(dir));
 }
 
 TEST_CASE("cps render takes the overlay and camera flags", "[cli][figure]") {

@@ -254,7 +254,9 @@ TEST_CASE("cps figure paper writes the counterparts of Figs. 6 to 10", "[cli][fi
   // Fig. 7 compares the original push factor with the single frame push factor at 0.5 s.
   const nlohmann::json fig7 =
       nlohmann::json::parse(slurp(dir / "figs/fig7_intersecting_stack.png.json"))["parameters"];
-  CHECK(fig7["compare"] == "push");
+  CHECK(fig7["compare"] == "push=baumgarte,split");
+  REQUIRE(fig7["variants"].size() == 2);
+  CHECK(fig7["variants"][1]["parameters"]["push"] == "split");
   CHECK(std::find(fig7["times_s"].begin(), fig7["times_s"].end(), 0.5) != fig7["times_s"].end());
   CHECK(cps_run("figure paper --times 0,1", dir).exit_code == 2);
 }

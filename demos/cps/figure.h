@@ -1,6 +1,6 @@
 #pragma once
-// `cps figure`: one labelled PNG of a scene at chosen times (columns) for each variant of an
-// option (rows), like the paper's Fig. 7 (a)-(c); and the counterparts of the paper's
+// `cps figure`: one labelled figure (PNG, PDF or SVG, see compose.h) of a scene at chosen
+// times (columns) for each variant of an option (rows), like the paper's Fig. 7; and the counterparts of the paper's
 // Figs. 6-10 (`cps figure paper`). The command itself is add_figure in command.h.
 
 #include "compose.h"

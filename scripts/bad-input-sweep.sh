@@ -64,7 +64,7 @@ declare -A KIND=(
   ['*:--max-correction']=pos_1e6 ['*:--soft-substeps']=substeps
   ['*:--position-iterations']=iterations
   ['*:--size']=size ['*:--times']=times
-  ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png
+  ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png ['figure:--format']=choice
   ['*:--trace']=trace ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
   ['simulate:scene']=scene_one ['render:scene']=scene_many ['figure:scene']=scene_figure
   ['report:scene']=scene_report ['bench:--scene']=scene_bench

@@ -13,6 +13,11 @@ cps_packages=(
   libosmesa6-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri
   # Plots of `cps report`, videos of `cps render --video`.
   gnuplot-nox ffmpeg
+  # Figures of `cps figure` (PNG, PDF, SVG with the labels as text): cairo, and the font it
+  # typesets the labels in, DejaVu Sans.
+  libcairo2-dev fonts-dejavu-core
+  # Tests only: pdftotext reads the text of the figures' and the report's PDFs.
+  poppler-utils
 )
 
 cps_install_missing() {

@@ -512,6 +512,8 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
     CHECK(std::count(csv.begin(), csv.end(), '\n') == 3);  // header and two runs
     CHECK(fs::file_size(dir / "merged/stack_residual_rms_N.png") > 1000);
     CHECK(fs::exists(dir / "merged/stack_residual_rms_N.svg"));
+    // And a PDF of it (gnuplot's pdfcairo) beside the PNG, for a paper.
+    CHECK(slurp(dir / "merged/stack_residual_rms_N.pdf").substr(0, 5) == "%PDF-");
   }
   SECTION("--list-runs prints one command per run; all of them merge into a complete report") {
     const Result r = cps("report mass_ratio_10 --quick --list-runs --out o", dir);

@@ -158,13 +158,19 @@ TEST_CASE("cps render --overlay draws every variant in one view in its colour, w
   INFO(f.err);
   REQUIRE(f.exit_code == 0);
   const cps::render::Image fig = cps::render::read_png(dir / "f.png");
-  CHECK(fig.width == 2 * 200);
-  CHECK(fig.height == 150);  // one row: the variants share each panel
-  CHECK(pixels_of_hue(fig, kBlueHue, 15.0, 40, 150 - 45) > 50);
-  CHECK(pixels_of_hue(fig, kOrangeHue, 15.0, 40, 150 - 45) > 50);
   const nlohmann::json side = nlohmann::json::parse(slurp(dir / "f.png.json"));
   CHECK(side["parameters"]["comparison"]["layout"] == "overlay");
-  CHECK(side["parameters"]["image_size_px"] == nlohmann::json({400, 150}));
+  CHECK(side["parameters"]["image_size_px"] == nlohmann::json({fig.width, fig.height}));
+  // One row: the variants share each panel (the caption strips and the legend lie outside it).
+  const nlohmann::json& panels = side["parameters"]["panels_px"];
+  REQUIRE(panels.size() == 2);
+  CHECK(panels[0]["rect"][1] == panels[1]["rect"][1]);
+  const int top = panels[0]["rect"][1];
+  CHECK(pixels_of_hue(fig, kBlueHue, 15.0, top + 40, top + 150 - 45) > 50);
+  CHECK(pixels_of_hue(fig, kOrangeHue, 15.0, top + 40, top + 150 - 45) > 50);
+  // The legend's swatches in their strip below the panels.
+  CHECK(pixels_of_hue(fig, kBlueHue, 5.0, top + 150, fig.height) > 20);
+  CHECK(pixels_of_hue(fig, kOrangeHue, 5.0, top + 150, fig.height) > 20);
 }
 
 TEST_CASE("a bad --compare or --overlay exits 2 naming the problem and writes nothing",

@@ -5,6 +5,10 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#ifdef CPS_HAVE_RENDERER
+#include "cps/render/renderer.h"
+#endif
+
 #include <sys/wait.h>
 
 #include <cmath>
@@ -24,7 +28,7 @@ using cli_test::Result;
 using cli_test::run_cps;
 using cli_test::slurp;
 
-Result cps(const std::string& args, const fs::path& dir) { return run_cps(args, dir); }
+Result cps_run(const std::string& args, const fs::path& dir) { return run_cps(args, dir); }
 
 fs::path fresh_dir(const std::string& name) { return cli_test::fresh_dir("cps_cli_figure_test_" + name); }
 
@@ -48,6 +52,48 @@ std::pair<int, int> png_size(const fs::path& p) {
   };
   return {be32(16), be32(20)};
 }
+
+// The page size the figure's sidecar records ({0, 0} without a sidecar).
+std::pair<int, int> sidecar_size(const fs::path& figure) {
+  const fs::path side = figure.string() + ".json";
+  if (!fs::exists(side)) return {0, 0};
+  const nlohmann::json size = nlohmann::json::parse(slurp(side))["parameters"]["image_size_px"];
+  return {size[0].get<int>(), size[1].get<int>()};
+}
+
+// The text of a PDF as pdftotext (poppler-utils) reads it; "" if it cannot.
+std::string pdf_text(const fs::path& pdf) {
+  const fs::path txt = pdf.string() + ".txt";
+  const std::string command = "pdftotext -q '" + pdf.string() + "' '" + txt.string() + "'";
+  if (std::system(command.c_str()) != 0) return "";
+  return slurp(txt);
+}
+
+// The panels' rectangles (x, y, width, height) and letters the sidecar of `figure` records.
+struct PanelRect {
+  int x, y, w, h;
+  std::string letter;
+};
+std::vector<PanelRect> sidecar_panels(const fs::path& figure) {
+  std::vector<PanelRect> out;
+  const nlohmann::json side = nlohmann::json::parse(slurp(figure.string() + ".json"));
+  for (const auto& p : side["parameters"]["panels_px"]) {
+    out.push_back({p["rect"][0], p["rect"][1], p["rect"][2], p["rect"][3], p["letter"]});
+  }
+  return out;
+}
+
+// (a), (b), ... in reading order: row by row (y increasing), each row left to right.
+void check_reading_order(const std::vector<PanelRect>& panels) {
+  for (std::size_t k = 0; k < panels.size(); ++k) {
+    INFO("panel " << k);
+    CHECK(panels[k].letter == std::string("(") + static_cast<char>('a' + k) + ")");
+    if (k == 0) continue;
+    const PanelRect& a = panels[k - 1];
+    const PanelRect& b = panels[k];
+    CHECK((b.y > a.y || (b.y == a.y && b.x > a.x)));
+  }
+}
 #endif
 
 // The rows of a CSV file, each split at commas.
@@ -70,14 +116,25 @@ std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
 #ifdef CPS_HAVE_RENDERER
 TEST_CASE("cps figure writes one PNG of times x variants panels with a sidecar", "[cli][figure]") {
   const fs::path dir = fresh_dir("size");
-  const Result r = cps("figure intersecting_stack --times 0,0.25,0.5 --compare push=baumgarte,split --size 48x32 "
+  const Result r = cps_run("figure intersecting_stack --times 0,0.25,0.5 --compare push=baumgarte,split --size 48x32 "
                        "--out f.png",
                        dir);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
+  // The page holds the 3 x 2 panels (one column per time, one row per variant of --push) and
+  // their caption strips.
   const auto [w, h] = png_size(dir / "f.png");
-  CHECK(w == 3 * 48);  // one column per time
-  CHECK(h == 2 * 32);  // one row per variant of --push
+  CHECK(std::make_pair(w, h) == sidecar_size(dir / "f.png"));
+  CHECK(w > 3 * 48);
+  CHECK(h > 2 * 32);
+  const std::vector<PanelRect> panels = sidecar_panels(dir / "f.png");
+  REQUIRE(panels.size() == 6);
+  for (const PanelRect& p : panels) CHECK((p.w == 48 && p.h == 32));
+  check_reading_order(panels);
+  // Bare (--no-label): the panels alone, abutting.
+  REQUIRE(cps_run("figure intersecting_stack --times 0,0.25,0.5 --compare push=baumgarte,split "
+              "--size 48x32 --no-label --out bare.png", dir).exit_code == 0);
+  CHECK(png_size(dir / "bare.png") == std::make_pair(3 * 48, 2 * 32));
   const nlohmann::json side = nlohmann::json::parse(slurp(dir / "f.png.json"));
   CHECK(side["written_by"] == "cps figure");
   CHECK(side["parameters"]["times_s"].size() == 3);
@@ -86,9 +143,9 @@ TEST_CASE("cps figure writes one PNG of times x variants panels with a sidecar",
   CHECK(side["command_line"].dump().find("\"--times\",\"0,0.25,0.5\"") != std::string::npos);
 
   // Its own file is replaced without --force; the default name is out/figures/SCENE.png.
-  CHECK(cps("figure intersecting_stack --times 0,0.25 --size 48x32 --out f.png", dir).exit_code == 0);
+  CHECK(cps_run("figure intersecting_stack --times 0,0.25 --size 48x32 --no-label --out f.png", dir).exit_code == 0);
   CHECK(png_size(dir / "f.png") == std::make_pair(2 * 48, 32));
-  CHECK(cps("figure stack --times 0 --size 40x24", dir).exit_code == 0);
+  CHECK(cps_run("figure stack --times 0 --size 40x24 --no-label", dir).exit_code == 0);
   CHECK(png_size(dir / "out/figures/stack.png") == std::make_pair(40, 24));
   CHECK(fs::exists(dir / "out/figures/stack.png.json"));
 }
@@ -105,12 +162,12 @@ TEST_CASE("cps figure rejects bad --times with exit 2, naming the value, and wri
                         {"1e999", "'1e999'"},   {"1,,2", "empty"},  {"0,1e6", "'1e6'"}};
   for (const Case& c : cases) {
     INFO("--times " << c.times);
-    const Result r = cps("figure stack --size 32x32 --times '" + c.times + "'", dir);
+    const Result r = cps_run("figure stack --size 32x32 --times '" + c.times + "'", dir);
     CHECK(r.exit_code == 2);
     CHECK(r.err.find(c.says) != std::string::npos);
   }
-  CHECK(cps("figure stack --size 32x32", dir).exit_code == 2);  // --times is required
-  CHECK(cps("figure nosuchscene --times 0", dir).err.find("cps list") != std::string::npos);
+  CHECK(cps_run("figure stack --size 32x32", dir).exit_code == 2);  // --times is required
+  CHECK(cps_run("figure nosuchscene --times 0", dir).err.find("cps list") != std::string::npos);
   CHECK(!fs::exists(dir / "out"));
 }
 
@@ -118,7 +175,7 @@ TEST_CASE("cps figure keeps a file it did not write unless --force", "[cli][figu
   const fs::path dir = fresh_dir("foreign");
   const std::string foreign = "a figure someone made by hand\n";
   write_text(dir / "mine.png", foreign);
-  const Result r = cps("figure stack --times 0 --size 32x32 --out mine.png", dir);
+  const Result r = cps_run("figure stack --times 0 --size 32x32 --out mine.png", dir);
   CHECK(r.exit_code == 2);
   CHECK(r.err.find("--force") != std::string::npos);
   CHECK(slurp(dir / "mine.png") == foreign);
@@ -126,11 +183,12 @@ TEST_CASE("cps figure keeps a file it did not write unless --force", "[cli][figu
 
   // A sidecar that is not ours does not make the file ours either.
   write_text(dir / "mine.png.json", "{\"written_by\": \"someone else\"}");
-  CHECK(cps("figure stack --times 0 --size 32x32 --out mine.png", dir).exit_code == 2);
+  CHECK(cps_run("figure stack --times 0 --size 32x32 --out mine.png", dir).exit_code == 2);
   CHECK(slurp(dir / "mine.png") == foreign);
 
-  CHECK(cps("figure stack --times 0 --size 32x32 --out mine.png --force", dir).exit_code == 0);
-  CHECK(png_size(dir / "mine.png") == std::make_pair(32, 32));
+  CHECK(cps_run("figure stack --times 0 --size 32x32 --out mine.png --force", dir).exit_code == 0);
+  CHECK(png_size(dir / "mine.png") == sidecar_size(dir / "mine.png"));
+  CHECK(png_size(dir / "mine.png").first > 0);
 }
 
 TEST_CASE("cps figure never touches foreign files beside its targets", "[cli][figure][output]") {
@@ -139,22 +197,22 @@ TEST_CASE("cps figure never touches foreign files beside its targets", "[cli][fi
   write_text(dir / "f.png.tmp", "notes 1");
   write_text(dir / "f.png.json.tmp", "notes 2");
   for (const std::string force : {"", " --force"}) {
-    const Result r = cps("figure stack --times 0 --size 32x32 --out f.png" + force, dir);
+    const Result r = cps_run("figure stack --times 0 --size 32x32 --out f.png" + force, dir);
     INFO(force << ": " << r.err);
     REQUIRE(r.exit_code == 0);
-    CHECK(png_size(dir / "f.png") == std::make_pair(32, 32));
+    CHECK(png_size(dir / "f.png") == sidecar_size(dir / "f.png"));
     CHECK(slurp(dir / "f.png.tmp") == "notes 1");
     CHECK(slurp(dir / "f.png.json.tmp") == "notes 2");
   }
   // The folder's run.json lists what cps wrote there, over several runs.
-  REQUIRE(cps("figure stack --times 0 --size 32x32 --out g.png", dir).exit_code == 0);
+  REQUIRE(cps_run("figure stack --times 0 --size 32x32 --out g.png", dir).exit_code == 0);
   const nlohmann::json manifest = nlohmann::json::parse(slurp(dir / "run.json"));
   CHECK(manifest["files"] == nlohmann::json({"f.png", "f.png.json", "g.png", "g.png.json"}));
   // A run.json that is not cps's is foreign, as any other file.
   const fs::path other = dir / "other";
   fs::create_directories(other);
   write_text(other / "run.json", "{\"mine\": true}");
-  const Result refused = cps("figure stack --times 0 --size 32x32 --out other/f.png", dir);
+  const Result refused = cps_run("figure stack --times 0 --size 32x32 --out other/f.png", dir);
   CHECK(refused.exit_code == 2);
   CHECK(refused.err.find("run.json") != std::string::npos);
   CHECK(slurp(other / "run.json") == "{\"mine\": true}");
@@ -164,7 +222,7 @@ TEST_CASE("cps figure never touches foreign files beside its targets", "[cli][fi
 TEST_CASE("cps figure --out below a file is refused before any work", "[cli][figure][output]") {
   const fs::path dir = fresh_dir("out_file");
   write_text(dir / "somefile", "not a folder");
-  const Result r = cps("figure stack --times 0 --size 32x32 --out somefile/f.png", dir);
+  const Result r = cps_run("figure stack --times 0 --size 32x32 --out somefile/f.png", dir);
   CHECK(r.exit_code == 2);
   CHECK(r.err.find("somefile") != std::string::npos);
   CHECK(slurp(dir / "somefile") == "not a folder");
@@ -172,7 +230,7 @@ TEST_CASE("cps figure --out below a file is refused before any work", "[cli][fig
 
 TEST_CASE("cps figure paper writes the counterparts of Figs. 6 to 10", "[cli][figure]") {
   const fs::path dir = fresh_dir("paper");
-  const Result r = cps("figure paper --size 32x24 --out figs", dir);
+  const Result r = cps_run("figure paper --size 32x24 --out figs", dir);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   const std::pair<std::string, int> figures[] = {{"fig6_stack", 6},
@@ -183,32 +241,122 @@ TEST_CASE("cps figure paper writes the counterparts of Figs. 6 to 10", "[cli][fi
   for (const auto& [name, number] : figures) {
     INFO(name);
     const fs::path png = dir / "figs" / (name + ".png");
-    const auto [w, h] = png_size(png);
     const nlohmann::json side = nlohmann::json::parse(slurp(fs::path(png.string() + ".json")));
     CHECK(side["parameters"]["caption"].get<std::string>().find("Fig. " + std::to_string(number)) !=
           std::string::npos);
-    CHECK(w == 32 * static_cast<int>(side["parameters"]["times_s"].size()));
-    CHECK(h == 24 * static_cast<int>(side["parameters"]["variants"].size()));
+    CHECK(png_size(png) == sidecar_size(png));
+    // Every panel lettered, (a), (b), ... in reading order, the same way in every figure.
+    const std::vector<PanelRect> panels = sidecar_panels(png);
+    CHECK(panels.size() == side["parameters"]["times_s"].size() * side["parameters"]["variants"].size());
+    for (const PanelRect& p : panels) CHECK((p.w == 32 && p.h == 24));
+    check_reading_order(panels);
   }
   // Fig. 7 compares the original push factor with the single frame push factor at 0.5 s.
   const nlohmann::json fig7 =
       nlohmann::json::parse(slurp(dir / "figs/fig7_intersecting_stack.png.json"))["parameters"];
-  CHECK(fig7["compare"] == "push");
+  CHECK(fig7["compare"] == "push=baumgarte,split");
+  REQUIRE(fig7["variants"].size() == 2);
+  CHECK(fig7["variants"][1]["parameters"]["push"] == "split");
   CHECK(std::find(fig7["times_s"].begin(), fig7["times_s"].end(), 0.5) != fig7["times_s"].end());
-  CHECK(cps("figure paper --times 0,1", dir).exit_code == 2);
+  CHECK(cps_run("figure paper --times 0,1", dir).exit_code == 2);
+}
+
+TEST_CASE("cps figure --format pdf writes its labels as text, svg as glyphs", "[cli][figure][format]") {
+  const fs::path dir = fresh_dir("format");
+  const Result r = cps_run("figure intersecting_stack --times 0,0.5 --compare push=baumgarte,split "
+                       "--size 160x90 --format pdf --out f.pdf", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(slurp(dir / "f.pdf").substr(0, 5) == "%PDF-");
+  CHECK(fs::exists(dir / "f.pdf.json"));
+  // pdftotext finds every label as text: the letters of the four panels, the times, the
+  // compared parameter and its values, the scene in the title.
+  const std::string text = pdf_text(dir / "f.pdf");
+  INFO(text);
+  for (const char* label : {"(a)", "(b)", "(c)", "(d)", "t = 0.00 s", "t = 0.50 s", "push",
+                            "baumgarte", "split", "intersecting_stack"}) {
+    INFO(label);
+    CHECK(text.find(label) != std::string::npos);
+  }
+  CHECK(text.find("(e)") == std::string::npos);  // four panels, four letters
+
+  // The format follows --out's extension when --format is not given. cairo's SVG writes each
+  // glyph once as a <symbol> and places it with <use>: the labels are glyph outlines, the
+  // panels <image> elements.
+  REQUIRE(cps_run("figure intersecting_stack --times 0,0.5 --size 64x36 --out f.svg", dir).exit_code == 0);
+  const std::string svg = slurp(dir / "f.svg");
+  CHECK(svg.find("<svg") != std::string::npos);
+  CHECK(svg.find("<symbol overflow=\"visible\" id=\"glyph") != std::string::npos);
+  CHECK(svg.find("xlink:href=\"#glyph") != std::string::npos);
+  CHECK(svg.find("<image") != std::string::npos);
+  CHECK(nlohmann::json::parse(slurp(dir / "f.svg.json"))["parameters"]["format"] == "svg");
+}
+
+TEST_CASE("cps figure's labels lie in strips outside the scene", "[cli][figure][format]") {
+  const fs::path dir = fresh_dir("strips");
+  const std::string args = "figure intersecting_stack --times 0,0.5 --compare push=baumgarte,split "
+                           "--size 96x64 ";
+  REQUIRE(cps_run(args + "--out labelled.png", dir).exit_code == 0);
+  REQUIRE(cps_run(args + "--no-label --out bare.png", dir).exit_code == 0);
+  const cps::render::Image labelled = cps::render::read_png(dir / "labelled.png");
+  const cps::render::Image bare = cps::render::read_png(dir / "bare.png");
+  const std::vector<PanelRect> at_l = sidecar_panels(dir / "labelled.png");
+  const std::vector<PanelRect> at_b = sidecar_panels(dir / "bare.png");
+  REQUIRE(at_l.size() == 4);
+  REQUIRE(at_b.size() == 4);
+  const auto pixel = [](const cps::render::Image& im, int x, int y, int ch) {
+    return im.pixels[3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(im.width) +
+                          static_cast<std::size_t>(x)) + static_cast<std::size_t>(ch)];
+  };
+  for (std::size_t k = 0; k < 4; ++k) {
+    INFO("panel " << k);
+    // The scene's pixels with labels are those without: no label covers any of them.
+    int differ = 0;
+    for (int y = 0; y < 64; ++y) {
+      for (int x = 0; x < 96; ++x) {
+        for (int ch = 0; ch < 3; ++ch) {
+          differ += pixel(labelled, at_l[k].x + x, at_l[k].y + y, ch) !=
+                    pixel(bare, at_b[k].x + x, at_b[k].y + y, ch);
+        }
+      }
+    }
+    CHECK(differ == 0);
+    // And the caption strip below the panel holds text: dark pixels on white.
+    int ink = 0;
+    for (int y = at_l[k].y + 64; y < at_l[k].y + 64 + 14; ++y) {
+      for (int x = at_l[k].x; x < at_l[k].x + 96; ++x) ink += pixel(labelled, x, y, 0) < 128;
+    }
+    CHECK(ink > 20);
+  }
+}
+
+TEST_CASE("cps figure rejects a bad --format with exit 2, naming it, and writes nothing",
+          "[cli][figure][format]") {
+  const fs::path dir = fresh_dir("bad_format");
+  const Result r = cps_run("figure stack --times 0 --size 32x32 --format jpg", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("jpg") != std::string::npos);
+  CHECK(r.err.find("png") != std::string::npos);  // and what is allowed
+  // A name that does not end as the format says.
+  const Result mismatch = cps_run("figure stack --times 0 --size 32x32 --format pdf --out f.png", dir);
+  CHECK(mismatch.exit_code == 2);
+  CHECK(mismatch.err.find(".pdf") != std::string::npos);
+  const Result unknown = cps_run("figure stack --times 0 --size 32x32 --out f.jpg", dir);
+  CHECK(unknown.exit_code == 2);
+  CHECK(fs::is_empty(dir));
 }
 
 TEST_CASE("cps render takes the overlay and camera flags", "[cli][figure]") {
   const fs::path dir = fresh_dir("render_flags");
-  const Result r = cps("render pendulum_grid --seconds 0.1 --fps 10 --size 32x32 --contacts "
+  const Result r = cps_run("render pendulum_grid --seconds 0.1 --fps 10 --size 32x32 --contacts "
                        "--no-rods --label --camera top --orbit 10 --out o",
                        dir);
   INFO(r.err);
   CHECK(r.exit_code == 0);
   CHECK(png_size(dir / "o/pendulum_grid/frame_000001.png") == std::make_pair(32, 32));
   const std::string quick = "render stack --seconds 0.1 --fps 10 --size 32x32 --out o ";
-  CHECK(cps(quick + "--camera sideways", dir).exit_code == 2);
-  const Result nan = cps(quick + "--orbit nan", dir);
+  CHECK(cps_run(quick + "--camera sideways", dir).exit_code == 2);
+  const Result nan = cps_run(quick + "--orbit nan", dir);
   CHECK(nan.exit_code == 2);
   CHECK(nan.err.find("--orbit") != std::string::npos);
   CHECK(!fs::exists(dir / "o/stack"));
@@ -218,7 +366,7 @@ TEST_CASE("cps render --speed spaces frames speed / fps simulated seconds apart"
   const fs::path dir = fresh_dir("render_speed");
   // 0.25 s/s at 10 fps: frames 0.025 s apart over 0.5 s = 21 frames; 1.5 steps of 1/60 s, so
   // each frame shows the nearest step and run.json says so.
-  const Result slow = cps("render stack --seconds 0.5 --fps 10 --speed 0.25 --size 16x16 --label "
+  const Result slow = cps_run("render stack --seconds 0.5 --fps 10 --speed 0.25 --size 16x16 --label "
                           "--out o",
                           dir);
   INFO(slow.err);
@@ -233,7 +381,7 @@ TEST_CASE("cps render --speed spaces frames speed / fps simulated seconds apart"
   CHECK(p["frame_times"][0].get<std::string>().find("nearest") != std::string::npos);
   CHECK(slow.err.find("nearest") != std::string::npos);
   // 2 s/s at 30 fps: frames 1/15 s = 4 steps apart, exact; 1 s gives 16 frames.
-  const Result fast = cps("render stack --seconds 1 --fps 30 --speed 2 --size 16x16 --out f", dir);
+  const Result fast = cps_run("render stack --seconds 1 --fps 30 --speed 2 --size 16x16 --out f", dir);
   REQUIRE(fast.exit_code == 0);
   const nlohmann::json q = nlohmann::json::parse(slurp(dir / "f/stack/run.json"))["parameters"];
   CHECK(q["frames"] == 16);
@@ -243,13 +391,13 @@ TEST_CASE("cps render --speed spaces frames speed / fps simulated seconds apart"
                                 "--fov 1", "--eye 1,2", "--target a,b,c", "--eye 1e7,0,0",
                                 "--eye 1,2,3 --target 1,2,3"}) {
     INFO(bad);
-    const Result r = cps(quick + bad, dir);
+    const Result r = cps_run(quick + bad, dir);
     CHECK(r.exit_code == 2);
     CHECK(r.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);
   }
   CHECK(!fs::exists(dir / "b"));
   // Eye, target and field of view are recorded with the camera actually used.
-  REQUIRE(cps(quick + "--eye 10,8,20 --target 0,2,0 --fov 30", dir).exit_code == 0);
+  REQUIRE(cps_run(quick + "--eye 10,8,20 --target 0,2,0 --fov 30", dir).exit_code == 0);
   const nlohmann::json c = nlohmann::json::parse(slurp(dir / "b/stack/run.json"))["parameters"];
   CHECK(c["camera_resolved"]["eye_m"][0] == 10.0);
   CHECK(c["camera_resolved"]["target_m"][1] == 2.0);
@@ -259,7 +407,7 @@ TEST_CASE("cps render --speed spaces frames speed / fps simulated seconds apart"
 
 TEST_CASE("cps simulate --trace writes every body per step and obeys free fall", "[cli][trace]") {
   const fs::path dir = fresh_dir("trace");
-  const Result r = cps("simulate stack --seconds 0.5 --trace t.csv", dir);
+  const Result r = cps_run("simulate stack --seconds 0.5 --trace t.csv", dir);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   const auto rows = read_csv(dir / "t.csv");
@@ -308,19 +456,19 @@ TEST_CASE("cps simulate --trace keeps a file that is not a trace unless --force"
   const fs::path dir = fresh_dir("trace_foreign");
   const std::string foreign = "measurements,from,the,lab\n1,2,3,4\n";
   write_text(dir / "lab.csv", foreign);
-  const Result r = cps("simulate stack --seconds 0.1 --trace lab.csv", dir);
+  const Result r = cps_run("simulate stack --seconds 0.1 --trace lab.csv", dir);
   CHECK(r.exit_code == 2);
   CHECK(r.err.find("--force") != std::string::npos);
   CHECK(slurp(dir / "lab.csv") == foreign);
   CHECK(!fs::exists(dir / "lab.csv.tmp"));
   // A trace written by cps is replaced without --force; --force replaces the foreign file.
-  CHECK(cps("simulate stack --seconds 0.1 --trace t.csv", dir).exit_code == 0);
-  CHECK(cps("simulate stack --seconds 0.2 --trace t.csv", dir).exit_code == 0);
+  CHECK(cps_run("simulate stack --seconds 0.1 --trace t.csv", dir).exit_code == 0);
+  CHECK(cps_run("simulate stack --seconds 0.2 --trace t.csv", dir).exit_code == 0);
   CHECK(read_csv(dir / "t.csv").size() == 1u + 13u * 6u);
-  CHECK(cps("simulate stack --seconds 0.1 --trace lab.csv --force", dir).exit_code == 0);
+  CHECK(cps_run("simulate stack --seconds 0.1 --trace lab.csv --force", dir).exit_code == 0);
   CHECK(slurp(dir / "lab.csv").rfind("step,t_s,", 0) == 0);
   // A folder that does not exist is created, as for the --out of render and figure.
-  const Result missing = cps("simulate stack --seconds 0.1 --trace no/such/dir/t.csv", dir);
+  const Result missing = cps_run("simulate stack --seconds 0.1 --trace no/such/dir/t.csv", dir);
   CHECK(missing.exit_code == 0);
   CHECK(read_csv(dir / "no/such/dir/t.csv").size() == 1u + 7u * 6u);
   // run.json lists the traces cps wrote in that folder; it is cps's, so replaced without --force.
@@ -332,14 +480,14 @@ TEST_CASE("cps simulate --trace keeps a file that is not a trace unless --force"
 TEST_CASE("cps simulate --trace never touches a foreign file beside it", "[cli][trace][output]") {
   const fs::path dir = fresh_dir("trace_tmp");
   write_text(dir / "t.csv.tmp", "notes");
-  const Result r = cps("simulate stack --seconds 0.1 --trace t.csv", dir);
+  const Result r = cps_run("simulate stack --seconds 0.1 --trace t.csv", dir);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   CHECK(slurp(dir / "t.csv.tmp") == "notes");
   CHECK(slurp(dir / "t.csv").rfind("step,t_s,", 0) == 0);
   // --trace below a file: refused before the run, naming it.
   write_text(dir / "somefile", "not a folder");
-  const Result below = cps("simulate stack --seconds 0.1 --trace somefile/t.csv", dir);
+  const Result below = cps_run("simulate stack --seconds 0.1 --trace somefile/t.csv", dir);
   CHECK(below.exit_code == 2);
   CHECK(below.err.find("somefile") != std::string::npos);
   CHECK(slurp(dir / "somefile") == "not a folder");
@@ -371,7 +519,7 @@ TEST_CASE("every command's --help states the units of its options", "[cli][help]
   cases.back().says.push_back("--times");
 #endif
   for (const Case& c : cases) {
-    const Result r = cps(c.command + " --help", dir);
+    const Result r = cps_run(c.command + " --help", dir);
     INFO("cps " << c.command << " --help");
     CHECK(r.exit_code == 0);
     for (const std::string& s : c.says) {

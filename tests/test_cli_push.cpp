@@ -98,6 +98,10 @@ TEST_CASE("cps report push --quick compares every push method of the table: file
   for (const char* png : {"push_overlap.png", "push_speed.png"}) {
     CHECK(slurp(dir / "q" / png).substr(0, 8) == std::string("\x89PNG\r\n\x1a\n", 8));
   }
+  // Each diagram also as a PDF of the same name, for a paper.
+  for (const char* pdf : {"push_overlap.pdf", "push_speed.pdf"}) {
+    CHECK(slurp(dir / "q" / pdf).substr(0, 5) == "%PDF-");
+  }
 
   // push.csv: one row per method per case, every column with its unit (or a name, not a
   // quantity), every measure a finite number or the documented "never" / "none".

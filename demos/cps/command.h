@@ -48,7 +48,7 @@ Command add_bench(CLI::App& app);
 /// and assembled into a video). argc and argv are recorded in each folder's run.json.
 Command add_render(CLI::App& app, int argc, char** argv);
 
-/// `cps figure SCENE|paper`: one labelled PNG per figure, a panel per time and variant, with a
+/// `cps figure SCENE|paper`: one labelled PNG, PDF or SVG per figure, a panel per time and variant, with a
 /// JSON sidecar that records argc and argv.
 Command add_figure(CLI::App& app, int argc, char** argv);
 #endif

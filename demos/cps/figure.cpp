@@ -65,21 +65,6 @@ std::vector<double> parse_times(const std::string& text) {
   return times;
 }
 
-render::Image stack_vertically(const std::vector<render::Image>& images) {
-  if (images.empty()) throw std::invalid_argument("stack_vertically: no images");
-  render::Image out;
-  out.width = images.front().width;
-  for (const render::Image& im : images) {
-    if (im.width != out.width) {
-      throw std::invalid_argument("stack_vertically: widths differ (" + std::to_string(im.width) +
-                                  " and " + std::to_string(out.width) + ")");
-    }
-    out.height += im.height;
-    out.pixels.insert(out.pixels.end(), im.pixels.begin(), im.pixels.end());
-  }
-  return out;
-}
-
 namespace {
 
 // A 1-pixel dark frame along the edges of the image, so neighbouring panels stay apart.
@@ -107,7 +92,17 @@ std::string format_time(double t) {
 
 }  // namespace
 
-render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer) {
+std::string subfigure_letter(std::size_t k) {
+  std::string letters;
+  std::size_t n = k;
+  do {
+    letters.insert(letters.begin(), static_cast<char>('a' + n % 26));
+    n = n / 26;
+  } while (n-- > 0);
+  return "(" + letters + ")";
+}
+
+ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer) {
   const scenes::Scene& scene = *spec.scene;
   std::vector<scenes::Run> runs;
   for (const Variant& v : spec.variants) runs.push_back(make_run_or_usage_error(scene, v.overrides));
@@ -116,52 +111,51 @@ render::Image render_figure(const FigureSpec& spec, render::Renderer& renderer) 
   std::vector<const World*> worlds;
   for (const scenes::Run& run : runs) worlds.push_back(&run.world);
   const DrawStyle style = resolve_style(scene, worlds, spec.view, aspect, spec.times.back());
-  const int label_scale = std::max(1, renderer.height() / 360);
 
-  std::vector<render::Image> rows;
+  ComposedFigure out;
+  FigurePage& page = out.page;
+  page.columns = static_cast<int>(spec.times.size());
+  page.rows = spec.overlay ? 1 : static_cast<int>(runs.size());
+  page.panel_width = renderer.width();
+  page.panel_height = renderer.height();
+  page.labels = spec.label;
+  page.title = spec.caption.empty() ? std::string(scene.name)
+                                    : spec.caption + ": " + std::string(scene.name);
+  std::vector<std::string> texts;
+  // Reading order: row by row, each row left to right in time.
   if (spec.overlay) {
-    std::vector<render::Image> row;
     for (std::size_t c = 0; c < spec.times.size(); ++c) {
       for (scenes::Run& run : runs) run.advance_to(spec.times[c]);
       render::Image panel = renderer.draw(overlay_draw_list(worlds, style));
       draw_border(panel);
-      if (spec.label) {
-        std::string text;
-        if (!spec.caption.empty()) text += spec.caption + "\n";
-        const std::string tag = !spec.tags.empty() && c < spec.tags[0].size() ? spec.tags[0][c] : "";
-        text += (tag.empty() ? "" : tag + " ") + std::string(scene.name) + "\n";
-        text += format_time(runs.front().world.time());
-        render::draw_label(panel, 4 * label_scale, 4 * label_scale, text, label_scale);
-      }
-      // The legend even without labels: without it the colours mean nothing.
-      draw_overlay_legend(panel, spec.comparison, spec.variants, label_scale);
-      row.push_back(std::move(panel));
+      out.panels.push_back(std::move(panel));
+      texts.push_back(format_time(runs.front().world.time()));
     }
-    return row.size() == 1 ? std::move(row.front()) : render::side_by_side(row);
-  }
-  for (std::size_t r = 0; r < runs.size(); ++r) {
-    std::vector<render::Image> row;
-    for (std::size_t c = 0; c < spec.times.size(); ++c) {
-      runs[r].advance_to(spec.times[c]);
-      render::Image panel = renderer.draw(draw_list(runs[r].world, style));
-      draw_border(panel);
-      if (spec.label) {
-        std::string text;
-        if (!spec.caption.empty()) text += spec.caption + "\n";
-        const std::string tag =
-            r < spec.tags.size() && c < spec.tags[r].size() ? spec.tags[r][c] : std::string();
-        text += (tag.empty() ? "" : tag + " ") + std::string(scene.name) + "\n";
-        if (!spec.variants[r].label.empty()) text += spec.variants[r].label + "\n";
-        text += format_time(runs[r].world.time());
-        render::draw_label(panel, 4 * label_scale, 4 * label_scale,
-                           render::wrap_text(text, panel.width - 8 * label_scale, label_scale),
-                           label_scale);
-      }
-      row.push_back(std::move(panel));
+    // The legend even without labels: without it the colours mean nothing. It has a strip of
+    // its own below the panels.
+    page.legend_heading = legend_heading(spec.comparison);
+    for (std::size_t k = 0; k < spec.variants.size(); ++k) {
+      page.legend.push_back({overlay_colour(k), spec.variants[k].legend});
     }
-    rows.push_back(row.size() == 1 ? std::move(row.front()) : render::side_by_side(row));
+  } else {
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      for (std::size_t c = 0; c < spec.times.size(); ++c) {
+        runs[r].advance_to(spec.times[c]);
+        render::Image panel = renderer.draw(draw_list(runs[r].world, style));
+        draw_border(panel);
+        out.panels.push_back(std::move(panel));
+        std::string text = format_time(runs[r].world.time());
+        if (!spec.variants[r].label.empty()) text += "\n" + spec.variants[r].label;
+        texts.push_back(text);
+      }
+    }
   }
-  return stack_vertically(rows);
+  const bool lettered = out.panels.size() > 1;
+  for (std::size_t k = 0; k < out.panels.size(); ++k) {
+    page.panels.push_back({&out.panels[k], lettered ? subfigure_letter(k) : std::string(), texts[k]});
+  }
+  out.layout = layout_page(page);
+  return out;
 }
 
 fs::path sidecar_path(const fs::path& png) {
@@ -170,7 +164,7 @@ fs::path sidecar_path(const fs::path& png) {
   return p;
 }
 
-nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
+nlohmann::json figure_json(const FigureSpec& spec, const PageLayout& layout, int argc, char** argv) {
   nlohmann::json variants = nlohmann::json::array();
   for (std::size_t k = 0; k < spec.variants.size(); ++k) {
     const Variant& v = spec.variants[k];
@@ -182,6 +176,14 @@ nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
   const int columns = static_cast<int>(spec.times.size());
   const int rows = spec.overlay ? 1 : static_cast<int>(spec.variants.size());
   const std::optional<scenes::CameraPreset>& preset = spec.view.preset;
+  // Where each panel's scene pixels lie in the page (x, y, width, height), in reading order,
+  // with its sub-figure letter.
+  nlohmann::json panels = nlohmann::json::array();
+  for (std::size_t k = 0; k < layout.panels.size(); ++k) {
+    const PageLayout::Rect& r = layout.panels[k];
+    panels.push_back({{"letter", layout.panels.size() > 1 ? subfigure_letter(k) : std::string()},
+                      {"rect", {r.x, r.y, r.width, r.height}}});
+  }
   const nlohmann::json parameters = {
           {"scene", spec.scene->name},
           {"compare", spec.compare},
@@ -192,7 +194,12 @@ nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
           {"layout", spec.overlay ? "one row, every variant as a ghost in each panel, columns = times"
                                   : "rows = variants, columns = times"},
           {"panel_size_px", {spec.panel_width, spec.panel_height}},
-          {"image_size_px", {columns * spec.panel_width, rows * spec.panel_height}},
+          {"grid", {{"rows", rows}, {"columns", columns}}},
+          {"format", std::string(figure_extension(spec.format).substr(1))},
+          {"image_size_px", {layout.width, layout.height}},
+          {"panels_px", panels},
+          {"font", {{"family", "DejaVu Sans"}, {"size_px", layout.font_size},
+                    {"rule", "max(10, panel height / 24) px; 1 px = 1 pt in PDF and SVG"}}},
           {"camera", spec.view.camera},
           {"camera_preset",
            preset ? nlohmann::json{{"eye_m", {preset->eye.x(), preset->eye.y(), preset->eye.z()}},
@@ -215,31 +222,33 @@ nlohmann::json figure_json(const FigureSpec& spec, int argc, char** argv) {
   return sidecar;
 }
 
-void write_figure(const fs::path& png, const render::Image& image, const nlohmann::json& sidecar) {
-  write_json_atomic(sidecar_path(png), sidecar);
-  write_file_atomic(png, render::encode_png(image));
+void write_figure(const fs::path& file, const std::string& bytes, const nlohmann::json& sidecar) {
+  write_json_atomic(sidecar_path(file), sidecar);
+  write_text_atomic(file, bytes);
 }
 
 const std::vector<PaperFigure>& paper_figures() {
   static const std::vector<PaperFigure> figures = {
-      {"fig6_stack.png", "paper Fig. 6", "stack", "", {0.0, 1.0, 10.0, 85.0}, {}, std::nullopt,
+      {"fig6_stack", "paper Fig. 6", "stack", "", {0.0, 1.0, 10.0, 85.0}, std::nullopt,
        "the stack test: five cubes dropped 0.6 m apart land and stand; the paper's stack falls "
        "after about 85 s, so the last column is t = 85 s"},
-      {"fig7_intersecting_stack.png", "paper Fig. 7", "intersecting_stack", "push",
+      // The paper's two: the original push factor and the single frame push factor (a bare
+      // "push" now compares all five push methods of the engine).
+      {"fig7_intersecting_stack", "paper Fig. 7", "intersecting_stack", "push=baumgarte,split",
        {0.0, 0.5, 1.0},
-       {{"(a)", "(b)", ""}, {"(a)", "(c)", ""}},
        // The --camera fit framing of the original push factor's run over the figure's 1 s
        // (rounded; the single frame run stays inside it): the cubes it throws up stay in view
        // in every panel (from the earlier (15, 17, 36) the top cube left the 1 s panel).
        scenes::CameraPreset{Vec3(22.5, 25.0, 49.0), Vec3(0.6, 17.3, 0.3), 45.0},
-       "(a) the intersecting start; (b) the original push factor at 0.5 s: the cubes fly apart; "
-       "(c) the single frame push factor at 0.5 s: the cubes stop once the overlap is gone"},
-      {"fig8_funnel.png", "paper Fig. 8", "funnel", "", {0.0, 0.6, 1.5, 10.0}, {}, std::nullopt,
+       "the paper's (a) intersecting start is our (a) and (d); its (b), the original push factor "
+       "at 0.5 s, is our (b): the cubes fly apart; its (c), the single frame push factor at 0.5 s, "
+       "is our (e): the cubes stop once the overlap is gone"},
+      {"fig8_funnel", "paper Fig. 8", "funnel", "", {0.0, 0.6, 1.5, 10.0}, std::nullopt,
        "20 balls poured into a funnel of 4 planes come to rest"},
-      {"fig9_pendulum_grid.png", "paper Fig. 9", "pendulum_grid", "", {0.0, 2.0, 10.0}, {},
+      {"fig9_pendulum_grid", "paper Fig. 9", "pendulum_grid", "", {0.0, 2.0, 10.0},
        std::nullopt, "a 5 x 5 grid of pendulums holds the shapes resting on top"},
-      {"fig10_pendulum_wave.png", "paper Fig. 10", "pendulum_wave", "",
-       {0.0, 5.0, 15.0, 30.0, 60.0}, {},
+      {"fig10_pendulum_wave", "paper Fig. 10", "pendulum_wave", "",
+       {0.0, 5.0, 15.0, 30.0, 60.0},
        // From above (tilted 3 degrees): the pendulums swing in the y-z plane, so the wave shows as the
        // line of balls snaking across the picture. Close enough that the 2.45 m line spans about
        // 85 % of a 16:9 panel's width (it spanned 64 % from 2.6 m); the swing (about +-0.1 m in
@@ -260,6 +269,7 @@ struct FigureOptions {
   bool overlay = false;
   std::string size = "640x360";
   std::string out;
+  std::string format;  // "" : from --out's extension, else png
   bool force = false;
   scenes::Overrides overrides;
   View view;  // --camera, --contacts, --rods, --orbit
@@ -271,6 +281,8 @@ struct FigureOptions {
 // rendered or written.
 int run_figure(const FigureOptions& o, int argc, char** argv) {
   const PixelSize size = parse_size(o.size);
+  std::optional<FigureFormat> format;
+  if (!o.format.empty()) format = parse_figure_format(o.format);
   struct Planned {
     FigureSpec spec;
     fs::path png;
@@ -283,6 +295,7 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
     spec.panel_height = size.height;
     spec.view = o.view;
     spec.label = o.label;
+    spec.format = format.value_or(FigureFormat::png);
     return spec;
   };
   if (o.scene == "paper") {
@@ -299,10 +312,9 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
       spec.comparison = parse_comparison(f.compare, o.overrides);
       spec.variants = comparison_variants(spec.comparison, o.overrides);
       spec.caption = f.caption + " counterpart";
-      spec.tags = f.tags;
       spec.view.preset = f.preset;
       spec.what = f.what;
-      plan.push_back({spec, folder / f.file});
+      plan.push_back({spec, folder / (f.file + std::string(figure_extension(spec.format)))});
     }
   } else {
     const std::vector<const scenes::Scene*> chosen = select_scenes(o.scene);
@@ -323,14 +335,24 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
     spec.comparison = parse_comparison(o.compare, o.overrides);
     spec.variants = comparison_variants(spec.comparison, o.overrides);
     spec.overlay = o.overlay;
-    const fs::path png =
-        o.out.empty()
-            ? fs::path("out/figures") / (o.scene + comparison_suffix(spec.comparison, o.overlay) + ".png")
-            : fs::path(o.out);
-    if (png.extension() != ".png") {
-      throw UsageError("--out " + png.string() + ": the figure is a PNG; give a name ending in .png");
+    if (!format && !o.out.empty()) {
+      // No --format: the format --out's extension names.
+      const std::string ext = fs::path(o.out).extension().string();
+      if (ext == ".pdf") format = FigureFormat::pdf;
+      if (ext == ".svg") format = FigureFormat::svg;
     }
-    plan.push_back({spec, png});
+    spec.format = format.value_or(FigureFormat::png);
+    const std::string ext(figure_extension(spec.format));
+    const fs::path file =
+        o.out.empty()
+            ? fs::path("out/figures") / (o.scene + comparison_suffix(spec.comparison, o.overlay) + ext)
+            : fs::path(o.out);
+    if (file.extension() != ext) {
+      throw UsageError("--out " + file.string() + ": the figure is a " + ext.substr(1) +
+                       " file (--format " + ext.substr(1) + "); give a name ending in " + ext +
+                       (format ? "" : ", or --format pdf or svg for a name ending in .pdf or .svg"));
+    }
+    plan.push_back({spec, file});
   }
   for (const Planned& p : plan) {
     for (const Variant& v : p.spec.variants) {
@@ -341,6 +363,7 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
       resolve_style(*p.spec.scene, run.world, p.spec.view,
                     static_cast<float>(size.width) / static_cast<float>(size.height));
     }
+    // The panels alone; the caption strips add a few lines of text per row.
     const long long w = static_cast<long long>(p.spec.times.size()) * size.width;
     const long long h =
         static_cast<long long>(p.spec.overlay ? 1 : p.spec.variants.size()) * size.height;
@@ -366,11 +389,12 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
   render::Renderer renderer(size.width, size.height, *render::parse_backend(o.backend));
   begin_output(output, info);
   for (const Planned& p : plan) {
-    const render::Image image = render_figure(p.spec, renderer);
-    write_figure(p.png, image, figure_json(p.spec, argc, argv));
-    std::printf("%s: %dx%d pixels, %zu times x %zu variants (%s)\n", p.png.c_str(), image.width,
-                image.height, p.spec.times.size(), p.spec.variants.size(),
-                sidecar_path(p.png).filename().c_str());
+    const ComposedFigure figure = render_figure(p.spec, renderer);
+    write_figure(p.png, compose_page(figure.page, p.spec.format, figure.layout),
+                 figure_json(p.spec, figure.layout, argc, argv));
+    std::printf("%s: %dx%d %s, %zu times x %zu variants (%s)\n", p.png.c_str(), figure.layout.width,
+                figure.layout.height, p.spec.format == FigureFormat::png ? "pixels" : "points",
+                p.spec.times.size(), p.spec.variants.size(), sidecar_path(p.png).filename().c_str());
   }
   end_output(output, info);
   return 0;
@@ -382,7 +406,8 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<FigureOptions>();
   CLI::App* sub = app.add_subcommand(
       "figure",
-      "one labelled PNG of a scene: a panel per time (columns) and per variant (rows); "
+      "one labelled figure (PNG, PDF or SVG) of a scene: a panel per time (columns) and per "
+      "variant (rows), each with a caption strip below it; "
       "'cps figure paper' writes the counterparts of the paper's Figs. 6-10");
   sub->add_option("scene", o->scene, "scene name (see 'cps list'), the path of a scene file (.json), or 'paper'")->required();
   add_seed_option(*sub, o->scene);
@@ -401,11 +426,17 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
   sub->add_option("--size", o->size, "size of ONE panel, WxH in pixels, each in [16, 8192]")
       ->capture_default_str();
   sub->add_option("--out", o->out,
-                  "output PNG (default out/figures/SCENE[-compare-PARAM[-VALUES]][-overlay].png); for "
+                  "output file (default out/figures/SCENE[-compare-PARAM[-VALUES]][-overlay].png, "
+                  ".pdf or .svg as --format says); for "
                   "'paper', "
                   "the folder (default out/figures); a FILE.json sidecar records the run, and the "
                   "folder's run.json lists the files cps wrote there")
       ->check(kNotEmpty);
+  sub->add_option("--format", o->format,
+                  "png (pixels), pdf or svg (the panels as embedded images, every label, "
+                  "sub-figure letter and caption as text in DejaVu Sans: ready for LaTeX); "
+                  "default: from --out's extension (.png, .pdf, .svg), else png")
+      ->check(CLI::IsMember({"png", "pdf", "svg"}));
   sub->add_flag("--force", o->force,
                 "replace the PNG, its sidecar or the folder's run.json although no earlier cps "
                 "run wrote them (run.json lists the files cps wrote there); any other file in "

@@ -778,7 +778,8 @@ std::string plot_script(const Diagram& d, const fs::path& data, const std::strin
   return gp.str();
 }
 
-// One diagram DIR/SCENE_<measure>.png and .svg: the measure against physics time, log-log, in
+// One diagram DIR/SCENE_<measure>.png, .svg and .pdf (the PDF through gnuplot's pdfcairo
+// terminal, its text as text, for a paper): the measure against physics time, log-log, in
 // small multiples (see plot_script). False if no run has a value of the measure.
 bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& m,
                   const std::vector<const Row*>& rows, const std::string& title_note) {
@@ -800,17 +801,24 @@ bool plot_measure(const fs::path& dir, const std::string& scene, const Measure& 
   // gnuplot writes the pictures into temporaries of this run, renamed once it has succeeded.
   AtomicFile png(dir / (stem + ".png"));
   AtomicFile svg(dir / (stem + ".svg"));
+  AtomicFile pdf(dir / (stem + ".pdf"));
   png.hand_over();
   svg.hand_over();
+  pdf.hand_over();
   std::ostringstream gp;
   gp << "set terminal pngcairo size " << width << "," << height << " font ',10' noenhanced\n"
      << "set output '" << png.temporary().string() << "'\n" << body;
   gp << "set terminal svg size " << width << "," << height << " font ',10' noenhanced\n"
-     << "set output '" << svg.temporary().string() << "'\n" << body << "unset output\n";
+     << "set output '" << svg.temporary().string() << "'\n" << body;
+  // The PDF at 100 pixels of the PNG per inch, so its 10 pt text sits as in the PNG.
+  gp << "set terminal pdfcairo size " << width / 100.0 << "in," << height / 100.0
+     << "in font ',10' noenhanced\n"
+     << "set output '" << pdf.temporary().string() << "'\n" << body << "unset output\n";
   write_text_atomic(script, gp.str());
   run_gnuplot(script);
   png.commit();
   svg.commit();
+  pdf.commit();
   return true;
 }
 
@@ -1535,7 +1543,7 @@ std::vector<std::string> report_files(const std::vector<std::string>& scenes) {
   for (const std::string& scene : scenes) {
     files.push_back(file_stem(scene) + ".csv");
     for (const Measure& m : kMeasures) {
-      for (const char* ext : {".png", ".svg"}) files.push_back(file_stem(scene) + "_" + m.column + ext);
+      for (const char* ext : {".png", ".svg", ".pdf"}) files.push_back(file_stem(scene) + "_" + m.column + ext);
     }
   }
   return files;

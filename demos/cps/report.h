@@ -83,7 +83,7 @@ Row execute_run(const RunSpec& spec, int repeats);
 std::vector<std::string> missing_runs(const std::vector<Row>& rows, std::size_t& planned);
 
 /// Writes DIR/SCENE.csv (one per scene present in rows, columns sorted with the settings first),
-/// the work-precision diagrams DIR/SCENE_<measure>.png and .svg through gnuplot (a panel per
+/// the work-precision diagrams DIR/SCENE_<measure>.png, .svg and .pdf through gnuplot (a panel per
 /// solver, push and friction model on shared axes, the warm-started iteration lines in the cold
 /// run's panel; diverged runs on the top edge; values under
 /// the measure's round-off floor drawn on it), DIR/mass_ratio.csv (the mass ratio pair: held or
@@ -99,7 +99,7 @@ void write_report(const std::filesystem::path& dir, const std::vector<Row>& rows
                   const std::vector<std::string>& missing, std::size_t planned);
 
 /// The files write_report may write into DIR for these scenes (plain names): report.md,
-/// mass_ratio.csv, and per scene SCENE.csv and each measure's SCENE_<measure>.png and .svg. Every
+/// mass_ratio.csv, and per scene SCENE.csv and each measure's SCENE_<measure>.png, .svg and .pdf. Every
 /// one is checked by the output rule (output.h) before a report's work begins.
 std::vector<std::string> report_files(const std::vector<std::string>& scenes);
 

@@ -15,7 +15,8 @@ namespace cps::cli {
 
 /// The files `cps report push` writes into its output folder (plain names): push.csv, push.md,
 /// push_overlap.png (the largest overlap against time) and push_speed.png (the largest body
-/// speed against time).
+/// speed against time), each also as a PDF of the same name (.pdf, gnuplot's pdfcairo: vector
+/// lines and text).
 std::vector<std::string> push_report_files();
 
 /// The files it writes into OUT/plots: the gnuplot data and script of each diagram

@@ -1,0 +1,91 @@
+#pragma once
+// The page of a `cps figure`: rendered panels laid out in a grid, each with a caption strip
+// below it (sub-figure letter, time, variant), a title strip above the grid and, for --overlay,
+// a legend strip below it, all composed with cairo. The same drawing code writes a PNG (a cairo
+// image surface whose pixels go through cps's own PNG writer, render::encode_png), a PDF
+// (cairo_pdf_surface) or an SVG (cairo_svg_surface); in PDF and SVG the panels are embedded
+// images of the rendered pixels and every label is vector text in DejaVu Sans, so a figure goes
+// into LaTeX as it is. Text never covers a panel: the strips lie outside the panels.
+//
+// Units: one pixel of a panel is one point (1/72 in) of the PDF or SVG page.
+
+#include "cps/render/renderer.h"
+
+#include <array>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cps::cli {
+
+/// The file format of a figure (--format).
+enum class FigureFormat { png, pdf, svg };
+
+/// Parses --format: "png", "pdf" or "svg". Throws UsageError "--format X: allowed are png, pdf,
+/// svg" otherwise.
+FigureFormat parse_figure_format(std::string_view text);
+
+/// The file name extension of `format`, with the dot (".png", ".pdf", ".svg").
+std::string_view figure_extension(FigureFormat format);
+
+/// One panel of a figure page: the rendered scene and its caption.
+struct PagePanel {
+  const render::Image* image = nullptr;  ///< panel_width x panel_height pixels (RGB8)
+  std::string letter;                    ///< sub-figure letter, e.g. "(a)"; none if empty
+  std::string text;                      ///< caption after the letter; lines split at '\n'
+};
+
+/// One entry of an overlay's legend: a colour swatch (sRGB, each in [0, 1]) and its text.
+struct PageLegendEntry {
+  std::array<float, 3> srgb{};
+  std::string text;
+};
+
+/// What a figure page holds. panels.size() == rows * columns, in reading order (row by row).
+struct FigurePage {
+  int rows = 1;
+  int columns = 1;
+  int panel_width = 640;   ///< px, > 0
+  int panel_height = 360;  ///< px, > 0
+  std::vector<PagePanel> panels;
+  /// With labels: the title strip above the grid (if not empty), the caption strips below the
+  /// panels and the white gutters between panels. Without labels the panels abut as one grid
+  /// and only a legend (if any) is added below.
+  bool labels = true;
+  std::string title;
+  std::string legend_heading;
+  std::vector<PageLegendEntry> legend;  ///< empty: no legend strip
+};
+
+/// Where each part of a composed page lies, in pixels (points in PDF and SVG) from the top left.
+struct PageLayout {
+  int width = 0;
+  int height = 0;
+  /// Font size of every label (px = pt): max(10, panel_height / 24), so a 640x360 panel's
+  /// captions are 15 px tall, about 1/24 of the panel, and never below 10 pt.
+  double font_size = 10.0;
+  struct Rect {
+    int x = 0;
+    int y = 0;
+    int width = 0;
+    int height = 0;
+  };
+  std::vector<Rect> panels;  ///< one per panel, in reading order; exactly the panel's pixels
+};
+
+/// The layout of `page` (text measured with cairo in DejaVu Sans): the caption strips all have
+/// the height of the longest caption after wrapping to the panel width, so the grid is regular.
+/// Throws std::invalid_argument if panels.size() != rows * columns or a panel's image is not
+/// panel_width x panel_height.
+PageLayout layout_page(const FigurePage& page);
+
+/// Composes `page` as a file of `format` (the bytes to write) laid out as layout_page says.
+/// PNG: the page's pixels encoded by render::encode_png (RGB8, white background). PDF, SVG:
+/// one page of layout.width x layout.height points, the panels as embedded images, the text as
+/// text. Throws std::runtime_error if cairo fails.
+std::string compose_page(const FigurePage& page, FigureFormat format, const PageLayout& layout);
+
+/// The page's pixels as composed for PNG (for tests and for the PNG path of compose_page).
+render::Image compose_page_pixels(const FigurePage& page, const PageLayout& layout);
+
+}  // namespace cps::cli

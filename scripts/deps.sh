@@ -13,6 +13,8 @@ cps_packages=(
   libosmesa6-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri
   # Plots of `cps report`, videos of `cps render --video`.
   gnuplot-nox ffmpeg
+  # glTF 2.0 binaries of `cps export` (header only; built and read back by the tests).
+  libtinygltf-dev
 )
 
 cps_install_missing() {

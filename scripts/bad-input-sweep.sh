@@ -69,6 +69,7 @@ declare -A KIND=(
   ['simulate:scene']=scene_one ['render:scene']=scene_many ['figure:scene']=scene_figure
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
+  ['export:scene']=scene_one ['export:--out']=out_glb
 )
 
 # The commands, each with the valid command line an option under test is added to (a short,
@@ -83,6 +84,7 @@ declare -A BASE=(
   [report]='report intersecting_stack --list-runs --out out'
   [bench]='bench --quick --scene intersecting_stack'
   [scene]='scene stack --out out/s.json'
+  [export]='export stack --seconds 0.1 --fps 10 --out out/s.glb'
 )
 RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
 MERGE_SRC=$root/merge-src                              # a complete sweep, made below
@@ -154,6 +156,8 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         "$good.it1.ss1.ws2" "$good.it1.ss1.ws-0.1" "$good.it1.ss1.wsnan" "$good.it1.ss1.wsinf" \
         "$good.it1.ss1.ws1e-1" "$good.it1.ss1.ws0x1" "$good.it1.ss1.ws" "$good.it1.ss1.ws0.5.5" \
         "$good.it1.ss1.ws 0.5" "$good.it1.ss1.WS0.5" "$good.it1.ws0.5" "$good.it1.ss1.ws1.0001" ;;
+    out_glb)  # not a .glb path that can be written as a new file
+      printf '%s\n' "" file file/s.glb adir .glb s.png s.GLB /dev/null . ;;
     out_json)  # cannot be written as a new scene file
       printf '%s\n' "" file file/s.json adir /dev/null . ;;
     seed)  # a decimal integer in [0, 2^64 - 1] (and only for the random scene)
@@ -215,6 +219,7 @@ EXTRA=(
   "push/--list-runs|report push --list-runs --out out"
   "push/--seed|report push --seed 3 --out out"
   "--rendering/--quick|bench --rendering=false --quick=junk"
+  "samples/--fps/--seconds|export stack --seconds 1e5 --fps 1000 --out out/s.glb"
 )
 
 # Valid command lines (some at the edges of the ranges): each must exit 0.
@@ -232,6 +237,8 @@ CONTROLS=(
   "render stack --seconds 0.1 --fps 10 --size 96x32 --compare beta=0,0.5,1 --out out"
   "render stack --seconds 0.1 --fps 10 --size 16x16 --compare dt=1/60,1/120 --overlay --out out"
   "figure stack --times 0 --size 16x16 --compare push --overlay --out out/f.png"
+  "export stack --seconds 0.1 --fps 10 --out out/s.glb"
+  "export pendulum_grid --seconds 0.1 --fps 5e-324 --out out/p.glb"
 )
 
 # ---------------------------------------------------------------------------------------------

@@ -18,6 +18,8 @@ cps_packages=(
   libcairo2-dev fonts-dejavu-core
   # Tests only: pdftotext reads the text of the figures' and the report's PDFs.
   poppler-utils
+  # glTF 2.0 binaries of `cps export` (header only; built and read back by the tests).
+  libtinygltf-dev
 )
 
 cps_install_missing() {

@@ -51,6 +51,11 @@ Command add_render(CLI::App& app, int argc, char** argv);
 /// `cps figure SCENE|paper`: one labelled PNG, PDF or SVG per figure, a panel per time and variant, with a
 /// JSON sidecar that records argc and argv.
 Command add_figure(CLI::App& app, int argc, char** argv);
+
+/// `cps export SCENE --out FILE.glb`: a run as a glTF 2.0 binary (meshes, materials in the
+/// renderer's colours, rods as cylinders, one animation sampled at --fps, the scene's camera).
+/// argc and argv are recorded in the folder's run.json.
+Command add_export(CLI::App& app, int argc, char** argv);
 #endif
 
 }  // namespace cps::cli

@@ -31,14 +31,17 @@ constexpr std::array<glm::vec3, 6> kPalette = {{{0.85f, 0.33f, 0.20f},
                                                 {0.60f, 0.35f, 0.70f},
                                                 {0.15f, 0.65f, 0.70f}}};
 
-// The colour of body `body`: the scene's own (style.body_colours) if it has one, else the palette's.
-glm::vec3 colour_of(std::size_t body, const DrawStyle& style) {
+}  // namespace
+
+glm::vec3 body_colour(std::size_t body, const DrawStyle& style) {
   if (body < style.body_colours.size() && style.body_colours[body]) {
     const Vec3& c = *style.body_colours[body];
     return {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};
   }
   return kPalette[body % kPalette.size()];
 }
+
+namespace {
 
 // A length (m) that says how big a movable body is: its largest half extent or its radius;
 // 0 for planes and static bodies.
@@ -96,7 +99,7 @@ render::DrawList draw_list(const World& world, const DrawStyle& style) {
   const auto& bodies = world.bodies();
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
-    const glm::vec3 colour = style.body_colour.value_or(colour_of(i, style));
+    const glm::vec3 colour = style.body_colour.value_or(body_colour(i, style));
     if (b.shape.kind == ShapeKind::box) {
       list.boxes.push_back({to_glm(b.x), to_glm(b.o), to_glm(b.shape.half_extents), colour,
                             style.body_alpha});

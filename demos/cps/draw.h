@@ -99,6 +99,11 @@ struct View {
   Overlays overlays;
 };
 
+/// The colour (linear RGB, each in [0, 1]) draw_list gives body `body` (its index in the world)
+/// when style.body_colour is unset: the scene's own (style.body_colours) if it has one, else a
+/// palette colour by index, so that neighbouring bodies differ. `cps export` uses it too.
+glm::vec3 body_colour(std::size_t body, const DrawStyle& style);
+
 /// A snapshot of `world` for the renderer: every box and sphere, every distance constraint as a
 /// rod (unless style.overlays.rods is false), every plane (checkered, on the square of
 /// style.plane_centre and style.plane_half_size_m), the contact overlay if asked. Colours come

@@ -26,6 +26,7 @@ int run(int argc, char** argv) {
 #ifdef CPS_HAVE_RENDERER
       cli::add_render(app, argc, argv),
       cli::add_figure(app, argc, argv),
+      cli::add_export(app, argc, argv),
 #endif
   };
 

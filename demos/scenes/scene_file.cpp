@@ -651,6 +651,17 @@ std::span<const std::optional<Vec3>> body_colours(const Scene& scene) {
   return {};
 }
 
+std::vector<std::string> body_names(const Scene& scene) {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < r.scenes.size(); ++i) {
+    if (&r.scenes[i] != &scene) continue;
+    for (const FileBody& b : r.files[i].bodies) names.push_back(b.name);
+  }
+  return names;
+}
+
 std::string_view scene_schema_text() { return assets::scene_schema; }
 
 // ---- Writing a world as a scene file --------------------------------------------------------

@@ -90,6 +90,10 @@ std::string_view example_scene_text(std::string_view name);
 /// renderer's palette): a scene file's "color"s; empty for a scene that is not a loaded file.
 std::span<const std::optional<Vec3>> body_colours(const Scene& scene);
 
+/// The names of a scene's bodies by body index (a scene file's "name"s, "" where a body has
+/// none); empty for a scene that is not a loaded file.
+std::vector<std::string> body_names(const Scene& scene);
+
 /// The JSON Schema of the format (assets/schemas/scene.schema.json, embedded at build time).
 std::string_view scene_schema_text();
 

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 using cli_test::fresh_dir;
@@ -22,21 +23,44 @@ namespace {
 
 Result run(const std::string& args, const fs::path& dir) { return cli_test::run_cps(args, dir); }
 
-// Mean absolute difference (0-255) over rows [y0, y1) of two panels of width w placed at x = a
-// and x = b in `image`.
-double panel_difference(const cps::render::Image& image, int a, int b, int w, int y0, int y1) {
+// A panel's place in a frame, [x, y, width, height] in pixels, as run.json's layout.panels_px
+// gives it.
+struct Rect {
+  int x, y, width, height;
+};
+
+std::vector<Rect> panels_of(const nlohmann::json& run_json) {
+  std::vector<Rect> rects;
+  for (const nlohmann::json& r : run_json["parameters"]["layout"]["panels_px"]) {
+    rects.push_back({r[0].get<int>(), r[1].get<int>(), r[2].get<int>(), r[3].get<int>()});
+  }
+  return rects;
+}
+
+// Mean absolute difference (0-255) of two panels of the same size in `image`.
+double panel_difference(const cps::render::Image& image, const Rect& a, const Rect& b) {
   double sum = 0.0;
-  for (int y = y0; y < y1; ++y) {
-    for (int x = 0; x < w; ++x) {
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
       for (int c = 0; c < 3; ++c) {
-        const auto at = [&](int x0) {
-          return image.pixels[3 * (static_cast<std::size_t>(y) * image.width + x0 + x) + c];
+        const auto at = [&](const Rect& r) {
+          return image.pixels[3 * (static_cast<std::size_t>(r.y + y) * image.width + r.x + x) + c];
         };
         sum += std::abs(static_cast<int>(at(a)) - static_cast<int>(at(b)));
       }
     }
   }
-  return sum / (3.0 * w * (y1 - y0));
+  return sum / (3.0 * a.width * a.height);
+}
+
+// Dark pixels (red channel below 128: text ink on the white strip) in rows [y0, y1) and columns
+// [x0, x1).
+int ink_in(const cps::render::Image& image, int x0, int x1, int y0, int y1) {
+  int n = 0;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = x0; x < x1; ++x) n += image.pixels[3 * (static_cast<std::size_t>(y) * image.width + x)] < 128;
+  }
+  return n;
 }
 
 // Hue (degrees) and saturation of an RGB8 pixel.
@@ -86,16 +110,25 @@ TEST_CASE("cps render --compare with three values of beta lays out 3 labelled pa
   REQUIRE(r.exit_code == 0);
   const fs::path folder = dir / "out" / "intersecting_stack-compare-beta-0.05_0.2_0.5";
   const cps::render::Image last = cps::render::read_png(folder / "frame_000001.png");
-  CHECK(last.width == 480);  // 1 x 3 panels of 160 x 240
+  CHECK(last.width == 480);  // 1 x 3 cells of 160 x 240: --size exactly
   CHECK(last.height == 240);
-  // Below the labels (the top 100 rows), at t = 1 s: beta = 0.05 still pushes the cubes apart
-  // slowly, 0.5 has thrown them out; a few grey levels on average is a different picture (the
-  // same picture differs by 0).
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(folder / "run.json"));
+  const std::vector<Rect> at = panels_of(manifest);
+  REQUIRE(at.size() == 3);
+  for (const Rect& r : at) {
+    // Each scene in its cell, with a caption strip below it that holds its label and time.
+    CHECK(r.width > 100);
+    CHECK(r.width <= 160);
+    CHECK(r.height > 100);
+    CHECK(r.y + r.height < 240 - 24);
+    CHECK(ink_in(last, r.x, r.x + r.width, r.y + r.height, 240) > 50);
+  }
+  // At t = 1 s: beta = 0.05 still pushes the cubes apart slowly, 0.5 has thrown them out; a few
+  // grey levels on average is a different picture (the same picture differs by 0).
   for (const auto& [a, b] : {std::pair{0, 1}, std::pair{0, 2}, std::pair{1, 2}}) {
     INFO("panels " << a << " and " << b);
-    CHECK(panel_difference(last, 160 * a, 160 * b, 160, 100, 240) > 1.0);
+    CHECK(panel_difference(last, at[static_cast<std::size_t>(a)], at[static_cast<std::size_t>(b)]) > 1.0);
   }
-  const nlohmann::json manifest = nlohmann::json::parse(slurp(folder / "run.json"));
   const nlohmann::json& p = manifest["parameters"];
   CHECK(p["compare"]["parameter"] == "beta");
   CHECK(p["compare"]["values"] == nlohmann::json({0.05, 0.2, 0.5}));
@@ -121,31 +154,38 @@ TEST_CASE("cps render --overlay draws every variant in one view in its colour, w
           "[cli][compare]") {
   const fs::path dir = fresh_dir("cps_compare_overlay");
   const Result r = run("render intersecting_stack --compare push=baumgarte,split --overlay --seconds 0.5 --fps 2 "
-                       "--size 320x240 --out out",
+                       "--size 480x360 --out out",
                        dir);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   const fs::path folder = dir / "out" / "intersecting_stack-compare-push-baumgarte_split-overlay";
   const cps::render::Image frame = cps::render::read_png(folder / "frame_000001.png");
-  CHECK(frame.width == 320);  // one view of --size
-  CHECK(frame.height == 240);
-  // Above the legend (bottom 50 rows) and below the label (top 30): at 0.5 s the baumgarte cubes
-  // have flown up (blue ghosts) while the split ones stand (orange ghosts). Hue within 15
-  // degrees; each ghost cube covers hundreds of pixels, so 100 is a safe floor.
+  CHECK(frame.width == 480);  // one view of --size
+  CHECK(frame.height == 360);
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(folder / "run.json"));
+  const std::vector<Rect> at = panels_of(manifest);
+  REQUIRE(at.size() == 1);
+  const Rect scene = at.front();
+  // The scene, then below it the caption strip (the time) and the legend strip.
+  CHECK(scene.height > 200);
+  CHECK(scene.y + scene.height < 360 - 40);
+  // In the scene: at 0.5 s the baumgarte cubes have flown up (blue ghosts) while the split ones
+  // stand (orange ghosts). Hue within 15 degrees; each ghost cube covers hundreds of pixels, so
+  // 100 is a safe floor.
   double blue_y = 0.0;
   double orange_y = 0.0;
-  const int blue = pixels_of_hue(frame, kBlueHue, 15.0, 30, 240 - 50, &blue_y);
-  const int orange = pixels_of_hue(frame, kOrangeHue, 15.0, 30, 240 - 50, &orange_y);
+  const int blue = pixels_of_hue(frame, kBlueHue, 15.0, scene.y, scene.y + scene.height, &blue_y);
+  const int orange = pixels_of_hue(frame, kOrangeHue, 15.0, scene.y, scene.y + scene.height, &orange_y);
   CHECK(blue > 100);
   CHECK(orange > 100);
   // Each colour is one variant: the blue (baumgarte) cubes are higher up the picture than the
   // orange (split) stack, by more than a cube's height on average (at this size a cube is
-  // about 10 pixels). Bodies in their own palette colours would mix both hues in both stacks.
+  // about 15 pixels). Bodies in their own palette colours would mix both hues in both stacks.
   CHECK(blue_y < orange_y - 10.0);
-  // The legend's swatches: both colours in the bottom-left corner.
-  CHECK(pixels_of_hue(frame, kBlueHue, 5.0, 240 - 50, 240) > 20);
-  CHECK(pixels_of_hue(frame, kOrangeHue, 5.0, 240 - 50, 240) > 20);
-  const nlohmann::json manifest = nlohmann::json::parse(slurp(folder / "run.json"));
+  // The legend's swatches: both colours below the scene, and the strips hold text.
+  CHECK(pixels_of_hue(frame, kBlueHue, 5.0, scene.y + scene.height, 360) > 20);
+  CHECK(pixels_of_hue(frame, kOrangeHue, 5.0, scene.y + scene.height, 360) > 20);
+  CHECK(ink_in(frame, 0, 480, scene.y + scene.height, 360) > 100);
   CHECK(manifest["parameters"]["compare"]["layout"] == "overlay");
   CHECK(manifest["parameters"]["compare"]["values"] == nlohmann::json({"baumgarte", "split"}));
 

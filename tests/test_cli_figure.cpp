@@ -330,6 +330,47 @@ TEST_CASE("cps figure's labels lie in strips outside the scene", "[cli][figure][
   }
 }
 
+TEST_CASE("cps render --label writes the captions in a strip below the scene, never over it",
+          "[cli][figure][format]") {
+  const fs::path dir = fresh_dir("render_strips");
+  REQUIRE(cps_run("render stack --seconds 0.5 --fps 2 --size 320x240 --label --out l", dir).exit_code == 0);
+  const cps::render::Image labelled = cps::render::read_png(dir / "l/stack/frame_000001.png");
+  CHECK(labelled.width == 320);  // the frame is --size; the scene gives up the strip's rows
+  CHECK(labelled.height == 240);
+  const nlohmann::json layout =
+      nlohmann::json::parse(slurp(dir / "l/stack/run.json"))["parameters"]["layout"];
+  REQUIRE(layout["panels_px"].size() == 1);
+  const int x0 = layout["panels_px"][0][0];
+  const int y0 = layout["panels_px"][0][1];
+  const int w = layout["panels_px"][0][2];
+  const int h = layout["panels_px"][0][3];
+  CHECK(y0 + h < 240 - 20);  // two lines of 10 px text at least below it
+  // The same scene at the scene's own size without a label: the camera frames the same aspect,
+  // so every pixel of the scene must be the same. A label drawn over the scene would differ.
+  const std::string bare_size = std::to_string(w) + "x" + std::to_string(h);
+  REQUIRE(cps_run("render stack --seconds 0.5 --fps 2 --size " + bare_size + " --out b", dir).exit_code == 0);
+  const cps::render::Image bare = cps::render::read_png(dir / "b/stack/frame_000001.png");
+  REQUIRE(bare.width == w);
+  REQUIRE(bare.height == h);
+  const auto pixel = [](const cps::render::Image& im, int x, int y, int ch) {
+    return im.pixels[3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(im.width) +
+                          static_cast<std::size_t>(x)) + static_cast<std::size_t>(ch)];
+  };
+  int differ = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int ch = 0; ch < 3; ++ch) differ += pixel(labelled, x0 + x, y0 + y, ch) != pixel(bare, x, y, ch);
+    }
+  }
+  CHECK(differ == 0);
+  // The strip below holds the text (the scene's name and the time): dark pixels on white.
+  int ink = 0;
+  for (int y = y0 + h; y < 240; ++y) {
+    for (int x = 0; x < 320; ++x) ink += pixel(labelled, x, y, 0) < 128;
+  }
+  CHECK(ink > 100);
+}
+
 TEST_CASE("cps figure rejects a bad --format with exit 2, naming it, and writes nothing",
           "[cli][figure][format]") {
   const fs::path dir = fresh_dir("bad_format");
@@ -348,12 +389,18 @@ TEST_CASE("cps figure rejects a bad --format with exit 2, naming it, and writes 
 
 TEST_CASE("cps render takes the overlay and camera flags", "[cli][figure]") {
   const fs::path dir = fresh_dir("render_flags");
-  const Result r = cps_run("render pendulum_grid --seconds 0.1 --fps 10 --size 32x32 --contacts "
+  const Result r = cps_run("render pendulum_grid --seconds 0.1 --fps 10 --size 96x96 --contacts "
                        "--no-rods --label --camera top --orbit 10 --out o",
                        dir);
   INFO(r.err);
   CHECK(r.exit_code == 0);
-  CHECK(png_size(dir / "o/pendulum_grid/frame_000001.png") == std::make_pair(32, 32));
+  CHECK(png_size(dir / "o/pendulum_grid/frame_000001.png") == std::make_pair(96, 96));
+  // At 32x32 the caption strips would leave the scene no room: refused, naming the size.
+  const Result tiny = cps_run("render pendulum_grid --seconds 0.1 --fps 10 --size 32x32 --label --out t", dir);
+  CHECK(tiny.exit_code == 2);
+  CHECK(tiny.err.find("--size 32x32") != std::string::npos);
+  CHECK(tiny.err.find("16x16") != std::string::npos);
+  CHECK(!fs::exists(dir / "t"));
   const std::string quick = "render stack --seconds 0.1 --fps 10 --size 32x32 --out o ";
   CHECK(cps_run(quick + "--camera sideways", dir).exit_code == 2);
   const Result nan = cps_run(quick + "--orbit nan", dir);
@@ -366,7 +413,7 @@ TEST_CASE("cps render --speed spaces frames speed / fps simulated seconds apart"
   const fs::path dir = fresh_dir("render_speed");
   // 0.25 s/s at 10 fps: frames 0.025 s apart over 0.5 s = 21 frames; 1.5 steps of 1/60 s, so
   // each frame shows the nearest step and run.json says so.
-  const Result slow = cps_run("render stack --seconds 0.5 --fps 10 --speed 0.25 --size 16x16 --label "
+  const Result slow = cps_run("render stack --seconds 0.5 --fps 10 --speed 0.25 --size 96x96 --label "
                           "--out o",
                           dir);
   INFO(slow.err);

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -29,7 +30,7 @@ struct Metrics {
 
 Metrics metrics_of(const FigurePage& page) {
   Metrics m;
-  m.font = std::max(10.0, page.panel_height / 24.0);
+  m.font = page.font_size > 0.0 ? page.font_size : std::max(10.0, page.panel_height / 24.0);
   m.line = 1.25 * m.font;
   m.pad = static_cast<int>(std::lround(0.35 * m.font));
   m.gutter = page.labels ? static_cast<int>(std::lround(0.6 * m.font)) : 0;
@@ -117,6 +118,17 @@ CairoPtr measuring_context(SurfacePtr& surface) {
   return CairoPtr(cairo_create(surface.get()), cairo_destroy);
 }
 
+// The height of every caption strip: the longest caption of `page` wrapped to panels `width`
+// px wide, in lines (at least one), and its padding; 0 without labels.
+int caption_height(cairo_t* cr, const FigurePage& page, const Metrics& m, int width) {
+  if (!page.labels) return 0;
+  std::size_t lines = 1;
+  for (const PagePanel& p : page.panels) {
+    lines = std::max(lines, caption_lines(cr, p, m, width - 2.0 * m.pad).lines.size());
+  }
+  return static_cast<int>(std::ceil(static_cast<double>(lines) * m.line + 2 * m.pad));
+}
+
 int title_height(cairo_t* cr, const FigurePage& page, const Metrics& m, double width) {
   if (!page.labels || page.title.empty()) return 0;
   set_font(cr, m.font, true);
@@ -148,6 +160,7 @@ void draw_page(cairo_t* cr, const FigurePage& page, const PageLayout& layout) {
 
   // The panels, pixel for pixel.
   for (std::size_t k = 0; k < page.panels.size(); ++k) {
+    if (page.panels[k].image == nullptr) continue;  // an empty cell stays white
     const render::Image& im = *page.panels[k].image;
     SurfacePtr img(cairo_image_surface_create(CAIRO_FORMAT_RGB24, im.width, im.height),
                    cairo_surface_destroy);
@@ -191,7 +204,7 @@ void draw_page(cairo_t* cr, const FigurePage& page, const PageLayout& layout) {
       const PageLayout::Rect& r = layout.panels[k];
       const CaptionLines c = caption_lines(cr, page.panels[k], m, text_width);
       cairo_save(cr);
-      cairo_rectangle(cr, r.x, r.y + r.height, r.width, layout.height - (r.y + r.height));
+      cairo_rectangle(cr, r.x, r.y + r.height, r.width, layout.caption_height);
       cairo_clip(cr);
       double y = r.y + r.height + m.pad + ascent;
       const double x = r.x + m.pad;
@@ -236,6 +249,12 @@ cairo_status_t append(void* closure, const unsigned char* data, unsigned int len
 
 }  // namespace
 
+std::string time_caption(double t) {
+  char text[48];
+  std::snprintf(text, sizeof text, "t = %.2f s", t);
+  return text;
+}
+
 FigureFormat parse_figure_format(std::string_view text) {
   if (text == "png") return FigureFormat::png;
   if (text == "pdf") return FigureFormat::pdf;
@@ -259,7 +278,7 @@ PageLayout layout_page(const FigurePage& page) {
                                 std::to_string(page.rows) + " x " + std::to_string(page.columns));
   }
   for (const PagePanel& p : page.panels) {
-    if (p.image == nullptr || p.image->width != page.panel_width || p.image->height != page.panel_height) {
+    if (p.image != nullptr && (p.image->width != page.panel_width || p.image->height != page.panel_height)) {
       throw std::invalid_argument("layout_page: a panel is not " + std::to_string(page.panel_width) +
                                   "x" + std::to_string(page.panel_height));
     }
@@ -270,14 +289,8 @@ PageLayout layout_page(const FigurePage& page) {
   PageLayout layout;
   layout.font_size = m.font;
   layout.width = page.columns * page.panel_width + (page.columns - 1) * m.gutter + 2 * m.gutter;
-  int caption = 0;
-  if (page.labels) {
-    std::size_t lines = 1;
-    for (const PagePanel& p : page.panels) {
-      lines = std::max(lines, caption_lines(cr.get(), p, m, page.panel_width - 2.0 * m.pad).lines.size());
-    }
-    caption = static_cast<int>(std::ceil(static_cast<double>(lines) * m.line + 2 * m.pad));
-  }
+  const int caption = caption_height(cr.get(), page, m, page.panel_width);
+  layout.caption_height = caption;
   const int title = title_height(cr.get(), page, m, layout.width - 2.0 * m.gutter);
   for (int r = 0; r < page.rows; ++r) {
     for (int c = 0; c < page.columns; ++c) {
@@ -288,7 +301,32 @@ PageLayout layout_page(const FigurePage& page) {
   }
   layout.height = m.gutter + title + page.rows * (page.panel_height + caption) +
                   (page.rows - 1) * m.gutter + legend_height(page, m) + m.gutter;
+  if ((page.width > 0 && page.width < layout.width) || (page.height > 0 && page.height < layout.height)) {
+    throw std::invalid_argument("layout_page: the page needs " + std::to_string(layout.width) + "x" +
+                                std::to_string(layout.height) + " pixels, more than the " +
+                                std::to_string(page.width) + "x" + std::to_string(page.height) + " given");
+  }
+  if (page.width > 0) layout.width = page.width;
+  if (page.height > 0) layout.height = page.height;
   return layout;
+}
+
+std::pair<int, int> fit_panels(const FigurePage& page, int width, int height) {
+  if (page.font_size <= 0.0 || page.rows < 1 || page.columns < 1) {
+    throw std::invalid_argument("fit_panels: needs a font size (" + std::to_string(page.font_size) +
+                                ") and rows and columns >= 1");
+  }
+  const Metrics m = metrics_of(page);
+  SurfacePtr surface(nullptr, cairo_surface_destroy);
+  CairoPtr cr = measuring_context(surface);
+  // layout_page's sums, solved for the panel size.
+  const int panel_width = (width - (page.columns + 1) * m.gutter) / page.columns;
+  const int caption = caption_height(cr.get(), page, m, panel_width);
+  const int natural_width = page.columns * panel_width + (page.columns + 1) * m.gutter;
+  const int title = title_height(cr.get(), page, m, natural_width - 2.0 * m.gutter);
+  const int panel_height =
+      (height - (page.rows + 1) * m.gutter - title - legend_height(page, m) - page.rows * caption) / page.rows;
+  return {panel_width, panel_height};
 }
 
 render::Image compose_page_pixels(const FigurePage& page, const PageLayout& layout) {

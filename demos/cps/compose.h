@@ -14,6 +14,7 @@
 #include <array>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace cps::cli {
@@ -28,9 +29,14 @@ FigureFormat parse_figure_format(std::string_view text);
 /// The file name extension of `format`, with the dot (".png", ".pdf", ".svg").
 std::string_view figure_extension(FigureFormat format);
 
+/// A panel's time as its caption says it: "t = 1.25 s" (t in s, two decimals).
+std::string time_caption(double t);
+
 /// One panel of a figure page: the rendered scene and its caption.
 struct PagePanel {
-  const render::Image* image = nullptr;  ///< panel_width x panel_height pixels (RGB8)
+  /// panel_width x panel_height pixels (RGB8); null: an empty cell, left white (a grid the
+  /// panels do not fill), or a page laid out before its panels are drawn.
+  const render::Image* image = nullptr;
   std::string letter;                    ///< sub-figure letter, e.g. "(a)"; none if empty
   std::string text;                      ///< caption after the letter; lines split at '\n'
 };
@@ -55,6 +61,15 @@ struct FigurePage {
   std::string title;
   std::string legend_heading;
   std::vector<PageLegendEntry> legend;  ///< empty: no legend strip
+  /// Font size of every label (px = pt); 0: max(10, panel_height / 24). A video frame gives its
+  /// own (from the frame's height), so that its text does not depend on the panels it sizes.
+  double font_size = 0.0;
+  /// The page's size in pixels; 0: what the layout needs. A video frame gives --size: the grid
+  /// keeps its place at the top left and the spare pixels (fewer than a panel per row or column,
+  /// see fit_panels) stay white at the right and bottom. Must not be smaller than the layout
+  /// needs (layout_page throws).
+  int width = 0;
+  int height = 0;
 };
 
 /// Where each part of a composed page lies, in pixels (points in PDF and SVG) from the top left.
@@ -71,13 +86,25 @@ struct PageLayout {
     int height = 0;
   };
   std::vector<Rect> panels;  ///< one per panel, in reading order; exactly the panel's pixels
+  /// Height (px) of every caption strip, right below its panel; 0 without labels. A caption's
+  /// text is clipped to its strip.
+  int caption_height = 0;
 };
 
 /// The layout of `page` (text measured with cairo in DejaVu Sans): the caption strips all have
 /// the height of the longest caption after wrapping to the panel width, so the grid is regular.
-/// Throws std::invalid_argument if panels.size() != rows * columns or a panel's image is not
-/// panel_width x panel_height.
+/// Throws std::invalid_argument if panels.size() != rows * columns, a panel's image (if set) is
+/// not panel_width x panel_height, or page.width / page.height is set and smaller than needed.
 PageLayout layout_page(const FigurePage& page);
+
+/// The largest panel size {width, height} (px) with which `page` is at most width x height
+/// pixels: the gutters, the title, the caption strips (their text wrapped to that panel width
+/// and measured as layout_page does) and the legend take what they need, and the panels share
+/// the rest equally. The page's panel size and images are not read; its font size must be set
+/// (page.font_size > 0), since the default font follows the panel height. Either value may be
+/// <= 0 when the text leaves no room: the caller refuses that. Throws std::invalid_argument if
+/// page.font_size <= 0 or rows or columns < 1.
+std::pair<int, int> fit_panels(const FigurePage& page, int width, int height);
 
 /// Composes `page` as a file of `format` (the bytes to write) laid out as layout_page says.
 /// PNG: the page's pixels encoded by render::encode_png (RGB8, white background). PDF, SVG:

@@ -84,12 +84,6 @@ void draw_border(render::Image& image) {
   }
 }
 
-std::string format_time(double t) {
-  char text[48];
-  std::snprintf(text, sizeof text, "t = %.2f s", t);
-  return text;
-}
-
 }  // namespace
 
 std::string subfigure_letter(std::size_t k) {
@@ -129,14 +123,12 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
       render::Image panel = renderer.draw(overlay_draw_list(worlds, style));
       draw_border(panel);
       out.panels.push_back(std::move(panel));
-      texts.push_back(format_time(runs.front().world.time()));
+      texts.push_back(time_caption(runs.front().world.time()));
     }
     // The legend even without labels: without it the colours mean nothing. It has a strip of
     // its own below the panels.
     page.legend_heading = legend_heading(spec.comparison);
-    for (std::size_t k = 0; k < spec.variants.size(); ++k) {
-      page.legend.push_back({overlay_colour(k), spec.variants[k].legend});
-    }
+    page.legend = overlay_legend(spec.variants);
   } else {
     for (std::size_t r = 0; r < runs.size(); ++r) {
       for (std::size_t c = 0; c < spec.times.size(); ++c) {
@@ -144,7 +136,7 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
         render::Image panel = renderer.draw(draw_list(runs[r].world, style));
         draw_border(panel);
         out.panels.push_back(std::move(panel));
-        std::string text = format_time(runs[r].world.time());
+        std::string text = time_caption(runs[r].world.time());
         if (!spec.variants[r].label.empty()) text += "\n" + spec.variants[r].label;
         texts.push_back(text);
       }

@@ -38,22 +38,10 @@ render::DrawList overlay_draw_list(const std::vector<const World*>& worlds, cons
   return list;
 }
 
-std::vector<render::LegendEntry> overlay_legend(const std::vector<Variant>& variants) {
-  std::vector<render::LegendEntry> entries;
-  for (std::size_t k = 0; k < variants.size(); ++k) {
-    const std::array<float, 3> c = overlay_colour(k);
-    entries.push_back({glm::vec3(c[0], c[1], c[2]), variants[k].legend});
-  }
+std::vector<PageLegendEntry> overlay_legend(const std::vector<Variant>& variants) {
+  std::vector<PageLegendEntry> entries;
+  for (std::size_t k = 0; k < variants.size(); ++k) entries.push_back({overlay_colour(k), variants[k].legend});
   return entries;
-}
-
-void draw_overlay_legend(render::Image& image, const Comparison& comparison,
-                         const std::vector<Variant>& variants, int scale) {
-  const std::string heading = legend_heading(comparison);
-  const std::vector<render::LegendEntry> entries = overlay_legend(variants);
-  const auto [w, h] = render::legend_size(heading, entries, scale);
-  (void)w;
-  render::draw_legend(image, 4 * scale, image.height - h - 4 * scale, heading, entries, scale);
 }
 
 }  // namespace cps::cli

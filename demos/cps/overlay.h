@@ -4,9 +4,8 @@
 // Catto's Solver2D shows several solvers in one scene.
 
 #include "compare.h"
+#include "compose.h"
 #include "draw.h"
-
-#include "cps/render/image_ops.h"
 
 #include <vector>
 
@@ -20,12 +19,8 @@ namespace cps::cli {
 /// world or more than kMaxVariants.
 render::DrawList overlay_draw_list(const std::vector<const World*>& worlds, const DrawStyle& style);
 
-/// The legend of an overlay: per variant its colour and its Variant::legend text.
-std::vector<render::LegendEntry> overlay_legend(const std::vector<Variant>& variants);
-
-/// Draws the legend (render::draw_legend, heading legend_heading(comparison)) in the bottom-left
-/// corner of `image`, `scale` pixels per font unit (>= 1).
-void draw_overlay_legend(render::Image& image, const Comparison& comparison,
-                         const std::vector<Variant>& variants, int scale);
+/// The legend of an overlay: per variant its colour (overlay_colour, sRGB) and its
+/// Variant::legend text, for the legend strip of a figure or a frame (compose.h).
+std::vector<PageLegendEntry> overlay_legend(const std::vector<Variant>& variants);
 
 }  // namespace cps::cli

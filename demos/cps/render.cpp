@@ -10,12 +10,14 @@
 
 #include "cps/render/image_ops.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 
 namespace cps::cli {
@@ -51,46 +53,119 @@ std::string frame_name(long long k) {
   return name;
 }
 
-long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, const RenderJob& job,
-                  render::Renderer& renderer, render::PngWriter& writer, Progress* progress) {
-  const int label_scale = std::max(1, renderer.height() / 360);
+namespace {
 
+// A panel's caption in a frame: its label (if any), then the time t (s) on a line of its own.
+std::string frame_caption(const std::string& label, double t) {
+  return (label.empty() ? std::string() : label + "\n") + time_caption(t);
+}
+
+}  // namespace
+
+bool frame_has_captions(const RenderJob& job, const std::vector<std::string>& labels) {
+  if (job.frame_width <= 0 || job.frame_height <= 0) return false;
+  if (job.overlay) return true;
+  for (const std::string& label : labels) {
+    if (!label.empty()) return true;
+  }
+  return false;
+}
+
+FigurePage frame_page(const RenderJob& job, const std::vector<std::string>& labels, double t) {
+  if (job.frame_width <= 0 || job.frame_height <= 0) {
+    throw std::invalid_argument("frame_page: a frame of " + std::to_string(job.frame_width) + "x" +
+                                std::to_string(job.frame_height) + " pixels");
+  }
+  FigurePage page;
+  const std::size_t panels = job.overlay ? 1 : labels.size();
+  page.columns = job.overlay ? 1 : std::max(1, std::min(job.columns > 0 ? job.columns : static_cast<int>(panels),
+                                                         static_cast<int>(panels)));
+  page.rows = static_cast<int>((panels + static_cast<std::size_t>(page.columns) - 1) /
+                               static_cast<std::size_t>(page.columns));
+  page.font_size = std::max(10.0, job.frame_height / static_cast<double>(page.rows) / 30.0);
+  page.width = job.frame_width;
+  page.height = job.frame_height;
+  for (std::size_t p = 0; p < panels; ++p) {
+    page.panels.push_back({nullptr, "", frame_caption(labels.empty() ? std::string() : labels[p], t)});
+  }
+  // A last row that the variants do not fill: its empty cells have no caption.
+  for (std::size_t p = panels; p < static_cast<std::size_t>(page.rows * page.columns); ++p) {
+    page.panels.push_back({nullptr, "", ""});
+  }
+  if (job.overlay) {
+    page.legend_heading = job.legend_heading;
+    page.legend = job.legend;
+  }
+  const auto [w, h] = fit_panels(page, job.frame_width, job.frame_height);
+  page.panel_width = w;
+  page.panel_height = h;
+  return page;
+}
+
+PageLayout frame_layout(const RenderJob& job, const std::vector<std::string>& labels) {
+  if (frame_has_captions(job, labels)) {
+    return layout_page(frame_page(job, labels, frame_time(job, frame_count(job) - 1)));
+  }
+  const int n = job.overlay ? 1 : static_cast<int>(std::max<std::size_t>(1, labels.size()));
+  const int columns = std::min(job.columns > 0 ? job.columns : n, n);
+  const int rows = (n + columns - 1) / columns;
+  PageLayout layout;
+  const int width = job.frame_width / columns;
+  const int height = job.frame_height / rows;
+  layout.width = width * columns;
+  layout.height = height * rows;
+  for (int k = 0; k < n; ++k) layout.panels.push_back({(k % columns) * width, (k / columns) * height, width, height});
+  return layout;
+}
+
+long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, const RenderJob& job,
+                        render::Renderer& renderer, render::PngWriter& writer, Progress* progress) {
   const long long frames = frame_count(job);
-  std::vector<render::Image> pictures(job.overlay ? 1 : panels.size());
+  std::vector<std::string> labels;
   std::vector<const World*> worlds;
-  for (const Panel& panel : panels) worlds.push_back(&panel.run->world);
-  const auto time_text = [](double t) {
-    char time[32];
-    std::snprintf(time, sizeof time, "t = %.2f s", t);
-    return std::string(time);
-  };
+  for (const Panel& panel : panels) {
+    labels.push_back(panel.label);
+    worlds.push_back(&panel.run->world);
+  }
+  const bool captions = frame_has_captions(job, labels);
+  // The layout is fixed for the whole sequence, measured with the last frame's time (the
+  // widest), so the strips never move.
+  std::optional<FigurePage> base;
+  std::optional<PageLayout> layout;
+  if (captions) {
+    base = frame_page(job, labels, frame_time(job, frames - 1));
+    if (base->panel_width != renderer.width() || base->panel_height != renderer.height()) {
+      throw std::invalid_argument("render_frames: the renderer is " + std::to_string(renderer.width()) + "x" +
+                                  std::to_string(renderer.height()) + ", the captions leave " +
+                                  std::to_string(base->panel_width) + "x" + std::to_string(base->panel_height));
+    }
+    layout = layout_page(*base);
+  }
+  std::vector<render::Image> pictures(job.overlay ? 1 : panels.size());
   for (long long k = 0; k < frames; ++k) {
     const double t = frame_time(job, k);
     for (Panel& panel : panels) panel.run->advance_to(t);
     if (job.overlay) {
       pictures[0] = renderer.draw(overlay_draw_list(worlds, style));
-      const std::string& label = panels.front().label;
-      render::draw_label(pictures[0], 4 * label_scale, 4 * label_scale,
-                         (label.empty() ? "" : label + "\n") + time_text(worlds.front()->time()),
-                         label_scale);
-      const int legend_height = render::legend_size(job.legend_heading, job.legend, label_scale).second;
-      render::draw_legend(pictures[0], 4 * label_scale, pictures[0].height - legend_height - 4 * label_scale,
-                          job.legend_heading, job.legend, label_scale);
-    }
-    for (std::size_t p = 0; p < panels.size() && !job.overlay; ++p) {
-      pictures[p] = renderer.draw(draw_list(panels[p].run->world, style));
-      if (!panels[p].label.empty()) {
-        const std::string text = panels[p].label + "\n" + time_text(panels[p].run->world.time());
-        render::draw_label(pictures[p], 4 * label_scale, 4 * label_scale,
-                           render::wrap_text(text, pictures[p].width - 8 * label_scale, label_scale),
-                           label_scale);
+    } else {
+      for (std::size_t p = 0; p < panels.size(); ++p) {
+        pictures[p] = renderer.draw(draw_list(panels[p].run->world, style));
       }
     }
-    writer.write(job.folder / frame_name(k),
-                 pictures.size() == 1 ? std::move(pictures.front())
-                                      : render::grid(pictures, job.columns > 0
-                                                                   ? job.columns
-                                                                   : static_cast<int>(pictures.size())));
+    if (!captions) {
+      writer.write(job.folder / frame_name(k),
+                   pictures.size() == 1
+                       ? std::move(pictures.front())
+                       : render::grid(pictures, job.columns > 0 ? job.columns : static_cast<int>(pictures.size())));
+    } else {
+      // Each caption says its own world's time (the variants' steps may differ).
+      FigurePage page = *base;
+      for (std::size_t p = 0; p < pictures.size(); ++p) {
+        page.panels[p].image = &pictures[p];
+        page.panels[p].text = frame_caption(labels[p], worlds[p]->time());
+      }
+      writer.write(job.folder / frame_name(k), compose_page_pixels(page, *layout));
+    }
     if (progress != nullptr) progress->update(k + 1);
   }
   writer.finish();
@@ -146,12 +221,21 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
   struct Job {
     const scenes::Scene* scene;
     std::vector<scenes::Run> runs;
-    DrawStyle style;  // the same camera for the whole sequence
+    std::vector<std::string> labels;  // per variant: its caption's label
+    std::pair<int, int> scene_px;     // the scene's size in each panel (frame_layout)
+    nlohmann::json panels_px = nlohmann::json::array();  // each panel's [x, y, width, height] in a frame
+    DrawStyle style;                  // the same camera for the whole sequence
   };
   std::vector<Job> jobs;
   for (const scenes::Scene* s : selected) {
-    Job job{s, {}, {}};
-    for (const Variant& v : variants) job.runs.push_back(make_run_or_usage_error(*s, v.overrides));
+    Job job{s, {}, {}, {}, nlohmann::json::array(), {}};
+    for (const Variant& v : variants) {
+      job.runs.push_back(make_run_or_usage_error(*s, v.overrides));
+      // --overlay: the legend names the variants; the label, the scene (with --label).
+      std::string label = o.overlay ? "" : v.label;
+      if (o.label) label = std::string(s->name) + (label.empty() ? "" : "\n" + label);
+      job.labels.push_back(label);
+    }
     jobs.push_back(std::move(job));
   }
   // --video: ffmpeg is looked for before rendering; without it the frames are still
@@ -167,17 +251,10 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
                    o.video.c_str());
     }
   }
-  const float aspect = static_cast<float>(panel_width) / static_cast<float>(panel_height);
-  for (Job& job : jobs) {
-    std::vector<const World*> worlds;
-    for (const scenes::Run& run : job.runs) worlds.push_back(&run.world);
-    job.style = resolve_style(*job.scene, worlds, o.view, aspect,
-                              o.seconds.value_or(job.scene->default_seconds));
-  }
   // Every output folder is checked (foreign files, see output.h) before any is written.
   std::vector<RenderJob> specs;
   std::vector<OutputPlan> plans;
-  for (const Job& job : jobs) {
+  for (Job& job : jobs) {
     RenderJob spec;
     spec.seconds = o.seconds.value_or(job.scene->default_seconds);
     spec.fps = o.fps;
@@ -185,6 +262,8 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     spec.folder = fs::path(o.out) /
                   (std::string(job.scene->name) + comparison_suffix(comparison, o.overlay));
     spec.columns = grid.columns;
+    spec.frame_width = panel_width * grid.columns;
+    spec.frame_height = panel_height * grid.rows;
     spec.overlay = o.overlay;
     if (o.overlay) {
       spec.legend_heading = legend_heading(comparison);
@@ -208,6 +287,27 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
                        " GiB of pixels, more than the 64 GiB a render may draw; give fewer frames "
                        "or a smaller --size");
     }
+    // The caption strips (labels, time, legend) lie outside the scene: what they leave of each
+    // panel is where the scene is drawn.
+    const PageLayout frame = frame_layout(spec, job.labels);
+    job.scene_px = {frame.panels.front().width, frame.panels.front().height};
+    for (std::size_t k = 0; k < (o.overlay ? 1 : variants.size()); ++k) {  // not a grid's empty cells
+      const PageLayout::Rect& r = frame.panels[k];
+      job.panels_px.push_back({r.x, r.y, r.width, r.height});
+    }
+    if (job.scene_px.first < 16 || job.scene_px.second < 16) {
+      throw UsageError("--size " + o.size + ": the caption strips below the scene (its label, the time" +
+                       std::string(o.overlay ? " and the legend" : "") + ") leave it " +
+                       std::to_string(std::max(0, job.scene_px.first)) + "x" +
+                       std::to_string(std::max(0, job.scene_px.second)) +
+                       " pixels of each panel; a scene needs at least 16x16: give a larger --size" +
+                       std::string(o.label ? " or leave out --label" : ""));
+    }
+    std::vector<const World*> worlds;
+    for (const scenes::Run& run : job.runs) worlds.push_back(&run.world);
+    job.style = resolve_style(*job.scene, worlds, o.view,
+                              static_cast<float>(job.scene_px.first) / static_cast<float>(job.scene_px.second),
+                              spec.seconds);
     std::vector<std::string> files;
     files.reserve(static_cast<std::size_t>(frames));
     for (long long k = 0; k < frames; ++k) files.push_back(frame_name(k));
@@ -229,8 +329,9 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
     video_info = run_info("render", argc, argv,
                           {{"video", o.video}, {"fps", o.fps}, {"frames_folders", folders}});
   }
-  render::Renderer renderer(panel_width, panel_height, *render::parse_backend(o.backend));
-  std::fprintf(stderr, "render: %s\n", renderer.context_description().c_str());
+  // One renderer at the scene's size; another only when a scene's captions leave it another
+  // size (--label with scene names of more lines).
+  std::optional<render::Renderer> renderer;
   // Encoding overlaps drawing: one encoder thread keeps up with llvmpipe (see cps bench). Each
   // frame is written atomically under the output rule (output.h).
   render::PngWriter writer(
@@ -240,13 +341,15 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     Job& job = jobs[j];
     const RenderJob& spec = specs[j];
+    if (!renderer || renderer->width() != job.scene_px.first || renderer->height() != job.scene_px.second) {
+      renderer.reset();
+      renderer.emplace(job.scene_px.first, job.scene_px.second, *render::parse_backend(o.backend));
+      std::fprintf(stderr, "render: %s\n", renderer->context_description().c_str());
+    }
     std::vector<Panel> panels;
     nlohmann::json world = nlohmann::json::array();
     for (std::size_t v = 0; v < variants.size(); ++v) {
-      // --overlay: the legend names the variants; the label, the scene (with --label).
-      std::string label = o.overlay ? "" : variants[v].label;
-      if (o.label) label = std::string(job.scene->name) + (label.empty() ? "" : "\n" + label);
-      panels.push_back({&job.runs[v], label});
+      panels.push_back({&job.runs[v], job.labels[v]});
       world.push_back({{"label", variants[v].label},
                        {"overlay_colour_srgb", o.overlay ? nlohmann::json(overlay_colour(v))
                                                          : nlohmann::json(nullptr)},
@@ -273,10 +376,13 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
          {"frames", frame_count(spec)},
          {"size", {{"width", size.width}, {"height", size.height}}},
          {"compare", comparison_json(comparison, o.overlay)},
-         {"layout", o.overlay ? nlohmann::json{{"overlay", true}, {"panel_px", {panel_width, panel_height}}}
+         {"layout", o.overlay ? nlohmann::json{{"overlay", true},
+                                               {"frame_px", {spec.frame_width, spec.frame_height}},
+                                               {"panels_px", job.panels_px}}
                               : nlohmann::json{{"rows", grid.rows},
                                                {"columns", grid.columns},
-                                               {"panel_px", {panel_width, panel_height}}}},
+                                               {"frame_px", {spec.frame_width, spec.frame_height}},
+                                               {"panels_px", job.panels_px}}},
          {"backend", o.backend},
          {"camera", o.view.camera},
          {"camera_resolved", camera_json(job.style.camera)},
@@ -293,7 +399,7 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
          {"world", world}});
     begin_output(plans[j], info);
     Progress progress("render " + spec.folder.filename().string(), frame_count(spec), "frames");
-    const long long frames = render_frames(job.style, panels, spec, renderer, writer, &progress);
+    const long long frames = render_frames(job.style, panels, spec, *renderer, writer, &progress);
     end_output(plans[j], info);
     const std::string folder = spec.folder.filename().string();
     std::printf("%s: %lld frames in %s\n", folder.c_str(), frames, spec.folder.c_str());
@@ -303,8 +409,8 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
       video.frames_folder = spec.folder;
       video.frames = static_cast<int>(frames);  // at most kMaxFrames
       video.fps = o.fps;
-      video.width = o.overlay ? panel_width : panel_width * grid.columns;
-      video.height = o.overlay ? panel_height : panel_height * grid.rows;
+      video.width = spec.frame_width;
+      video.height = spec.frame_height;
       video.output = fs::path(o.out) / (folder + "." + o.video);
       if (!ffmpeg) {
         videos_left.push_back(video);

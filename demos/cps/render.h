@@ -91,7 +91,7 @@ PageLayout frame_layout(const RenderJob& job, const std::vector<std::string>& la
 /// without, the pictures abut as one grid (render::grid). Drawing stays on the calling thread (it owns the GL context); each finished frame
 /// goes to `writer`, which encodes it on its threads while the next frame is drawn; this returns
 /// after every frame is written. `progress` (may be null) is updated once per frame. Returns the
-/// number of frames (at most kMaxFrames: the caller checks frame_count first). Throws std::runtime_error if a frame cannot be drawn or written (frames
+/// number of frames (at most kMaxFrames: the caller checks frame_count first). Throws std::invalid_argument if the frames have captions and the renderer is not the size they leave, std::runtime_error if a frame cannot be drawn or written (frames
 /// already written stay, each complete; none is left half-written under its final name).
 long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, const RenderJob& job,
                   render::Renderer& renderer, render::PngWriter& writer, Progress* progress);

@@ -8,10 +8,6 @@
 #include <nlohmann/json.hpp>
 
 // The reading half of tinygltf, for this test only; images are never read (the files have none).
-#define TINYGLTF_IMPLEMENTATION
-#define TINYGLTF_NO_STB_IMAGE
-#define TINYGLTF_NO_STB_IMAGE_WRITE
-#define TINYGLTF_NO_EXTERNAL_IMAGE
 #include <tiny_gltf.h>
 
 #include <array>

@@ -13,6 +13,8 @@
 #include "cps/render/renderer.h"
 #endif
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>

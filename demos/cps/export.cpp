@@ -15,10 +15,8 @@
 // tinygltf's implementation lives in this file only. Images are never read or written (the file
 // has none), so tinygltf takes neither stb_image nor stb_image_write: the renderer's PNG code is
 // the only image code in the binary.
-#define TINYGLTF_IMPLEMENTATION
-#define TINYGLTF_NO_STB_IMAGE
-#define TINYGLTF_NO_STB_IMAGE_WRITE
-#define TINYGLTF_NO_EXTERNAL_IMAGE
+#include <CLI/CLI.hpp>
+
 #include <tiny_gltf.h>
 
 #include <algorithm>

@@ -7,6 +7,8 @@
 
 #include "cps/render/image_ops.h"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>

@@ -4,6 +4,8 @@
 #include "scene.h"
 #include "scene_file.h"
 
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
 #include <span>
 #include <string>

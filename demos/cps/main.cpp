@@ -5,6 +5,8 @@
 #include "options.h"
 #include "output.h"
 
+#include <CLI/CLI.hpp>
+
 #include <iostream>
 #include <string>
 #include <vector>

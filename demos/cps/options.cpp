@@ -2,6 +2,8 @@
 
 #include "scene_file.h"
 
+#include <CLI/CLI.hpp>
+
 #include <charconv>
 #include <cmath>
 #include <functional>

@@ -4,12 +4,17 @@
 #include "compare.h"
 #include "scene.h"
 
-#include <CLI/CLI.hpp>
-
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
+
+// CLI11 (Debian's 2.1, header only) costs about 10 s of compile time in every file that includes
+// it: the headers name its classes only, and the files that add options include it.
+namespace CLI {
+class App;
+class Validator;
+}  // namespace CLI
 
 namespace cps::cli {
 

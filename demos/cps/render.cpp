@@ -10,6 +10,8 @@
 
 #include "cps/render/image_ops.h"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

@@ -7,6 +7,8 @@
 #include "report_push.h"
 #include "stress/mass_ratio.h"
 
+#include <CLI/CLI.hpp>
+
 #include <unistd.h>
 
 #include <algorithm>

@@ -5,6 +5,8 @@
 #include "output.h"
 #include "scene_file.h"
 
+#include <CLI/CLI.hpp>
+
 #include <filesystem>
 #include <iostream>
 #include <memory>

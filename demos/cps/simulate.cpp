@@ -6,6 +6,8 @@
 #include "progress.h"
 #include "state_hash.h"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

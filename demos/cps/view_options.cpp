@@ -4,6 +4,8 @@
 
 #include "cps/parameters.h"
 
+#include <CLI/CLI.hpp>
+
 #include <cmath>
 #include <regex>
 #include <sstream>

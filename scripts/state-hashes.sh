@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The state hash at the end of every paper and stress scene (each at its own duration) for every
-# combination of --push, --solver and --assembly, one line each:
+# combination of --push (every push method the binary offers), --solver and --assembly, one line
+# each:
 #   SCENE PUSH SOLVER ASSEMBLY HASH
 # Usage: scripts/state-hashes.sh [CPS]               print the table (CPS: default build/demos/cps)
 #        scripts/state-hashes.sh --check FILE [CPS]  rerun every line of FILE with --expect-hash;
@@ -32,8 +33,11 @@ fi
 cps=${1:-build/demos/cps}
 scenes=$("$cps" list | awk '/^Scaled/{exit} /^  /{print $1}')
 echo "# scene push solver assembly state_hash   ($("$cps" simulate stack --seconds 0.02 --json | sed -n 's/.*"engine_version": "\(.*\)".*/\1/p'))"
+# The push methods as the binary's --help lists them: "--push {baumgarte, split, ...}".
+pushes=$("$cps" simulate --help | sed -n 's/^ *--push {\([^}]*\)}.*/\1/p' | tr -d ',')
+[ -n "$pushes" ] || { echo "state-hashes.sh: no --push methods in '$cps simulate --help'" >&2; exit 1; }
 for scene in $scenes; do
-  for push in baumgarte split; do
+  for push in $pushes; do
     for solver in pgs jacobi; do
       for assembly in explicit matrix-free; do
         hash=$("$cps" simulate "$scene" --push "$push" --solver "$solver" --assembly "$assembly" \

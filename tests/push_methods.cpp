@@ -14,7 +14,7 @@ int push_methods() { return static_cast<int>(cps::parameter("push").choices.size
 
 int paper_push_methods() {
   int n = 0;
-  for (const cps::Choice& c : cps::parameter("push").choices) n += c.source.rfind("Sec. ", 0) == 0;
+  for (const cps::Choice& c : cps::parameter("push").choices) n += c.in_paper;
   return n;
 }
 

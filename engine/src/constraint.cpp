@@ -86,7 +86,7 @@ void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
       contact.bias = -params.restitution * approach;
       contact.restitution = contact.bias;
     }
-    // Split impulse (split_impulse.h): a shallow contact's push stays in the velocity solve.
+    // Split impulse (push/split_impulse.cpp): a shallow contact's push stays in the velocity solve.
     if (c.depth <= params.velocity_push_depth) {
       contact.bias += contact.push;
       contact.push = 0.0;

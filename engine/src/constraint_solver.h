@@ -28,7 +28,7 @@ struct SolveSettings {
   FrictionModel friction = FrictionModel::fixed;
   /// nullptr: rigid rows (the paper's A lambda = b). Else c values gamma_j >= 0 (dimensionless):
   /// the solve is of (A + diag(gamma_j A_jj)) lambda = b, soft rows as Box2D v3 makes them
-  /// (soft_step.h: gamma = 1 / (h omega (2 zeta + h omega))); gamma_j = 0 leaves row j rigid.
+  /// (push/soft_step.cpp: gamma = 1 / (h omega (2 zeta + h omega))); gamma_j = 0 leaves row j rigid.
   const std::vector<double>* softness = nullptr;
 };
 

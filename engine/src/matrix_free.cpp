@@ -161,7 +161,7 @@ void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lam
 // Soft rows (SolveSettings::softness): PGS or Jacobi row by row on (A + diag(gamma_j A_jj)),
 // lambda_j <- clamp(lambda_j + ((b_j - (A lambda)_j) / A_jj - gamma_j lambda_j) / (1 + gamma_j)),
 // which is Box2D v3's soft update with mass scale 1 / (1 + gamma) and impulse scale
-// gamma / (1 + gamma) (soft_step.h). With gamma_j = 0 it is Eq. 7.1.1.
+// gamma / (1 + gamma) (push/soft_step.cpp). With gamma_j = 0 it is Eq. 7.1.1.
 template <bool kCoupled>
 void soft_sweeps(MatrixFreeSystem& s, const std::vector<double>& softness, bool jacobi,
                  int iterations, std::vector<double>& lambda) {

@@ -12,6 +12,14 @@
 #include <type_traits>
 
 namespace cps {
+
+// The push methods, one file each in engine/src/push/ (push_method.h).
+std::unique_ptr<PushMethod> make_baumgarte();
+std::unique_ptr<PushMethod> make_single_frame_push();
+std::unique_ptr<PushMethod> make_split_impulse();
+std::unique_ptr<PushMethod> make_soft_step();
+std::unique_ptr<PushMethod> make_ngs();
+
 namespace {
 
 template <auto Member>
@@ -38,11 +46,16 @@ void set_member(WorldDef& d, const ParameterValue& v) {
 }
 
 constexpr std::array kPushChoices = {
-    Choice{"baumgarte", static_cast<int>(PushMode::baumgarte), "Sec. 5.3", "push factor"},
-    Choice{"split", static_cast<int>(PushMode::split), "Sec. 8.1", "single frame push factor"},
-    Choice{"split-impulse", static_cast<int>(PushMode::split_impulse), "Bullet", "split impulse"},
-    Choice{"soft", static_cast<int>(PushMode::soft), "Box2D v3", "soft step"},
-    Choice{"ngs", static_cast<int>(PushMode::ngs), "Box2D v2.4", "non-linear Gauss-Seidel"},
+    Choice{"baumgarte", static_cast<int>(PushMode::baumgarte), "Sec. 5.3", "push factor",
+           /*in_paper=*/true, &make_baumgarte},
+    Choice{"split", static_cast<int>(PushMode::split), "Sec. 8.1", "single frame push factor",
+           /*in_paper=*/true, &make_single_frame_push},
+    Choice{"split-impulse", static_cast<int>(PushMode::split_impulse), "Bullet", "split impulse",
+           /*in_paper=*/false, &make_split_impulse},
+    Choice{"soft", static_cast<int>(PushMode::soft), "Box2D v3", "soft step",
+           /*in_paper=*/false, &make_soft_step},
+    Choice{"ngs", static_cast<int>(PushMode::ngs), "Box2D v2.4", "non-linear Gauss-Seidel",
+           /*in_paper=*/false, &make_ngs},
 };
 constexpr std::array kSolverChoices = {
     Choice{"pgs", static_cast<int>(SolverKind::pgs), "Sec. 7.2", "projected Gauss-Seidel"},
@@ -338,23 +351,17 @@ const std::array kParameters = {
               .set = &set_member<&WorldDef::measure_residual>},
 };
 
-std::string number_text(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.17g", v);
-  // The shortest text that reads back as v, up to 17 digits (0.2 rather than 0.2000...01).
-  for (int digits = 1; digits < 17; ++digits) {
-    char shorter[40];
-    std::snprintf(shorter, sizeof shorter, "%.*g", digits, v);
-    if (std::strtod(shorter, nullptr) == v) return shorter;
-  }
-  return text;
-}
-
 std::string unit_suffix(const Parameter& p) {
   return p.unit.empty() ? std::string() : " (" + std::string(p.unit) + ")";
 }
 
 }  // namespace
+
+std::string shortest_decimal(double v) {
+  char text[40];
+  const auto [end, ec] = std::to_chars(text, text + sizeof text, v);
+  return ec == std::errc() ? std::string(text, end) : std::string("nan");
+}
 
 std::optional<double> parse_decimal(std::string_view text, bool allow_fraction) {
   const auto whole = [](std::string_view t) -> std::optional<double> {
@@ -376,20 +383,20 @@ std::string Parameter::allowed() const {
     case ParameterType::real: {
       std::string s = "finite and ";
       if (max == kInfinity) {
-        s += (min_exclusive ? "> " : ">= ") + number_text(min);
+        s += (min_exclusive ? "> " : ">= ") + shortest_decimal(min);
       } else {
-        s = std::string(min_exclusive ? "in (" : "in [") + number_text(min) + ", " +
-            number_text(max) + "]";
+        s = std::string(min_exclusive ? "in (" : "in [") + shortest_decimal(min) + ", " +
+            shortest_decimal(max) + "]";
       }
       return s + unit_suffix(*this);
     }
     case ParameterType::integer:
-      return "a whole number in [" + number_text(min) + ", " + number_text(max) + "]";
+      return "a whole number in [" + shortest_decimal(min) + ", " + shortest_decimal(max) + "]";
     case ParameterType::boolean:
       return "true or false";
     case ParameterType::vector3:
-      return "three numbers x,y,z, each in [" + number_text(min) + ", " + number_text(max) + "]" +
-             unit_suffix(*this);
+      return "three numbers x,y,z, each in [" + shortest_decimal(min) + ", " +
+             shortest_decimal(max) + "]" + unit_suffix(*this);
     case ParameterType::choice: {
       std::string s = "one of: ";
       for (std::size_t i = 0; i < choices.size(); ++i) {
@@ -505,11 +512,11 @@ std::string Parameter::format(const ParameterValue& v) const {
       if (c.value == std::get<int>(v)) return std::string(c.name);
     }
   }
-  if (std::holds_alternative<double>(v)) return number_text(std::get<double>(v));
+  if (std::holds_alternative<double>(v)) return shortest_decimal(std::get<double>(v));
   if (std::holds_alternative<int>(v)) return std::to_string(std::get<int>(v));
   if (std::holds_alternative<bool>(v)) return std::get<bool>(v) ? "true" : "false";
   const Vec3& x = std::get<Vec3>(v);
-  return number_text(x.x()) + "," + number_text(x.y()) + "," + number_text(x.z());
+  return shortest_decimal(x.x()) + "," + shortest_decimal(x.y()) + "," + shortest_decimal(x.z());
 }
 
 std::string_view Parameter::choice_name(int value) const {

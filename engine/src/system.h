@@ -25,7 +25,7 @@ using SparseRowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 /// and the first solve of Sec. 8.1), bias only (the second solve of Sec. 8.1, v without the
 /// constraint-correcting push factor), or the push alone with the bodies taken at rest and no
 /// external force, b = push / dt (the pseudo-velocity solve of the split impulse,
-/// split_impulse.h).
+/// push/split_impulse.cpp).
 enum class TargetTerms : int { push_and_bias, bias_only, push_from_rest };
 
 /// The target velocity v_j (m/s) of a row in a solve of these terms: push + bias, bias, or push.

@@ -31,7 +31,7 @@ inline constexpr int kWorldBody = -1;
 ///   limit mu lambda_n); -1 otherwise.
 /// - mu: for a friction row, the friction coefficient (dimensionless).
 /// - restitution: for a contact row that bounces (Eq. 8.2.1), its target -eps j . v1 (m/s), also
-///   in bias; 0 otherwise. The soft step (soft_step.h) recomputes every target each substep and
+///   in bias; 0 otherwise. The soft step (engine/src/push/soft_step.cpp) recomputes every target each substep and
 ///   applies this one at the end of the step, as Box2D v3 does.
 /// body_a or body_b may be kWorldBody (a fixed world point): that half of j then acts on nothing.
 struct ConstraintRow {
@@ -72,7 +72,7 @@ struct RowParams {
   double restitution_threshold = 1.0;
   double penetration_slop = 0.0;  ///< m, >= 0: depth the push leaves (WorldDef::penetration_slop)
   /// m: contacts no deeper than this keep their push in the velocity solve (it is moved into
-  /// bias). The split impulse (split_impulse.h) sets it to WorldDef::split_impulse_threshold;
+  /// bias). The split impulse (engine/src/push/split_impulse.cpp) sets it to WorldDef::split_impulse_threshold;
   /// -inf (the default) moves nothing.
   double velocity_push_depth = -kInfinity;
 };

@@ -8,6 +8,7 @@
 
 #include "cps/math.h"
 
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -16,16 +17,19 @@
 
 namespace cps {
 
-/// How violated constraints are corrected.
+class PushMethod;  // internal to the engine: engine/src/push/push_method.h
+
+/// How violated constraints are corrected; each is one file in engine/src/push/, made through
+/// its entry in the push parameter's table (Choice::make_push_method).
 enum class PushMode {
   baumgarte,  ///< the push factor stays in the velocity (Eq. 5.2.3, 5.3.1): one solve a step
   split,      ///< the single frame push factor (Sec. 8.1): positions move with f_cv, the stored
               ///< momenta with f_c0 from a second solve without the push
-  split_impulse,  ///< Bullet's split impulse (engine/src/split_impulse.h): the push solved on
+  split_impulse,  ///< Bullet's split impulse (engine/src/push/split_impulse.cpp): the push solved on
                   ///< pseudo-velocities from rest, added to the positions' motion only
-  soft,       ///< Box2D v3's soft step (engine/src/soft_step.h): substeps, soft rows with a
+  soft,       ///< Box2D v3's soft step (engine/src/push/soft_step.cpp): substeps, soft rows with a
               ///< stiffness (Hz) and damping ratio, then a relax solve without the push
-  ngs,        ///< non-linear Gauss-Seidel (engine/src/ngs.h): a velocity solve without the push,
+  ngs,        ///< non-linear Gauss-Seidel (engine/src/push/ngs.cpp): a velocity solve without the push,
               ///< then positions moved directly to reduce the overlaps and rod errors
 };
 
@@ -65,7 +69,7 @@ struct WorldDef {
   double friction = 0.5;                 ///< friction coefficient mu (dimensionless) >= 0; 0.5
   double restitution = 0.0;              ///< coefficient of restitution eps in [0, 1]; 0
   double restitution_threshold = 1.0;    ///< approach speed (m/s) >= 0 below which no bounce; 1
-  PushMode push = PushMode::baumgarte;   ///< Sec. 5 (baumgarte) or Sec. 8.1 (split)
+  PushMode push = PushMode::baumgarte;   ///< Sec. 5.3 (baumgarte), Sec. 8.1 (split) or another
   SolverKind solver = SolverKind::pgs;   ///< Sec. 7.2 PGS, or Jacobi
   FrictionModel friction_model = FrictionModel::fixed;  ///< Sec. 5.4 fixed, or coupled
   RotationUpdate rotation = RotationUpdate::linear;     ///< Eq. 3.2.4, or Eq. 12.4.1
@@ -88,7 +92,7 @@ struct WorldDef {
   /// impulse is not carried over) when its contact (same body pair and contact feature) or rod
   /// persists, and from 0 when it is new (engine/src/warm_start.h). 0 (the default) is the
   /// paper's initial guess 0 everywhere. Typical 0.8; 1 can feed energy into stiff piles and
-  /// chains (README, "Warm starting").
+  /// chains (docs/findings.md, "Warm starting").
   double warm_start = 0.0;
   /// Split impulse (push split-impulse) only: contacts no deeper than this (m, >= 0) keep their
   /// push in the velocity solve, as Baumgarte; deeper ones are pushed out on pseudo-velocities.
@@ -148,6 +152,11 @@ struct Choice {
   /// The paper's name for it (or the field's, where the paper has none), for labels:
   /// "single frame push factor"; may be empty.
   std::string_view title{};
+  /// Defined in the paper (Tamis & Maggiore 2015); false for the methods it is compared with.
+  bool in_paper = false;
+  /// Push choices only: makes the method (engine/src/push/, internal to the engine); nullptr for
+  /// the other parameters' choices.
+  std::unique_ptr<PushMethod> (*make_push_method)() = nullptr;
 };
 
 /// A parameter's value: double (real), int (integer, and choice: the enum's value), bool
@@ -197,6 +206,10 @@ struct Parameter {
 /// allow_fraction, also "a/b" for two such numbers with b != 0 (a time step as 1/60).
 /// std::nullopt for anything else. Every numeric option of the command line is read by it.
 std::optional<double> parse_decimal(std::string_view text, bool allow_fraction = false);
+
+/// The shortest decimal text that reads back as exactly v ("0.2", "30", "1e-06", "1e+06"):
+/// std::to_chars' shortest round-trip form; "inf", "-inf" or "nan" for those. No errors.
+std::string shortest_decimal(double v);
 
 /// The table: every WorldDef member once, in WorldDef's order.
 std::span<const Parameter> world_parameters();

@@ -1,6 +1,6 @@
 #pragma once
 // The world and its step. One step reads as the paper's stages, in order, each a function of
-// World (engine/src/world.cpp):
+// World (engine/src/world.cpp) over the step context (engine/src/step_context.h):
 //   external_forces   Sec. 6.1  f_ext = [m g, 0] per movable body
 //   collide           Sec. 4    each box's and plane's rotation, the broad phase's candidate
 //                               pairs (broad_phase.h), a manifold for each pair that touches
@@ -8,16 +8,12 @@
 //   build_rows        Sec. 5    contact, friction (only with mu > 0) and distance rows; with
 //                               warm starting, each row's initial guess (Sec. 6.2.3)
 //   prepare           Sec. 6    J, M^-1 and A (explicit), or the packed rows (matrix-free)
-//   solve             Sec. 7    lambda by PGS or Jacobi, f_cv = f_ext + J^T lambda (Eq. 6.2.1)
-//   solve again       Sec. 8.1  with the single frame push factor: the push left out of v,
-//                               f_c0 = f_ext + J^T lambda_0
-//   integrate         Sec. 3.2  semi-implicit Euler: positions with f_cv, stored momenta with
-//                               f_c0 (split) or f_cv (baumgarte)
-// The push methods beyond the paper's replace the two last stages, each in its own file:
-// split-impulse (split_impulse.h: a velocity solve without the push, then the push solved on
-// pseudo-velocities that move the positions only), soft (soft_step.h: substeps, each a soft
-// solve that moves the positions and a relax solve that sets the momenta) and ngs (ngs.h: a
-// velocity solve without the push, the integration, then the positions projected).
+//   push method       Secs. 7, 8.1, 3.2: the solves of A lambda = b and the integration, as the
+//                               chosen method (WorldDef::push) does them, one file each in
+//                               engine/src/push/: baumgarte (Sec. 5.3: one solve, f_cv moves
+//                               positions and momenta), split (Sec. 8.1: a second solve without
+//                               the push sets the momenta), and the methods compared with the
+//                               paper's: split-impulse, soft, ngs.
 
 #include "cps/body.h"
 #include "cps/collision.h"
@@ -35,15 +31,10 @@
 
 namespace cps {
 
-// Internal to the engine (engine/src): the broad phase, the solve, the target terms of a solve.
+// Internal to the engine (engine/src): the broad phase, the step context, the push method.
 class BroadPhase;
-class ConstraintSolver;
-class WarmStartCache;
-class SplitImpulse;
-class SoftStep;
-class NgsProjection;
-struct SolveSettings;
-enum class TargetTerms : int;
+struct StepContext;
+class PushMethod;
 
 /// The most candidate pairs the broad phase may list in one step (count). A pair costs 8 bytes;
 /// the largest scaled scenes list about 10 per body. Beyond it World::step throws.
@@ -110,16 +101,16 @@ class World {
   const Body& body(int i) const { return bodies_.at(static_cast<std::size_t>(i)); }
   const std::vector<DistanceConstraint>& distances() const { return distances_; }
   /// Simulated time (s): steps taken times dt.
-  double time() const { return static_cast<double>(counters_.steps) * def_.dt; }
-  const StepCounters& counters() const { return counters_; }
-  const ResidualStats& residual() const { return residual_; }
+  double time() const { return static_cast<double>(counters().steps) * def_.dt; }
+  const StepCounters& counters() const;
+  const ResidualStats& residual() const;
   /// Manifolds found by the last step's collision stage (normals from a to b, depths in m).
-  const std::vector<Manifold>& manifolds() const { return manifolds_; }
+  const std::vector<Manifold>& manifolds() const;
   /// Rows built by the last step (c of them) and lambda of its first solve (c, N).
-  const std::vector<ConstraintRow>& rows() const { return rows_; }
-  const std::vector<double>& lambda() const { return lambda_; }
+  const std::vector<ConstraintRow>& rows() const;
+  const std::vector<double>& lambda() const;
   /// lambda of the last step's second solve (c, N; Sec. 8.1, push split only; empty otherwise).
-  const std::vector<double>& lambda_second() const { return lambda0_; }
+  const std::vector<double>& lambda_second() const;
   /// With warm starting on (WorldDef::warm_start > 0): the contact points of the last step that
   /// persisted from the step before it (same body pair and contact feature), whose rows started
   /// from the cached lambdas (count). 0 with warm starting off.
@@ -133,53 +124,24 @@ class World {
   void external_forces();
   void collide();
   void build_rows();
-  void prepare();
-  void solve(TargetTerms terms, std::vector<double>& lambda, Eigen::VectorXd& f,
-             const std::vector<double>* initial);
-  void solve_with(const SolveSettings& settings, TargetTerms terms, std::vector<double>& lambda,
-                  Eigen::VectorXd& f, const std::vector<double>* initial);
-  SolveSettings settings(double dt) const;
-  void integrate();
-  // The push methods beyond the paper's, each in its own file (engine/src/split_impulse.h,
-  // soft_step.h, ngs.h): they replace the solve and integrate stages.
-  void step_split_impulse(bool warm);
-  void step_soft(bool warm);
-  void step_ngs(bool warm);
-  void count_residual(double max, double sum_squares, std::int64_t rows);
 
   WorldDef def_;
   std::vector<Body> bodies_;
   std::vector<DistanceConstraint> distances_;
-  std::vector<Manifold> manifolds_;
-  std::vector<ConstraintRow> rows_;
-  std::vector<double> lambda_;
-  std::vector<double> lambda0_;
-  // Buffers reused from step to step (nothing is allocated once they are big enough): external
-  // and total forces per body (6n: f_ext, f_cv, f_c0), rotation matrices per body, candidate
-  // pairs, body velocities for the rows and which of them are computed.
-  Eigen::VectorXd f_ext_;
-  Eigen::VectorXd f_cv_;
-  Eigen::VectorXd f_c0_;
+  // What the stages share and keep (step_context.h): manifolds, rows, lambdas, forces, the
+  // solver, the warm-start cache, the counters.
+  std::unique_ptr<StepContext> ctx_;
+  // The method of def_.push (made when first needed, again when def_.push changes).
+  std::unique_ptr<PushMethod> push_;
+  PushMode push_mode_ = PushMode::baumgarte;
+  // The collide and build stages' buffers, reused from step to step (nothing is allocated once
+  // they are big enough): rotation matrices per body, candidate pairs, body velocities for the
+  // rows and which of them are computed.
+  std::unique_ptr<BroadPhase> broad_phase_;
   std::vector<Mat3> rotations_;
   std::vector<std::pair<int, int>> pairs_;
   std::vector<BodyVelocity> velocities_;
   std::vector<unsigned char> velocity_known_;
-  std::unique_ptr<BroadPhase> broad_phase_;
-  std::unique_ptr<ConstraintSolver> solver_;  // made for def_.assembly when first needed
-  // Warm starting (Sec. 6.2.3): the last step's contacts and lambdas (made when first needed),
-  // and this step's initial guesses of the two solves (c each, N).
-  std::unique_ptr<WarmStartCache> warm_start_;
-  std::vector<double> initial_;
-  std::vector<double> initial_second_;
-  // The push methods' per-step state (made when first needed; nothing in them outlives a step).
-  std::unique_ptr<SplitImpulse> split_impulse_;
-  std::unique_ptr<SoftStep> soft_;
-  std::unique_ptr<NgsProjection> ngs_;
-  Eigen::VectorXd zero_force_;  // 6n zeros: the soft step's positions-only integration
-  std::vector<double> relax_start_;  // the soft step's last relaxed lambda (c, N)
-  Assembly solver_assembly_ = Assembly::matrix_free;
-  StepCounters counters_;
-  ResidualStats residual_;
 };
 
 }  // namespace cps

@@ -1,4 +1,3 @@
-#pragma once
 // Split impulse: `--push split-impulse`. Source: Bullet Physics, btSequentialImpulseConstraintSolver
 // with btContactSolverInfo::m_splitImpulse (resolveSplitPenetrationImpulse, and the position
 // update of writeBackBodies with m_pushVelocity and m_turnVelocity); E. Coumans, "Bullet 2.x
@@ -40,11 +39,10 @@
 //   pseudo-velocity solve starts from 0, as Bullet's), and both assemblies (explicit and
 //   matrix-free, for both solves).
 
-#include "constraint_solver.h"
+#include "push_method.h"
 
-#include "cps/body.h"
-#include "cps/constraint.h"
-#include "cps/parameters.h"
+#include "../buffers.h"
+#include "../constraint_solver.h"
 
 #include <Eigen/Core>
 
@@ -52,30 +50,75 @@
 #include <vector>
 
 namespace cps {
+namespace {
 
-/// The pseudo-velocity solve of the split impulse, with its own rows and solver (buffers kept
-/// from step to step: no allocation once they have their working size).
-class SplitImpulse {
+class SplitImpulse final : public PushMethod {
  public:
-  /// Solves the pseudo-velocities of the rows that carry a push (contact rows with push > 0, and
-  /// every rod row) with `settings` (its dt the step's, its softness ignored) from rest, and sets
-  /// f_position = f_momentum + J_p^T lambda_p (6n: force and torque per body, N and N m): the
-  /// force that moves the positions this step. rows: the step's rows (c); bodies (n) as before
-  /// the integration; f_momentum: f_c0 of the velocity solve (6n). No errors.
-  void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-             Assembly assembly, const SolveSettings& settings, const Eigen::VectorXd& f_momentum,
-             Eigen::VectorXd& f_position);
+  // Shallow contacts (depth <= split_impulse_threshold, m) keep their push in the velocity solve.
+  void adjust_rows(const WorldDef& def, RowParams& params) const override {
+    params.velocity_push_depth = def.split_impulse_threshold;
+  }
 
-  /// The pseudo-velocity rows of the last solve (c_p) and their lambda (c_p, N).
-  const std::vector<ConstraintRow>& rows() const { return rows_; }
-  const std::vector<double>& lambda() const { return lambda_; }
+  // 1. the velocity solve without the push sets f_c0 (the momenta); 2. the push on
+  // pseudo-velocities from rest adds J_p^T lambda_p to the force that moves the positions.
+  void step(StepContext& ctx) override {
+    ctx.lambda_second.clear();
+    ctx.solve(TargetTerms::bias_only, ctx.lambda, ctx.f_c0, ctx.warm_guess());
+    ctx.store_warm_start();
+    if (!ctx.rows.empty()) {
+      solve_pseudo_velocities(ctx.rows, *ctx.bodies, ctx.def->assembly, ctx.settings(ctx.def->dt),
+                              ctx.f_c0, ctx.f_cv);
+      ++ctx.counters.solves;
+    } else {
+      ctx.f_cv = ctx.f_c0;
+    }
+    ctx.integrate(ctx.f_cv, ctx.f_c0, ctx.def->dt);
+  }
 
  private:
-  std::vector<ConstraintRow> rows_;
-  std::vector<double> lambda_;
-  Eigen::VectorXd zero_force_;  // 6n zeros: no external force on the pseudo-velocities
+  // Solves the pseudo-velocities of the rows that carry a push (contact rows with push > 0, and
+  // every rod row) with `settings` (its softness ignored) from rest, and sets
+  // f_position = f_momentum + J_p^T lambda_p (6n). rows: the step's (c); bodies (n) as before the
+  // integration; f_momentum: f_c0 of the velocity solve (6n).
+  void solve_pseudo_velocities(const std::vector<ConstraintRow>& rows,
+                               const std::vector<Body>& bodies, Assembly assembly,
+                               const SolveSettings& settings, const Eigen::VectorXd& f_momentum,
+                               Eigen::VectorXd& f_position) {
+    rows_.clear();
+    detail::reserve_with_headroom(rows_, rows.size());
+    for (const ConstraintRow& r : rows) {
+      if ((r.kind == RowKind::contact && r.push > 0.0) || r.kind == RowKind::distance) {
+        rows_.push_back(r);
+        rows_.back().normal_row = -1;  // no friction rows here
+      }
+    }
+    if (rows_.empty()) {
+      lambda_.clear();
+      f_position = f_momentum;
+      return;
+    }
+    if (!solver_ || assembly_ != assembly) {
+      solver_ = make_constraint_solver(assembly);
+      assembly_ = assembly;
+    }
+    zero_force_.setZero(f_momentum.size());  // no allocation once it has the size
+    solver_->prepare(rows_, bodies);
+    SolveSettings pseudo = settings;
+    pseudo.softness = nullptr;
+    solver_->solve(rows_, bodies, zero_force_, TargetTerms::push_from_rest, pseudo, lambda_,
+                   nullptr);
+    add_constraint_forces(rows_, lambda_, f_momentum, f_position);  // + J_p^T lambda_p
+  }
+
+  std::vector<ConstraintRow> rows_;  // c_p pseudo-velocity rows
+  std::vector<double> lambda_;       // c_p, N
+  Eigen::VectorXd zero_force_;       // 6n zeros: no external force on the pseudo-velocities
   std::unique_ptr<ConstraintSolver> solver_;
   Assembly assembly_ = Assembly::matrix_free;
 };
+
+}  // namespace
+
+std::unique_ptr<PushMethod> make_split_impulse() { return std::make_unique<SplitImpulse>(); }
 
 }  // namespace cps

@@ -1,0 +1,63 @@
+#pragma once
+// A push method: how a step corrects the constraint error (overlaps, rod stretch) and sets the
+// stored momenta. It is the solve and integrate stages of World::step (world.h), after the rows
+// are built and prepared; each method is one file in this folder with its derivation and
+// sources on top, made through its entry in the push parameter's table (parameters.cpp,
+// Choice::make_push_method).
+
+#include "../step_context.h"
+
+#include "cps/constraint.h"
+#include "cps/parameters.h"
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace cps {
+
+/// One way of correcting the constraint error. An object keeps its own buffers from step to step
+/// (nothing of a step's physics outlives it except through the warm-start cache).
+class PushMethod {
+ public:
+  virtual ~PushMethod() = default;
+
+  /// Adjusts how the rows are built for this method (Sec. 5), before the build stage. The paper's
+  /// methods leave `params` as they are. No errors.
+  virtual void adjust_rows(const WorldDef& def, RowParams& params) const {
+    (void)def;
+    (void)params;
+  }
+
+  /// The solve and integrate stages: solves with ctx's rows and prepared solver, leaves the
+  /// step's lambda (and lambda_second, or clears it) in ctx, stores the warm start, and moves the
+  /// bodies over ctx.def->dt. No errors.
+  virtual void step(StepContext& ctx) = 0;
+};
+
+/// The contact points of `manifolds` (count).
+inline std::size_t contact_point_count(const std::vector<Manifold>& manifolds) {
+  std::size_t n = 0;
+  for (const Manifold& m : manifolds) n += static_cast<std::size_t>(m.count);
+  return n;
+}
+
+/// Calls visit(m, c, a, b, Ra_t, Rb_t) for every contact point c of every manifold m, in the
+/// order of the contact rows (World::build_rows), with its bodies a and b and the transposes of
+/// their rotation matrices (world to body frame), for methods that follow a contact point in
+/// the frames of its bodies through the step. No errors.
+template <class Visit>
+void for_each_contact_point(const std::vector<Manifold>& manifolds, const std::vector<Body>& bodies,
+                            Visit&& visit) {
+  for (const Manifold& m : manifolds) {
+    const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
+    const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
+    const Mat3 Ra_t = a.rotation().transpose();
+    const Mat3 Rb_t = b.rotation().transpose();
+    for (int i = 0; i < m.count; ++i) {
+      visit(m, m.contacts[static_cast<std::size_t>(i)], a, b, Ra_t, Rb_t);
+    }
+  }
+}
+
+}  // namespace cps

@@ -1,0 +1,63 @@
+// The step context (see step_context.h).
+#include "step_context.h"
+
+#include "integrator.h"
+
+#include <algorithm>
+
+namespace cps {
+
+StepContext::StepContext(const StepContext& other)
+    : manifolds(other.manifolds),
+      rows(other.rows),
+      lambda(other.lambda),
+      lambda_second(other.lambda_second),
+      warm_start(other.warm_start ? std::make_unique<WarmStartCache>(*other.warm_start) : nullptr),
+      counters(other.counters),
+      residual(other.residual) {}
+
+StepContext::~StepContext() = default;
+
+SolveSettings StepContext::settings(double dt) const {
+  return SolveSettings{dt, def->iterations, def->solver, def->friction_model};
+}
+
+void StepContext::prepare() {
+  if (rows.empty()) return;
+  if (!solver || solver_assembly != def->assembly) {
+    solver = make_constraint_solver(def->assembly);
+    solver_assembly = def->assembly;
+  }
+  solver->prepare(rows, *bodies);
+}
+
+void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<double>& out,
+                        Eigen::VectorXd& f, const std::vector<double>* start) {
+  if (rows.empty()) {
+    out.clear();
+    f = f_ext;
+    return;
+  }
+  solver->solve(rows, *bodies, f_ext, terms, s, out, start);
+  ++counters.solves;
+  if (def->measure_residual) {
+    double max;
+    double sum_squares;
+    solver->residual(rows, def->friction_model, out, max, sum_squares);
+    residual.max = std::max(residual.max, max);
+    residual.sum_squares += sum_squares;
+    residual.rows += static_cast<std::int64_t>(rows.size());
+  }
+  add_constraint_forces(rows, out, f_ext, f);
+}
+
+void StepContext::store_warm_start() {
+  if (warm()) warm_start->store(manifolds, rows, distances->size(), lambda, lambda_second);
+}
+
+void StepContext::integrate(const Eigen::VectorXd& f_position, const Eigen::VectorXd& f_momentum,
+                            double h) {
+  cps::integrate(*bodies, f_position, f_momentum, h, def->rotation);
+}
+
+}  // namespace cps

@@ -1,0 +1,86 @@
+#pragma once
+// The step context: what the stages of one World::step share (after Box2D v3's b2StepContext,
+// erincatto/box2d src/solver.h): the world's parameters and bodies, the manifolds, rows, lambdas
+// and forces the stages make, the solver of A lambda = b, the warm-start cache and the counters.
+// World owns one; the push method of the step (push/push_method.h) reads and writes it in the
+// solve and integrate stages.
+
+#include "constraint_solver.h"
+#include "system.h"
+#include "warm_start.h"
+
+#include "cps/body.h"
+#include "cps/collision.h"
+#include "cps/constraint.h"
+#include "cps/parameters.h"
+#include "cps/world.h"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+namespace cps {
+
+/// What one step's stages share. n bodies, c rows. Forces are 6n vectors: force and torque per
+/// body (N, N m). Buffers keep their storage from step to step (no allocation once grown).
+struct StepContext {
+  StepContext() = default;
+  /// Copies the last step's results (manifolds, rows, both lambdas), the warm-start cache and
+  /// the counters; the buffers and the solver start empty (nothing in them outlives a step).
+  StepContext(const StepContext& other);
+  StepContext& operator=(const StepContext&) = delete;
+  StepContext(StepContext&&) noexcept = default;
+  StepContext& operator=(StepContext&&) noexcept = default;
+  ~StepContext();
+
+  // Set by World::step before the first stage.
+  const WorldDef* def = nullptr;
+  std::vector<Body>* bodies = nullptr;
+  const std::vector<DistanceConstraint>* distances = nullptr;
+
+  std::vector<Manifold> manifolds;    ///< Sec. 4: the manifolds of this step's collide stage
+  std::vector<ConstraintRow> rows;    ///< Sec. 5: c rows: contacts, friction, rods
+  std::vector<double> lambda;         ///< c, N: the solve that sets the step's result
+  std::vector<double> lambda_second;  ///< c, N: the second solve of Sec. 8.1 (split only)
+  Eigen::VectorXd f_ext;              ///< 6n: f_ext = [m g, 0] per movable body (Sec. 6.1)
+  Eigen::VectorXd f_cv;               ///< 6n: f_ext + J^T lambda, the force that moves positions
+  Eigen::VectorXd f_c0;               ///< 6n: the force of the stored momenta (Sec. 8.1)
+  std::unique_ptr<ConstraintSolver> solver;  ///< for def->assembly, made by prepare()
+  Assembly solver_assembly = Assembly::matrix_free;
+  /// Warm starting (Sec. 6.2.3): the last step's contacts and lambdas (made when first needed),
+  /// and this step's initial guesses of the two solves (c each, N).
+  std::unique_ptr<WarmStartCache> warm_start;
+  std::vector<double> initial;
+  std::vector<double> initial_second;
+  StepCounters counters;
+  ResidualStats residual;
+
+  /// Warm starting is on (WorldDef::warm_start > 0).
+  bool warm() const { return def->warm_start > 0.0; }
+  /// The first solve's initial guess: the warm start's (c, N), or nullptr for lambda = 0.
+  const std::vector<double>* warm_guess() const { return warm() ? &initial : nullptr; }
+  /// The settings of a solve over dt (s): def's sweeps, solver and friction model, rigid rows.
+  SolveSettings settings(double dt) const;
+
+  /// Builds what the step's solves share (Sec. 6: A, or the packed rows), with a new solver when
+  /// def->assembly changed. Nothing without rows.
+  void prepare();
+  /// Solves A lambda = b (Sec. 7) with settings `s` for the `terms` of the targets from `start`
+  /// (c, N; nullptr: from 0) into `out` (c, N), then f = f_ext + J^T out (Eq. 6.2.1, 6n),
+  /// counting the solve and, with def->measure_residual, its residual. Without rows: out empty,
+  /// f = f_ext. No errors.
+  void solve(const SolveSettings& s, TargetTerms terms, std::vector<double>& out,
+             Eigen::VectorXd& f, const std::vector<double>* start);
+  /// solve() over the whole step (dt).
+  void solve(TargetTerms terms, std::vector<double>& out, Eigen::VectorXd& f,
+             const std::vector<double>* start) {
+    solve(settings(def->dt), terms, out, f, start);
+  }
+  /// With warm starting on, stores this step's lambda and lambda_second for the next step.
+  void store_warm_start();
+  /// Sec. 3.2 over h (s): positions with f_position, stored momenta with f_momentum (6n each).
+  void integrate(const Eigen::VectorXd& f_position, const Eigen::VectorXd& f_momentum, double h);
+};
+
+}  // namespace cps

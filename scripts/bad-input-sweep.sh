@@ -54,15 +54,6 @@ declare -A KIND=(
   ['*:--overlay']=flag ['*:--compare']=compare
   ['*:--seconds']=seconds ['*:--fps']=fps ['*:--orbit']=orbit ['*:--speed']=speed
   ['*:--eye']=point ['*:--target']=point ['*:--fov']=fov
-  ['*:--dt']=dt ['*:--iterations']=iterations
-  ['*:--beta']=unit_interval ['*:--restitution']=unit_interval ['*:--warm-start']=unit_interval
-  ['*:--friction']=nonneg_1e6 ['*:--restitution-threshold']=nonneg_1e6
-  ['*:--contact-margin']=nonneg_1e6 ['*:--penetration-slop']=nonneg_1e6
-  ['*:--split-impulse-threshold']=nonneg_1e6 ['*:--contact-hertz']=nonneg_1e6
-  ['*:--contact-damping-ratio']=nonneg_1e6 ['*:--rod-hertz']=nonneg_1e6
-  ['*:--rod-damping-ratio']=nonneg_1e6 ['*:--contact-push-max-speed']=pos_1e6
-  ['*:--max-correction']=pos_1e6 ['*:--soft-substeps']=substeps
-  ['*:--position-iterations']=iterations
   ['*:--size']=size ['*:--times']=times
   ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png ['figure:--format']=choice
   ['*:--trace']=trace ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
@@ -71,6 +62,17 @@ declare -A KIND=(
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
   ['export:scene']=scene_one ['export:--out']=out_glb
 )
+
+# The world parameters' kinds come from the parameter table itself (`cps parameters --format
+# tsv`: flag, type, min, max, min excluded, unit), as param:TYPE:MIN:MAX:EXCL:UNIT; their bad
+# values are made from the range in bad_values below. Choices and flags are classified from --help.
+while IFS=$'\t' read -r flag type min max excl unit; do
+  case $type in real | integer) KIND["*:$flag"]="param:$type:$min:$max:$excl:$unit" ;; esac
+done < <("$CPS" parameters --format tsv)
+if [[ -z ${KIND['*:--dt']:-} ]]; then
+  echo "bad-input-sweep: '$CPS parameters --format tsv' gave no --dt row" >&2
+  exit 3
+fi
 
 # The commands, each with the valid command line an option under test is added to (a short,
 # cheap run: a bad value accepted by mistake costs little). The option under test is removed
@@ -85,6 +87,7 @@ declare -A BASE=(
   [bench]='bench --quick --scene intersecting_stack'
   [scene]='scene stack --out out/s.json'
   [export]='export stack --seconds 0.1 --fps 10 --out out/s.glb'
+  [parameters]='parameters --format tsv'
 )
 RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
 MERGE_SRC=$root/merge-src                              # a complete sweep, made below
@@ -110,16 +113,26 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     point)  # X,Y,Z in m, each finite with |value| <= 1e6
       printf '%s\n' "" 1 1,2 1,2,3,4 , ,, 1,,3 1,2, ,1,2 a,b,c nan,0,0 0,inf,0 0,0,-inf \
         1e7,0,0 0,-1000001,0 0x10,0,0 1/2,0,0 "1;2;3" 1e400,0,0 ;;
-    dt)  # [1e-6, 1] s, a fraction allowed
-      printf '%s\n' "$NUM_COMMON" -1 0 1e-7 1e-320 5e-324 1e-400 2 1/0 0/1 1/-60 -1/60 1/60x \
-        1//60 /60 1/ 1/inf nan/1 1/1e-7 ;;
-    unit_interval) printf '%s\n' "$NUM_COMMON" -1 -1e-9 1.5 1/2 ;;     # [0, 1]
-    nonneg_1e6) printf '%s\n' "$NUM_COMMON" -1 -1e-9 1000001 1/2 ;;    # [0, 1e6]
-    pos_1e6) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 1000001 1/2 ;;  # (0, 1e6]
-    substeps) printf '%s\n' "$NUM_COMMON" -1 0 1001 1.5 1/2 2147483648 ;;  # whole, [1, 1000]
-    iterations)  # whole numbers in [1, 1e4]
-      printf '%s\n' "$NUM_COMMON" -1 0 10001 1.5 25.0 1e3 1/2 1e-320 5e-324 2147483648 \
-        99999999999999999999 ;;
+    param:*)  # a world parameter: param:TYPE:MIN:MAX:EXCL:UNIT from the parameter table
+      local type lo hi excl unit
+      IFS=: read -r _ type lo hi excl unit <<< "$kind"
+      printf '%s\n' "$NUM_COMMON" -1
+      # Just outside each end: below min (min itself when it is excluded), above max.
+      awk -v lo="$lo" -v hi="$hi" -v excl="$excl" 'BEGIN {
+        if (excl == 1) { print lo; print "-0"; print "1e-400" }
+        else if (lo == 0) print "-1e-9"
+        else printf "%.17g\n", lo - (lo < 0 ? -lo : lo) / 10
+        if (hi != "inf") { printf "%.17g\n", hi + 1; printf "%.17g\n", hi * 2 }
+      }'
+      case $type in
+        integer) printf '%s\n' 1.5 "$lo.0" 1e3 1/2 1e-320 5e-324 2147483648 99999999999999999999 ;;
+        real)
+          if [[ $unit == s ]]; then  # a time: a fraction is allowed, a bad one is refused
+            printf '%s\n' 1e-320 5e-324 1/0 0/1 1/-60 -1/60 1/60x 1//60 /60 1/ 1/inf nan/1 1/1e-7
+          else
+            printf '%s\n' 1/2
+          fi ;;
+      esac ;;
     choice)  # the choices from --help
       printf '%s\n' "" nosuch "${1^^}" "$1 " " $1" "$1,$1" 1 ;;
     size)  # WxH, each in [16, 8192]

@@ -1,7 +1,7 @@
 // --compare and --overlay, in-process: which parameter, which values, the labels, the errors,
 // the grid, the output names (demos/cps/compare.h).
-#include "compare.h"
-#include "options.h"
+#include "options/compare.h"
+#include "options/options.h"
 
 #include <catch2/catch.hpp>
 

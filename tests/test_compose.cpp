@@ -1,7 +1,7 @@
 // The caption page of figures and frames (demos/cps/compose.h), in-process: a frame laid out by
 // fit_panels is exactly the size asked, its panels and caption strips lie inside it without
 // overlapping, and the panels are as large as the text allows.
-#include "compose.h"
+#include "pictures/compose.h"
 
 #include <catch2/catch.hpp>
 

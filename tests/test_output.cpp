@@ -1,8 +1,8 @@
 // The output rule of the cps command (demos/cps/output.h), checked in-process: atomic writes that
 // fail cleanly on a full disk and never open a file they did not create, which targets a run may
 // replace, run.json of exclusive and shared folders, and the leftovers of interrupted runs.
-#include "options.h"
-#include "output.h"
+#include "options/options.h"
+#include "output/output.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

@@ -1,8 +1,8 @@
 // The views of `cps render` and `cps figure` (demos/cps/draw.h): --camera fit keeps every body
 // in the picture over the whole run, the planes keep one extent for the whole run, --eye,
 // --target and --fov replace the camera's, and every scene's default view shows its bodies.
-#include "draw.h"
-#include "options.h"
+#include "pictures/draw.h"
+#include "options/options.h"
 
 #include "cps/render/renderer.h"
 

@@ -1,8 +1,8 @@
 #pragma once
-// The commands of `cps`, one file each (list.cpp, simulate.cpp, report.cpp, bench.cpp, and with
-// the renderer render.cpp and figure.cpp). Each owns its options: its add_* function registers
-// a subcommand on the application with its options and returns how to run it; main.cpp parses
-// the command line and runs the command chosen.
+// The commands of `cps`, one file each in commands/ (list, simulate, scene, parameters, report,
+// bench, and with the renderer render, figure and export). Each owns its options: its add_*
+// function registers a subcommand on the application with its options and returns how to run
+// it; main.cpp parses the command line and runs the command chosen.
 
 #include <functional>
 
@@ -43,6 +43,10 @@ Command add_report(CLI::App& app, int argc, char** argv);
 /// rule: never a foreign file without --force, atomically). argc and argv are recorded in the
 /// folder's run.json.
 Command add_scene(CLI::App& app, int argc, char** argv);
+
+/// `cps parameters`: the world parameter table as Markdown, JSON, the scene schema's world
+/// section or tab-separated rows (--format).
+Command add_parameters(CLI::App& app);
 
 /// `cps bench`: microseconds per physics step, cost growth with body count and, with the
 /// renderer, milliseconds per rendered frame, as Markdown on stdout.

@@ -2,8 +2,8 @@
 // render them to PNG frames and figures. Each command lives in its own file (see command.h);
 // this file assembles them and turns errors into exit codes.
 #include "command.h"
-#include "options.h"
-#include "output.h"
+#include "options/options.h"
+#include "output/output.h"
 
 #include <CLI/CLI.hpp>
 
@@ -25,6 +25,7 @@ int run(int argc, char** argv) {
       cli::add_report(app, argc, argv),
       cli::add_bench(app),
       cli::add_scene(app, argc, argv),
+      cli::add_parameters(app),
 #ifdef CPS_HAVE_RENDERER
       cli::add_render(app, argc, argv),
       cli::add_figure(app, argc, argv),

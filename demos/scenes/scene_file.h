@@ -1,6 +1,6 @@
 #pragma once
 // Scene files: a scene written as JSON (assets/schemas/scene.schema.json is the format's source
-// of truth; README.md, "Scene files", describes it). A file is checked in three passes, each
+// of truth; docs/scene-files.md describes it). A file is checked in three passes, each
 // error naming the file, the JSON pointer of the bad value (/bodies/3/mass_kg), the value and
 // what is allowed:
 //   1. syntax (nlohmann-json, comments allowed): the line and column;
@@ -101,7 +101,7 @@ std::string_view scene_schema_text();
 /// as the world holds them, with the scene's name, description, duration, camera and plane
 /// opacity. Running the file steps exactly as the scene does (the same state_hash) when its
 /// bodies' initial state can be written so that make_body rebuilds the same bits; see
-/// README.md, "Scene files", for the scenes where it cannot.
+/// docs/scene-files.md, "Writing a scene as a file", for the scenes where it cannot.
 nlohmann::json scene_file_json(const Scene& scene, const World& as_built);
 
 /// Measurements that apply to any world, for scene files (keys carry units as suffixes):

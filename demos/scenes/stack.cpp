@@ -1,7 +1,7 @@
 // The stack test, paper Sec. 10.1: five cubes of edge 2.4 m and mass 1.2 kg, centres 3 m apart
 // (0.6 m gaps), the bottom centre 2 m above the ground; g = -10 m/s^2, 60 Hz, 25 iterations,
 // beta = 0.2, no contact caching. The paper reports that the stack topples after about 85 s;
-// ours slides rather than falls (README, "Why the paper's stack drifts"), so its metric is the
+// ours slides rather than falls (docs/findings.md, "Why the paper's stack drifts"), so its metric is the
 // time a cube slides off the column's axis.
 #include "scene.h"
 

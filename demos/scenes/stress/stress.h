@@ -1,5 +1,5 @@
 #pragma once
-// The stress scenes (issue 4, "Stability on stiff and extreme cases"): the functions the scene
+// The stress scenes (stability on stiff and extreme cases): the functions the scene
 // table (stress_table.cpp) lists, and the measurements they share. The scenes probe what the
 // paper's own five do not: large mass ratios, a heavy impact on a pendulum grid, a large time
 // step, fast spin, deep overlap, a long chain, scaled units, degenerate geometry and random
@@ -24,7 +24,7 @@ bool all_finite(const World& world);
 
 /// Energy bookkeeping of a run, fed after every step (and once before the first).
 ///
-/// Derivation of the bound it keeps (NOTES.md, Sec. 3.2 and 6.2.9). Over one step of semi-
+/// Derivation of the bound it keeps (the paper's Sec. 3.2 and Eq. 6.2.9). Over one step of semi-
 /// implicit Euler with momenta advanced by the impulse dt (f + J^T lambda) and positions moved by
 /// the new velocity v2, the energy E = KE + PE changes by exactly
 ///   dE = dt lambda . (J v2) - 1/2 |v2 - v1|^2_M  (+ the rotation term below),

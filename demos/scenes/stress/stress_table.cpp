@@ -1,4 +1,4 @@
-// The stress scenes: stiff and extreme cases (issue 4), listed apart from the paper's scenes.
+// The stress scenes: stiff and extreme cases, listed apart from the paper's scenes.
 // One file per scene or small group in this directory; stress.h declares them. The physics each
 // one probes, and its checks, are in tests/test_stress.cpp.
 #include "scene.h"

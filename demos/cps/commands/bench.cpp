@@ -1,0 +1,463 @@
+// `cps bench`: microseconds per physics step (explicit and matrix-free side by side), the cost
+// of warm starting, the cost growth with body count, and milliseconds per rendered frame.
+#include "command.h"
+#include "options/options.h"
+#include "output/output.h"
+#include "scene.h"
+
+#ifdef CPS_HAVE_RENDERER
+#include "output/atomic_file.h"
+#include "pictures/draw.h"
+#include "commands/render.h"
+
+#include "cps/render/renderer.h"
+#endif
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <time.h>
+#include <unistd.h>
+
+namespace cps::cli {
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// CPU time of the calling thread (s): the physics runs on this one thread, so time the machine
+// gives to other processes (this one is shared) does not count against it, as wall time would.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// Time and work per step of a scene over a window: microseconds (thread CPU time), constraint
+// rows and contact points per step.
+struct StepCost {
+  double us = 0.0;        ///< median repeat's microseconds per step
+  double rows = 0.0;      ///< rows per step in the window (contact, friction, distance)
+  double contacts = 0.0;  ///< contact points per step in the window
+};
+
+// The world is advanced, untimed, to `start_s`; a copy of it is then stepped `steps` times once
+// untimed (the copy's buffers grow to their working size) and `repeats` times timed, each from
+// a fresh copy of the same state, so every repeat times the same window. The median repeat's
+// thread CPU time per step counts. start_s >= 0 (s); steps >= 1; repeats >= 1. warm_start, if
+// set, replaces the scene's warm starting factor (dimensionless, [0, 1]) from the start.
+StepCost step_cost(const scenes::Scene& scene, Assembly assembly, double start_s, int steps,
+                   int repeats, std::optional<double> warm_start = std::nullopt) {
+  scenes::Run run = scenes::make_run(scene);
+  WorldDef def = run.world.def();
+  def.assembly = assembly;
+  if (warm_start) def.warm_start = *warm_start;
+  run.world.set_def(def);
+  while (run.world.time() + 0.5 * def.dt < start_s) run.world.step();
+  StepCost cost;
+  std::vector<double> times;
+  for (int r = 0; r <= repeats; ++r) {
+    World world = run.world;
+    const StepCounters before = world.counters();
+    const double start = thread_cpu_seconds();
+    for (int k = 0; k < steps; ++k) world.step();
+    const double us = 1e6 * (thread_cpu_seconds() - start) / steps;
+    if (r == 0) {  // the untimed warm-up repeat; the window's work is the same in every repeat
+      cost.rows = static_cast<double>(world.counters().rows - before.rows) / steps;
+      cost.contacts = static_cast<double>(world.counters().contacts - before.contacts) / steps;
+      continue;
+    }
+    times.push_back(us);
+  }
+  cost.us = median(times);
+  return cost;
+}
+
+// Steps in a scene's bench window (at least 1); quick: the first third of it.
+int window_steps(const scenes::Scene& scene, bool quick) {
+  const double dt = scene.world_def().dt;
+  const double seconds = quick ? scene.bench.seconds / 3.0 : scene.bench.seconds;
+  return std::max(1, static_cast<int>(std::lround(seconds / dt)));
+}
+
+// Least-squares slope of log(time) against log(bodies).
+double log_log_slope(const std::vector<std::pair<double, double>>& points) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (const auto& [x, y] : points) {
+    sx += std::log(x);
+    sy += std::log(y);
+    sxx += std::log(x) * std::log(x);
+    sxy += std::log(x) * std::log(y);
+  }
+  const double n = static_cast<double>(points.size());
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+#ifdef CPS_HAVE_RENDERER
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The rendering table: per paper scene at 1280x720 over its first second at 30 fps.
+//  - Stages, one at a time on this thread: milliseconds per frame of physics, draw (including
+//    the readback) and PNG encode + atomic write, each the median over the frames.
+//  - "physics + draw": the real loop without the PNG files (advance, draw, drop the image), and
+//    "end to end": the real pipeline (render_frames: physics and drawing on this thread, PNG
+//    encoding on the writer's thread, until the last file is written); each is the total time /
+//    frames of one run, median of `repeats` runs taken in turn (physics + draw, end to end, ...)
+//    so that a change in the machine's load hits both alike.
+// The renderer first draws the scene's first frame once, untimed: llvmpipe compiles its shader
+// variants for a new state on first use (tens of milliseconds), which would otherwise land in
+// whichever measurement came first.
+// Returns one JSON object per scene (the keys name the units); prints the Markdown table when
+// `markdown` is set.
+nlohmann::json render_table(bool quick, bool markdown) {
+  constexpr int k_width = 1280;
+  constexpr int k_height = 720;
+  constexpr double k_fps = 30.0;
+  constexpr double k_seconds = 1.0;
+  constexpr float k_aspect = static_cast<float>(k_width) / k_height;
+  const int repeats = quick ? 1 : 3;
+  if (markdown) {
+    std::printf("\n## Rendering at %dx%d: milliseconds per frame (first %.0f s at %.0f fps; stages "
+              "one at a time: median over the frames; physics + draw (no PNG) and end to end "
+              "(PNG written on a second thread): total / frames, median of %d run%s)\n\n"
+              "| scene | physics | draw | PNG encode + write | PNG KiB | physics + draw | "
+              "end to end | end to end / (physics + draw) |\n|---|---|---|---|---|---|---|---|\n",
+                k_width, k_height, k_seconds, k_fps, repeats, repeats > 1 ? "s" : "");
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  render::Renderer renderer(k_width, k_height);
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("cps_bench_frames_" + std::to_string(getpid()));
+  std::filesystem::create_directories(folder);
+  RenderJob job;
+  job.seconds = k_seconds;
+  job.fps = k_fps;
+  job.folder = folder;
+  const int frames = static_cast<int>(frame_count(job));  // a few dozen
+  for (const scenes::Scene& scene : scenes::paper_scenes()) {
+    std::fprintf(stderr, "bench: rendering %s\n", std::string(scene.name).c_str());
+    {  // Warm-up (untimed).
+      scenes::Run run = scenes::make_run(scene);
+      renderer.draw(draw_list(run.world, resolve_style(scene, run.world, View{}, k_aspect)));
+    }
+    // Stages, one at a time.
+    std::vector<double> physics, draw, encode;
+    double bytes = 0.0;
+    {
+      scenes::Run run = scenes::make_run(scene);
+      const DrawStyle style = resolve_style(scene, run.world, View{}, k_aspect);
+      for (int k = 0; k < frames; ++k) {
+        auto start = Clock::now();
+        run.advance_to(static_cast<double>(k) / k_fps);
+        physics.push_back(1e3 * seconds_since(start));
+        start = Clock::now();
+        const render::Image image = renderer.draw(draw_list(run.world, style));
+        draw.push_back(1e3 * seconds_since(start));
+        start = Clock::now();
+        write_file_atomic(folder / "frame.png", render::encode_png(image));
+        encode.push_back(1e3 * seconds_since(start));
+        bytes += static_cast<double>(std::filesystem::file_size(folder / "frame.png"));
+      }
+    }
+    // The loop without PNG files, then the real pipeline, in turn.
+    std::vector<double> alone, end_to_end;
+    for (int r = 0; r < repeats; ++r) {
+      {
+        scenes::Run run = scenes::make_run(scene);
+        const DrawStyle style = resolve_style(scene, run.world, View{}, k_aspect);
+        const auto start = Clock::now();
+        for (int k = 0; k < frames; ++k) {
+          run.advance_to(static_cast<double>(k) / k_fps);
+          const render::Image image = renderer.draw(draw_list(run.world, style));
+        }
+        alone.push_back(1e3 * seconds_since(start) / frames);
+      }
+      {
+        scenes::Run run = scenes::make_run(scene);
+        std::vector<Panel> panels{{&run, ""}};
+        const DrawStyle style = resolve_style(scene, run.world, View{}, k_aspect);
+        render::PngWriter writer(
+            [](const std::filesystem::path& path, std::span<const std::uint8_t> png) {
+              write_file_atomic(path, png);
+            },
+            1, 3);
+        const auto start = Clock::now();
+        render_frames(style, panels, job, renderer, writer, nullptr);
+        end_to_end.push_back(1e3 * seconds_since(start) / frames);
+      }
+    }
+    const double a = median(alone);
+    const double e = median(end_to_end);
+    rows.push_back({{"scene", scene.name},
+                    {"width_px", k_width},
+                    {"height_px", k_height},
+                    {"frames", frames},
+                    {"physics_ms", median(physics)},
+                    {"draw_ms", median(draw)},
+                    {"png_ms", median(encode)},
+                    {"png_kib", bytes / frames / 1024.0},
+                    {"physics_and_draw_ms", a},
+                    {"end_to_end_ms", e}});
+    if (markdown) {
+      std::printf("| %s | %.1f | %.1f | %.1f | %.0f | %.1f | %.1f | %.2f |\n",
+                  std::string(scene.name).c_str(), median(physics), median(draw), median(encode),
+                  bytes / frames / 1024.0, a, e, e / a);
+      std::fflush(stdout);
+    }
+  }
+  std::filesystem::remove_all(folder);
+  return rows;
+}
+#endif
+
+// The options of `cps bench`.
+struct BenchOptions {
+  bool quick = false;
+  bool rendering = false;  // only the rendering table
+  bool json = false;       // one JSON document on stdout instead of Markdown tables
+  std::vector<std::string> scenes;  // only these scenes, physics table only (empty: every table)
+};
+
+// The physics table's scenes: the paper's, then scaled ones (larger ones unless quick).
+std::vector<std::string> physics_scenes(bool quick) {
+  std::vector<std::string> names;
+  for (const scenes::Scene& s : scenes::paper_scenes()) names.emplace_back(s.name);
+  for (const char* s : {"stack_40", "pyramid_100", "funnel_100", "pendulum_grid_10",
+                        "pendulum_wave_1000"}) {
+    names.emplace_back(s);
+  }
+  if (!quick) {
+    for (const char* s : {"pyramid_1000", "funnel_2000", "pendulum_wave_10000"}) names.emplace_back(s);
+  }
+  return names;
+}
+
+// The physics table: each scene of `names` over its bench window (Scene::bench), explicit and
+// matrix-free.
+nlohmann::json physics_table(const std::vector<std::string>& names, bool quick, bool markdown) {
+  // At least 5 repeats, and enough that the timed steps add up to 3 s of a 60 Hz scene (1 s
+  // quick): a short window (the intersecting stack's 6 steps) is repeated more often.
+  const int timed_steps = quick ? 60 : 180;
+  if (markdown) {
+    std::printf("## Physics: microseconds per step (one thread; its CPU time; median of the "
+                "repeats of the scene's window, each from a copy of the state at its start: at "
+                "least 5 repeats and %d steps)\n\n"
+                "| scene | bodies | window (s) | repeats | contacts/step | rows/step | explicit "
+                "(us/step) | matrix-free (us/step) | speed-up |\n"
+                "|---|---|---|---|---|---|---|---|---|\n",
+                timed_steps);
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  for (const std::string& name : names) {
+    const scenes::Scene& scene = *scenes::find_scene(name);
+    const int steps = window_steps(scene, quick);
+    const double dt = scene.world_def().dt;
+    const double start = scene.bench.start_s;
+    const int repeats = std::max(5, (timed_steps + steps - 1) / steps);
+    std::fprintf(stderr, "bench: %s\n", name.c_str());
+    const StepCost e = step_cost(scene, Assembly::explicit_matrices, start, steps, repeats);
+    const StepCost m = step_cost(scene, Assembly::matrix_free, start, steps, repeats);
+    const std::size_t bodies = scenes::make_run(scene).world.bodies().size();
+    const double end = start + steps * dt;
+    rows.push_back({{"scene", name},
+                    {"bodies", bodies},
+                    {"window_start_s", start},
+                    {"window_end_s", end},
+                    {"window_reason", scene.bench.reason},
+                    {"steps", steps},
+                    {"repeats", repeats},
+                    {"contacts_per_step", m.contacts},
+                    {"rows_per_step", m.rows},
+                    {"explicit_us_per_step", e.us},
+                    {"matrix_free_us_per_step", m.us}});
+    if (markdown) {
+      std::printf("| %s | %zu | %.2f-%.2f | %d | %.1f | %.1f | %.1f | %.1f | %.2fx |\n",
+                  name.c_str(), bodies, start, end, repeats, m.contacts, m.rows, e.us, m.us,
+                  e.us / m.us);
+      std::fflush(stdout);
+    }
+  }
+  if (markdown) {
+    std::printf("\nWindows:\n\n");
+    for (const std::string& name : names) {
+      const std::string_view reason = scenes::find_scene(name)->bench.reason;
+      std::printf("- %s: %.*s\n", name.c_str(), static_cast<int>(reason.size()), reason.data());
+    }
+  }
+  return rows;
+}
+
+// The cost of warm starting (matrix-free, each scene over its bench window from the same state
+// at its start, at the scene's sweeps): cold (factor 0, the paper), the matching alone (factor
+// 1e-100: the contacts are matched, the cache kept and every guess computed, but the guesses are
+// 1e-100 of a lambda, so the run does the physics of the cold run to round-off; 1e-300 would
+// make subnormal numbers, which are slow), and warm started at 0.8 (its own physics: other
+// contacts, other rows).
+nlohmann::json warm_start_table(const std::vector<std::string>& names, bool quick, bool markdown) {
+  const int timed_steps = quick ? 60 : 180;
+  if (markdown) {
+    std::printf("\n## Warm starting: microseconds per step (matrix-free; the scene's window and "
+                "sweeps; cold = factor 0, the paper; matching = factor 1e-100, the same physics "
+                "with the cache kept and every guess computed)\n\n"
+                "| scene | cold (us/step) | matching (us/step) | cost of matching | warm 0.8 "
+                "(us/step) | rows/step cold | rows/step warm 0.8 |\n"
+                "|---|---|---|---|---|---|---|\n");
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  for (const std::string& name : names) {
+    const scenes::Scene& scene = *scenes::find_scene(name);
+    const int steps = window_steps(scene, quick);
+    const int repeats = std::max(5, (timed_steps + steps - 1) / steps);
+    const double start = scene.bench.start_s;
+    std::fprintf(stderr, "bench: %s warm starting\n", name.c_str());
+    const StepCost cold = step_cost(scene, Assembly::matrix_free, start, steps, repeats, 0.0);
+    const StepCost match = step_cost(scene, Assembly::matrix_free, start, steps, repeats, 1e-100);
+    const StepCost warm = step_cost(scene, Assembly::matrix_free, start, steps, repeats, 0.8);
+    const double cost = match.us / cold.us - 1.0;
+    rows.push_back({{"scene", name},
+                    {"cold_us_per_step", cold.us},
+                    {"matching_us_per_step", match.us},
+                    {"matching_cost_fraction", cost},
+                    {"warm_0.8_us_per_step", warm.us},
+                    {"rows_per_step_cold", cold.rows},
+                    {"rows_per_step_warm_0.8", warm.rows}});
+    if (markdown) {
+      std::printf("| %s | %.1f | %.1f | %+.1f %% | %.1f | %.1f | %.1f |\n", name.c_str(), cold.us,
+                  match.us, 100.0 * cost, warm.us, cold.rows, warm.rows);
+      std::fflush(stdout);
+    }
+  }
+  return rows;
+}
+
+// The cost growth table (matrix-free): log-log slopes of time per step against bodies and rows.
+nlohmann::json growth_table(bool quick, bool markdown) {
+  constexpr int k_repeats = 5;
+  if (markdown) {
+    std::printf("\n## Cost growth (matrix-free): log-log slope of time per step against bodies\n\n"
+                "Also against the rows per step: a larger pile has more contacts per body (fewer "
+                "bodies on its edges), so part of the growth is more work per body.\n\n"
+                "| family | bodies: us/step (rows/step) | slope against bodies | slope against rows "
+                "|\n|---|---|---|---|\n");
+  }
+  const std::vector<int> sizes = quick ? std::vector<int>{100, 300, 1000}
+                                       : std::vector<int>{100, 300, 1000, 3000, 5000};
+  nlohmann::json families = nlohmann::json::array();
+  for (const char* family : {"pyramid", "funnel"}) {
+    std::vector<std::pair<double, double>> by_bodies;
+    std::vector<std::pair<double, double>> by_rows;
+    nlohmann::json points = nlohmann::json::array();
+    std::string cells;
+    for (const int n : sizes) {
+      const std::string name = std::string(family) + "_" + std::to_string(n);
+      std::fprintf(stderr, "bench: %s\n", name.c_str());
+      const scenes::Scene& scene = *scenes::find_scene(name);
+      const double bodies = static_cast<double>(scenes::make_run(scene).world.bodies().size());
+      const StepCost cost =
+          step_cost(scene, Assembly::matrix_free, scene.bench.start_s, quick ? 3 : 6, k_repeats);
+      by_bodies.emplace_back(bodies, cost.us);
+      by_rows.emplace_back(std::max(cost.rows, 1.0), cost.us);
+      points.push_back({{"scene", name},
+                        {"bodies", bodies},
+                        {"rows_per_step", cost.rows},
+                        {"matrix_free_us_per_step", cost.us}});
+      char cell[96];
+      std::snprintf(cell, sizeof cell, "%s%.0f: %.0f (%.0f)", cells.empty() ? "" : ", ", bodies,
+                    cost.us, cost.rows);
+      cells += cell;
+    }
+    const double slope_bodies = log_log_slope(by_bodies);
+    const double slope_rows = log_log_slope(by_rows);
+    families.push_back({{"family", std::string(family) + "_N"},
+                        {"points", points},
+                        {"slope_against_bodies", slope_bodies},
+                        {"slope_against_rows", slope_rows}});
+    if (markdown) {
+      std::printf("| %s_N | %s | %.2f | %.2f |\n", family, cells.c_str(), slope_bodies, slope_rows);
+    }
+  }
+  return families;
+}
+
+// The tables, as Markdown (or one JSON document) on stdout; progress on stderr. quick: fewer
+// and smaller scenes and a third of each window (seconds instead of minutes), one end-to-end
+// rendering run per scene instead of three. rendering_only: only the rendering table. Returns
+// the exit code (2 for rendering_only in a build without the renderer).
+int run_bench(const BenchOptions& o) {
+#ifndef CPS_HAVE_RENDERER
+  if (o.rendering) {
+    std::fprintf(stderr, "cps bench: built without the renderer (CPS_BUILD_RENDERER=OFF)\n");
+    return 2;
+  }
+#endif
+  if (o.rendering && !o.scenes.empty()) {
+    throw UsageError("--scene and --rendering exclude each other: --scene times the physics of "
+                     "the named scenes, --rendering only the rendering table");
+  }
+  std::vector<std::string> names;
+  for (const std::string& name : o.scenes) {
+    try {
+      for (const scenes::Scene* scene : select_scenes(name)) names.emplace_back(scene->name);
+    } catch (const UsageError& e) {
+      throw UsageError(std::string("--scene ") + name + ": " + e.what());
+    }
+  }
+  const bool markdown = !o.json;
+  nlohmann::json out = {{"engine_version", engine_version()}, {"quick", o.quick}};
+  if (!names.empty()) {
+    out["physics"] = physics_table(names, o.quick, markdown);
+  } else {
+    if (!o.rendering) {
+      out["physics"] = physics_table(physics_scenes(o.quick), o.quick, markdown);
+      out["warm_start"] = warm_start_table({"stack", "funnel"}, o.quick, markdown);
+      out["growth"] = growth_table(o.quick, markdown);
+    }
+#ifdef CPS_HAVE_RENDERER
+    out["rendering"] = render_table(o.quick, markdown);
+#endif
+  }
+  if (o.json) std::printf("%s\n", out.dump(2).c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command add_bench(CLI::App& app) {
+  auto o = std::make_shared<BenchOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "bench", "microseconds per step (explicit and matrix-free), the cost of warm starting, cost "
+             "growth, ms per frame");
+  sub->add_flag("--quick", o->quick, "smaller scenes and fewer steps (results in us/step, ms/frame)");
+  sub->add_flag("--rendering", o->rendering,
+                "only the rendering table (ms per frame at 1280x720: draw, PNG, end to end)");
+  sub->add_flag("--json", o->json,
+                "print one JSON document (physics, growth, rendering; keys carry their units) "
+                "instead of the Markdown tables");
+  sub->add_option("--scene", o->scenes,
+                  "time only these scenes (a name, a scaled scene such as funnel_500, 'all' or 'stress'; "
+                  "repeatable): the physics table alone, each scene over its window")
+      ->check(kNotEmpty);
+  add_seed_option(*sub, o->scenes);
+  return {sub, [o] { return run_bench(*o); }};
+}
+
+}  // namespace cps::cli

@@ -1,0 +1,197 @@
+#include "options/options.h"
+
+#include "scene_file.h"
+
+#include <CLI/CLI.hpp>
+
+#include <charconv>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <utility>
+#include <vector>
+#include <sstream>
+
+namespace cps::cli {
+
+
+CLI::Validator decimal_in(double lo, double hi, bool lo_open, const std::string& unit,
+                          bool allow_fraction) {
+  const std::string range = std::string(lo_open ? "(" : "[") + shortest_decimal(lo) + ", " +
+                            shortest_decimal(hi) + "]" + (unit.empty() ? "" : " " + unit);
+  return CLI::Validator(
+      [=](std::string& input) -> std::string {
+        const std::optional<double> v = parse_decimal(input, allow_fraction);
+        if (!v) {
+          return input + ": not a number; give a decimal number" +
+                 (allow_fraction ? std::string(" or a fraction such as 1/60") : "") + " in " + range;
+        }
+        if (!std::isfinite(*v) || (lo_open ? !(*v > lo) : !(*v >= lo)) || *v > hi) {
+          return input + ": it must be in " + range;
+        }
+        input = shortest_decimal(*v);
+        return {};
+      },
+      range);
+}
+
+void add_seconds_option(CLI::App& cmd, std::optional<double>& seconds, const std::string& limits) {
+  cmd.add_option("--seconds", seconds,
+                 "simulated time (s) in (0, 1e5]; default: the scene's; " + limits)
+      ->check(decimal_in(0.0, kMaxSeconds, true, "s"));
+}
+
+const CLI::Validator kNotEmpty(
+    [](std::string& input) -> std::string {
+      return input.empty() ? "an empty value is not allowed; give a name" : std::string();
+    },
+    "");
+
+void check_steps(const std::string& what, double seconds, double dt) {
+  const double steps = std::ceil(seconds / dt);
+  if (steps > kMaxSteps) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "%s: %.6g s at dt = %.6g s is %.4g steps, more than the %.0f steps a run may "
+                  "take; give fewer --seconds or a larger --dt",
+                  what.c_str(), seconds, dt, steps, kMaxSteps);
+    throw UsageError(text);
+  }
+}
+
+std::string option_help(const Parameter& p) {
+  std::string help(p.help);
+  help += "; " + p.allowed() + "; default: the scene's";
+  return help;
+}
+
+void add_world_options(CLI::App& cmd, scenes::Overrides& o) {
+  for (const Parameter& p : world_parameters()) {
+    if (p.flag.empty()) continue;
+    const Parameter* param = &p;
+    // The table parses and checks the text (its message names the flag, the value and what is
+    // allowed); the callback runs only on text the check accepted.
+    cmd.add_option_function<std::string>(
+           "--" + std::string(p.flag),
+           [param, &o](const std::string& text) { o.set(*param, param->parse(text)); },
+           option_help(p))
+        ->type_name(p.type == ParameterType::choice ? "{" + p.allowed().substr(8) + "}"
+                    : p.type == ParameterType::integer ? "INT"
+                                                       : "NUMBER")
+        ->check(CLI::Validator(
+            [param](std::string& text) -> std::string {
+              try {
+                param->parse(text);
+              } catch (const std::invalid_argument& e) {
+                // CLI11 puts the flag in front of the message already.
+                const std::string why = e.what();
+                const std::string prefix = "--" + std::string(param->flag) + " ";
+                return why.rfind(prefix, 0) == 0 ? why.substr(prefix.size()) : why;
+              }
+              return {};
+            },
+            ""));
+  }
+}
+
+std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
+  std::vector<const scenes::Scene*> selected;
+  if (name == "all" || name == "stress") {
+    for (const scenes::Scene& s : name == "all" ? scenes::paper_scenes() : scenes::stress_scenes()) {
+      selected.push_back(&s);
+    }
+    return selected;
+  }
+  try {
+    if (const scenes::Scene* s = scenes::find_scene(name)) return {s};
+  } catch (const scenes::SceneFileError& e) {
+    throw UsageError(e.what());
+  }
+  std::string known;
+  for (const scenes::Scene& s : scenes::all_scenes()) known += std::string(known.empty() ? "" : ", ") + std::string(s.name);
+  std::string examples;
+  for (const std::string_view e : scenes::example_scene_names()) {
+    examples += (examples.empty() ? "" : ", ") + std::string(e);
+  }
+  std::string families;
+  for (const std::string_view f : scenes::scaled_families()) {
+    families += (families.empty() ? "" : ", ") + std::string(f);
+  }
+  throw UsageError("unknown scene '" + name + "'; the scenes are: " + known +
+                   " (or 'all' for the paper's scenes, 'stress' for the stress scenes); the "
+                   "example scene files " + examples + "; random_SEED (the random scene with "
+                   "that seed); the scaled scenes " + families +
+                   "; or the path of a scene file ending in .json; 'cps list' describes them");
+}
+
+std::string with_seed(const std::string& scene, std::uint64_t seed) {
+  const std::string seeded = "random_" + std::to_string(seed);
+  if (scene == "random" || scene == seeded) return seeded;
+  if (scene.rfind("random_", 0) == 0) {
+    throw UsageError("--seed " + std::to_string(seed) + ": the scene " + scene +
+                     " already names its seed; give the seed once (random --seed N, or random_N)");
+  }
+  throw UsageError("--seed " + std::to_string(seed) + ": the scene " + scene +
+                   " is not random; --seed applies to the random scene only (random, random_N)");
+}
+
+namespace {
+
+// Adds --seed to `cmd`; `apply` turns the seed into scene names once the command line is parsed.
+void add_seed(CLI::App& cmd, std::function<void(std::uint64_t)> apply) {
+  auto seed = std::make_shared<std::optional<std::uint64_t>>();
+  cmd.add_option_function<std::string>(
+         "--seed",
+         [seed](const std::string& text) { *seed = std::stoull(text); },
+         "seed of the random scene (an integer in [0, 18446744073709551615]): 'random --seed 7' "
+         "is random_7; refused for any other scene")
+      ->type_name("INT")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            std::uint64_t v = 0;
+            const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+            if (text.empty() || ec != std::errc() || end != text.data() + text.size()) {
+              return text + ": not allowed; give a decimal integer in [0, 18446744073709551615]";
+            }
+            return {};
+          },
+          ""));
+  cmd.parse_complete_callback([seed, apply = std::move(apply)] {
+    if (!seed->has_value()) return;
+    try {
+      apply(**seed);
+    } catch (const UsageError& e) {
+      // A CLI11 parse error: main reports it and exits 2.
+      throw CLI::ValidationError(e.what());
+    }
+  });
+}
+
+}  // namespace
+
+void add_seed_option(CLI::App& cmd, std::string& scene) {
+  add_seed(cmd, [&scene](std::uint64_t seed) { scene = with_seed(scene, seed); });
+}
+
+void add_seed_option(CLI::App& cmd, std::vector<std::string>& scenes) {
+  add_seed(cmd, [&scenes](std::uint64_t seed) {
+    if (scenes.empty()) {
+      throw UsageError("--seed " + std::to_string(seed) + ": no scene is random; --seed applies "
+                       "to the random scene (--scene random)");
+    }
+    for (std::string& s : scenes) s = with_seed(s, seed);
+  });
+}
+
+scenes::Run make_run_or_usage_error(const scenes::Scene& scene, const scenes::Overrides& o) {
+  try {
+    return scenes::make_run(scene, o);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string(scene.name) + ": " + e.what());
+  }
+}
+
+}  // namespace cps::cli

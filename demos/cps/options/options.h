@@ -1,0 +1,82 @@
+#pragma once
+// Command-line options shared by the cps subcommands, and their validation.
+
+#include "options/compare.h"
+#include "scene.h"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+// CLI11 (Debian's 2.1, header only) costs about 10 s of compile time in every file that includes
+// it: the headers name its classes only, and the files that add options include it.
+namespace CLI {
+class App;
+class Validator;
+}  // namespace CLI
+
+namespace cps::cli {
+
+/// A usage error: a bad value on the command line. The command exits with code 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// The world parameter overrides every stepping command takes: one option per parameter of the
+/// table (cps/parameters.h) that has a flag, its help, unit and allowed values from the table.
+void add_world_options(CLI::App& cmd, scenes::Overrides& overrides);
+
+/// Limits that keep one command's work finite. Each is stated in the --help of the options it
+/// bounds, and a command that would pass one is refused before any work (exit 2), naming the
+/// limit and the value.
+inline constexpr double kMaxSeconds = 1.0e5;  ///< s of simulated time a run (--seconds, --times)
+inline constexpr double kMaxSteps = 1.0e7;    ///< physics steps a run: seconds / dt
+inline constexpr double kMaxFps = 1000.0;     ///< frames per simulated second (--fps)
+inline constexpr double kMaxFrames = 1.0e5;   ///< frames in one render folder
+/// Raw pixel bytes one render may draw (frames x width x height x 3): 64 GiB. The PNG files
+/// are smaller; this bounds the drawing work.
+inline constexpr double kMaxPixelBytes = 68719476736.0;
+
+/// CLI11 validator for a decimal number (parse_decimal: no hex, no trailing text; a fraction such
+/// as 1/60 when allow_fraction) in [lo, hi], or (lo, hi] when lo_open, in `unit`. It hands CLI11
+/// the number written back in decimal, so CLI11 converts exactly the value checked. Its message
+/// names the text and the range.
+CLI::Validator decimal_in(double lo, double hi, bool lo_open, const std::string& unit,
+                          bool allow_fraction = false);
+
+/// Adds --seconds (simulated time, s, in (0, kMaxSeconds]; unset: the scene's default) to a
+/// command; `limits` says which further limits the command applies (appended to the help).
+void add_seconds_option(CLI::App& cmd, std::optional<double>& seconds, const std::string& limits);
+
+/// CLI11 validator that refuses an empty value ("--out ''").
+extern const CLI::Validator kNotEmpty;
+
+/// Throws UsageError naming the run, the steps it would take and kMaxSteps when seconds / dt
+/// (s / s) exceeds kMaxSteps.
+void check_steps(const std::string& what, double seconds, double dt);
+
+/// Scenes named on the command line: "all", "stress", one scene name (see scenes::find_scene:
+/// the tables, the example scene files, random_SEED, the scaled families) or the path of a scene
+/// file (ending in ".json"). Throws UsageError listing the scenes, the example files and the
+/// scaled families for an unknown name, and with the file's own message (file, JSON pointer,
+/// value, what is allowed) for a scene file that cannot be read or is not valid.
+std::vector<const scenes::Scene*> select_scenes(const std::string& name);
+
+/// Adds --seed N (the random scene's seed, a decimal integer in [0, 2^64 - 1]) to a command that
+/// takes the scene `scene` (or the scenes `scenes`): once the command line is parsed, it turns
+/// "random" (or random_N with the same N) into random_N. A scene that is not random is refused
+/// (exit 2, naming the scene), as is a random_M with another seed.
+void add_seed_option(CLI::App& cmd, std::string& scene);
+void add_seed_option(CLI::App& cmd, std::vector<std::string>& scenes);
+
+/// The scene name `scene` with the seed applied (see add_seed_option). Throws UsageError for a
+/// scene that is not random, or random_M with M != seed.
+std::string with_seed(const std::string& scene, std::uint64_t seed);
+
+// Variant, comparable_options and compare_variants (--compare): compare.h.
+
+/// Builds a run and turns a bad parameter (std::invalid_argument) into a UsageError.
+scenes::Run make_run_or_usage_error(const scenes::Scene& scene, const scenes::Overrides& o);
+
+}  // namespace cps::cli

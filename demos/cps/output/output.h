@@ -1,0 +1,120 @@
+#pragma once
+// The output rule of the cps command: every file cps writes (frames, videos, figures, traces,
+// reports, run.json) goes through this module.
+//  - Every target is checked before anything is written (plan_output). A file that no earlier
+//    cps run listed in its folder's run.json is foreign: a run that would replace one is refused
+//    (UsageError, exit 2) naming it. --force (the `force` argument) lets a run replace a foreign
+//    file that has exactly the name of one of its targets; no other foreign file is ever
+//    removed, truncated, renamed or opened for writing, with or without it.
+//  - Every file is written to a temporary of this run, created exclusively, checked and renamed
+//    (atomic_file.h): a reader sees the old file or the new one, never a part, and a failed write
+//    names the target and the OS's reason.
+//  - Every folder written gets run.json (k_manifest_name): this run's parameters, the files cps
+//    wrote there, and the runs still writing (their tokens), so that the leftover temporaries of
+//    an interrupted run are removed by the next one, and nothing else is.
+
+#include "output/atomic_file.h"
+#include "scene.h"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cps::cli {
+
+/// The name of the manifest every output folder receives.
+inline constexpr const char* k_manifest_name = "run.json";
+
+/// How runs share an output folder.
+enum class FolderUse {
+  /// The folder holds one run's outputs and nothing else (render's OUT/SCENE/): any entry no
+  /// earlier cps run listed is foreign and the folder is refused without force; a rerun removes
+  /// the earlier runs' files it does not write again (a longer render's extra frames); run.json
+  /// lists exactly this run's files. One run at a time: a folder another live cps run is writing
+  /// is refused.
+  exclusive,
+  /// The folder collects the outputs of many runs, and may hold other files (figure's
+  /// out/figures, render's OUT/ for videos, report's folders, a trace's folder): only this run's
+  /// targets (and run.json) are checked; other entries, foreign or cps's, are left alone; runs
+  /// may write it at the same time (run.json is updated under a lock). run.json lists every file
+  /// a cps run wrote there that still exists, and describes the last run that began or ended.
+  shared,
+};
+
+/// What one run will write into one folder, decided (and checked) before anything is written.
+struct OutputPlan {
+  std::filesystem::path folder;          ///< may not exist yet; "" is the current folder
+  FolderUse use = FolderUse::exclusive;  ///< how runs share it
+  std::vector<std::string> files;  ///< names (in `folder`) this run writes, run.json aside
+  std::vector<std::string> stale;  ///< exclusive: earlier runs' files this run does not rewrite
+};
+
+/// Checks that `folder` may receive `files` (plain names: no '/', not "." or "..", not
+/// run.json) and returns the plan. Reads only; writes nothing. Throws UsageError (exit 2), naming
+/// the path and what to do (`option`, e.g. "--out" or "--trace", names the option to change):
+///  - `folder` exists and is not a folder, or it is missing and its nearest existing ancestor is
+///    not a folder (`--out somefile/x`) or cannot be written into (no write or search
+///    permission: checked with access(2), so not for root);
+///  - a target, or run.json, exists and is not a regular file or a symbolic link (a folder of
+///    that name), even with `force`;
+///  - without `force`: a target, or run.json, exists and no earlier cps run wrote it (it is not
+///    listed in the folder's run.json, or run.json is not cps's); for an exclusive folder, also
+///    any other entry no earlier run wrote (a few are named, with their count);
+///  - exclusive, without `force`: another cps run that may still be running (run.json lists it
+///    as unfinished, and it ran on another host, or its process, same pid and start time, is
+///    alive) is writing into the folder.
+/// Leftover temporaries of an interrupted cps run (see begin_output) are the run's own, not
+/// foreign. A missing folder is fine: begin_output creates it.
+OutputPlan plan_output(const std::filesystem::path& folder, std::vector<std::string> files,
+                       bool force, FolderUse use = FolderUse::exclusive,
+                       std::string_view option = "--out");
+
+/// Starts writing a planned folder: creates it (and its parents), then, under an exclusive
+/// flock(2) of the folder (best effort: skipped where the file system has none), removes the
+/// leftover temporaries of interrupted runs and writes run.json with `info` (see run_info),
+/// "tool": "cps", "complete": false, "files" (this run's targets, and the earlier runs' files
+/// still present: an interrupted run remains recognised as cps's own by the next one) and
+/// "unfinished_runs" (each {"run_token", "pid", "host", "start", "files"}: this run's, and those
+/// of other runs that may still be writing). A leftover is a file named temporary_name(F, T)
+/// where T is the token of an unfinished run that is no longer running (same host, and its pid
+/// is gone or started at another time) and F is run.json or one of that run's files; or a
+/// temporary_name(run.json, T) whose content is a cps manifest listing T as such a run. Nothing
+/// else is removed. Throws std::runtime_error naming the path if the folder, a removal or
+/// run.json fails.
+void begin_output(const OutputPlan& plan, const nlohmann::json& info);
+
+/// After the run wrote its files (after begin_output): under the lock, removes `stale`
+/// (exclusive), then rewrites run.json with `info`, this run taken off "unfinished_runs",
+/// "complete": true if no run is left on it, and "files": exclusive, this run's targets;
+/// shared, every file listed before or by this run that still exists (or that a run still
+/// writing will write). Throws std::runtime_error
+/// naming the path on failure.
+void end_output(const OutputPlan& plan, const nlohmann::json& info);
+
+/// Writes `j` (indented, with a final newline) to `path` atomically (write_text_atomic). Throws
+/// std::runtime_error "cannot write PATH: REASON" on failure; the old file, if any, stays.
+void write_json_atomic(const std::filesystem::path& path, const nlohmann::json& j);
+
+/// The description of this invocation for run.json: {"command": subcommand, "command_line":
+/// [argv...], "engine_version": `git describe --always --dirty` at build time ("unknown" when built
+/// outside git), "date_utc": ISO 8601 (YYYY-MM-DDTHH:MM:SSZ), "parameters": parameters}.
+nlohmann::json run_info(const std::string& command, int argc, char** argv,
+                        const nlohmann::json& parameters);
+
+/// One parameter's value as JSON: a number, a bool, [x, y, z], or a choice's name.
+nlohmann::json parameter_json(const Parameter& p, const ParameterValue& v);
+
+/// The overrides given on the command line, by the table's JSON key ("dt_s", "iterations",
+/// "push", ...; units as the key's suffix); an empty object when none.
+nlohmann::json overrides_json(const scenes::Overrides& overrides);
+
+/// Every world parameter with its value, by the table's JSON key.
+nlohmann::json parameters_json(const WorldDef& def);
+
+/// `git describe --always --dirty` of the sources at build time, or "unknown".
+const char* engine_version();
+
+}  // namespace cps::cli

@@ -49,7 +49,7 @@ TEST_CASE("every push method but the paper's Baumgarte recovers the intersecting
   // with a 5 mm penetration slop: at the paper's settings (no warm start, no slop) the resting
   // contacts are pushed to depth 0, break and re-form (a jolt of about g dt = 0.17 m/s now and
   // then), and without warm starting 25 sweeps leave a 5-high column sinking and shearing in
-  // the split impulse and ngs, whose velocity solve has no push to make up for it (README, "The
+  // the split impulse and ngs, whose velocity solve has no push to make up for it (docs/findings.md, "The
   // push factor among its rivals"). From 3 s to 4 s every cube is then slower than 0.01 m/s and
   // within 3.5 cm of its height (each of the five contacts under it may sit up to the slop deep,
   // 2.5 cm at the top, and the soft contacts give a little more under the column's weight).
@@ -105,7 +105,7 @@ TEST_CASE("a resting box does not jitter under any push method", "[push_methods]
   // penetration slop (Box2D's linear slop). Without it every method drives the depth to 0 (a
   // converged solve cancels gravity within the step, so nothing sinks the box back), the
   // collision drops the corners that reach 0, and about once a second the box falls a step onto
-  // an edge: a jolt of 0.05 to 0.15 m/s, in all five methods (README, "The push factor among its
+  // an edge: a jolt of 0.05 to 0.15 m/s, in all five methods (docs/findings.md, "The push factor among its
   // rivals"). A step of free fall gives g dt = 0.17 m/s; a box that keeps its four contacts moves
   // at the solver's residual. Bound: below 1 mm/s from 1 s to 3 s.
   for (const Choice& choice : parameter("push").choices) {

@@ -80,7 +80,7 @@ TEST_CASE("a penetration slop leaves a resting box that deep; the push alone bre
   // ends at s for every slop tried, and the four corners never lose their contact once landed.
   // With s = 0 (the paper's push at the paper's margin 0) the push drives the depth to 0, a
   // corner then has no contact for a step, the box falls back and the contact is made again:
-  // it never comes to rest (the cause of the stack's creep, README "Why the paper's stack
+  // it never comes to rest (the cause of the stack's creep, docs/findings.md, "Why the paper's stack
   // drifts").
   for (const double slop : {0.0, 0.001, 0.005, 0.02}) {
     WorldDef def;
@@ -119,7 +119,7 @@ TEST_CASE("a penetration slop leaves a resting box that deep; the push alone bre
 TEST_CASE("with a penetration slop and warm starting at 1 the stack stands for 600 s",
           "[world][stack][warm_start][slop]") {
   // Without a slop the push drives resting depths to 0, corners lose their contact for a step,
-  // their rows restart from 0 and the column rocks and creeps (README, "Why the paper's stack
+  // their rows restart from 0 and the column rocks and creeps (docs/findings.md, "Why the paper's stack
   // drifts"). With a 5 mm slop every point persists, a warm start at 1 starts each solve at
   // last step's answer and the cubes stand still once landed. Measured: creep 0.3 mm after the
   // landing (0.3 m without a slop). Bound: 1 cm, the target set for a standing column.

@@ -64,6 +64,32 @@ void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<M
                             double contact_margin, std::size_t max_pairs,
                             std::vector<std::pair<int, int>>& pairs) {
   const std::size_t n = bodies.size();
+  pairs.clear();
+  classify(bodies, rotations, contact_margin);
+  if (widths_.size() <= kAllPairsMax) {
+    // A small world: every body is tested against every other, as the oversize ones are.
+    for (std::size_t i = 0; i < n; ++i) {
+      if (broad_class_[i] != BroadClass::plane) broad_class_[i] = BroadClass::oversize;
+    }
+    for (std::size_t i = 0; i < n; ++i) pairs_of_ungridded(bodies, i, pairs);
+    check_pair_count(pairs.size(), max_pairs, n);
+    return;
+  }
+  build_grid(bodies);
+  detail::resize_with_headroom(candidates_, n + planes_.size());
+  for (std::size_t ia = 0; ia < n; ++ia) {
+    check_pair_count(pairs.size(), max_pairs, n);  // at most n pairs past the limit
+    if (broad_class_[ia] != BroadClass::gridded) {
+      pairs_of_ungridded(bodies, ia, pairs);
+    } else {
+      pairs_of_gridded(bodies, ia, pairs);
+    }
+  }
+}
+
+void BroadPhase::classify(const std::vector<Body>& bodies, const std::vector<Mat3>& rotations,
+                          double contact_margin) {
+  const std::size_t n = bodies.size();
   bounds_.resize(n);
   broad_class_.resize(n);
   cell_.resize(n);
@@ -71,7 +97,6 @@ void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<M
   planes_.clear();
   oversize_.clear();
   widths_.clear();
-  pairs.clear();
   detail::reserve_with_headroom(widths_, n);
   detail::reserve_with_headroom(planes_, n);
   detail::reserve_with_headroom(oversize_, n);
@@ -96,15 +121,39 @@ void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<M
     const double width = (bounds_[i].hi - bounds_[i].lo).maxCoeff();
     widths_.push_back(std::isfinite(width) ? width : 0.0);
   }
-  if (widths_.size() <= kAllPairsMax) {
-    // A small world: every body is tested against every other, as the oversize ones are.
-    for (std::size_t i = 0; i < n; ++i) {
-      if (broad_class_[i] != BroadClass::plane) broad_class_[i] = BroadClass::oversize;
-    }
-    for (std::size_t i = 0; i < n; ++i) pairs_of_ungridded(bodies, i, pairs);
-    check_pair_count(pairs.size(), max_pairs, n);
-    return;
-  }
+}
+
+std::int32_t BroadPhase::GridShape::cell_coordinate(double x) const {
+  double q = std::floor(x * inv_edge);
+  if (!(q >= -kMaxCell)) q = -kMaxCell;  // also NaN
+  if (q > kMaxCell) q = kMaxCell;
+  return static_cast<std::int32_t>(q);
+}
+
+inline std::uint64_t BroadPhase::GridShape::key(std::int32_t x, std::int32_t y,
+                                                std::int32_t z) const {
+  // x - low + 1, y - low + 1 and z - low + 1 are in [0, size) for the cells a body looks at.
+  const auto rx = static_cast<std::uint64_t>(static_cast<std::int64_t>(x) - low[0] + 1);
+  const auto ry = static_cast<std::uint64_t>(static_cast<std::int64_t>(y) - low[1] + 1);
+  const auto rz = static_cast<std::uint64_t>(static_cast<std::int64_t>(z) - low[2] + 1);
+  const std::uint64_t row =
+      dense ? size_x * (ry + size_y * rz) : (ry * 19349663u) ^ (rz * 83492791u);
+  return (rx + row) & mask;
+}
+
+namespace {
+
+// The smallest power of two >= count, and >= 4 (the three buckets of a row range are distinct).
+std::uint64_t power_of_two_from(std::uint64_t count) {
+  std::uint64_t p = 4;
+  while (p < count) p *= 2;
+  return p;
+}
+
+}  // namespace
+
+void BroadPhase::build_grid(const std::vector<Body>& bodies) {
+  const std::size_t n = bodies.size();
   // Bodies much wider than the median go to the oversize list; the rest set the cell edge.
   double limit = kInfinity;
   if (!widths_.empty()) {
@@ -125,68 +174,42 @@ void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<M
       ++gridded;
     }
   }
+  GridShape& g = shape_;
   const double edge = widest > 0.0 && std::isfinite(widest) ? kCellGrowth * widest : 1.0;
-  const double inv_edge = 1.0 / edge;
-  const auto cell_coordinate = [inv_edge](double x) {
-    double q = std::floor(x * inv_edge);
-    if (!(q >= -kMaxCell)) q = -kMaxCell;  // also NaN
-    if (q > kMaxCell) q = kMaxCell;
-    return static_cast<std::int32_t>(q);
-  };
+  g.inv_edge = 1.0 / edge;
   // Cells of the gridded bodies and the box of cells they span.
-  std::array<std::int32_t, 3> low{0, 0, 0};
   std::array<std::int32_t, 3> high{0, 0, 0};
+  g.low = {0, 0, 0};
   bool first = true;
   for (std::size_t i = 0; i < n; ++i) {
     if (broad_class_[i] != BroadClass::gridded) continue;
     const Vec3& lo = bounds_[i].lo;
-    cell_[i] = {cell_coordinate(lo.x()), cell_coordinate(lo.y()), cell_coordinate(lo.z())};
+    cell_[i] = {g.cell_coordinate(lo.x()), g.cell_coordinate(lo.y()), g.cell_coordinate(lo.z())};
     for (int k = 0; k < 3; ++k) {
-      low[k] = first ? cell_[i][k] : std::min(low[k], cell_[i][k]);
+      g.low[k] = first ? cell_[i][k] : std::min(g.low[k], cell_[i][k]);
       high[k] = first ? cell_[i][k] : std::max(high[k], cell_[i][k]);
     }
     first = false;
   }
-  // Bucket of a cell: x + row(y, z), so that the cells x - 1, x, x + 1 of a row are three
-  // consecutive buckets (one range of the sorted bodies). When the box of cells is at most
-  // kDenseCells times the body count, row(y, z) numbers the rows of the box densely and no two
-  // cells share a bucket; otherwise it is a hash of (y, z) (Teschner et al. 2003) and a bucket
-  // may also hold other cells, which the row test below skips.
-  const std::uint64_t size_x = static_cast<std::uint64_t>(high[0] - low[0]) + 3;
-  const std::uint64_t size_y = static_cast<std::uint64_t>(high[1] - low[1]) + 3;
-  const std::uint64_t size_z = static_cast<std::uint64_t>(high[2] - low[2]) + 3;
-  const double box_cells = static_cast<double>(size_x) * static_cast<double>(size_y) *
+  // Dense when the box of cells is at most kDenseCells times the body count.
+  g.size_x = static_cast<std::uint64_t>(high[0] - g.low[0]) + 3;
+  g.size_y = static_cast<std::uint64_t>(high[1] - g.low[1]) + 3;
+  const std::uint64_t size_z = static_cast<std::uint64_t>(high[2] - g.low[2]) + 3;
+  const double box_cells = static_cast<double>(g.size_x) * static_cast<double>(g.size_y) *
                            static_cast<double>(size_z);
-  const bool dense = box_cells <= kDenseCells * static_cast<double>(gridded);
-  const auto power_of_two_from = [](std::uint64_t count) {
-    std::uint64_t p = 4;  // >= 4: the three buckets of a row range are distinct
-    while (p < count) p *= 2;
-    return p;
-  };
-  const std::uint64_t buckets =
-      power_of_two_from(dense ? static_cast<std::uint64_t>(box_cells) : 2 * gridded);
-  const std::uint64_t mask = buckets - 1;
+  g.dense = box_cells <= kDenseCells * static_cast<double>(gridded);
+  g.buckets = power_of_two_from(g.dense ? static_cast<std::uint64_t>(box_cells) : 2 * gridded);
+  g.mask = g.buckets - 1;
   // Room for the most buckets this body count can ask for, so that bodies spreading out (a
   // larger box of cells) do not make a step allocate.
   detail::reserve_with_headroom(
       bucket_start_, static_cast<std::size_t>(power_of_two_from(
                          static_cast<std::uint64_t>(kDenseCells) * gridded)) + 2);
-  const auto row_key = [&](std::int32_t y, std::int32_t z) -> std::uint64_t {
-    // y - low + 1 and z - low + 1 are in [0, size) for the rows a body looks at.
-    const auto ry = static_cast<std::uint64_t>(static_cast<std::int64_t>(y) - low[1] + 1);
-    const auto rz = static_cast<std::uint64_t>(static_cast<std::int64_t>(z) - low[2] + 1);
-    if (dense) return size_x * (ry + size_y * rz);
-    return (ry * 19349663u) ^ (rz * 83492791u);
-  };
-  const auto key = [&](std::int32_t x, std::int32_t y, std::int32_t z) {
-    const auto rx = static_cast<std::uint64_t>(static_cast<std::int64_t>(x) - low[0] + 1);
-    return (rx + row_key(y, z)) & mask;
-  };
   // Counting sort of the gridded bodies by bucket (index order within a bucket).
-  detail::assign_with_headroom(bucket_start_, static_cast<std::size_t>(buckets) + 2, 0);
+  detail::assign_with_headroom(bucket_start_, static_cast<std::size_t>(g.buckets) + 2, 0);
   for (std::size_t i = 0; i < n; ++i) {
     if (broad_class_[i] != BroadClass::gridded) continue;
-    bucket_of_[i] = static_cast<std::uint32_t>(key(cell_[i][0], cell_[i][1], cell_[i][2]));
+    bucket_of_[i] = static_cast<std::uint32_t>(g.key(cell_[i][0], cell_[i][1], cell_[i][2]));
     ++bucket_start_[bucket_of_[i] + 2];
   }
   for (std::size_t k = 2; k < bucket_start_.size(); ++k) bucket_start_[k] += bucket_start_[k - 1];
@@ -196,60 +219,56 @@ void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<M
     grid_[static_cast<std::size_t>(bucket_start_[bucket_of_[i] + 1]++)] = {
         static_cast<int>(i), bodies[i].is_static(), cell_[i], bounds_[i]};
   }
-  detail::resize_with_headroom(candidates_, n + planes_.size());
+}
 
-  for (std::size_t ia = 0; ia < n; ++ia) {
-    check_pair_count(pairs.size(), max_pairs, n);  // at most n pairs past the limit
-    const int a = static_cast<int>(ia);
-    const bool a_static = bodies[ia].is_static();
-    if (broad_class_[ia] != BroadClass::gridded) {
-      pairs_of_ungridded(bodies, ia, pairs);
-      continue;
+void BroadPhase::pairs_of_gridded(const std::vector<Body>& bodies, std::size_t ia,
+                                  std::vector<std::pair<int, int>>& pairs) {
+  const GridShape& g = shape_;
+  const int a = static_cast<int>(ia);
+  const bool a_static = bodies[ia].is_static();
+  // Bodies of higher index in the 27 cells around a's: per neighbour row one range of
+  // buckets. The test is without branches; a hit is kept by advancing the count.
+  std::size_t count = 0;
+  const Bounds& ba = bounds_[ia];
+  const std::array<std::int32_t, 3> c = cell_[ia];
+  const auto scan = [&](int begin, int end, std::int32_t y, std::int32_t z) {
+    for (int k = begin; k < end; ++k) {
+      const GridEntry& e = grid_[static_cast<std::size_t>(k)];
+      // The row test keeps a body that shares its bucket with another row from being taken
+      // twice; cells of this row beyond x +- 1 can only be there by wrapping (hashed rows)
+      // and fail the bounds test.
+      const bool hit = (e.body > a) & (e.cell[1] == y) & (e.cell[2] == z) &
+                       !(a_static & e.is_static) & bounds_overlap(ba, e.bounds);
+      candidates_[count] = e.body;
+      count += hit ? 1 : 0;
     }
-    // Bodies of higher index in the 27 cells around a's: per neighbour row one range of
-    // buckets. The test is without branches; a hit is kept by advancing the count.
-    std::size_t count = 0;
-    const Bounds& ba = bounds_[ia];
-    const std::array<std::int32_t, 3> c = cell_[ia];
-    const auto scan = [&](int begin, int end, std::int32_t y, std::int32_t z) {
-      for (int k = begin; k < end; ++k) {
-        const GridEntry& e = grid_[static_cast<std::size_t>(k)];
-        // The row test keeps a body that shares its bucket with another row from being taken
-        // twice; cells of this row beyond x +- 1 can only be there by wrapping (hashed rows)
-        // and fail the bounds test.
-        const bool hit = (e.body > a) & (e.cell[1] == y) & (e.cell[2] == z) &
-                         !(a_static & e.is_static) & bounds_overlap(ba, e.bounds);
-        candidates_[count] = e.body;
-        count += hit ? 1 : 0;
-      }
-    };
-    for (std::int32_t y = c[1] - 1; y <= c[1] + 1; ++y) {
-      for (std::int32_t z = c[2] - 1; z <= c[2] + 1; ++z) {
-        const auto first_bucket = static_cast<std::size_t>(key(c[0] - 1, y, z));
-        if (first_bucket + 3 <= buckets) {
-          scan(bucket_start_[first_bucket], bucket_start_[first_bucket + 3], y, z);
-        } else {  // the three buckets wrap around the end of the table
-          for (std::int32_t x = c[0] - 1; x <= c[0] + 1; ++x) {
-            const auto bucket = static_cast<std::size_t>(key(x, y, z));
-            scan(bucket_start_[bucket], bucket_start_[bucket + 1], y, z);
-          }
+  };
+  for (std::int32_t y = c[1] - 1; y <= c[1] + 1; ++y) {
+    for (std::int32_t z = c[2] - 1; z <= c[2] + 1; ++z) {
+      const auto first_bucket = static_cast<std::size_t>(g.key(c[0] - 1, y, z));
+      if (first_bucket + 3 <= g.buckets) {
+        scan(bucket_start_[first_bucket], bucket_start_[first_bucket + 3], y, z);
+      } else {  // the three buckets wrap around the end of the table
+        for (std::int32_t x = c[0] - 1; x <= c[0] + 1; ++x) {
+          const auto bucket = static_cast<std::size_t>(g.key(x, y, z));
+          scan(bucket_start_[bucket], bucket_start_[bucket + 1], y, z);
         }
       }
     }
-    for (const int b : oversize_) {
-      const auto ib = static_cast<std::size_t>(b);
-      if (b > a && !(a_static && bodies[ib].is_static()) && bounds_overlap(ba, bounds_[ib])) {
-        candidates_[count++] = b;
-      }
-    }
-    if (!a_static) {
-      for (const int p : planes_) {
-        if (p > a) candidates_[count++] = p;
-      }
-    }
-    std::sort(candidates_.begin(), candidates_.begin() + static_cast<std::ptrdiff_t>(count));
-    for (std::size_t k = 0; k < count; ++k) pairs.emplace_back(a, candidates_[k]);
   }
+  for (const int b : oversize_) {
+    const auto ib = static_cast<std::size_t>(b);
+    if (b > a && !(a_static && bodies[ib].is_static()) && bounds_overlap(ba, bounds_[ib])) {
+      candidates_[count++] = b;
+    }
+  }
+  if (!a_static) {
+    for (const int p : planes_) {
+      if (p > a) candidates_[count++] = p;
+    }
+  }
+  std::sort(candidates_.begin(), candidates_.begin() + static_cast<std::ptrdiff_t>(count));
+  for (std::size_t k = 0; k < count; ++k) pairs.emplace_back(a, candidates_[k]);
 }
 
 // The pairs (ia, b), b > ia, in order, of a body kept out of the grid: a plane pairs with every

@@ -48,9 +48,38 @@ class BroadPhase {
     std::array<std::int32_t, 3> cell;  // grid cell of the lower corner
     Bounds bounds;
   };
+  // The grid's cells: where the box of cells starts, its size, and how a cell maps to a bucket.
+  // Bucket of a cell: x + row(y, z), so that the cells x - 1, x, x + 1 of a row are three
+  // consecutive buckets (one range of the sorted bodies). A dense grid numbers the rows of the
+  // box; a hashed one hashes (y, z) (Teschner et al. 2003), and a bucket may also hold other
+  // cells, which the row test of the pair scan skips.
+  struct GridShape {
+    double inv_edge = 1.0;                    // 1 / cell edge (1/m)
+    std::array<std::int32_t, 3> low{0, 0, 0};  // lowest cell of the gridded bodies
+    std::uint64_t size_x = 0;                 // cells of the box along x and y (+ 2 margin)
+    std::uint64_t size_y = 0;
+    bool dense = false;
+    std::uint64_t buckets = 0;                // a power of two >= 4
+    std::uint64_t mask = 0;                   // buckets - 1
+    std::int32_t cell_coordinate(double x) const;
+    std::uint64_t key(std::int32_t x, std::int32_t y, std::int32_t z) const;
+  };
+
+  // Stage 1: bounds grown by half the contact margin and the class of every body; planes listed.
+  void classify(const std::vector<Body>& bodies, const std::vector<Mat3>& rotations,
+                double contact_margin);
+  // Stage 2: the oversize bodies out of the grid, the cell edge, each gridded body's cell, the
+  // shape of the grid and its buckets, and the counting sort of the gridded bodies by bucket.
+  void build_grid(const std::vector<Body>& bodies);
+  // Stage 3: the pairs (ia, b), b > ia, in order, of a gridded body, from the 27 cells around
+  // its own, the oversize bodies and the planes.
+  void pairs_of_gridded(const std::vector<Body>& bodies, std::size_t ia,
+                        std::vector<std::pair<int, int>>& pairs);
   // The pairs (ia, b), b > ia, in order, of a body kept out of the grid.
   void pairs_of_ungridded(const std::vector<Body>& bodies, std::size_t ia,
                           std::vector<std::pair<int, int>>& pairs) const;
+
+  GridShape shape_;
 
   std::vector<Bounds> bounds_;                     // per body, grown by the contact margin (m)
   std::vector<BroadClass> broad_class_;            // per body

@@ -29,7 +29,9 @@ bool within(const Vec3& v, double limit) {
 }  // namespace
 
 World::World(const WorldDef& def)
-    : def_(def), ctx_(std::make_unique<StepContext>()), broad_phase_(std::make_unique<BroadPhase>()) {
+    : def_(def),
+      ctx_(std::make_unique<StepContext>()),
+      broad_phase_(std::make_unique<BroadPhase>()) {
   def_.validate();
 }
 
@@ -195,9 +197,9 @@ void World::build_rows() {
   // updated last hold at the end of the solve. Sliding velocity left over is never corrected
   // (no push acts along a tangent), while a normal row's residual is a small sink the push
   // factor takes back. With the friction rows after all contact rows, the contact rows updated
-  // later in a sweep no longer disturb the sliding velocity the friction rows set (docs/findings.md, "Why
-  // the paper's stack drifts": the stack slid 2.4 m in 600 s with each point's friction rows
-  // right after its contact row).
+  // later in a sweep no longer disturb the sliding velocity the friction rows set
+  // (docs/findings.md, "Why the paper's stack drifts": the stack slid 2.4 m in 600 s with each
+  // point's friction rows right after its contact row).
   for (const Manifold& m : ctx.manifolds) {
     append_normal_rows(m, bodies_, velocity(m.body_a), velocity(m.body_b), params, rows);
   }

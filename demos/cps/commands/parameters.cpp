@@ -141,7 +141,8 @@ std::string table_markdown() {
       "| option | JSON key | meaning | unit | allowed | default |\n"
       "|---|---|---|---|---|---|\n";
   for (const Parameter& p : world_parameters()) {
-    const std::string flag = p.flag.empty() ? "(scene files only)" : "`--" + std::string(p.flag) + "`";
+    const std::string flag =
+        p.flag.empty() ? "(scene files only)" : "`--" + std::string(p.flag) + "`";
     md += "| " + flag + " | `" + std::string(p.json_key) + "` | " + cell(p.help) + " | " +
           (p.unit.empty() ? "" : std::string(p.unit)) + " | " + cell(p.allowed()) + " | " +
           cell(default_text(p)) + " |\n";

@@ -69,8 +69,8 @@ void turn(Quat& o, const Vec3& theta) {
 }
 
 // Moves a and b (either may be null: the world) along k to change C by -C, shared by their
-// inverse masses and inertias (the comment at the top); point_a, point_b: where the constraint acts on each (m),
-// C in m.
+// inverse masses and inertias (the comment at the top); point_a, point_b: where the constraint
+// acts on each (m), C in m.
 void correct(Body* a, Body* b, const Vec3& point_a, const Vec3& point_b, const Vec3& k, double C) {
   const Lever la = lever(a, a != nullptr ? Vec3(point_a - a->x) : Vec3::Zero(), k);
   const Lever lb = lever(b, b != nullptr ? Vec3(point_b - b->x) : Vec3::Zero(), k);

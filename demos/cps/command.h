@@ -4,14 +4,9 @@
 // function registers a subcommand on the application with its options and returns how to run
 // it; main.cpp parses the command line and runs the command chosen.
 
-#include <functional>
+#include "options/cli_fwd.h"
 
-// CLI11 (Debian's 2.1, header only) costs about 10 s of compile time in every file that includes
-// it: the headers name its classes only, and the files that add options include it.
-namespace CLI {
-class App;
-class Validator;
-}  // namespace CLI
+#include <functional>
 
 namespace cps::cli {
 

@@ -1,6 +1,7 @@
 #pragma once
 // Command-line options shared by the cps subcommands, and their validation.
 
+#include "options/cli_fwd.h"
 #include "options/compare.h"
 #include "scene.h"
 
@@ -8,13 +9,6 @@
 #include <optional>
 #include <string>
 #include <vector>
-
-// CLI11 (Debian's 2.1, header only) costs about 10 s of compile time in every file that includes
-// it: the headers name its classes only, and the files that add options include it.
-namespace CLI {
-class App;
-class Validator;
-}  // namespace CLI
 
 namespace cps::cli {
 

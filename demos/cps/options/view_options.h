@@ -2,16 +2,10 @@
 // The picture options `cps render` and `cps figure` share: the size of a picture, the camera,
 // the overlays and the labels.
 
+#include "options/cli_fwd.h"
 #include "pictures/draw.h"
 
 #include <string>
-
-// CLI11 (Debian's 2.1, header only) costs about 10 s of compile time in every file that includes
-// it: the headers name its classes only, and the files that add options include it.
-namespace CLI {
-class App;
-class Validator;
-}  // namespace CLI
 
 namespace cps::cli {
 

@@ -286,7 +286,20 @@ double rod_radius(const World& world) {
   return std::isfinite(size) ? std::min(0.02, 0.1 * size) : 0.02;
 }
 
-int run_export(const ExportOptions& o, int argc, char** argv) {
+// An export as planned: options, scene, duration and samples checked, the file's folder checked
+// (plan_output), nothing written. Sample k is the state at k / fps s, k = 0 .. samples - 1.
+struct ExportPlan {
+  const scenes::Scene* scene = nullptr;
+  scenes::Run run;
+  std::filesystem::path path;  // --out, FILE.glb
+  std::size_t samples = 0;     // floor(seconds x fps) + 1, at most kMaxFrames
+  nlohmann::json info;         // the folder's run.json
+  OutputPlan output;
+};
+
+// Checks the options, builds the run and checks its folder before anything is written. Throws
+// UsageError.
+ExportPlan plan_export(const ExportOptions& o, int argc, char** argv) {
   if (o.scene == "all" || o.scene == "stress") {
     throw UsageError("export takes one scene, not '" + o.scene + "'");
   }
@@ -306,32 +319,24 @@ int run_export(const ExportOptions& o, int argc, char** argv) {
                      std::to_string(static_cast<long long>(kMaxFrames)) +
                      " an export may write; give fewer --seconds or a lower --fps");
   }
-  const nlohmann::json info =
-      run_info("export", argc, argv,
-               {{"scene", scene->name},
-                {"seconds", seconds},
-                {"fps", o.fps},
-                {"out", o.out},
-                {"overrides", overrides_json(o.overrides)},
-                {"parameters", parameters_json(run.world.def())}});
-  const OutputPlan plan = plan_output(path.parent_path(), {path.filename().string()}, o.force,
-                                      FolderUse::shared, "--out");
+  nlohmann::json info = run_info("export", argc, argv,
+                                 {{"scene", scene->name},
+                                  {"seconds", seconds},
+                                  {"fps", o.fps},
+                                  {"out", o.out},
+                                  {"overrides", overrides_json(o.overrides)},
+                                  {"parameters", parameters_json(run.world.def())}});
+  OutputPlan output = plan_output(path.parent_path(), {path.filename().string()}, o.force,
+                                  FolderUse::shared, "--out");
+  return {scene, std::move(run), path, static_cast<std::size_t>(frames), std::move(info), std::move(output)};
+}
 
-  const World& world = run.world;
+// Bodies: a node each (nodes 0 .. bodies - 1), with its shape's mesh in the body frame and a
+// material of its colour in `style` (one "plane" material for every plane), named by the scene.
+void add_body_nodes(const scenes::Scene& scene, const World& world, const DrawStyle& style,
+                    tinygltf::Model& model, Builder& build, tinygltf::Scene& gscene) {
   const std::vector<Body>& bodies = world.bodies();
-  const std::vector<DistanceConstraint>& rods = world.distances();
-  const DrawStyle style = resolve_style(*scene, world, View{}, static_cast<float>(kAspect));
-  const render::DrawList as_built = draw_list(world, style);
-  const std::vector<std::string> names = scenes::body_names(*scene);
-
-  tinygltf::Model model;
-  model.asset.version = "2.0";
-  model.asset.generator = std::string("cps export ") + engine_version();
-  Builder build(model);
-  tinygltf::Scene gscene;
-  gscene.name = std::string(scene->name);
-
-  // Bodies: a node each, with its shape's mesh in the body frame.
+  const std::vector<std::string> names = scenes::body_names(scene);
   const render::PlaneItem plane_look;  // the renderer's plane colours
   const glm::vec3 plane_rgb = 0.5f * (plane_look.color_a + plane_look.color_b);
   int plane_material = -1;
@@ -363,7 +368,15 @@ int run_export(const ExportOptions& o, int argc, char** argv) {
     gscene.nodes.push_back(static_cast<int>(model.nodes.size()));
     model.nodes.push_back(std::move(node));
   }
-  // Rods: a node each, its unit cylinder along +y turned onto p_b - p_a and scaled to the length.
+}
+
+// Rods: a node each, "rod_R", sharing one mesh, the unit cylinder along +y that the animation
+// turns onto p_b - p_a and scales to the length, in the colour draw_list gives rods. Returns
+// the first rod's node.
+int add_rod_nodes(const World& world, const DrawStyle& style, tinygltf::Model& model, Builder& build,
+                  tinygltf::Scene& gscene) {
+  const std::vector<DistanceConstraint>& rods = world.distances();
+  const render::DrawList as_built = draw_list(world, style);
   const glm::vec3 rod_rgb = as_built.lines.empty() ? glm::vec3(0.15f) : as_built.lines.front().color;
   const int rod_mesh_index =
       rods.empty() ? -1 : build.mesh(rod_mesh(rod_radius(world)), build.material(rod_rgb, 1.0f, "rod"), "rod");
@@ -375,38 +388,55 @@ int run_export(const ExportOptions& o, int argc, char** argv) {
     gscene.nodes.push_back(static_cast<int>(model.nodes.size()));
     model.nodes.push_back(std::move(node));
   }
-  // The camera: the scene's view (as `cps render` shows it).
-  {
-    tinygltf::Camera camera;
-    camera.name = "camera";
-    camera.type = "perspective";
-    camera.perspective.yfov = style.camera.fov_y_deg * kPi / 180.0;
-    camera.perspective.aspectRatio = kAspect;
-    camera.perspective.znear = style.camera.near_m;
-    camera.perspective.zfar = style.camera.far_m;
-    model.cameras.push_back(camera);
-    tinygltf::Node node;
-    node.name = "camera";
-    node.camera = 0;
-    node.translation = {style.camera.eye.x, style.camera.eye.y, style.camera.eye.z};
-    node.rotation = look_rotation(style.camera.eye, style.camera.target, style.camera.up);
-    gscene.nodes.push_back(static_cast<int>(model.nodes.size()));
-    model.nodes.push_back(std::move(node));
-  }
+  return first_rod_node;
+}
 
-  // Sampling: the state after the step nearest to each t_k (as Run::advance_to).
-  const std::size_t n = static_cast<std::size_t>(frames);
+// The camera: the scene's view in `style` (as `cps render` shows it), at kAspect.
+void add_camera_node(const DrawStyle& style, tinygltf::Model& model, tinygltf::Scene& gscene) {
+  tinygltf::Camera camera;
+  camera.name = "camera";
+  camera.type = "perspective";
+  camera.perspective.yfov = style.camera.fov_y_deg * kPi / 180.0;
+  camera.perspective.aspectRatio = kAspect;
+  camera.perspective.znear = style.camera.near_m;
+  camera.perspective.zfar = style.camera.far_m;
+  model.cameras.push_back(camera);
+  tinygltf::Node node;
+  node.name = "camera";
+  node.camera = 0;
+  node.translation = {style.camera.eye.x, style.camera.eye.y, style.camera.eye.z};
+  node.rotation = look_rotation(style.camera.eye, style.camera.target, style.camera.up);
+  gscene.nodes.push_back(static_cast<int>(model.nodes.size()));
+  model.nodes.push_back(std::move(node));
+}
+
+// The animation's samples: times (s), and per body its translation (m; x, y, z a sample) and
+// rotation (x, y, z, w), per rod its first end (m), rotation from +y and scale (1, length, 1).
+struct Samples {
   std::vector<float> times;
-  std::vector<std::vector<float>> translation(bodies.size()), rotation(bodies.size());
-  std::vector<std::vector<float>> rod_t(rods.size()), rod_r(rods.size()), rod_s(rods.size());
-  Progress progress("export " + o.scene, static_cast<long long>(n), "samples", 2.0);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = static_cast<double>(k) / o.fps;
-    run.advance_to(t);
-    times.push_back(static_cast<float>(t));
+  std::vector<std::vector<float>> translation, rotation;
+  std::vector<std::vector<float>> rod_t, rod_r, rod_s;
+};
+
+// Steps the plan's run through its samples, each the state after the step nearest to its time
+// (as Run::advance_to), with progress on stderr.
+Samples sample_run(ExportPlan& plan, double fps, const std::string& scene_option) {
+  const std::vector<Body>& bodies = plan.run.world.bodies();
+  const std::vector<DistanceConstraint>& rods = plan.run.world.distances();
+  Samples s;
+  s.translation.resize(bodies.size());
+  s.rotation.resize(bodies.size());
+  s.rod_t.resize(rods.size());
+  s.rod_r.resize(rods.size());
+  s.rod_s.resize(rods.size());
+  Progress progress("export " + scene_option, static_cast<long long>(plan.samples), "samples", 2.0);
+  for (std::size_t k = 0; k < plan.samples; ++k) {
+    const double t = static_cast<double>(k) / fps;
+    plan.run.advance_to(t);
+    s.times.push_back(static_cast<float>(t));
     for (std::size_t i = 0; i < bodies.size(); ++i) {
-      push_vec(translation[i], bodies[i].x);
-      push_rotation(rotation[i], bodies[i].o, true);
+      push_vec(s.translation[i], bodies[i].x);
+      push_rotation(s.rotation[i], bodies[i].o, true);
     }
     for (std::size_t r = 0; r < rods.size(); ++r) {
       Vec3 p_a;
@@ -415,58 +445,96 @@ int run_export(const ExportOptions& o, int argc, char** argv) {
       const Vec3 d = p_b - p_a;
       const double length = d.norm();
       const Quat q = length > 0.0 ? Quat::FromTwoVectors(Vec3::UnitY(), d) : Quat::Identity();
-      push_vec(rod_t[r], p_a);
-      push_rotation(rod_r[r], q, true);
-      push_vec(rod_s[r], Vec3(1.0, length, 1.0));
+      push_vec(s.rod_t[r], p_a);
+      push_rotation(s.rod_r[r], q, true);
+      push_vec(s.rod_s[r], Vec3(1.0, length, 1.0));
     }
     progress.update(static_cast<long long>(k + 1));
   }
   progress.finish();
+  return s;
+}
 
+// The one animation, named after the scene: a LINEAR channel per body (translation, rotation;
+// nodes 0 ..) and per rod (translation, rotation, scale; nodes first_rod_node ..).
+void add_animation(const Samples& s, int first_rod_node, const std::string& name,
+                   tinygltf::Model& model, Builder& build) {
   tinygltf::Animation animation;
-  animation.name = std::string(scene->name);
-  const int time_accessor = build.floats(times, TINYGLTF_TYPE_SCALAR, 1, true, -1);
+  animation.name = name;
+  const int time_accessor = build.floats(s.times, TINYGLTF_TYPE_SCALAR, 1, true, -1);
   auto channel = [&](int node, const char* path_name, const std::vector<float>& values, int type,
                      int components) {
-    tinygltf::AnimationSampler s;
-    s.input = time_accessor;
-    s.output = build.floats(values, type, components, false, -1);
-    s.interpolation = "LINEAR";
-    animation.samplers.push_back(s);
+    tinygltf::AnimationSampler sampler;
+    sampler.input = time_accessor;
+    sampler.output = build.floats(values, type, components, false, -1);
+    sampler.interpolation = "LINEAR";
+    animation.samplers.push_back(sampler);
     tinygltf::AnimationChannel c;
     c.sampler = static_cast<int>(animation.samplers.size()) - 1;
     c.target_node = node;
     c.target_path = path_name;
     animation.channels.push_back(c);
   };
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    channel(static_cast<int>(i), "translation", translation[i], TINYGLTF_TYPE_VEC3, 3);
-    channel(static_cast<int>(i), "rotation", rotation[i], TINYGLTF_TYPE_VEC4, 4);
+  for (std::size_t i = 0; i < s.translation.size(); ++i) {
+    channel(static_cast<int>(i), "translation", s.translation[i], TINYGLTF_TYPE_VEC3, 3);
+    channel(static_cast<int>(i), "rotation", s.rotation[i], TINYGLTF_TYPE_VEC4, 4);
   }
-  for (std::size_t r = 0; r < rods.size(); ++r) {
+  for (std::size_t r = 0; r < s.rod_t.size(); ++r) {
     const int node = first_rod_node + static_cast<int>(r);
-    channel(node, "translation", rod_t[r], TINYGLTF_TYPE_VEC3, 3);
-    channel(node, "rotation", rod_r[r], TINYGLTF_TYPE_VEC4, 4);
-    channel(node, "scale", rod_s[r], TINYGLTF_TYPE_VEC3, 3);
+    channel(node, "translation", s.rod_t[r], TINYGLTF_TYPE_VEC3, 3);
+    channel(node, "rotation", s.rod_r[r], TINYGLTF_TYPE_VEC4, 4);
+    channel(node, "scale", s.rod_s[r], TINYGLTF_TYPE_VEC3, 3);
   }
   model.animations.push_back(std::move(animation));
-  model.scenes.push_back(std::move(gscene));
-  model.defaultScene = 0;
-  model.buffers.front().data.resize((model.buffers.front().data.size() + 3) / 4 * 4, 0);
+}
 
+// The model as a glTF 2.0 binary (tinygltf), its buffer padded to 4 bytes first. Throws
+// std::runtime_error naming `out` if tinygltf cannot serialise it.
+std::string glb_bytes(tinygltf::Model& model, const std::string& out) {
+  model.buffers.front().data.resize((model.buffers.front().data.size() + 3) / 4 * 4, 0);
   std::ostringstream bytes;
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToStream(&model, bytes, false, true)) {
-    throw std::runtime_error("cannot write " + o.out + ": tinygltf could not serialise the model");
+    throw std::runtime_error("cannot write " + out + ": tinygltf could not serialise the model");
   }
-  const std::string data = bytes.str();
-  begin_output(plan, info);
-  write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(data.data()), data.size()));
-  end_output(plan, info);
-  std::cerr << "export " << scene->name << ": " << bodies.size() << " bodies, " << rods.size()
-            << " rods, " << n << " samples at " << o.fps << " fps (" << data.size()
-            << " bytes) in " << o.out << "\n";
+  return bytes.str();
+}
+
+// Builds the model (bodies, rods, camera), steps the run through the samples, writes the file
+// under the output rule and prints what it holds on stderr. Throws std::runtime_error.
+int execute_export(const ExportOptions& o, ExportPlan& plan) {
+  const scenes::Scene& scene = *plan.scene;
+  const World& world = plan.run.world;
+  const DrawStyle style = resolve_style(scene, world, View{}, static_cast<float>(kAspect));
+
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = std::string("cps export ") + engine_version();
+  Builder build(model);
+  tinygltf::Scene gscene;
+  gscene.name = std::string(scene.name);
+  add_body_nodes(scene, world, style, model, build, gscene);
+  const int first_rod_node = add_rod_nodes(world, style, model, build, gscene);
+  add_camera_node(style, model, gscene);
+
+  const Samples samples = sample_run(plan, o.fps, o.scene);
+  add_animation(samples, first_rod_node, std::string(scene.name), model, build);
+  model.scenes.push_back(std::move(gscene));
+  model.defaultScene = 0;
+
+  const std::string data = glb_bytes(model, o.out);
+  begin_output(plan.output, plan.info);
+  write_file_atomic(plan.path, std::span(reinterpret_cast<const std::uint8_t*>(data.data()), data.size()));
+  end_output(plan.output, plan.info);
+  std::cerr << "export " << scene.name << ": " << world.bodies().size() << " bodies, "
+            << world.distances().size() << " rods, " << plan.samples << " samples at " << o.fps
+            << " fps (" << data.size() << " bytes) in " << o.out << "\n";
   return 0;
+}
+
+int run_export(const ExportOptions& o, int argc, char** argv) {
+  ExportPlan plan = plan_export(o, argc, argv);
+  return execute_export(o, plan);
 }
 
 }  // namespace

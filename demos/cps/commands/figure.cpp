@@ -271,118 +271,166 @@ struct FigureOptions {
   std::string backend = "osmesa";
 };
 
+// A figure as planned: what it shows and the file it goes to (its sidecar beside it).
+struct PlannedFigure {
+  FigureSpec spec;
+  fs::path png;
+};
+
+// A figure run as planned: the panel size, the figures (five for 'paper', else one), their
+// folder's plan (plan_output) and its run.json; everything checked, nothing written.
+struct FigurePlan {
+  PixelSize size;
+  std::vector<PlannedFigure> figures;
+  OutputPlan output;
+  nlohmann::json info;
+};
+
+// What every figure of the run shares: the panel size, view, labels and format (png unless
+// --format says; a scene's figure may take it from --out's extension).
+FigureSpec base_spec(const FigureOptions& o, const PixelSize& size, std::optional<FigureFormat> format,
+                     const scenes::Scene* scene) {
+  FigureSpec spec;
+  spec.scene = scene;
+  spec.panel_width = size.width;
+  spec.panel_height = size.height;
+  spec.view = o.view;
+  spec.label = o.label;
+  spec.format = format.value_or(FigureFormat::png);
+  return spec;
+}
+
+// `cps figure paper`: the paper_figures, each with its own times, comparison and camera preset,
+// into --out (default out/figures) as FILE.EXT. Throws UsageError if --times, --compare or
+// --overlay is given.
+std::vector<PlannedFigure> plan_paper_figures(const FigureOptions& o, const PixelSize& size,
+                                              std::optional<FigureFormat> format) {
+  if (!o.times.empty() || !o.compare.empty() || o.overlay) {
+    throw UsageError("cps figure paper chooses its own --times, --compare and --overlay for "
+                     "each figure; drop them, or name a scene (e.g. cps figure "
+                     "intersecting_stack --times 0,0.5 --compare push)");
+  }
+  const fs::path folder = o.out.empty() ? fs::path("out/figures") : fs::path(o.out);
+  std::vector<PlannedFigure> figures;
+  for (const PaperFigure& f : paper_figures()) {
+    FigureSpec spec = base_spec(o, size, format, select_scenes(f.scene).front());
+    spec.times = f.times;
+    spec.compare = f.compare;
+    spec.comparison = parse_comparison(f.compare, o.overrides);
+    spec.variants = comparison_variants(spec.comparison, o.overrides);
+    spec.caption = f.caption + " counterpart";
+    spec.view.preset = f.preset;
+    spec.what = f.what;
+    figures.push_back({spec, folder / (f.file + std::string(figure_extension(spec.format)))});
+  }
+  return figures;
+}
+
+// The file of a scene's figure: --out, or out/figures/SCENE[-compare-...][-overlay].EXT. Sets
+// spec.format: --format, else the format --out's extension names (.pdf, .svg), else png. Throws
+// UsageError if --out's extension is not the format's.
+fs::path figure_file(const FigureOptions& o, std::optional<FigureFormat> format, FigureSpec& spec) {
+  if (!format && !o.out.empty()) {
+    // No --format: the format --out's extension names.
+    const std::string ext = fs::path(o.out).extension().string();
+    if (ext == ".pdf") format = FigureFormat::pdf;
+    if (ext == ".svg") format = FigureFormat::svg;
+  }
+  spec.format = format.value_or(FigureFormat::png);
+  const std::string ext(figure_extension(spec.format));
+  const fs::path file =
+      o.out.empty()
+          ? fs::path("out/figures") / (o.scene + comparison_suffix(spec.comparison, o.overlay) + ext)
+          : fs::path(o.out);
+  if (file.extension() != ext) {
+    throw UsageError("--out " + file.string() + ": the figure is a " + ext.substr(1) +
+                     " file (--format " + ext.substr(1) + "); give a name ending in " + ext +
+                     (format ? "" : ", or --format pdf or svg for a name ending in .pdf or .svg"));
+  }
+  return file;
+}
+
+// `cps figure SCENE`: one figure of --times, a row per --compare variant (one with --overlay).
+// Throws UsageError for a bad scene, 'all' or 'stress', no --times, --overlay without --compare,
+// or a bad --times, --compare or --out.
+PlannedFigure plan_scene_figure(const FigureOptions& o, const PixelSize& size,
+                                std::optional<FigureFormat> format) {
+  const std::vector<const scenes::Scene*> chosen = select_scenes(o.scene);
+  if (o.scene == "all" || o.scene == "stress") {
+    throw UsageError("figure takes one scene or 'paper', not '" + o.scene + "'");
+  }
+  if (o.times.empty()) {
+    throw UsageError("--times is required: the simulated times (s) of the columns, e.g. "
+                     "--times 0,0.5,2");
+  }
+  if (o.overlay && o.compare.empty()) {
+    throw UsageError("--overlay draws the variants of --compare in one view; give --compare "
+                     "too (e.g. --compare push --overlay)");
+  }
+  FigureSpec spec = base_spec(o, size, format, chosen.front());
+  spec.times = parse_times(o.times);
+  spec.compare = o.compare;
+  spec.comparison = parse_comparison(o.compare, o.overrides);
+  spec.variants = comparison_variants(spec.comparison, o.overrides);
+  spec.overlay = o.overlay;
+  fs::path file = figure_file(o, format, spec);
+  return {spec, file};
+}
+
+// Bounds a figure's work before anything is written: each variant's physics steps to the last
+// time (check_steps), its view (an --eye on the target; "fit" frames as built here, so this costs
+// no pre-run), and the panels' grid at most 16384 pixels a side (the caption strips add a few
+// lines of text per row). Throws UsageError.
+void check_figure_work(const PlannedFigure& p, const PixelSize& size) {
+  for (const Variant& v : p.spec.variants) {
+    const scenes::Run run = make_run_or_usage_error(*p.spec.scene, v.overrides);
+    check_steps(std::string(p.spec.scene->name), p.spec.times.back(), run.world.def().dt);
+    resolve_style(*p.spec.scene, run.world, p.spec.view,
+                  static_cast<float>(size.width) / static_cast<float>(size.height));
+  }
+  const long long w = static_cast<long long>(p.spec.times.size()) * size.width;
+  const long long h = static_cast<long long>(p.spec.overlay ? 1 : p.spec.variants.size()) * size.height;
+  if (w > 16384 || h > 16384) {
+    throw UsageError("the figure would be " + std::to_string(w) + "x" + std::to_string(h) +
+                     " pixels (more than 16384 on a side); give fewer --times or a "
+                     "smaller --size");
+  }
+}
+
 // Everything is checked (scene, times, size, variants, output files) before anything is
-// rendered or written.
-int run_figure(const FigureOptions& o, int argc, char** argv) {
-  const PixelSize size = parse_size(o.size);
+// rendered or written. Throws UsageError.
+FigurePlan plan_figure(const FigureOptions& o, int argc, char** argv) {
+  FigurePlan plan;
+  plan.size = parse_size(o.size);
   std::optional<FigureFormat> format;
   if (!o.format.empty()) format = parse_figure_format(o.format);
-  struct Planned {
-    FigureSpec spec;
-    fs::path png;
-  };
-  std::vector<Planned> plan;
-  const auto base_spec = [&](const scenes::Scene* scene) {
-    FigureSpec spec;
-    spec.scene = scene;
-    spec.panel_width = size.width;
-    spec.panel_height = size.height;
-    spec.view = o.view;
-    spec.label = o.label;
-    spec.format = format.value_or(FigureFormat::png);
-    return spec;
-  };
   if (o.scene == "paper") {
-    if (!o.times.empty() || !o.compare.empty() || o.overlay) {
-      throw UsageError("cps figure paper chooses its own --times, --compare and --overlay for "
-                       "each figure; drop them, or name a scene (e.g. cps figure "
-                       "intersecting_stack --times 0,0.5 --compare push)");
-    }
-    const fs::path folder = o.out.empty() ? fs::path("out/figures") : fs::path(o.out);
-    for (const PaperFigure& f : paper_figures()) {
-      FigureSpec spec = base_spec(select_scenes(f.scene).front());
-      spec.times = f.times;
-      spec.compare = f.compare;
-      spec.comparison = parse_comparison(f.compare, o.overrides);
-      spec.variants = comparison_variants(spec.comparison, o.overrides);
-      spec.caption = f.caption + " counterpart";
-      spec.view.preset = f.preset;
-      spec.what = f.what;
-      plan.push_back({spec, folder / (f.file + std::string(figure_extension(spec.format)))});
-    }
+    plan.figures = plan_paper_figures(o, plan.size, format);
   } else {
-    const std::vector<const scenes::Scene*> chosen = select_scenes(o.scene);
-    if (o.scene == "all" || o.scene == "stress") {
-      throw UsageError("figure takes one scene or 'paper', not '" + o.scene + "'");
-    }
-    if (o.times.empty()) {
-      throw UsageError("--times is required: the simulated times (s) of the columns, e.g. "
-                       "--times 0,0.5,2");
-    }
-    if (o.overlay && o.compare.empty()) {
-      throw UsageError("--overlay draws the variants of --compare in one view; give --compare "
-                       "too (e.g. --compare push --overlay)");
-    }
-    FigureSpec spec = base_spec(chosen.front());
-    spec.times = parse_times(o.times);
-    spec.compare = o.compare;
-    spec.comparison = parse_comparison(o.compare, o.overrides);
-    spec.variants = comparison_variants(spec.comparison, o.overrides);
-    spec.overlay = o.overlay;
-    if (!format && !o.out.empty()) {
-      // No --format: the format --out's extension names.
-      const std::string ext = fs::path(o.out).extension().string();
-      if (ext == ".pdf") format = FigureFormat::pdf;
-      if (ext == ".svg") format = FigureFormat::svg;
-    }
-    spec.format = format.value_or(FigureFormat::png);
-    const std::string ext(figure_extension(spec.format));
-    const fs::path file =
-        o.out.empty()
-            ? fs::path("out/figures") / (o.scene + comparison_suffix(spec.comparison, o.overlay) + ext)
-            : fs::path(o.out);
-    if (file.extension() != ext) {
-      throw UsageError("--out " + file.string() + ": the figure is a " + ext.substr(1) +
-                       " file (--format " + ext.substr(1) + "); give a name ending in " + ext +
-                       (format ? "" : ", or --format pdf or svg for a name ending in .pdf or .svg"));
-    }
-    plan.push_back({spec, file});
+    plan.figures.push_back(plan_scene_figure(o, plan.size, format));
   }
-  for (const Planned& p : plan) {
-    for (const Variant& v : p.spec.variants) {
-      const scenes::Run run = make_run_or_usage_error(*p.spec.scene, v.overrides);
-      check_steps(std::string(p.spec.scene->name), p.spec.times.back(), run.world.def().dt);
-      // The view is checked (an --eye on the target) before anything is written; "fit" frames
-      // as built here, so this costs no pre-run.
-      resolve_style(*p.spec.scene, run.world, p.spec.view,
-                    static_cast<float>(size.width) / static_cast<float>(size.height));
-    }
-    // The panels alone; the caption strips add a few lines of text per row.
-    const long long w = static_cast<long long>(p.spec.times.size()) * size.width;
-    const long long h =
-        static_cast<long long>(p.spec.overlay ? 1 : p.spec.variants.size()) * size.height;
-    if (w > 16384 || h > 16384) {
-      throw UsageError("the figure would be " + std::to_string(w) + "x" + std::to_string(h) +
-                       " pixels (more than 16384 on a side); give fewer --times or a "
-                       "smaller --size");
-    }
-  }
+  for (const PlannedFigure& p : plan.figures) check_figure_work(p, plan.size);
   // The figures' folder collects figures of many runs (output.h, FolderUse::shared): each PNG
   // and its sidecar are checked before anything is rendered.
-  const fs::path folder = plan.front().png.parent_path();
+  const fs::path folder = plan.figures.front().png.parent_path();
   std::vector<std::string> files;
   nlohmann::json names = nlohmann::json::array();
-  for (const Planned& p : plan) {
+  for (const PlannedFigure& p : plan.figures) {
     files.push_back(p.png.filename().string());
     files.push_back(sidecar_path(p.png).filename().string());
     names.push_back(p.png.filename().string());
   }
-  const OutputPlan output = plan_output(folder, files, o.force, FolderUse::shared);
-  const nlohmann::json info =
-      run_info("figure", argc, argv, {{"scene", o.scene}, {"figures", names}});
-  render::Renderer renderer(size.width, size.height, *render::parse_backend(o.backend));
-  begin_output(output, info);
-  for (const Planned& p : plan) {
+  plan.output = plan_output(folder, files, o.force, FolderUse::shared);
+  plan.info = run_info("figure", argc, argv, {{"scene", o.scene}, {"figures", names}});
+  return plan;
+}
+
+// Renders and writes each planned figure and its sidecar, printing its size. Throws
+// std::runtime_error from the renderer or a write.
+int execute_figure(const FigureOptions& o, const FigurePlan& plan, int argc, char** argv) {
+  render::Renderer renderer(plan.size.width, plan.size.height, *render::parse_backend(o.backend));
+  begin_output(plan.output, plan.info);
+  for (const PlannedFigure& p : plan.figures) {
     const ComposedFigure figure = render_figure(p.spec, renderer);
     write_figure(p.png, compose_page(figure.page, p.spec.format, figure.layout),
                  figure_json(p.spec, figure.layout, argc, argv));
@@ -390,8 +438,13 @@ int run_figure(const FigureOptions& o, int argc, char** argv) {
                 figure.layout.height, p.spec.format == FigureFormat::png ? "pixels" : "points",
                 p.spec.times.size(), p.spec.variants.size(), sidecar_path(p.png).filename().c_str());
   }
-  end_output(output, info);
+  end_output(plan.output, plan.info);
   return 0;
+}
+
+int run_figure(const FigureOptions& o, int argc, char** argv) {
+  const FigurePlan plan = plan_figure(o, argc, argv);
+  return execute_figure(o, plan, argc, argv);
 }
 
 }  // namespace

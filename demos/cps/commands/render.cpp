@@ -177,6 +177,8 @@ long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, cons
 
 namespace {
 
+namespace fs = std::filesystem;
+
 // The options of `cps render`.
 struct RenderOptions {
   std::string scene;
@@ -195,142 +197,319 @@ struct RenderOptions {
   bool label = false;
 };
 
-// Everything is checked (scenes, size, variants, camera, output folders) before anything is
-// written.
-int run_render(const RenderOptions& o, int argc, char** argv) {
-  namespace fs = std::filesystem;
-  const PixelSize size = parse_size(o.size);
-  const std::vector<const scenes::Scene*> selected = select_scenes(o.scene);
-  const Comparison comparison = parse_comparison(o.compare, o.overrides);
-  const std::vector<Variant> variants = comparison_variants(comparison, o.overrides);
-  if (o.overlay && o.compare.empty()) {
-    throw UsageError("--overlay draws the variants of --compare in one view; give --compare too "
-                     "(e.g. --compare push --overlay)");
-  }
-  // The variants' panels in a grid of rows x columns that fills --size (one panel for
-  // --overlay); each panel at least 16x16 pixels.
+// One scene of a render as planned: a run and a caption label per variant, its frames, where
+// its panels lie in a frame, its camera and its frames folder, checked.
+struct SceneRender {
+  const scenes::Scene* scene = nullptr;
+  std::vector<scenes::Run> runs;
+  std::vector<std::string> labels;  // per variant: its caption's label
+  RenderJob spec;                   // seconds, fps, speed, folder, grid, frame size, legend
+  std::pair<int, int> scene_px;     // the scene's size in each panel (frame_layout)
+  nlohmann::json panels_px = nlohmann::json::array();  // each panel's [x, y, width, height] in a frame
+  DrawStyle style;                  // the same camera for the whole sequence
+  OutputPlan output;                // the frames folder
+};
+
+// A render as planned: every option, scene, variant, work bound and output checked, nothing
+// written. With --video, ffmpeg (none if not on PATH) and the videos' plan in OUT/ with its
+// run.json.
+struct RenderPlan {
+  PixelSize size;
+  Comparison comparison;
+  std::vector<Variant> variants;
+  Grid grid;  // the variants' panels in a frame ({1, 1} with --overlay)
+  std::vector<SceneRender> scenes;
+  std::optional<fs::path> ffmpeg;
+  std::optional<OutputPlan> video_output;
+  nlohmann::json video_info;
+};
+
+// The variants' panels in a grid of rows x columns that fills --size (one panel for
+// --overlay). Throws UsageError if a panel would be smaller than 16x16 pixels.
+Grid plan_grid(const RenderOptions& o, const PixelSize& size, std::size_t variants) {
   const Grid grid = o.overlay ? Grid{1, 1}
-                              : grid_layout(variants.size(), static_cast<double>(size.width) / size.height);
+                              : grid_layout(variants, static_cast<double>(size.width) / size.height);
   const int panel_width = size.width / grid.columns;
   const int panel_height = size.height / grid.rows;
   if (panel_width < 16 || panel_height < 16) {
     throw UsageError("--size " + o.size + ": --compare " + o.compare + " lays " +
-                     std::to_string(variants.size()) + " panels out as " +
+                     std::to_string(variants) + " panels out as " +
                      std::to_string(grid.rows) + " x " + std::to_string(grid.columns) + ", each " +
                      std::to_string(panel_width) + "x" + std::to_string(panel_height) +
                      " pixels; a panel needs at least 16x16: give a larger --size");
   }
-  struct Job {
-    const scenes::Scene* scene;
-    std::vector<scenes::Run> runs;
-    std::vector<std::string> labels;  // per variant: its caption's label
-    std::pair<int, int> scene_px;     // the scene's size in each panel (frame_layout)
-    nlohmann::json panels_px = nlohmann::json::array();  // each panel's [x, y, width, height] in a frame
-    DrawStyle style;                  // the same camera for the whole sequence
-  };
-  std::vector<Job> jobs;
-  for (const scenes::Scene* s : selected) {
-    Job job{s, {}, {}, {}, nlohmann::json::array(), {}};
-    for (const Variant& v : variants) {
-      job.runs.push_back(make_run_or_usage_error(*s, v.overrides));
-      // --overlay: the legend names the variants; the label, the scene (with --label).
-      std::string label = o.overlay ? "" : v.label;
-      if (o.label) label = std::string(s->name) + (label.empty() ? "" : "\n" + label);
-      job.labels.push_back(label);
-    }
-    jobs.push_back(std::move(job));
+  return grid;
+}
+
+// A scene's runs, one per variant, and their caption labels. Throws UsageError for parameters
+// the world refuses.
+SceneRender scene_runs(const RenderOptions& o, const scenes::Scene& scene,
+                       const std::vector<Variant>& variants) {
+  SceneRender job;
+  job.scene = &scene;
+  for (const Variant& v : variants) {
+    job.runs.push_back(make_run_or_usage_error(scene, v.overrides));
+    // --overlay: the legend names the variants; the label, the scene (with --label).
+    std::string label = o.overlay ? "" : v.label;
+    if (o.label) label = std::string(scene.name) + (label.empty() ? "" : "\n" + label);
+    job.labels.push_back(label);
   }
-  // --video: ffmpeg is looked for before rendering; without it the frames are still
-  // rendered and kept, and the command ends with an error saying how to finish the video.
-  std::optional<fs::path> ffmpeg;
-  std::vector<VideoJob> videos_left;
-  if (!o.video.empty()) {
-    ffmpeg = find_on_path("ffmpeg");
-    if (!ffmpeg) {
-      std::fprintf(stderr,
-                   "cps: warning: --video %s: ffmpeg is not on PATH; the frames will be "
-                   "rendered and kept, but no video made (install it: apt-get install ffmpeg)\n",
-                   o.video.c_str());
-    }
+  return job;
+}
+
+// --video: ffmpeg is looked for before rendering; without it a warning on stderr says that the
+// frames are still rendered and kept (the command then ends with an error saying how to finish
+// the video). None without --video.
+std::optional<fs::path> look_for_ffmpeg(const RenderOptions& o) {
+  if (o.video.empty()) return std::nullopt;
+  std::optional<fs::path> ffmpeg = find_on_path("ffmpeg");
+  if (!ffmpeg) {
+    std::fprintf(stderr,
+                 "cps: warning: --video %s: ffmpeg is not on PATH; the frames will be "
+                 "rendered and kept, but no video made (install it: apt-get install ffmpeg)\n",
+                 o.video.c_str());
   }
+  return ffmpeg;
+}
+
+// The frames of one scene: its duration (s), fps, speed, folder OUT/SCENE[-compare-...], and
+// the plan's grid filling as much of --size as divides among its cells.
+RenderJob frames_spec(const RenderOptions& o, const RenderPlan& plan, const scenes::Scene& scene) {
+  RenderJob spec;
+  spec.seconds = o.seconds.value_or(scene.default_seconds);
+  spec.fps = o.fps;
+  spec.speed = o.speed;
+  spec.folder = fs::path(o.out) / (std::string(scene.name) + comparison_suffix(plan.comparison, o.overlay));
+  spec.columns = plan.grid.columns;
+  spec.frame_width = plan.size.width / plan.grid.columns * plan.grid.columns;
+  spec.frame_height = plan.size.height / plan.grid.rows * plan.grid.rows;
+  spec.overlay = o.overlay;
+  if (o.overlay) {
+    spec.legend_heading = legend_heading(plan.comparison);
+    spec.legend = overlay_legend(plan.variants);
+  }
+  return spec;
+}
+
+// The work is bounded before anything is drawn or written: each run's physics steps
+// (check_steps), the frames (kMaxFrames) and the pixels drawn (kMaxPixelBytes, 3 bytes a pixel
+// of --size). Throws UsageError.
+void check_render_work(const RenderOptions& o, const PixelSize& size, const SceneRender& job) {
+  const std::string name(job.scene->name);
+  for (const scenes::Run& run : job.runs) check_steps(name, job.spec.seconds, run.world.def().dt);
+  const long long frames = frame_count(job.spec);
+  if (static_cast<double>(frames) > kMaxFrames) {
+    throw UsageError(name + ": " + std::to_string(frames) +
+                     " frames (--seconds x --fps / --speed) is more than the " +
+                     std::to_string(static_cast<long long>(kMaxFrames)) +
+                     " frames a render may write; give fewer --seconds or a lower --fps");
+  }
+  const double pixel_bytes = static_cast<double>(frames) * size.width * size.height * 3.0;
+  if (pixel_bytes > kMaxPixelBytes) {
+    throw UsageError(name + ": " + std::to_string(frames) + " frames of " + o.size + " pixels is " +
+                     std::to_string(static_cast<long long>(pixel_bytes / 1073741824.0)) +
+                     " GiB of pixels, more than the 64 GiB a render may draw; give fewer frames "
+                     "or a smaller --size");
+  }
+}
+
+// Sets job.scene_px and job.panels_px (the first `panels`, not a grid's empty cells) from
+// frame_layout: the caption strips (labels, time, legend) lie outside the scene, and what they
+// leave of each panel is where the scene is drawn. Throws UsageError if that is less than 16x16.
+void place_panels(const RenderOptions& o, std::size_t panels, SceneRender& job) {
+  const PageLayout frame = frame_layout(job.spec, job.labels);
+  job.scene_px = {frame.panels.front().width, frame.panels.front().height};
+  for (std::size_t k = 0; k < panels; ++k) {
+    const PageLayout::Rect& r = frame.panels[k];
+    job.panels_px.push_back({r.x, r.y, r.width, r.height});
+  }
+  if (job.scene_px.first < 16 || job.scene_px.second < 16) {
+    throw UsageError("--size " + o.size + ": the caption strips below the scene (its label, the time" +
+                     std::string(o.overlay ? " and the legend" : "") + ") leave it " +
+                     std::to_string(std::max(0, job.scene_px.first)) + "x" +
+                     std::to_string(std::max(0, job.scene_px.second)) +
+                     " pixels of each panel; a scene needs at least 16x16: give a larger --size" +
+                     std::string(o.label ? " or leave out --label" : ""));
+  }
+}
+
+// Plans one scene's frames: what they are, the work bound, the panels, the camera (resolve_style
+// at the scene's aspect) and the frames folder (plan_output: its foreign files). Throws
+// UsageError.
+void plan_scene(const RenderOptions& o, const RenderPlan& plan, SceneRender& job) {
+  job.spec = frames_spec(o, plan, *job.scene);
+  check_render_work(o, plan.size, job);
+  place_panels(o, o.overlay ? 1 : plan.variants.size(), job);
+  std::vector<const World*> worlds;
+  for (const scenes::Run& run : job.runs) worlds.push_back(&run.world);
+  job.style = resolve_style(*job.scene, worlds, o.view,
+                            static_cast<float>(job.scene_px.first) / static_cast<float>(job.scene_px.second),
+                            job.spec.seconds);
+  const long long frames = frame_count(job.spec);
+  std::vector<std::string> files;
+  files.reserve(static_cast<std::size_t>(frames));
+  for (long long k = 0; k < frames; ++k) files.push_back(frame_name(k));
+  job.output = plan_output(job.spec.folder, std::move(files), o.force);
+}
+
+// --video: the videos go to OUT/, beside the frames folders, which holds other files too (other
+// scenes' videos, whatever the user keeps there): only the videos are checked (FolderUse::shared).
+void plan_videos(const RenderOptions& o, int argc, char** argv, RenderPlan& plan) {
+  if (o.video.empty()) return;
+  std::vector<std::string> names;
+  nlohmann::json folders = nlohmann::json::array();
+  for (const SceneRender& job : plan.scenes) {
+    names.push_back(job.spec.folder.filename().string() + "." + o.video);
+    folders.push_back(job.spec.folder.filename().string());
+  }
+  plan.video_output = plan_output(fs::path(o.out), names, o.force, FolderUse::shared);
+  plan.video_info = run_info("render", argc, argv,
+                             {{"video", o.video}, {"fps", o.fps}, {"frames_folders", folders}});
+}
+
+// Everything is checked (scenes, size, variants, camera, work, output folders) before anything
+// is written; only the warning of look_for_ffmpeg is printed. Throws UsageError.
+RenderPlan plan_render(const RenderOptions& o, int argc, char** argv) {
+  RenderPlan plan;
+  plan.size = parse_size(o.size);
+  const std::vector<const scenes::Scene*> selected = select_scenes(o.scene);
+  plan.comparison = parse_comparison(o.compare, o.overrides);
+  plan.variants = comparison_variants(plan.comparison, o.overrides);
+  if (o.overlay && o.compare.empty()) {
+    throw UsageError("--overlay draws the variants of --compare in one view; give --compare too "
+                     "(e.g. --compare push --overlay)");
+  }
+  plan.grid = plan_grid(o, plan.size, plan.variants.size());
+  for (const scenes::Scene* s : selected) plan.scenes.push_back(scene_runs(o, *s, plan.variants));
+  plan.ffmpeg = look_for_ffmpeg(o);
   // Every output folder is checked (foreign files, see output.h) before any is written.
-  std::vector<RenderJob> specs;
-  std::vector<OutputPlan> plans;
-  for (Job& job : jobs) {
-    RenderJob spec;
-    spec.seconds = o.seconds.value_or(job.scene->default_seconds);
-    spec.fps = o.fps;
-    spec.speed = o.speed;
-    spec.folder = fs::path(o.out) /
-                  (std::string(job.scene->name) + comparison_suffix(comparison, o.overlay));
-    spec.columns = grid.columns;
-    spec.frame_width = panel_width * grid.columns;
-    spec.frame_height = panel_height * grid.rows;
-    spec.overlay = o.overlay;
-    if (o.overlay) {
-      spec.legend_heading = legend_heading(comparison);
-      spec.legend = overlay_legend(variants);
-    }
-    // The work is bounded before anything is drawn or written: steps, frames and pixels.
-    for (const scenes::Run& run : job.runs) {
-      check_steps(std::string(job.scene->name), spec.seconds, run.world.def().dt);
-    }
-    const long long frames = frame_count(spec);
-    if (static_cast<double>(frames) > kMaxFrames) {
-      throw UsageError(std::string(job.scene->name) + ": " + std::to_string(frames) +
-                       " frames (--seconds x --fps / --speed) is more than the " +
-                       std::to_string(static_cast<long long>(kMaxFrames)) +
-                       " frames a render may write; give fewer --seconds or a lower --fps");
-    }
-    const double pixel_bytes = static_cast<double>(frames) * size.width * size.height * 3.0;
-    if (pixel_bytes > kMaxPixelBytes) {
-      throw UsageError(std::string(job.scene->name) + ": " + std::to_string(frames) + " frames of " +
-                       o.size + " pixels is " + std::to_string(static_cast<long long>(pixel_bytes / 1073741824.0)) +
-                       " GiB of pixels, more than the 64 GiB a render may draw; give fewer frames "
-                       "or a smaller --size");
-    }
-    // The caption strips (labels, time, legend) lie outside the scene: what they leave of each
-    // panel is where the scene is drawn.
-    const PageLayout frame = frame_layout(spec, job.labels);
-    job.scene_px = {frame.panels.front().width, frame.panels.front().height};
-    for (std::size_t k = 0; k < (o.overlay ? 1 : variants.size()); ++k) {  // not a grid's empty cells
-      const PageLayout::Rect& r = frame.panels[k];
-      job.panels_px.push_back({r.x, r.y, r.width, r.height});
-    }
-    if (job.scene_px.first < 16 || job.scene_px.second < 16) {
-      throw UsageError("--size " + o.size + ": the caption strips below the scene (its label, the time" +
-                       std::string(o.overlay ? " and the legend" : "") + ") leave it " +
-                       std::to_string(std::max(0, job.scene_px.first)) + "x" +
-                       std::to_string(std::max(0, job.scene_px.second)) +
-                       " pixels of each panel; a scene needs at least 16x16: give a larger --size" +
-                       std::string(o.label ? " or leave out --label" : ""));
-    }
-    std::vector<const World*> worlds;
-    for (const scenes::Run& run : job.runs) worlds.push_back(&run.world);
-    job.style = resolve_style(*job.scene, worlds, o.view,
-                              static_cast<float>(job.scene_px.first) / static_cast<float>(job.scene_px.second),
-                              spec.seconds);
-    std::vector<std::string> files;
-    files.reserve(static_cast<std::size_t>(frames));
-    for (long long k = 0; k < frames; ++k) files.push_back(frame_name(k));
-    plans.push_back(plan_output(spec.folder, std::move(files), o.force));
-    specs.push_back(spec);
+  for (SceneRender& job : plan.scenes) plan_scene(o, plan, job);
+  plan_videos(o, argc, argv, plan);
+  return plan;
+}
+
+// run.json's "world" of a scene's frames: per variant its label, overlay colour (--overlay, else
+// null), overrides and world parameters.
+nlohmann::json variants_json(const RenderOptions& o, const RenderPlan& plan, const SceneRender& job) {
+  nlohmann::json world = nlohmann::json::array();
+  for (std::size_t v = 0; v < plan.variants.size(); ++v) {
+    world.push_back({{"label", plan.variants[v].label},
+                     {"overlay_colour_srgb", o.overlay ? nlohmann::json(overlay_colour(v))
+                                                       : nlohmann::json(nullptr)},
+                     {"overrides", overrides_json(plan.variants[v].overrides)},
+                     {"parameters", parameters_json(job.runs[v].world.def())}});
   }
-  // --video: the videos go to OUT/, beside the frames folders, which holds other files too
-  // (other scenes' videos, whatever the user keeps there): only the videos are checked.
-  std::optional<OutputPlan> video_plan;
-  nlohmann::json video_info;
-  if (!o.video.empty()) {
-    std::vector<std::string> names;
-    nlohmann::json folders = nlohmann::json::array();
-    for (const RenderJob& spec : specs) {
-      names.push_back(spec.folder.filename().string() + "." + o.video);
-      folders.push_back(spec.folder.filename().string());
-    }
-    video_plan = plan_output(fs::path(o.out), names, o.force, FolderUse::shared);
-    video_info = run_info("render", argc, argv,
-                          {{"video", o.video}, {"fps", o.fps}, {"frames_folders", folders}});
+  return world;
+}
+
+// The frame spacing notes of a scene's runs (frame_spacing_note; none when the frames fall on
+// physics steps), each also printed on stderr.
+nlohmann::json spacing_notes(const SceneRender& job) {
+  nlohmann::json notes = nlohmann::json::array();
+  for (const scenes::Run& run : job.runs) {
+    const std::string note = frame_spacing_note(job.spec, run.world.def().dt);
+    if (note.empty()) continue;
+    std::fprintf(stderr, "cps: note: %s: %s\n", job.scene->name.data(), note.c_str());
+    notes.push_back(note);
   }
+  return notes;
+}
+
+// The run.json of a scene's frames folder (run_info): the frames, size, comparison, layout in
+// pixels, view and overlays, and the variants' worlds.
+nlohmann::json frames_info(const RenderOptions& o, const RenderPlan& plan, const SceneRender& job,
+                           const nlohmann::json& notes, int argc, char** argv) {
+  const RenderJob& spec = job.spec;
+  const Overlays& overlays = o.view.overlays;
+  nlohmann::json layout = {{"frame_px", {spec.frame_width, spec.frame_height}}, {"panels_px", job.panels_px}};
+  if (o.overlay) {
+    layout["overlay"] = true;
+  } else {
+    layout["rows"] = plan.grid.rows;
+    layout["columns"] = plan.grid.columns;
+  }
+  return run_info(
+      "render", argc, argv,
+      {{"scene", job.scene->name},
+       {"seconds", spec.seconds},
+       {"fps", spec.fps},
+       {"speed", spec.speed},
+       {"frame_spacing_s", spec.speed / spec.fps},
+       {"frame_times", notes.empty() ? nlohmann::json("exact multiples of the physics step") : notes},
+       {"frames", frame_count(spec)},
+       {"size", {{"width", plan.size.width}, {"height", plan.size.height}}},
+       {"compare", comparison_json(plan.comparison, o.overlay)},
+       {"layout", layout},
+       {"backend", o.backend},
+       {"camera", o.view.camera},
+       {"camera_resolved", camera_json(job.style.camera)},
+       {"eye_m", o.view.eye ? nlohmann::json{o.view.eye->x(), o.view.eye->y(), o.view.eye->z()}
+                            : nlohmann::json(nullptr)},
+       {"target_m", o.view.target ? nlohmann::json{o.view.target->x(), o.view.target->y(), o.view.target->z()}
+                                  : nlohmann::json(nullptr)},
+       {"fov_y_deg", o.view.fov_y_deg ? nlohmann::json(*o.view.fov_y_deg) : nlohmann::json(nullptr)},
+       {"orbit_deg_per_s", overlays.orbit_deg_per_s},
+       {"contacts", overlays.contacts},
+       {"rods", overlays.rods},
+       {"label", o.label},
+       {"overrides", overrides_json(o.overrides)},
+       {"world", variants_json(o, plan, job)}});
+}
+
+// Makes `renderer` job's scene size on --backend unless it is already (one renderer serves
+// every scene whose captions leave the same size), and names its context on stderr.
+void fit_renderer(std::optional<render::Renderer>& renderer, const SceneRender& job,
+                  const std::string& backend) {
+  if (renderer && renderer->width() == job.scene_px.first && renderer->height() == job.scene_px.second) {
+    return;
+  }
+  renderer.reset();
+  renderer.emplace(job.scene_px.first, job.scene_px.second, *render::parse_backend(backend));
+  std::fprintf(stderr, "render: %s\n", renderer->context_description().c_str());
+}
+
+// Steps and draws a scene's frames into its folder (begin_output, render_frames, end_output)
+// and prints how many. Returns the number of frames.
+long long write_frames(const RenderOptions& o, const RenderPlan& plan, SceneRender& job,
+                       render::Renderer& renderer, render::PngWriter& writer, int argc, char** argv) {
+  std::vector<Panel> panels;
+  for (std::size_t v = 0; v < plan.variants.size(); ++v) panels.push_back({&job.runs[v], job.labels[v]});
+  const nlohmann::json notes = spacing_notes(job);
+  const nlohmann::json info = frames_info(o, plan, job, notes, argc, argv);
+  begin_output(job.output, info);
+  Progress progress("render " + job.spec.folder.filename().string(), frame_count(job.spec), "frames");
+  const long long frames = render_frames(job.style, panels, job.spec, renderer, writer, &progress);
+  end_output(job.output, info);
+  std::printf("%s: %lld frames in %s\n", job.spec.folder.filename().c_str(), frames, job.spec.folder.c_str());
+  return frames;
+}
+
+// --video: a scene's frames (at most kMaxFrames) assembled as OUT/FOLDER.FORMAT at --fps.
+VideoJob video_of(const RenderOptions& o, const RenderJob& spec, long long frames) {
+  VideoJob video;
+  video.format = *parse_video_format(o.video);
+  video.frames_folder = spec.folder;
+  video.frames = static_cast<int>(frames);
+  video.fps = o.fps;
+  video.width = spec.frame_width;
+  video.height = spec.frame_height;
+  video.output = fs::path(o.out) / (spec.folder.filename().string() + "." + o.video);
+  return video;
+}
+
+// Throws VideoError (the frames are kept) with the ffmpeg command line of each video left.
+[[noreturn]] void refuse_videos_left(const RenderOptions& o, const std::vector<VideoJob>& videos) {
+  std::string how;
+  for (const VideoJob& v : videos) how += "\n  " + shell_command(ffmpeg_arguments("ffmpeg", v, v.output));
+  throw VideoError("--video " + o.video +
+                   ": ffmpeg is not on PATH, so no video was made; install it "
+                   "(apt-get install ffmpeg). The frames are kept; to assemble them "
+                   "without rendering again, run:" + how);
+}
+
+// Renders the plan: each scene's frames, then its video (--video, when ffmpeg is there). Throws
+// VideoError after every scene's frames if ffmpeg is not, std::runtime_error on failure.
+int execute_render(const RenderOptions& o, RenderPlan& plan, int argc, char** argv) {
   // One renderer at the scene's size; another only when a scene's captions leave it another
   // size (--label with scene names of more lines).
   std::optional<render::Renderer> renderer;
@@ -339,102 +518,30 @@ int run_render(const RenderOptions& o, int argc, char** argv) {
   render::PngWriter writer(
       [](const fs::path& path, std::span<const std::uint8_t> bytes) { write_file_atomic(path, bytes); },
       1, 3);
-  if (video_plan && ffmpeg) begin_output(*video_plan, video_info);
-  for (std::size_t j = 0; j < jobs.size(); ++j) {
-    Job& job = jobs[j];
-    const RenderJob& spec = specs[j];
-    if (!renderer || renderer->width() != job.scene_px.first || renderer->height() != job.scene_px.second) {
-      renderer.reset();
-      renderer.emplace(job.scene_px.first, job.scene_px.second, *render::parse_backend(o.backend));
-      std::fprintf(stderr, "render: %s\n", renderer->context_description().c_str());
+  const bool videos = plan.video_output && plan.ffmpeg;
+  if (videos) begin_output(*plan.video_output, plan.video_info);
+  std::vector<VideoJob> videos_left;
+  for (SceneRender& job : plan.scenes) {
+    fit_renderer(renderer, job, o.backend);
+    const long long frames = write_frames(o, plan, job, *renderer, writer, argc, argv);
+    if (o.video.empty()) continue;
+    const VideoJob video = video_of(o, job.spec, frames);
+    if (!plan.ffmpeg) {
+      videos_left.push_back(video);
+      continue;
     }
-    std::vector<Panel> panels;
-    nlohmann::json world = nlohmann::json::array();
-    for (std::size_t v = 0; v < variants.size(); ++v) {
-      panels.push_back({&job.runs[v], job.labels[v]});
-      world.push_back({{"label", variants[v].label},
-                       {"overlay_colour_srgb", o.overlay ? nlohmann::json(overlay_colour(v))
-                                                         : nlohmann::json(nullptr)},
-                       {"overrides", overrides_json(variants[v].overrides)},
-                       {"parameters", parameters_json(job.runs[v].world.def())}});
-    }
-    nlohmann::json spacing_notes = nlohmann::json::array();
-    for (const scenes::Run& run : job.runs) {
-      const std::string note = frame_spacing_note(spec, run.world.def().dt);
-      if (note.empty()) continue;
-      std::fprintf(stderr, "cps: note: %s: %s\n", job.scene->name.data(), note.c_str());
-      spacing_notes.push_back(note);
-    }
-    const Overlays& overlays = o.view.overlays;
-    const nlohmann::json info = run_info(
-        "render", argc, argv,
-        {{"scene", job.scene->name},
-         {"seconds", spec.seconds},
-         {"fps", spec.fps},
-         {"speed", spec.speed},
-         {"frame_spacing_s", spec.speed / spec.fps},
-         {"frame_times", spacing_notes.empty() ? nlohmann::json("exact multiples of the physics step")
-                                               : nlohmann::json(spacing_notes)},
-         {"frames", frame_count(spec)},
-         {"size", {{"width", size.width}, {"height", size.height}}},
-         {"compare", comparison_json(comparison, o.overlay)},
-         {"layout", o.overlay ? nlohmann::json{{"overlay", true},
-                                               {"frame_px", {spec.frame_width, spec.frame_height}},
-                                               {"panels_px", job.panels_px}}
-                              : nlohmann::json{{"rows", grid.rows},
-                                               {"columns", grid.columns},
-                                               {"frame_px", {spec.frame_width, spec.frame_height}},
-                                               {"panels_px", job.panels_px}}},
-         {"backend", o.backend},
-         {"camera", o.view.camera},
-         {"camera_resolved", camera_json(job.style.camera)},
-         {"eye_m", o.view.eye ? nlohmann::json{o.view.eye->x(), o.view.eye->y(), o.view.eye->z()}
-                              : nlohmann::json(nullptr)},
-         {"target_m", o.view.target ? nlohmann::json{o.view.target->x(), o.view.target->y(), o.view.target->z()}
-                                    : nlohmann::json(nullptr)},
-         {"fov_y_deg", o.view.fov_y_deg ? nlohmann::json(*o.view.fov_y_deg) : nlohmann::json(nullptr)},
-         {"orbit_deg_per_s", overlays.orbit_deg_per_s},
-         {"contacts", overlays.contacts},
-         {"rods", overlays.rods},
-         {"label", o.label},
-         {"overrides", overrides_json(o.overrides)},
-         {"world", world}});
-    begin_output(plans[j], info);
-    Progress progress("render " + spec.folder.filename().string(), frame_count(spec), "frames");
-    const long long frames = render_frames(job.style, panels, spec, *renderer, writer, &progress);
-    end_output(plans[j], info);
-    const std::string folder = spec.folder.filename().string();
-    std::printf("%s: %lld frames in %s\n", folder.c_str(), frames, spec.folder.c_str());
-    if (!o.video.empty()) {
-      VideoJob video;
-      video.format = *parse_video_format(o.video);
-      video.frames_folder = spec.folder;
-      video.frames = static_cast<int>(frames);  // at most kMaxFrames
-      video.fps = o.fps;
-      video.width = spec.frame_width;
-      video.height = spec.frame_height;
-      video.output = fs::path(o.out) / (folder + "." + o.video);
-      if (!ffmpeg) {
-        videos_left.push_back(video);
-        continue;
-      }
-      encode_video(*ffmpeg, video);
-      std::printf("%s: video %s (%ju bytes)\n", folder.c_str(), video.output.c_str(),
-                  static_cast<std::uintmax_t>(fs::file_size(video.output)));
-    }
+    encode_video(*plan.ffmpeg, video);
+    std::printf("%s: video %s (%ju bytes)\n", job.spec.folder.filename().c_str(), video.output.c_str(),
+                static_cast<std::uintmax_t>(fs::file_size(video.output)));
   }
-  if (video_plan && ffmpeg) end_output(*video_plan, video_info);
-  if (!videos_left.empty()) {
-    std::string how;
-    for (const VideoJob& v : videos_left) {
-      how += "\n  " + shell_command(ffmpeg_arguments("ffmpeg", v, v.output));
-    }
-    throw VideoError("--video " + o.video +
-                     ": ffmpeg is not on PATH, so no video was made; install it "
-                     "(apt-get install ffmpeg). The frames are kept; to assemble them "
-                     "without rendering again, run:" + how);
-  }
+  if (videos) end_output(*plan.video_output, plan.video_info);
+  if (!videos_left.empty()) refuse_videos_left(o, videos_left);
   return 0;
+}
+
+int run_render(const RenderOptions& o, int argc, char** argv) {
+  RenderPlan plan = plan_render(o, argc, argv);
+  return execute_render(o, plan, argc, argv);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The cps command as a user runs it: exit codes, messages, and that bad input writes nothing.
 #include "cli_support.h"
 #include "push_methods.h"
+#include "report_csv.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -47,26 +48,9 @@ void expect_refused(const std::vector<Case>& cases, const fs::path& dir) {
   }
 }
 
-// The rows of a CSV file with a header line, each as column name -> cell ("" where empty).
+// The rows of a report CSV, each as column name -> cell ("" where empty).
 std::vector<std::map<std::string, std::string>> read_table(const fs::path& file) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  std::stringstream hs(line);
-  for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
-  std::vector<std::map<std::string, std::string>> rows;
-  while (std::getline(in, line)) {
-    std::stringstream ls(line);
-    std::map<std::string, std::string> row;
-    for (const std::string& c : header) {
-      std::string cell;
-      std::getline(ls, cell, ',');
-      row[c] = cell;
-    }
-    rows.push_back(row);
-  }
-  return rows;
+  return cli_test::read_report_csv(file).rows;
 }
 
 double value(const std::map<std::string, std::string>& row, const std::string& column) {

@@ -2,6 +2,7 @@
 // its physics (the paper's Fig. 7 point), and its refusals.
 #include "cli_support.h"
 #include "push_methods.h"
+#include "report_csv.h"
 
 #include <catch2/catch.hpp>
 
@@ -25,28 +26,6 @@ using cli_test::slurp;
 fs::path fresh_dir(const std::string& name) { return cli_test::fresh_dir("cps_cli_push_test_" + name); }
 
 using Table = std::vector<std::map<std::string, std::string>>;
-
-// The rows of a CSV file with a header line, each as column name -> cell.
-Table read_csv(const fs::path& file, std::vector<std::string>& header) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::stringstream hs(line);
-  header.clear();
-  for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
-  Table rows;
-  while (std::getline(in, line)) {
-    std::stringstream ls(line);
-    std::map<std::string, std::string> row;
-    for (const std::string& c : header) {
-      std::string cell;
-      std::getline(ls, cell, ',');
-      row[c] = cell;
-    }
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 // True if `text` is a finite number, as a whole.
 bool is_finite_number(const std::string& text) {
@@ -105,8 +84,9 @@ TEST_CASE("cps report push --quick compares every push method of the table: file
 
   // push.csv: one row per method per case, every column with its unit (or a name, not a
   // quantity), every measure a finite number or the documented "never" / "none".
-  std::vector<std::string> header;
-  const Table rows = read_csv(dir / "q" / "push.csv", header);
+  const cli_test::CsvRows csv = cli_test::read_report_csv(dir / "q" / "push.csv");
+  const std::vector<std::string>& header = csv.columns;
+  const Table& rows = csv.rows;
   const std::vector<std::string> cases = {"intersecting_stack", "sphere_in_box", "stack",
                                           "mass_ratio", "pendulum_grid", "pendulum_wave"};
   CHECK(rows.size() == methods.size() * cases.size());

@@ -3,7 +3,11 @@
 // table's order: cps::parameter("push").choices) on the same cases, each at the scene's own
 // settings with only push changed: the intersecting stack and sphere_in_box (overlaps resolved,
 // energy injected, final heights), the stack's drift, the mass ratios that hold, the pendulums'
-// rod and phase errors and the cost per step. Writes push.csv, push.md and two diagrams.
+// rod and phase errors and the cost per step (push_cases.h). Writes push.csv, push.md and two
+// diagrams.
+
+#include "report/csv.h"
+#include "report/push_cases.h"
 
 #include <nlohmann/json.hpp>
 
@@ -12,6 +16,10 @@
 #include <vector>
 
 namespace cps::cli {
+
+/// The scene argument of `cps report` that runs the push methods side by side instead of a
+/// sweep.
+inline constexpr const char* kPushReport = "push";
 
 /// The files `cps report push` writes into its output folder (plain names): push.csv, push.md,
 /// push_overlap.png (the largest overlap against time) and push_speed.png (the largest body
@@ -23,7 +31,13 @@ std::vector<std::string> push_report_files();
 /// (push_overlap.dat, .gp, push_speed.dat, .gp).
 std::vector<std::string> push_plot_files();
 
-/// Runs every push method on the cases (the full run; quick: the stack over 60 s instead of
+/// push.csv of these results: a row per method and case (intersecting_stack, sphere_in_box,
+/// stack, mass_ratio, pendulum_grid, pendulum_wave), columns with their unit as a suffix (_s,
+/// _m, _mps, _J, _rel, _deg; us_per_step: microseconds); "never" for a time not reached, "none"
+/// where no mass ratio held, "" where a column does not apply to the case.
+CsvTable push_table(const PushPlan& plan, const std::vector<MethodResults>& results);
+
+/// Runs every push method on the cases (plan_push_report; quick: the stack over 60 s instead of
 /// 600 s and the pendulum wave over 10 s instead of its 62 s) and writes push_report_files()
 /// into `out` and push_plot_files() into out/plots, both shared folders (output.h), with `info`
 /// (run_info) in their run.json. Every target is checked before any work: throws UsageError

@@ -1,0 +1,135 @@
+// `cps report`: the error against run time sweeps and the push methods side by side. The
+// options are read here; the work is the report library's (report/): sweep.h carries out the
+// sweeps, push_report.h the push methods.
+#include "command.h"
+
+#include "options/options.h"
+#include "output/output.h"
+#include "report/push_report.h"
+#include "report/sweep.h"
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <memory>
+
+namespace cps::cli {
+namespace {
+
+// The options of `cps report`.
+struct ReportOptions {
+  std::string scene = "all";
+  std::string out = "out/report";
+  bool quick = false;
+  bool list = false;
+  std::vector<std::string> merge;
+  std::string run;
+  bool force = false;
+};
+
+// The absolute path of this executable, for commands that must run anywhere.
+std::string self_path() {
+  char path[4096];
+  const ssize_t n = readlink("/proc/self/exe", path, sizeof path - 1);
+  if (n <= 0) return "cps";
+  path[n] = '\0';
+  return path;
+}
+
+// select_scenes for the report's scene argument: its error also names 'push'.
+std::vector<const scenes::Scene*> report_scenes(const std::string& name) {
+  try {
+    return select_scenes(name);
+  } catch (const UsageError& e) {
+    throw UsageError(std::string(e.what()) + "; cps report also takes '" + kPushReport +
+                     "' (every push method side by side: cps report push [--quick] [--out DIR])");
+  }
+}
+
+// `cps report push`: refuses the sweeps' options, then runs the push methods side by side.
+int run_push(const ReportOptions& o, const nlohmann::json& info) {
+  const char* sweep_only = !o.run.empty() ? "--run" : !o.merge.empty() ? "--merge"
+                           : o.list        ? "--list-runs" : nullptr;
+  if (sweep_only) {
+    throw UsageError(std::string("report push: ") + sweep_only +
+                     " applies to the sweeps (a scene, 'all' or 'stress'), not to the push "
+                     "methods side by side; cps report push takes --out, --quick and --force");
+  }
+  return run_push_report(o.out, o.quick, o.force, info);
+}
+
+int run_report(const ReportOptions& o, int argc, char** argv) {
+  nlohmann::json merged = nlohmann::json::array();
+  for (const std::string& m : o.merge) merged.push_back(m);
+  const nlohmann::json info = run_info(
+      "report", argc, argv,
+      {{"scene", o.scene}, {"quick", o.quick}, {"repeats", kTimingRepeats}, {"merge", merged},
+       {"run", o.run.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.run)}});
+  if (o.scene == kPushReport) return run_push(o, info);
+  const SweepOutput to{o.scene, o.quick, o.out, o.force, info};
+  if (!o.merge.empty()) return merge_report(to, {o.merge.begin(), o.merge.end()});
+  if (!o.run.empty()) {
+    const RunSpec spec = RunSpec::parse(o.run);
+    report_scenes(o.scene);  // the sweep it belongs to must be one
+    return run_one(to, spec);
+  }
+  const std::vector<const scenes::Scene*> scenes = report_scenes(o.scene);
+  if (o.list) {
+    for (const std::string& line : run_commands(self_path(), to, plan_runs(scenes, o.quick))) {
+      std::printf("%s\n", line.c_str());
+    }
+    return 0;
+  }
+  return run_sweep(to, scenes);
+}
+
+}  // namespace
+
+Command add_report(CLI::App& app, int argc, char** argv) {
+  auto o = std::make_shared<ReportOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "report", "error against run time: sweep solver settings, write CSV, plots, report.md; "
+                "'cps report push': every push method side by side (push.csv, push.md, plots)");
+  sub->add_option("scene", o->scene,
+                  "scene name, the path of a scene file (.json), 'all' (the paper's) or "
+                  "'stress'; with --run, the sweep the run belongs to; 'push': instead of a "
+                  "sweep, every push method (the choices of --push) on the same cases: the "
+                  "intersecting stack and sphere_in_box (overlaps resolved, energy injected, "
+                  "final heights), the stack over 600 s (60 s with --quick), the mass ratios "
+                  "that hold, the pendulums' rod and phase errors and the cost per step, into "
+                  "push.csv, push.md, push_overlap.png and push_speed.png in --out")
+      ->capture_default_str();
+  add_seed_option(*sub, o->scene);
+  sub->add_option("--out", o->out, "output folder")->capture_default_str()->check(kNotEmpty);
+  const std::size_t quick_runs = plan_runs(select_scenes("all"), true).size();
+  sub->add_flag("--quick", o->quick,
+                "a reduced sweep: iterations 1, 4, 16, 25, 64 and 4 substeps, fixed friction "
+                "only, Jacobi for the paper's push methods only, and warm-started PGS (warm "
+                "start 0.8 and 1) at iterations 1, 4, 16, 25 with Baumgarte push; each run "
+                "timed by the median of 3 timing runs as in the full sweep (the paper's five "
+                "scenes: " + std::to_string(quick_runs) + " runs; with the two push methods "
+                "baumgarte and split, 160 runs measured 63 s on 2 cores shared with other "
+                "jobs); with 'push': the stack over 60 s and the pendulum wave over 10 s");
+  CLI::Option* list = sub->add_flag("--list-runs", o->list,
+                "print one self-contained command per run, to spread the sweep over machines");
+  CLI::Option* merge = sub->add_option("--merge", o->merge,
+                  "combine the CSV files below these folders into one report in --out; if runs "
+                  "of the sweeps they belong to are missing, it names them on stderr, writes the "
+                  "report marked INCOMPLETE at the top (and in every diagram's title) and exits "
+                  "with 1")
+      ->check(kNotEmpty);
+  CLI::Option* run = sub->add_option("--run", o->run,
+                  "execute one run by its id (see --list-runs); the scene argument and --quick "
+                  "name the sweep it belongs to, recorded in its CSV for --merge")
+      ->check(kNotEmpty);
+  run->excludes(merge)->excludes(list);
+  merge->excludes(list);
+  sub->add_flag("--force", o->force,
+                "let the report replace files in --out that have the names of its own outputs "
+                "but that no earlier cps run wrote there (other files are never touched)");
+  return {sub, [o, argc, argv] { return run_report(*o, argc, argv); }};
+}
+
+}  // namespace cps::cli

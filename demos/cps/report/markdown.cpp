@@ -1,0 +1,331 @@
+#include "report/markdown.h"
+
+#include "report/mass_ratio.h"
+#include "report/run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace cps::cli {
+namespace {
+
+using Runs = std::vector<const RunResult*>;
+
+// The text of a run's column as its CSV has it; "" where the run has none.
+std::string text(const RunResult& r, std::string_view column) { return r.cell(column).value_or(""); }
+
+// The run at the paper's settings among `runs` (the last one), or nullptr.
+const RunResult* paper_run(const Runs& runs) {
+  const RunResult* base = nullptr;
+  for (const RunResult* r : runs) {
+    if (r->is_paper_setting()) base = r;
+  }
+  return base;
+}
+
+// The INCOMPLETE notice: how many planned runs are missing, the first 20 of them by id.
+void write_missing(std::ostream& md, const ReportContent& c) {
+  md << "**INCOMPLETE: " << c.missing.size() << " of the " << c.planned
+     << " planned runs are missing.** Every table and diagram below lacks them; the "
+        "headline compares only the runs present. Missing:";
+  for (std::size_t i = 0; i < c.missing.size() && i < 20; ++i) {
+    md << (i ? ", " : " ") << "`" << c.missing[i] << "`";
+  }
+  if (c.missing.size() > 20) md << " and " << c.missing.size() - 20 << " more";
+  md << ".\n\n";
+}
+
+// How many timing runs each run's time is the median of: "3", "1 to 3", or "the".
+std::string repeats_text(const ReportContent& c) {
+  int least = 1 << 30, most = 0;
+  for (const auto& [scene, runs] : c.runs) {
+    for (const RunResult* r : runs) {
+      const int n = r->timing_repeats.value_or(0);
+      if (n > 0) least = std::min(least, n), most = std::max(most, n);
+    }
+  }
+  if (most > 0 && least == most) return std::to_string(most);
+  if (most > 0) return std::to_string(least) + " to " + std::to_string(most);
+  return "the";
+}
+
+// What the numbers are: time, divergence, trajectory error, residual, substeps, warm start,
+// round-off floors.
+void write_definitions(std::ostream& md, const ReportContent& c) {
+  md << "Made by `cps report` from " << c.run_count << " runs. What the numbers are:\n\n"
+     << "- **Time (s/s)**: physics wall time per simulated second, the median of "
+     << repeats_text(c)
+     << " timing runs of the step alone (no metrics, no residual; column timing_repeats) after "
+        "the error run as warm-up; a run whose error run took over 2 s is timed once. A "
+        "diverged run is timed until it diverged.\n"
+     << "- **Diverged**: the state stopped being finite, or a penetration or rod error passed "
+        "the size of the largest movable body (the time: diverged_at_s). Its other measures "
+        "stop there and are left out of the headline. In the diagrams it is a red x on the top "
+        "edge, at its time until it diverged.\n"
+     << "- **Trajectory error (m)**: RMS distance of the movable bodies from a reference run "
+        "(PGS, " << kReferenceIterations << " iterations, " << kReferenceSubsteps
+     << " substeps, the run's push and friction model) at the scene's trajectory time, given "
+        "with its reason under each scene. A run that diverged before that time steps on to it "
+        "(the physics alone) while its state stays finite. **The reference's own error** (reference_check_m) is its "
+        "distance from the same run at " << kReferenceSubsteps / 2
+     << " substeps: halving dt halves a first-order method's error, so that distance is about "
+        "the reference's error. Trajectory errors under it are not resolved.\n"
+     << "- **LCP residual (N)**: the natural-map residual |lambda - clamp(lambda - (A lambda - "
+        "b) / A_jj, c_min, c_max)| over every row of every solve.\n"
+     << "- **Substeps**: steps per 1/60 s frame (dt = 1 / (60 substeps) s); the iteration sweep "
+        "runs at 1 substep, the substep sweep at 25 iterations.\n"
+     << "- **Warm start** (column warm_start, dimensionless): each PGS row's lambda starts from "
+        "this factor times its lambda of the previous step where its contact or rod persists "
+        "(Sec. 6.2.3); 0 is the paper's cold start from 0. Every run above starts cold but the "
+        "warm-started PGS iteration lines (1 substep), drawn in the same panels in their own "
+        "colours; each scene's table \"Warm starting\" gives the fewest iterations with which "
+        "PGS reaches the paper's error cold and warm, and the iterations saved.\n"
+     << "- **Round-off floors** (diagrams only; tables and CSVs keep every value): " << kFloorNotes
+     << "\n\n";
+}
+
+// The cheapest run (least time) among `runs`, not diverged, whose `measure` is at most half e0
+// (the paper's run's); for the trajectory error only runs whose reference's own error is under
+// half e0. nullptr if none.
+const RunResult* cheapest_halving(const Runs& runs, const std::string& measure, double e0) {
+  const bool trajectory = measure == "trajectory_error_m";
+  const RunResult* best = nullptr;
+  for (const RunResult* r : runs) {
+    if (r->diverged) continue;
+    const double e = r->value(measure);
+    const double t = r->value("wall_s_per_sim_s");
+    if (trajectory && !(0.5 * e0 > r->value("reference_check_m"))) continue;
+    if (e <= 0.5 * e0 && std::isfinite(t) && (!best || t < best->value("wall_s_per_sim_s"))) best = r;
+  }
+  return best;
+}
+
+// The headline row of one scene: its measure at the paper's settings and the cheapest run with
+// at most half of it.
+void write_headline_row(std::ostream& md, const std::string& scene, const Runs& runs) {
+  const std::string measure = primary_measure(scene);
+  const RunResult* base = paper_run(runs);
+  md << "| " << scene << " | " << label_of(measure) << " | ";
+  if (!base || base->diverged || std::isnan(base->value(measure))) {
+    md << (base ? "diverged or not measured" : "not in this sweep") << " | | | | |\n";
+    return;
+  }
+  const double e0 = base->value(measure);
+  const double t0 = base->value("wall_s_per_sim_s");
+  md << number(e0);
+  if (measure == "trajectory_error_m" && e0 < base->value("reference_check_m")) {
+    md << " (under its reference's own error, " << text(*base, "reference_check_m") << ")";
+  }
+  md << " | " << number(t0) << " | ";
+  const RunResult* best = cheapest_halving(runs, measure, e0);
+  if (!best) {
+    md << "none in this sweep | | |\n";
+    return;
+  }
+  const double t1 = best->value("wall_s_per_sim_s");
+  md << best->solver << ", " << best->push << ", " << best->friction_model << ", "
+     << best->iterations << " it, " << best->substeps
+     << (best->substeps == 1 ? " substep" : " substeps")
+     << (best->warm_start != 0.0 ? ", warm start " + shortest_decimal(best->warm_start) : std::string())
+     << ": " << number(best->value(measure)) << " | " << number(t1) << " | " << number(t1 / t0)
+     << " |\n";
+}
+
+// The headline: per scene, the paper's settings and the cheapest run with at most half their
+// error.
+void write_headline(std::ostream& md, const ReportContent& c) {
+  md << "## Headline: the paper's settings and the cheapest run with at most half their error\n\n"
+     << "The cheapest run (least time) whose value of the scene's measure is at most half the "
+        "value at the paper's settings, among every run of the scene (every solver, push and "
+        "friction model), diverged runs left out. For the trajectory error a run counts only "
+        "if half the paper's value is above its reference's own error.\n\n"
+     << "| scene | measure | at the paper's settings (PGS, Baumgarte, fixed friction, 25 it, 60 Hz) "
+        "| its time (s/s) | cheapest run with at most half of it | its time (s/s) | time ratio |\n"
+        "|---|---|---|---|---|---|---|\n";
+  for (const std::string& scene : c.scenes) write_headline_row(md, scene, c.runs.at(scene));
+  md << "\n";
+}
+
+// The warm start factors of the warm table: 0, kReportWarmStarts and any other of the runs,
+// ascending.
+std::vector<double> warm_factors(const Runs& runs) {
+  std::vector<double> factors = {0.0};
+  for (const double w : kReportWarmStarts) factors.push_back(w);
+  for (const RunResult* r : runs) {
+    if (std::find(factors.begin(), factors.end(), r->warm_start) == factors.end()) {
+      factors.push_back(r->warm_start);
+    }
+  }
+  std::sort(factors.begin(), factors.end());
+  return factors;
+}
+
+// The run with the fewest iterations at PGS, Baumgarte, fixed friction, 1 substep, warm start
+// w, not diverged, whose `measure` is at most e0; nullptr if none.
+const RunResult* fewest_reaching(const Runs& runs, double w, const std::string& measure, double e0) {
+  const RunResult* fewest = nullptr;
+  for (const RunResult* r : runs) {
+    if (r->solver != "pgs" || r->push != "baumgarte" || r->friction_model != "fixed" ||
+        r->substeps != 1 || r->warm_start != w || r->diverged) {
+      continue;
+    }
+    if (!(r->value(measure) <= e0)) continue;
+    if (!fewest || r->iterations < fewest->iterations) fewest = r;
+  }
+  return fewest;
+}
+
+// The table "Warm starting: what PGS needs to reach the paper's error" of one scene: for the
+// cold start 0 and each warm start factor (warm_factors), the fewest iterations at the paper's
+// other settings whose value of the scene's primary measure is at most the paper's run's (25
+// iterations, cold); that run's time and its ratio to the paper's run's; and the iterations
+// saved, 25 minus that count. "none in this sweep" where no run of the factor reaches it.
+void write_warm_table(std::ostream& md, const std::string& scene, const Runs& runs) {
+  const std::string measure = primary_measure(scene);
+  md << "### Warm starting: what PGS needs to reach the paper's error\n\n";
+  const RunResult* base = paper_run(runs);
+  if (!base || base->diverged || std::isnan(base->value(measure)) ||
+      !(base->value("wall_s_per_sim_s") > 0.0)) {
+    md << "The paper's run (PGS, Baumgarte, fixed friction, " << kPaperIterations
+       << " it, 1 substep, warm start 0) is "
+       << (base ? "diverged or without a value of " + label_of(measure) : std::string("not in this sweep"))
+       << ": nothing to compare with.\n\n";
+    return;
+  }
+  const double e0 = base->value(measure);
+  const double t0 = base->value("wall_s_per_sim_s");
+  md << "The fewest iterations at the paper's other settings (PGS, Baumgarte, fixed friction, "
+        "1 substep) with which a run's " << label_of(measure) << " is at most the paper's run's ("
+     << kPaperIterations << " it, warm start 0): " << number(e0) << ", in " << number(t0)
+     << " s/s. Iterations saved: " << kPaperIterations << " minus that count. Diverged runs never count.";
+  if (measure == "trajectory_error_m" && e0 < base->value("reference_check_m")) {
+    md << " The paper's value is under its reference's own error ("
+       << number(base->value("reference_check_m"))
+       << " m): the counts compare differences the reference does not resolve.";
+  }
+  md << "\n\n| warm start factor | fewest iterations | its " << label_of(measure)
+     << " | its time (s/s) | time ratio to the paper's run | iterations saved |\n"
+        "|---|---|---|---|---|---|\n";
+  for (const double w : warm_factors(runs)) {
+    md << "| " << shortest_decimal(w) << (w == 0.0 ? " (cold, the paper's)" : "") << " | ";
+    const RunResult* fewest = fewest_reaching(runs, w, measure, e0);
+    if (!fewest) {
+      md << "none in this sweep | | | | |\n";
+      continue;
+    }
+    const double t = fewest->value("wall_s_per_sim_s");
+    md << fewest->iterations << " | " << number(fewest->value(measure)) << " | " << number(t)
+       << " | " << number(t / t0) << " | " << kPaperIterations - fewest->iterations << " |\n";
+  }
+  md << "\n";
+}
+
+// A scene's horizon and trajectory time with their reasons, and the references' own errors.
+void write_scene_facts(std::ostream& md, const std::string& scene, const Runs& runs) {
+  if (const scenes::Scene* s = scenes::find_scene(scene)) {
+    md << "- **Horizon** " << number(s->report_horizon_s()) << " s: " << s->report.horizon_reason
+       << ".\n- **Trajectory time** ";
+    if (s->report.has_reference_solution) {
+      md << s->report.trajectory_reason << ".";
+    } else {
+      md << number(std::min(s->report_trajectory_time_s(), s->report_horizon_s())) << " s: "
+         << s->report.trajectory_reason << ".";
+    }
+    md << "\n";
+  }
+  std::map<std::string, std::string> checks;  // push, friction -> reference's own error
+  for (const RunResult* r : runs) {
+    const std::string check = text(*r, "reference_check_m");
+    if (!check.empty()) checks[r->push + ", " + r->friction_model + " friction"] = check;
+  }
+  if (checks.empty()) return;
+  md << "- **The reference's own error** at the trajectory time (m):";
+  bool first = true;
+  for (const auto& [variant, value] : checks) {
+    md << (first ? " " : "; ") << variant << ": " << value;
+    first = false;
+  }
+  md << ".\n";
+}
+
+// A scene's table of runs: settings, time, its primary measure, residual, penetration, rod
+// error, and when it diverged.
+void write_run_table(std::ostream& md, const std::string& scene, const Runs& runs) {
+  const std::string measure = primary_measure(scene);
+  md << "| solver | push | friction | iterations | substeps | warm start | time (s/s) | "
+     << label_of(measure)
+     << " | residual RMS (N) | penetration max (m) | rod error max (m) | diverged at (s) |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const RunResult* r : runs) {
+    md << "| " << r->solver << " | " << r->push << " | " << r->friction_model << " | "
+       << r->iterations << " | " << r->substeps << " | " << shortest_decimal(r->warm_start)
+       << " | " << text(*r, "wall_s_per_sim_s") << " | " << text(*r, measure) << " | "
+       << text(*r, "residual_rms_N") << " | " << text(*r, "penetration_max_m") << " | "
+       << text(*r, "rod_error_max_m") << " | "
+       << (r->diverged ? text(*r, "diverged_at_s") : "no") << " |\n";
+  }
+  md << "\n";
+}
+
+// One scene's section: its facts, the link to its CSV, the warm starting table, its diagrams
+// and its runs.
+void write_scene(std::ostream& md, const ReportContent& c, const std::string& scene) {
+  const Runs& runs = c.runs.at(scene);
+  const std::string stem = file_stem(scene);
+  md << "## " << scene << "\n\n";
+  write_scene_facts(md, scene, runs);
+  md << "\nAll runs: [" << stem << ".csv](" << stem << ".csv).\n\n";
+  write_warm_table(md, scene, runs);
+  const auto drawn = c.diagrams.find(scene);
+  if (drawn != c.diagrams.end()) {
+    for (const Measure* m : drawn->second) {
+      md << "![" << scene << " " << m->column << "](" << stem << "_" << m->column << ".png)\n\n";
+    }
+  }
+  write_run_table(md, scene, runs);
+}
+
+// The mass ratio section: how held is defined, and the table of mass_ratio.csv.
+void write_mass_ratios(std::ostream& md, const CsvTable& pairs) {
+  md << "## Mass ratios: does the stack hold?\n\n"
+     << "A heavy cube (R kg) resting on a light one (1 kg), both of edge "
+     << number(2.0 * scenes::kMassRatioHalfEdge) << " m, on the ground (stress scenes "
+        "mass_ratio_R), started at rest and run for " << number(kPairSeconds)
+     << " s at 60 Hz with 25 iterations. **Held** means the light cube is still between the "
+        "heavy cube and the ground: its centre within its half edge ("
+     << number(scenes::kMassRatioHalfEdge) << " m) of the heavy cube's vertical axis, so the "
+        "heavy cube's centre of mass is over its top face, and the heavy cube's centre within "
+     << number(kHeldHeightTolerance) << " m of its stacked height " << number(kStackedHeight)
+     << " m (squeezed out, it drops to " << number(scenes::kMassRatioHalfEdge)
+     << " m). The last column lists the iteration counts of 1, 2, 4, ..., 256 with which the "
+        "same run holds with under 1 cm of overlap (holding need not grow with the count). All "
+        "in [mass_ratio.csv](mass_ratio.csv).\n\n"
+     << "| mass ratio | solver | push | held at 25 it | heavy cube height (m) | light cube off "
+        "the heavy one's axis (m) | deepest overlap (m) | iterations that hold, overlap under "
+        "1 cm |\n|---|---|---|---|---|---|---|---|\n";
+  for (std::size_t i = 0; i < pairs.rows.size(); ++i) {
+    const auto cell = [&](const char* column) { return pairs.cell(i, column); };
+    md << "| " << cell("mass_ratio") << " | " << cell("solver") << " | " << cell("push") << " | "
+       << (cell("held") == "1" ? "yes" : "no") << " | " << cell("heavy_height_m") << " | "
+       << cell("light_offset_m") << " | " << cell("overlap_m") << " | "
+       << (cell("iterations_holding").empty() ? std::string("none") : cell("iterations_holding"))
+       << " |\n";
+  }
+  md << "\n";
+}
+
+}  // namespace
+
+std::string report_markdown(const ReportContent& content) {
+  std::ostringstream md;
+  md << "# Error against run time\n\n";
+  if (!content.missing.empty()) write_missing(md, content);
+  write_definitions(md, content);
+  write_headline(md, content);
+  for (const std::string& scene : content.scenes) write_scene(md, content, scene);
+  write_mass_ratios(md, content.pairs);
+  return md.str();
+}
+
+}  // namespace cps::cli

@@ -1,0 +1,83 @@
+#include "report/mass_ratio.h"
+
+#include "report/run.h"
+
+#include <string>
+
+namespace cps::cli {
+namespace {
+
+// The overlap (m) under which a pair that holds counts in iterations_holding: 1 cm.
+constexpr double kHoldingOverlap = 0.01;
+
+// The pair in `world` (made by scenes::populate_mass_ratio: body 1 light, body 2 heavy). Held:
+// the light cube is still between the heavy cube and the ground, that is its centre is within
+// h of the heavy cube's vertical axis (the heavy cube's centre of mass is over the light cube's
+// top face: it rests on it, not beside it) and the heavy cube's centre is within
+// kHeldHeightTolerance of its stacked height.
+PairOutcome pair_outcome(const World& world) {
+  PairOutcome o;
+  if (!sane_state(world)) return o;
+  const Vec3& light = world.body(1).x;
+  const Vec3& heavy = world.body(2).x;
+  o.finite = true;
+  o.light_offset_m = std::hypot(light.x() - heavy.x(), light.z() - heavy.z());
+  o.heavy_height_m = heavy.y();
+  o.overlap_m = scenes::max_penetration_now(world);
+  o.held = o.light_offset_m <= scenes::kMassRatioHalfEdge &&
+           std::abs(o.heavy_height_m - kStackedHeight) <= kHeldHeightTolerance;
+  return o;
+}
+
+}  // namespace
+
+PairOutcome run_pair(double ratio, SolverKind solver, PushMode push, int iterations,
+                     double seconds) {
+  WorldDef def = scenes::mass_ratio_world_def();
+  def.solver = solver;
+  def.push = push;
+  def.iterations = iterations;
+  World world(def);
+  scenes::populate_mass_ratio(world, ratio);
+  while (world.time() + 0.5 * def.dt < seconds) {
+    world.step();
+    if (!sane_state(world)) return {};
+  }
+  return pair_outcome(world);
+}
+
+std::vector<PairRow> mass_ratio_study() {
+  std::vector<PairRow> rows;
+  for (const double ratio : kMassRatios) {
+    for (const Choice& c : parameter("push").choices) {
+      const auto push = static_cast<PushMode>(c.value);
+      for (const SolverKind solver : {SolverKind::pgs, SolverKind::jacobi}) {
+        PairRow r{ratio, solver, push, run_pair(ratio, solver, push, kPairTableIterations, kPairSeconds), {}};
+        for (int n = 1; n <= 256; n *= 2) {
+          const PairOutcome q = run_pair(ratio, solver, push, n, kPairSeconds);
+          if (q.held && q.overlap_m < kHoldingOverlap) r.iterations_holding.push_back(n);
+        }
+        rows.push_back(std::move(r));
+      }
+    }
+  }
+  return rows;
+}
+
+CsvTable mass_ratio_table(const std::vector<PairRow>& rows) {
+  CsvTable table;
+  table.columns = {"solver", "push", "iterations", "mass_ratio", "seconds", "held",
+                   "heavy_height_m", "light_offset_m", "overlap_m", "iterations_holding"};
+  for (const PairRow& r : rows) {
+    std::string holding;
+    for (const int n : r.iterations_holding) holding += (holding.empty() ? "" : " ") + std::to_string(n);
+    table.rows.push_back({std::string(name_of(r.solver)), std::string(name_of(r.push)),
+                          std::to_string(kPairTableIterations), number(r.mass_ratio),
+                          number(kPairSeconds), r.outcome.held ? "1" : "0",
+                          number(r.outcome.heavy_height_m), number(r.outcome.light_offset_m),
+                          number(r.outcome.overlap_m), holding});
+  }
+  return table;
+}
+
+}  // namespace cps::cli

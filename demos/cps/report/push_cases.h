@@ -1,0 +1,122 @@
+#pragma once
+// The cases of `cps report push`, run for one push method at a time: each at the scene's own
+// settings with only the world parameter push changed. The measures are defined here, at the
+// functions that compute them, and in push.md's legend (push_report.cpp).
+
+#include "scene.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cps::cli {
+
+/// An overlap counts as resolved under this depth (m): 1 mm, a thousandth of the cubes' size.
+inline constexpr double kResolvedOverlap = 1e-3;
+/// The intersecting stack's and sphere_in_box's runs (s): the intersecting stack's default
+/// duration, long enough for a method that brings the column to rest to have done so.
+inline constexpr double kColumnSeconds = 4.0;
+/// The stack's run (s): 600 s, and 60 s in --quick.
+inline constexpr double kStackSeconds = 600.0;
+inline constexpr double kQuickStackSeconds = 60.0;
+/// In --quick the pendulum scenes run at most this long (s): the pendulum grid its whole 10 s,
+/// the pendulum wave 10 of its 62 s.
+inline constexpr double kQuickPendulumSeconds = 10.0;
+/// Timed repeats of the intersecting stack's first window (the median counts), after one
+/// untimed repeat that warms the caches.
+inline constexpr int kCostRepeats = 5;
+/// The mass ratio pairs run at the paper's solver and iteration count.
+inline constexpr int kPairIterations = 25;
+
+/// One push method: a choice of the world parameter push.
+struct Method {
+  std::string name;   ///< "baumgarte"
+  std::string label;  ///< "baumgarte (push factor, Sec. 5.3)": the name, title and source
+  int value = 0;      ///< the PushMode value
+};
+
+/// Every push method of this build, in the table's order (cps::parameter("push").choices).
+std::vector<Method> push_methods();
+
+/// What `cps report push` runs: the methods, the scenes of its cases and how long each runs (s;
+/// quick: the stack over kQuickStackSeconds, the pendulums at most kQuickPendulumSeconds).
+struct PushPlan {
+  bool quick = false;
+  std::vector<Method> methods;
+  const scenes::Scene* intersecting = nullptr;  ///< intersecting_stack (Sec. 10.2)
+  const scenes::Scene* sphere = nullptr;        ///< sphere_in_box (stress)
+  const scenes::Scene* stack = nullptr;         ///< stack (Sec. 10.1)
+  const scenes::Scene* grid = nullptr;          ///< pendulum_grid
+  const scenes::Scene* wave = nullptr;          ///< pendulum_wave
+  double stack_seconds = 0.0;
+  double grid_seconds = 0.0;
+  double wave_seconds = 0.0;
+};
+
+/// The plan of the full run, or with `quick` the quick one. Throws std::logic_error if this
+/// build lacks one of the scenes.
+PushPlan plan_push_report(bool quick);
+
+/// One sample of a run's time series: time (s), largest overlap (m) of the state at that time,
+/// largest body speed (m/s).
+struct Sample {
+  double t = 0.0;
+  double overlap_m = 0.0;
+  double speed_mps = 0.0;
+};
+
+/// A column pushed out of overlap (the intersecting stack, sphere_in_box): see run_column.
+struct ColumnResult {
+  double seconds = 0.0;               ///< simulated (s)
+  double dt = 0.0;                    ///< the scene's time step (s)
+  std::optional<double> diverged_at;  ///< s
+  std::optional<double> resolved_at;  ///< s: overlaps under kResolvedOverlap from here to the end
+  double max_overlap_m = 0.0;
+  double peak_speed_mps = 0.0;
+  double energy_injected_J = std::nan("");
+  double height_error_m = std::nan("");
+  std::vector<double> final_heights;  ///< m, movable bodies in body order
+  std::vector<double> rest;           ///< m, the same bodies at rest (rest_heights)
+  std::vector<Sample> series;         ///< every step's state, from t = 0
+};
+
+/// A scene run for its metrics (scene.h's Metrics::report) over `seconds` (s): the metrics, the
+/// time the state stopped being sane (if it did), and the wall clock (s) spent in World::step
+/// alone and the steps taken.
+struct MetricsResult {
+  nlohmann::json metrics;
+  std::optional<double> diverged_at;  ///< s
+  double step_wall_s = 0.0;
+  long long steps = 0;
+  double dt = 0.0;   ///< the scene's time step (s)
+  double seconds = 0.0;  ///< how long it was to run (s)
+};
+
+/// The cases of one method, in the order of push.md's columns.
+struct MethodResults {
+  Method method;
+  ColumnResult intersecting;
+  ColumnResult sphere;
+  double intersecting_us = std::nan("");  ///< us per step over the intersecting stack's window
+  MetricsResult stack;
+  std::vector<double> held;  ///< the mass ratios (kMassRatios) whose pair held, ascending
+  MetricsResult grid;
+  MetricsResult wave;
+};
+
+/// Runs every case of `plan` for method `m`, calling `tick` after each of the 7 cases (IS,
+/// SiB, IS cost, stack, mass ratios, grid, wave). Throws UsageError for a bad parameter,
+/// std::logic_error for a column scene without a ground plane.
+MethodResults run_method(const PushPlan& plan, const Method& m, const std::function<void()>& tick);
+
+/// The number of cases run_method runs (and ticks).
+inline constexpr int kPushCases = 7;
+
+/// A metric's number, or NaN where it is missing or not a number (null: never happened).
+double metric(const nlohmann::json& metrics, const char* key);
+
+}  // namespace cps::cli

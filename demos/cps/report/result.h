@@ -1,0 +1,101 @@
+#pragma once
+// The result of one run of the sweep (RunResult): its settings and measures as named, typed
+// fields, one per CSV column, and their CSV files (SCENE.csv, the --run files) written and read
+// back by the same code.
+
+#include "report/csv.h"
+#include "report/plan.h"
+
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cps::cli {
+
+/// One run's row of the report's CSVs. Each field is the CSV column of its name (units as the
+/// suffix: _s seconds, _m metres, _N newtons, _deg degrees, _rel a ratio; us_per_step
+/// microseconds). A measure that is std::nullopt does not apply to the run (its column is left
+/// out of a CSV where no row has it); one that is NaN applies but has no value (an empty cell).
+/// Measures are kept at the CSV's precision (at_csv_precision). The settings' names are the
+/// parameter table's choice names, kept as text so that a CSV of another build reads back.
+struct RunResult {
+  // The settings (RunSpec).
+  std::string scene;
+  std::string solver;          ///< "pgs", "jacobi"
+  std::string push;            ///< a choice of the world parameter push: "baumgarte", ...
+  std::string friction_model;  ///< "fixed", "coupled"
+  int iterations = 0;          ///< solver iterations per solve
+  int substeps = 0;            ///< steps per 1/60 s frame
+  double warm_start = 0.0;     ///< warm start factor; 0 also where a CSV has no column
+  std::optional<double> dt_s;       ///< the time step (s)
+  std::optional<double> horizon_s;  ///< simulated time of the run (s)
+
+  // What happened.
+  bool diverged = false;                ///< the state blew up (see execute_run)
+  std::optional<double> diverged_at_s;  ///< when (s); only for a diverged run
+  std::optional<double> wall_s_per_sim_s;  ///< physics wall time per simulated second (s/s)
+  std::optional<double> us_per_step;       ///< wall time per step (us)
+  std::optional<int> timing_repeats;       ///< timing runs whose median was taken
+  std::optional<double> trajectory_time_s;   ///< when positions are compared (s)
+  std::optional<double> trajectory_error_m;  ///< RMS distance from the reference run (m)
+  std::optional<double> reference_check_m;   ///< the reference's own error (m)
+  std::optional<double> phase_error_deg;     ///< the metric max_phase_error_deg (deg)
+  std::optional<double> residual_max_N;      ///< largest LCP residual of any row (N)
+  std::optional<double> residual_rms_N;      ///< RMS LCP residual over every row (N)
+  std::optional<double> penetration_max_m;   ///< deepest contact penetration (m)
+  std::optional<double> penetration_rms_m;   ///< RMS contact penetration (m)
+  std::optional<double> rod_error_max_m;     ///< largest rod length error (m)
+  std::optional<double> rod_error_rms_m;     ///< RMS rod length error (m)
+  std::optional<double> energy_drift_rel;    ///< the metric energy_drift_rel
+
+  // The sweep the run belongs to (recorded so that --merge can tell what is missing).
+  std::optional<std::string> sweep;  ///< the scene argument: a scene, "all" or "stress"
+  std::optional<bool> quick;         ///< the quick sweep
+
+  /// The scene's numeric metrics (columns "metric.NAME", by NAME; booleans as 0 and 1).
+  std::map<std::string, double> metrics;
+  /// Columns this build does not know (a CSV of another build), by name, as text.
+  std::map<std::string, std::string> other;
+
+  /// The run's id (RunSpec::id of its settings).
+  std::string id() const;
+  /// "solver push friction_model", e.g. "pgs baumgarte fixed".
+  std::string variant() const;
+  /// True at the paper's settings: PGS, Baumgarte push, fixed friction, kPaperIterations
+  /// iterations, 1 substep, cold start.
+  bool is_paper_setting() const;
+  /// The number in column `column` (a measure: "trajectory_error_m", "metric.max_speed_mps",
+  /// "wall_s_per_sim_s", ...); NaN where the run has none.
+  double value(std::string_view column) const;
+  /// The text of column `column` as the CSV writes it; std::nullopt where the run has no such
+  /// column (see RunResult).
+  std::optional<std::string> cell(std::string_view column) const;
+};
+
+/// A result with `spec`'s settings and nothing measured.
+RunResult result_of(const RunSpec& spec);
+
+/// The results as one CSV table: the columns any result has, the settings first, then the
+/// measures, the sweep, and the metrics and other columns sorted by name; cells as
+/// RunResult::cell ("" where a result has no such column).
+CsvTable results_table(const std::vector<RunResult>& results);
+
+/// The results in a CSV table (as results_table writes them): empty cells are columns the run
+/// does not have. Throws UsageError naming `source` (a file) if the first column is not "scene"
+/// or a setting (solver, push, friction_model, iterations, substeps, diverged) is missing or not
+/// a number where one is due.
+std::vector<RunResult> results_of(const CsvTable& table, const std::string& source);
+
+/// Writes results_table(results) to `file` atomically. Throws std::runtime_error "cannot write
+/// FILE: REASON" on failure.
+void write_results(const std::filesystem::path& file, const std::vector<RunResult>& results);
+
+/// Reads every *.csv below the given folders (as written by write_report or `--run`), in path
+/// order, except mass_ratio.csv, which holds no runs. Throws UsageError naming a folder that does
+/// not exist or a file that is not a report CSV (results_of).
+std::vector<RunResult> read_results(const std::vector<std::filesystem::path>& dirs);
+
+}  // namespace cps::cli

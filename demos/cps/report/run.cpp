@@ -1,0 +1,275 @@
+#include "report/run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <optional>
+
+namespace cps::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A measure at the CSV's precision (see RunResult).
+double csv(double v) { return at_csv_precision(v); }
+
+// The full size (m) of the largest movable body: a box's longest edge, a ball's diameter.
+double largest_body_size(const World& world) {
+  double size = 0.0;
+  for (const Body& b : world.bodies()) {
+    if (b.is_static()) continue;
+    size = std::max(size, b.shape.kind == ShapeKind::sphere ? 2.0 * b.shape.radius
+                                                            : 2.0 * b.shape.half_extents.maxCoeff());
+  }
+  return size > 0.0 ? size : kInfinity;
+}
+
+// Positions (m) of the movable bodies, in body order.
+std::vector<Vec3> positions(const World& world) {
+  std::vector<Vec3> x;
+  for (const Body& b : world.bodies()) {
+    if (!b.is_static()) x.push_back(b.x);
+  }
+  return x;
+}
+
+// True once `world` has stepped to time t (s), to half a step.
+bool reached(const World& world, double t) { return world.time() + 0.5 * world.def().dt >= t; }
+
+// Positions of the movable bodies (m) once `spec` has been stepped to time t (s), or nullopt if
+// the run blew up on the way (see sane_state).
+std::optional<std::vector<Vec3>> positions_at(const RunSpec& spec, double t) {
+  scenes::Run run = scenes::make_run(spec.scene_def(), spec.overrides());
+  run.world.step();  // at least one step, as every run
+  while (!reached(run.world, t)) {
+    if (!sane_state(run.world)) return std::nullopt;
+    run.world.step();
+  }
+  if (!sane_state(run.world)) return std::nullopt;
+  return positions(run.world);
+}
+
+// RMS distance (m) between two lists of the same bodies' positions.
+double rms_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double sq = 0.0;
+  const std::size_t n = std::min(a.size(), b.size());
+  for (std::size_t i = 0; i < n; ++i) sq += (a[i] - b[i]).squaredNorm();
+  return n ? std::sqrt(sq / static_cast<double>(n)) : 0.0;
+}
+
+// The reference of a run at its scene's trajectory time: the positions (nullopt if the reference
+// blew up), and its own error estimate check_m (m), the RMS distance between the reference and
+// the same run at half its substeps. For a first-order method halving dt halves the error, so
+// the distance between the two is about the reference's own error; where contacts make the
+// scene chaotic it is large, and trajectory errors below it mean nothing.
+struct Reference {
+  std::optional<std::vector<Vec3>> positions;
+  double check_m = std::nan("");
+};
+
+// The reference of `spec` (its solver, iterations and substeps replaced); computed once per
+// process and kept.
+const Reference& reference_of(const RunSpec& spec) {
+  static std::mutex mutex;
+  static std::map<std::string, Reference> cache;
+  RunSpec ref = spec;
+  ref.solver = SolverKind::pgs;
+  ref.iterations = kReferenceIterations;
+  ref.substeps = kReferenceSubsteps;
+  ref.warm_start = 0.0;  // one reference for the cold and the warm runs: the paper's start
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto it = cache.find(ref.id());
+  if (it != cache.end()) return it->second;
+  const double t = ref.scene_def().report_trajectory_time_s();
+  Reference r;
+  r.positions = positions_at(ref, t);
+  RunSpec half = ref;
+  half.substeps = kReferenceSubsteps / 2;
+  const std::optional<std::vector<Vec3>> check = positions_at(half, t);
+  if (r.positions && check) r.check_m = rms_distance(*r.positions, *check);
+  return cache[ref.id()] = r;
+}
+
+// Largest and RMS of a measure over samples.
+struct Spread {
+  double max = 0.0;
+  double sum_sq = 0.0;
+  std::int64_t n = 0;
+  void add(double v) {
+    max = std::max(max, v);
+    sum_sq += v * v;
+    ++n;
+  }
+};
+
+// The error run of a spec: the run itself (residuals, metrics), what was measured after every
+// step, and how long it took (s, wall clock).
+struct ErrorRun {
+  scenes::Run run;
+  Spread penetration;          // m, every contact of every step
+  Spread rod_error;            // m, every rod of every step
+  std::vector<Vec3> at_traj;   // positions at the trajectory time; empty if not reached
+  std::optional<double> diverged_at;  // s
+  double wall_s = 0.0;
+};
+
+// Adds the contacts' penetrations and the rods' length errors of the world's last step.
+void observe_errors(const World& world, ErrorRun& e) {
+  for (const Manifold& m : world.manifolds()) {
+    for (int i = 0; i < m.count; ++i) {
+      e.penetration.add(std::max(0.0, m.contacts[static_cast<std::size_t>(i)].depth));
+    }
+  }
+  for (const DistanceConstraint& d : world.distances()) {
+    Vec3 a;
+    Vec3 b;
+    distance_endpoints(d, world.bodies(), a, b);
+    e.rod_error.add(std::abs((b - a).norm() - d.length));
+  }
+}
+
+// Steps the error run to `horizon` (s), measuring every step, and records the positions at
+// t_traj (s). A run has diverged when its state is not finite or its penetration or rod error
+// passes the size of the largest movable body (bodies then pass through each other, rods
+// stretch past any shape in the scene): its numbers measure the blow-up, not the method's
+// accuracy.
+ErrorRun error_run(const scenes::Scene& scene, scenes::Overrides o, double horizon, double t_traj) {
+  o.set("measure_residual", true);
+  const auto start = Clock::now();
+  ErrorRun e{scenes::make_run(scene, o), {}, {}, {}, {}, 0.0};
+  World& world = e.run.world;
+  const double size_bound = largest_body_size(world);
+  while (!reached(world, horizon)) {
+    e.run.step();
+    if (!sane_state(world)) {
+      e.diverged_at = world.time();
+      break;
+    }
+    observe_errors(world, e);
+    if (e.at_traj.empty() && reached(world, t_traj)) e.at_traj = positions(world);
+    if (e.penetration.max > size_bound || e.rod_error.max > size_bound) {
+      e.diverged_at = world.time();
+      break;
+    }
+  }
+  e.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return e;
+}
+
+// A run that diverged before the trajectory time steps on to it (the physics alone) while its
+// state stays finite: how far the blow-up has carried the bodies by then is its trajectory
+// error. A step that refuses the blown-up state (too many contacts) ends it without one.
+void step_on_to(ErrorRun& e, double t_traj) {
+  try {
+    World& world = e.run.world;
+    while (sane_state(world) && !reached(world, t_traj)) world.step();
+    if (sane_state(world)) e.at_traj = positions(world);
+  } catch (const std::exception&) {
+    e.at_traj.clear();
+  }
+}
+
+// The error run's measures into `r`: residuals, penetration (with collision), rod errors (with
+// rods) and, if it did not diverge, the scene's metrics.
+void record_errors(const ErrorRun& e, RunResult& r) {
+  const World& world = e.run.world;
+  r.diverged = e.diverged_at.has_value();
+  if (e.diverged_at) r.diverged_at_s = csv(*e.diverged_at);
+  const ResidualStats& res = world.residual();
+  r.residual_max_N = csv(res.max);
+  r.residual_rms_N = csv(res.rms());
+  const auto rms = [](const Spread& s) {
+    return std::sqrt(s.sum_sq / static_cast<double>(s.n ? s.n : 1));
+  };
+  if (world.def().collision) {
+    r.penetration_max_m = csv(e.penetration.max);
+    r.penetration_rms_m = csv(e.penetration.n ? rms(e.penetration) : 0.0);
+  }
+  if (!world.distances().empty()) {
+    r.rod_error_max_m = csv(e.rod_error.max);
+    r.rod_error_rms_m = csv(rms(e.rod_error));
+  }
+  if (r.diverged) return;
+  // The numeric entries of the scene's metrics (booleans as 0/1, arrays and nulls left out).
+  const nlohmann::json metrics = e.run.metrics->report();
+  for (const auto& [key, value] : metrics.items()) {
+    if (value.is_number()) r.metrics[key] = csv(value.get<double>());
+    if (value.is_boolean()) r.metrics[key] = value.get<bool>() ? 1.0 : 0.0;
+  }
+  if (metrics.contains("max_phase_error_deg")) {
+    r.phase_error_deg = csv(metrics["max_phase_error_deg"].get<double>());
+  }
+  if (metrics.contains("energy_drift_rel")) {
+    r.energy_drift_rel = csv(metrics["energy_drift_rel"].get<double>());
+  }
+}
+
+// Timing runs: the physics step alone, residuals off, metrics not fed; the median of `repeats`
+// runs to `until` (s) sets the run's time per simulated second and per step.
+void record_timing(const scenes::Scene& scene, scenes::Overrides o, double until, int repeats,
+                   RunResult& r) {
+  o.set("measure_residual", false);
+  std::vector<double> seconds;
+  std::int64_t steps = 0;
+  double simulated = 0.0;
+  for (int k = 0; k < repeats; ++k) {
+    scenes::Run timed = scenes::make_run(scene, o);
+    const auto start = Clock::now();
+    do {
+      timed.world.step();
+    } while (!reached(timed.world, until));
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    steps = timed.world.counters().steps;
+    simulated = timed.world.time();
+  }
+  if (seconds.empty()) return;
+  std::sort(seconds.begin(), seconds.end());
+  const double median = seconds[seconds.size() / 2];
+  r.wall_s_per_sim_s = csv(median / simulated);
+  r.us_per_step = csv(1e6 * median / static_cast<double>(std::max<std::int64_t>(steps, 1)));
+  r.timing_repeats = static_cast<int>(seconds.size());
+}
+
+}  // namespace
+
+bool sane_state(const World& world) {
+  for (const Body& b : world.bodies()) {
+    if (!b.x.allFinite() || !b.p.allFinite() || !b.l.allFinite() || !b.o.coeffs().allFinite()) {
+      return false;
+    }
+    if (b.x.norm() > 1e6 || b.velocity().norm() > 1e6) return false;
+  }
+  return true;
+}
+
+RunResult execute_run(const RunSpec& spec, int repeats) {
+  const scenes::Scene& scene = spec.scene_def();
+  const double horizon = scene.report_horizon_s();
+  const bool has_trajectory = !scene.report.has_reference_solution;
+  const double t_traj = std::min(scene.report_trajectory_time_s(), horizon);
+  const scenes::Overrides o = spec.overrides();
+  RunResult r = result_of(spec);
+  r.dt_s = csv(std::get<double>(*o.find("dt")));
+  r.horizon_s = csv(horizon);
+
+  ErrorRun e = error_run(scene, o, horizon, t_traj);
+  if (has_trajectory && e.diverged_at && e.at_traj.empty()) step_on_to(e, t_traj);
+  record_errors(e, r);
+  if (has_trajectory) {
+    const Reference& ref = reference_of(spec);
+    r.trajectory_time_s = csv(t_traj);
+    r.reference_check_m = csv(ref.check_m);
+    if (!e.at_traj.empty() && ref.positions) {
+      r.trajectory_error_m = csv(rms_distance(e.at_traj, *ref.positions));
+    }
+  }
+  // The error run was the warm-up. A run whose error run took over 2 s is timed once. A
+  // diverged run is timed up to the time it diverged: what the method cost until it failed.
+  if (e.wall_s > 2.0) repeats = std::min(repeats, 1);
+  record_timing(scene, o, e.diverged_at.value_or(horizon), repeats, r);
+  return r;
+}
+
+}  // namespace cps::cli

@@ -1,0 +1,146 @@
+#include "report/sweep.h"
+
+#include "options/options.h"
+#include "options/progress.h"
+#include "output/output.h"
+#include "report/mass_ratio.h"
+#include "report/report.h"
+#include "report/run.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <set>
+
+namespace cps::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The report's two folders (OUT and OUT/plots, both shared: see output.h), checked for the
+// report of `scenes` before any work; write() then begins them, calls `body` and ends them, so
+// that each folder's run.json lists what was written.
+struct ReportOutput {
+  OutputPlan main;
+  OutputPlan plots;
+  nlohmann::json info;
+
+  ReportOutput(const fs::path& out, const std::vector<std::string>& scenes, bool force,
+               nlohmann::json run)
+      : main(plan_output(out, report_files(scenes), force, FolderUse::shared)),
+        plots(plan_output(out / "plots", plot_files(scenes), force, FolderUse::shared)),
+        info(std::move(run)) {}
+
+  template <class Body>
+  void write(Body&& body) {
+    begin_output(main, info);
+    begin_output(plots, info);
+    body();
+    end_output(plots, info);
+    end_output(main, info);
+  }
+};
+
+// A run's result with the sweep it belongs to.
+RunResult execute_in_sweep(const SweepOutput& to, const RunSpec& spec) {
+  RunResult r = execute_run(spec, kTimingRepeats);
+  r.sweep = to.sweep;
+  r.quick = to.quick;
+  return r;
+}
+
+// The scenes of `runs`, in the order of their first run.
+std::vector<std::string> scenes_of(const std::vector<RunResult>& runs) {
+  std::vector<std::string> scenes;
+  for (const RunResult& r : runs) {
+    if (std::find(scenes.begin(), scenes.end(), r.scene) == scenes.end()) scenes.push_back(r.scene);
+  }
+  return scenes;
+}
+
+}  // namespace
+
+int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& scenes) {
+  const std::vector<RunSpec> runs = plan_runs(scenes, to.quick);
+  ReportOutput output(to.out, scene_names(scenes), to.force, to.info);
+  std::vector<RunResult> results;
+  Progress progress("report " + to.sweep, static_cast<long long>(runs.size()), "runs");
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    results.push_back(execute_in_sweep(to, runs[i]));
+    progress.update(static_cast<long long>(i + 1));
+  }
+  progress.finish();
+  output.write([&] { write_report(to.out, results, mass_ratio_study(), {}, results.size()); });
+  std::printf("%zu runs: %s/report.md\n", results.size(), to.out.c_str());
+  return 0;
+}
+
+int run_one(const SweepOutput& to, const RunSpec& spec) {
+  const std::string file = run_file_name(spec);
+  const OutputPlan plan = plan_output(to.out, {file}, to.force, FolderUse::shared);
+  const RunResult result = execute_in_sweep(to, spec);
+  begin_output(plan, to.info);
+  write_results(to.out / file, {result});
+  end_output(plan, to.info);
+  return 0;
+}
+
+std::vector<std::string> run_commands(const std::string& exe, const SweepOutput& to,
+                                      const std::vector<RunSpec>& runs) {
+  std::vector<std::string> lines;
+  const std::string out = to.out.string();
+  for (const RunSpec& r : runs) {
+    lines.push_back("'" + exe + "' report '" + to.sweep + "' --run " + r.id() + " --out '" + out +
+                    "/runs'" + (to.quick ? " --quick" : ""));
+  }
+  lines.push_back("# when all have finished: '" + exe + "' report --merge '" + out +
+                  "/runs' --out '" + out + "'");
+  return lines;
+}
+
+std::vector<std::string> missing_runs(const std::vector<RunResult>& runs, std::size_t& planned) {
+  std::set<std::pair<std::string, bool>> sweeps;
+  std::set<std::string> present;
+  for (const RunResult& r : runs) {
+    sweeps.emplace(r.sweep.value_or(r.scene), r.quick.value_or(false));
+    present.insert(r.id());
+  }
+  std::vector<std::string> missing;
+  std::set<std::string> seen;
+  for (const auto& [sweep, quick] : sweeps) {
+    std::vector<const scenes::Scene*> scenes;
+    try {
+      scenes = select_scenes(sweep);
+    } catch (const std::exception&) {
+      // A sweep this build does not know (a CSV of another build): its plan is unknown.
+    }
+    for (const RunSpec& spec : plan_runs(scenes, quick)) {
+      const std::string id = spec.id();
+      if (seen.insert(id).second && !present.count(id)) missing.push_back(id);
+    }
+  }
+  planned = seen.size();
+  return missing;
+}
+
+int merge_report(const SweepOutput& to, const std::vector<fs::path>& dirs) {
+  const std::vector<RunResult> runs = read_results(dirs);
+  if (runs.empty()) throw UsageError("--merge: no report CSV found below the given folders");
+  std::size_t planned = 0;
+  const std::vector<std::string> missing = missing_runs(runs, planned);
+  ReportOutput output(to.out, scenes_of(runs), to.force, to.info);
+  output.write([&] { write_report(to.out, runs, mass_ratio_study(), missing, planned); });
+  if (missing.empty()) {
+    std::printf("merged %zu runs into %s/report.md\n", runs.size(), to.out.c_str());
+    return 0;
+  }
+  std::string named;
+  for (std::size_t i = 0; i < missing.size() && i < 5; ++i) named += (i ? ", " : "") + missing[i];
+  if (missing.size() > 5) named += " and " + std::to_string(missing.size() - 5) + " more";
+  std::fprintf(stderr,
+               "report --merge: %zu of the %zu planned runs are missing: %s. %s/report.md "
+               "is marked INCOMPLETE.\n",
+               missing.size(), planned, named.c_str(), to.out.c_str());
+  return 1;
+}
+
+}  // namespace cps::cli

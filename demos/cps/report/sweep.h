@@ -1,0 +1,60 @@
+#pragma once
+// The sweeps of `cps report`, carried out: a whole sweep into a report folder, one run by its id,
+// the commands that spread a sweep over machines, and the merge of their CSVs.
+
+#include "report/plan.h"
+#include "report/result.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace cps::cli {
+
+/// Timing runs per run (the median is taken), in the quick sweep as in the full one.
+inline constexpr int kTimingRepeats = 3;
+
+/// Where a sweep's outputs go and what they record.
+struct SweepOutput {
+  std::string sweep;           ///< the scene argument: a scene, "all" or "stress" (RunResult::sweep)
+  bool quick = false;          ///< the quick sweep (RunResult::quick)
+  std::filesystem::path out;   ///< the output folder
+  bool force = false;          ///< replace same-named foreign files (output.h)
+  nlohmann::json info;         ///< run_info for the folders' run.json
+};
+
+/// Runs every run of plan_runs(scenes, quick) (kTimingRepeats timing runs each, progress on
+/// stderr) and the mass ratio study, and writes the report (write_report) into `to.out` and
+/// `to.out`/plots, both shared folders (output.h). Every target is checked before any work:
+/// throws UsageError naming a foreign file it would replace (without force) or an unusable
+/// folder; std::runtime_error if a file cannot be written or gnuplot fails. Prints "N runs:
+/// OUT/report.md" on stdout. Returns the exit code, 0.
+int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& scenes);
+
+/// Runs `spec` alone and writes its CSV (one row, run_file_name) into `to.out`, a shared folder,
+/// with the sweep it belongs to. Throws as run_sweep does. Returns the exit code, 0.
+int run_one(const SweepOutput& to, const RunSpec& spec);
+
+/// The commands of `--list-runs`: per run of `runs`, `'EXE' report 'SWEEP' --run ID --out
+/// 'OUT/runs'` (with --quick for a quick sweep), then a comment line with the merge command.
+std::vector<std::string> run_commands(const std::string& exe, const SweepOutput& to,
+                                      const std::vector<RunSpec>& runs);
+
+/// The ids (RunSpec::id) of the runs that the sweeps named in `runs` plan (plan_runs of the
+/// run's sweep, a scene selector as select_scenes takes, and its quick flag) and that no run
+/// holds, in plan order. A run without a sweep (an older build's CSV) belongs to the full sweep
+/// of its own scene; a sweep this build cannot select plans nothing. `planned` is set to the
+/// number of distinct planned runs.
+std::vector<std::string> missing_runs(const std::vector<RunResult>& runs, std::size_t& planned);
+
+/// Reads the CSVs below `dirs` (read_results), runs the mass ratio study and writes one report
+/// of them into `to.out` (as run_sweep; `to.sweep` and `to.quick` are not used). Throws
+/// UsageError if no report CSV is found or a file is not one, and as run_sweep does. If planned
+/// runs are missing (missing_runs), the report is marked INCOMPLETE, stderr names the first 5
+/// and the return is 1; else stdout says "merged N runs into OUT/report.md" and the return is 0.
+int merge_report(const SweepOutput& to, const std::vector<std::filesystem::path>& dirs);
+
+}  // namespace cps::cli

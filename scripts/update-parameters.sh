@@ -2,7 +2,7 @@
 # Rewrites the two copies of the world parameter table outside the code from `cps parameters`:
 # the world section of assets/schemas/scene.schema.json and the option table of docs/commands.md
 # (between its "cps parameters" markers). Run it after changing the table in
-# engine/src/parameters.cpp; tests/test_cli_parameters.cpp fails until it has run.
+# engine/src/parameters.cpp; tests/cli/test_cli_parameters.cpp fails until it has run.
 # Usage: scripts/update-parameters.sh [CPS]   (CPS: default build/demos/cps). Needs python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."

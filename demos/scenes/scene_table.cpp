@@ -44,7 +44,7 @@ const std::array kScenes = {
           .plane_opacity = 1.0,
           // The default 4 s: the cubes the Baumgarte push throws apart rise to about 55 m and
           // fall back; this view (the --camera fit framing of the default run, rounded) keeps
-          // every cube in the picture at every time (tests/test_views.cpp checks it).
+          // every cube in the picture at every time (tests/pictures/test_views.cpp checks it).
           .camera = CameraPreset{Vec3(36.0, 40.0, 78.0), Vec3(1.5, 28.0, 1.0), 45.0},
           .bench = {.start_s = 0.0, .seconds = 0.1,
                     .reason = "the first 0.1 s, while the push factor pushes the overlapping "

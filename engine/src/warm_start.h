@@ -25,7 +25,7 @@ namespace cps {
 /// number of sweeps PGS does not take all of it back, and the step gains energy (Catto,
 /// erincatto/solver2d issue 8: "errors in warm starting energy can grow unbounded"). So a contact
 /// starts from a cached value in its third step, once it has two. Measured per step against the energy bound of
-/// tests/test_stress.cpp (the largest dE - dW - dR over the run, tolerance in brackets), factor
+/// tests/physics/test_stress.cpp (the largest dE - dW - dR over the run, tolerance in brackets), factor
 /// 0.8, last lambda only / smaller of the last two: stack landing 0.080 / 0.011 J (0.0106 J),
 /// stack_dt_0.1 1.75 / -0.039 J (0.013 J), mass_ratio_10 0.0087 / -0.0028 J (0.0036 J).
 /// The step's rows must be laid out as World::build_rows lays them out: one contact row per

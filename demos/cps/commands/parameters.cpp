@@ -1,7 +1,7 @@
 // `cps parameters`: the world parameter table (engine/src/parameters.cpp) as Markdown, JSON, the
 // scene schema's world section, or tab-separated rows for scripts. The schema's world section
 // (assets/schemas/scene.schema.json) and the option table of docs/commands.md are this output;
-// tests/test_cli_parameters.cpp fails when they differ, and scripts/update-parameters.sh rewrites
+// tests/cli/test_cli_parameters.cpp fails when they differ, and scripts/update-parameters.sh rewrites
 // them.
 #include "command.h"
 

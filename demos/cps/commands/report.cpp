@@ -5,7 +5,7 @@
 
 #include "options/options.h"
 #include "output/output.h"
-#include "report/push_report.h"
+#include "report/push/report.h"
 #include "report/sweep.h"
 
 #include <CLI/CLI.hpp>

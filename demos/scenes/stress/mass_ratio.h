@@ -40,7 +40,7 @@ MassRatioOutcome run_mass_ratio(double ratio, int iterations, double seconds);
 /// The smallest iteration count in {1, 2, 4, ..., 256} with which the pair holds and the deepest
 /// overlap after 5 s is below 1 cm; -1 if none of them does. ratio as in populate_mass_ratio.
 ///
-/// What to expect (a 1D model of the column, checked by tests/test_stress.cpp): the ground row
+/// What to expect (a 1D model of the column, checked by tests/physics/test_stress.cpp): the ground row
 /// and the cube-cube row form A = [[1/m1, -1/m1], [-1/m1, 1/m1 + 1/m2]]; Gauss-Seidel from 0
 /// reduces the error of lambda by rho = A12^2 / (A11 A22) = R / (1 + R) per sweep, so after N
 /// sweeps the ground row misses rho^N of the load and the pair sinks by rho^N g dt^2 per step,

@@ -1,6 +1,6 @@
 // The stress scenes: stiff and extreme cases, listed apart from the paper's scenes.
 // One file per scene or small group in this directory; stress.h declares them. The physics each
-// one probes, and its checks, are in tests/test_stress.cpp.
+// one probes, and its checks, are in tests/physics/test_stress.cpp.
 #include "scene.h"
 #include "stress/mass_ratio.h"
 #include "stress/stress.h"

@@ -38,7 +38,7 @@
 //      the first's (split.cpp): lambda_s carries the push, and the sweeps that do not converge
 //      leave part of it in the momenta. Measured from lambda_s at 25 sweeps: the intersecting
 //      stack's cubes reach 1.24 m/s, and energy enters beyond the push work by up to 1.13 J in a
-//      step of chain_20 and 0.29 J at dt = 0.1 s (tests/test_stress.cpp, "[push_methods]");
+//      step of chain_20 and 0.29 J at dt = 0.1 s (tests/physics/test_stress.cpp, "[push_methods]");
 //      from the last lambda_r: 0.003 m/s, and the bound holds. Box2D's one relax sweep per
 //      substep could not do more than continue from lambda_s.
 // After the last substep the restitution of a contact that approached faster than the

@@ -3,11 +3,11 @@
 // table's order: cps::parameter("push").choices) on the same cases, each at the scene's own
 // settings with only push changed: the intersecting stack and sphere_in_box (overlaps resolved,
 // energy injected, final heights), the stack's drift, the mass ratios that hold, the pendulums'
-// rod and phase errors and the cost per step (push_cases.h). Writes push.csv, push.md and two
+// rod and phase errors and the cost per step (push/cases.h). Writes push.csv, push.md and two
 // diagrams.
 
 #include "report/csv.h"
-#include "report/push_cases.h"
+#include "report/push/cases.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,7 +1,7 @@
 #pragma once
 // The cases of `cps report push`, run for one push method at a time: each at the scene's own
 // settings with only the world parameter push changed. The measures are defined here, at the
-// functions that compute them, and in push.md's legend (push_report.cpp).
+// functions that compute them, and in push.md's legend (push/report.cpp).
 
 #include "scene.h"
 

@@ -2,7 +2,7 @@
 // The push methods of the engine's parameter table (cps::parameter("push").choices), for the
 // command-line tests whose expectations follow them (the report's sweeps, cps report push). In
 // a file of its own so that test files with a local function called cps need not include the
-// engine's headers. Link cps::engine and tests/push_methods.cpp.
+// engine's headers. Link cps::engine and tests/cli/push_methods.cpp.
 
 #include <string>
 #include <vector>

@@ -1,6 +1,6 @@
-// `cps report push`: the push methods side by side (see push_report.h): the cases run per
-// method (push_cases.h), then push.csv, push.md and the diagrams written from their results.
-#include "report/push_report.h"
+// `cps report push`: the push methods side by side (see push/report.h): the cases run per
+// method (push/cases.h), then push.csv, push.md and the diagrams written from their results.
+#include "report/push/report.h"
 
 #include "options/progress.h"
 #include "output/atomic_file.h"

@@ -1,4 +1,4 @@
-#include "report/push_cases.h"
+#include "report/push/cases.h"
 
 #include "options/options.h"
 #include "report/mass_ratio.h"

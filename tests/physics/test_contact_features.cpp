@@ -47,7 +47,7 @@ BodyDef box(const Vec3& half, double mass, const Vec3& position, bool is_static 
 TEST_CASE("a box resting on a box keeps its contact features", "[collision][features]") {
   // A 0.8 m cube on a 2 m x 0.5 m x 2 m slab on the ground. The contacts get a 1 mm margin: at
   // margin 0 a converged push drives each depth to 0 and round-off then decides whether a
-  // resting corner counts as touching (tests/test_stress.cpp, touching boxes), which is the
+  // resting corner counts as touching (tests/physics/test_stress.cpp, touching boxes), which is the
   // contact rule, not the feature ids tested here.
   WorldDef def;
   def.contact_margin = 0.001;

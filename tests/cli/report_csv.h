@@ -1,7 +1,7 @@
 #pragma once
 // The report's CSV files read back by the report library's own reader (demos/cps/report/csv.h),
 // for the command-line tests. In a file of its own so that test files with a local function
-// called cps need not include the library's headers. Link cps_report and tests/report_csv.cpp.
+// called cps need not include the library's headers. Link cps_report and tests/cli/report_csv.cpp.
 
 #include <filesystem>
 #include <map>

@@ -59,36 +59,6 @@ std::string shown(const json& v) {
                        ": " + why);
 }
 
-// Levenshtein distance, for "did you mean" suggestions.
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
-// The candidate nearest to `word` (by edit distance; the first on a tie).
-std::string nearest(std::string_view word, const std::vector<std::string>& candidates) {
-  std::string best;
-  std::size_t best_distance = std::string::npos;
-  for (const std::string& c : candidates) {
-    const std::size_t d = edit_distance(word, c);
-    if (d < best_distance) {
-      best = c;
-      best_distance = d;
-    }
-  }
-  return best;
-}
-
 std::string joined(const std::vector<std::string>& words) {
   std::string s;
   for (const std::string& w : words) s += (s.empty() ? "" : ", ") + w;
@@ -193,7 +163,7 @@ std::vector<std::string> required_keys(const json& schema_node, const json& valu
       std::vector<std::string> where = path;
       where.push_back(key);
       fail(origin, pointer_of(where),
-           "unknown key \"" + key + "\"; did you mean \"" + nearest(key, known) +
+           "unknown key \"" + key + "\"; did you mean \"" + nearest_name(key, known) +
                "\"? (the keys allowed here are: " + joined(known) + ")");
     }
     for (const std::string& key : required_keys(*node, *value)) {
@@ -425,7 +395,7 @@ int body_ref(const std::string& origin, const json& j, const std::string& at,
   fail(origin, at,
        shown(j) + ": no body has this name" +
            (names.empty() ? std::string("; no body has a name (give \"name\" to a body, or use its index)")
-                          : "; did you mean \"" + nearest(name, names) + "\"? (the names are: " + joined(names) + ")"));
+                          : "; did you mean \"" + nearest_name(name, names) + "\"? (the names are: " + joined(names) + ")"));
 }
 
 // Line and column (from 1) of byte `at` of `text`.
@@ -553,6 +523,39 @@ json parse_json_text(std::string_view text, const std::string& origin) {
 }
 
 }  // namespace
+
+// Levenshtein distance, for "did you mean" suggestions.
+namespace {
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::string nearest_name(std::string_view word, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t best_distance = std::string::npos;
+  for (const std::string& c : candidates) {
+    const std::size_t d = edit_distance(word, c);
+    if (d < best_distance) {
+      best = c;
+      best_distance = d;
+    }
+  }
+  return best;
+}
 
 SceneFile parse_scene_file(std::string_view text, const std::string& origin) {
   const json doc = parse_json_text(text, origin);

@@ -105,7 +105,8 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
   local kind=$1
   shift
   case $kind in
-    seconds) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 100001 1/2 ;;  # (0, 1e5], no fraction
+    seconds)  # (0, 1e5] s, a fraction allowed, at least one step of the scene's dt
+      printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 1e-300 100001 1/0 0/1 -1/60 1//60 1/ nan/1 ;;
     fps) printf '%s\n' "$NUM_COMMON" -1 0 1e-400 1001 1/2 ;;           # (0, 1000]
     orbit) printf '%s\n' "$NUM_COMMON" -36001 36001 -1e5 1/2 ;;        # [-36000, 36000]
     speed) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 100.5 101 1/2 ;;  # (0, 100] s/s
@@ -139,7 +140,7 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
       printf '%s\n' "" 12x 8x8 15x16 16x15 8193x16 16x8193 0x0 -16x16 16x-16 1280x720x3 1280X720 \
         1280*720 0x10 99999x99999 123456x720 1e3x720 " 1280x720" nan x 1280 16x16junk ;;
     times)  # comma separated, finite, >= 0, increasing, at most 1e5 s, at most 64 of them
-      printf '%s\n' "" , 0, ,0 0,,1 nan inf -inf -1 0,-1 1,0 0,0 0x10 1x 10s 1/2 1e308 1e12 \
+      printf '%s\n' "" , 0, ,0 0,,1 nan inf -inf -1 0,-1 1,0 0,0 0x10 1x 10s 1/0 1//60 -1/60 1e308 1e12 \
         100001 4294967297 0,1e-400x "0;1" "$(seq_csv 65)" ;;
     compare)  # PARAM=V1,...,Vn (2 to 6 distinct values the table accepts) or a choice alone
       printf '%s\n' "" nosuch nosuch=1,2 gravity=0,0,-10 collision=true,false PUSH "push " " push" \

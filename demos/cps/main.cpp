@@ -4,6 +4,7 @@
 #include "command.h"
 #include "options/options.h"
 #include "output/output.h"
+#include "scene.h"
 
 #include <CLI/CLI.hpp>
 
@@ -14,6 +15,37 @@
 namespace {
 
 using namespace cps;
+
+// What an unexpected argument of the command argv[1] is: the first word starting with '-' that
+// the command has no option for, with the option nearest to it ("did you mean"), or CLI11's
+// message `fallback` when every such word is known (a stray value).
+std::string unknown_option_message(CLI::App& app, int argc, char** argv,
+                                   const std::string& fallback) {
+  const CLI::App* sub = nullptr;
+  for (const CLI::App* s : app.get_subcommands({})) {
+    if (argc > 1 && s->get_name() == argv[1]) sub = s;
+  }
+  if (sub == nullptr) return fallback;
+  const std::string command = sub->get_name();
+  for (int i = 2; i < argc; ++i) {
+    std::string word = argv[i];
+    if (word.size() < 2 || word[0] != '-') continue;
+    word = word.substr(0, word.find('='));
+    if (sub->get_option_no_throw(word) != nullptr) continue;
+    if (sub->get_name() == "figure" && word == "--seconds") {
+      return command + ": no --seconds: a figure takes its times from --times (s), e.g. "
+                       "--times 0,0.5,2, and runs until the last of them";
+    }
+    std::vector<std::string> names;
+    for (const CLI::Option* o : sub->get_options()) {
+      for (const std::string& n : o->get_lnames()) names.push_back("--" + n);
+    }
+    return command + ": unknown option '" + word + "'; did you mean '" +
+           scenes::nearest_name(word, names) + "'? Run 'cps " + command +
+           " --help' for its options.";
+  }
+  return fallback + "\nRun 'cps --help' or 'cps COMMAND --help' for usage.";
+}
 
 int run(int argc, char** argv) {
   CLI::App app{"cps: the constraint based physics solver of Tamis & Maggiore (2015)"};
@@ -63,6 +95,9 @@ int run(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const CLI::ExtrasError& e) {
+    std::cerr << "cps: " << unknown_option_message(app, argc, argv, e.what()) << "\n";
+    return 2;
   } catch (const CLI::ParseError& e) {
     std::cerr << "cps: " << e.what() << "\nRun 'cps --help' or 'cps COMMAND --help' for usage.\n";
     return 2;

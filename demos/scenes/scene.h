@@ -128,6 +128,10 @@ std::span<const Scene> all_scenes();
 /// or is not valid.
 const Scene* find_scene(std::string_view name);
 
+/// The candidate nearest to `word` by edit distance (Levenshtein; the first on a tie), for "did
+/// you mean" in messages; "" when there are no candidates. No errors.
+std::string nearest_name(std::string_view word, const std::vector<std::string>& candidates);
+
 /// The random scene with this seed, named random_SEED (see find_scene); kept for the program's
 /// life.
 const Scene* random_scene(std::uint64_t seed);

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <deque>
@@ -56,36 +57,6 @@ std::string shown(const json& v) {
                        const std::string& why) {
   throw SceneFileError(origin + ": " + (pointer.empty() ? std::string("(top level)") : pointer) +
                        ": " + why);
-}
-
-// Levenshtein distance, for "did you mean" suggestions.
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
-// The candidate nearest to `word` (by edit distance; the first on a tie).
-std::string nearest(std::string_view word, const std::vector<std::string>& candidates) {
-  std::string best;
-  std::size_t best_distance = std::string::npos;
-  for (const std::string& c : candidates) {
-    const std::size_t d = edit_distance(word, c);
-    if (d < best_distance) {
-      best = c;
-      best_distance = d;
-    }
-  }
-  return best;
 }
 
 std::string joined(const std::vector<std::string>& words) {
@@ -192,7 +163,7 @@ std::vector<std::string> required_keys(const json& schema_node, const json& valu
       std::vector<std::string> where = path;
       where.push_back(key);
       fail(origin, pointer_of(where),
-           "unknown key \"" + key + "\"; did you mean \"" + nearest(key, known) +
+           "unknown key \"" + key + "\"; did you mean \"" + nearest_name(key, known) +
                "\"? (the keys allowed here are: " + joined(known) + ")");
     }
     for (const std::string& key : required_keys(*node, *value)) {
@@ -424,34 +395,170 @@ int body_ref(const std::string& origin, const json& j, const std::string& at,
   fail(origin, at,
        shown(j) + ": no body has this name" +
            (names.empty() ? std::string("; no body has a name (give \"name\" to a body, or use its index)")
-                          : "; did you mean \"" + nearest(name, names) + "\"? (the names are: " + joined(names) + ")"));
+                          : "; did you mean \"" + nearest_name(name, names) + "\"? (the names are: " + joined(names) + ")"));
+}
+
+// Line and column (from 1) of byte `at` of `text`.
+std::string line_column(std::string_view text, std::size_t at) {
+  at = std::min(at, text.size());
+  std::size_t line = 1;
+  std::size_t column = 1;
+  for (std::size_t i = 0; i < at; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return std::to_string(line) + ":" + std::to_string(column);
+}
+
+// Where the parse is: one frame per open object or array, for the pointer of a message and the
+// keys an object already has.
+struct ParseFrame {
+  bool object = false;
+  std::size_t index = 0;             // array: the element being read
+  std::string key;                   // object: the member being read
+  std::vector<std::string> keys;     // object: the keys read so far
+};
+
+// Text for a message, at most 120 characters: the start and the end of a longer one.
+std::string excerpt(const std::string& text) {
+  if (text.size() <= 120) return text;
+  return text.substr(0, 40) + "..." + text.substr(text.size() - 77);
+}
+
+std::string pointer_at(const std::vector<ParseFrame>& frames) {
+  std::vector<std::string> tokens;
+  for (const ParseFrame& f : frames) tokens.push_back(f.object ? f.key : std::to_string(f.index));
+  return excerpt(pointer_of(tokens));
+}
+
+// The byte where the n-th (from 0) key `key` of the text starts: an unescaped "key" followed by
+// ':' (after white space); npos if not found (a key written with escapes).
+std::size_t key_position(std::string_view text, const std::string& key, std::size_t n) {
+  const std::string quoted = "\"" + key + "\"";
+  for (std::size_t at = text.find(quoted); at != std::string_view::npos;
+       at = text.find(quoted, at + 1)) {
+    if (at > 0 && text[at - 1] == '\\') continue;
+    std::size_t after = at + quoted.size();
+    while (after < text.size() && std::isspace(static_cast<unsigned char>(text[after]))) ++after;
+    if (after < text.size() && text[after] == ':' && n-- == 0) return at;
+  }
+  return std::string_view::npos;
+}
+
+// Parses the JSON text of a scene file: comments allowed; refused, with the file, line:column
+// and pointer: nesting deeper than kMaxSceneFileDepth, a key twice in one object, a number out
+// of the range of a double, a NUL byte (the parser would stop there and take what follows for
+// the end), anything after the document, and any syntax error.
+json parse_json_text(std::string_view text, const std::string& origin) {
+  const std::size_t nul = text.find('\0');
+  if (nul != std::string_view::npos) {
+    throw SceneFileError(origin + ":" + line_column(text, nul) +
+                         ": a NUL byte: a scene file is JSON text, and nothing may follow the "
+                         "document");
+  }
+  std::vector<ParseFrame> frames;
+  std::map<std::string, std::size_t> key_count;  // keys seen so far, for their position
+  const json::parser_callback_t track = [&](int, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        if (frames.size() >= kMaxSceneFileDepth) {
+          throw SceneFileError(origin + ": " + pointer_at(frames) + ": nested deeper than " +
+                               std::to_string(kMaxSceneFileDepth) +
+                               " objects and arrays; a scene file needs 4");
+        }
+        frames.push_back({event == json::parse_event_t::object_start, 0, {}, {}});
+        break;
+      case json::parse_event_t::key: {
+        ParseFrame& f = frames.back();
+        f.key = parsed.get<std::string>();
+        const std::size_t seen = key_count[f.key]++;
+        if (std::find(f.keys.begin(), f.keys.end(), f.key) != f.keys.end()) {
+          const std::size_t at = key_position(text, f.key, seen);
+          throw SceneFileError(origin + ":" +
+                               (at == std::string_view::npos ? "" : line_column(text, at) + ":") +
+                               " " + pointer_at(frames) + ": the key \"" + excerpt(f.key) +
+                               "\" a second time in one object; give each key once");
+        }
+        f.keys.push_back(f.key);
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames.pop_back();
+        if (!frames.empty() && !frames.back().object) ++frames.back().index;
+        break;
+      case json::parse_event_t::value:
+        if (!frames.empty() && !frames.back().object) ++frames.back().index;
+        break;
+    }
+    return true;
+  };
+  try {
+    return json::parse(text, track, true, /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    // e.byte: the byte where parsing stopped, counted from 1.
+    std::string why = e.what();
+    const std::size_t cut = why.find("syntax error");
+    if (cut != std::string::npos) why = why.substr(cut);
+    throw SceneFileError(origin + ":" + line_column(text, e.byte == 0 ? 0 : e.byte - 1) +
+                         ": not valid JSON (comments are allowed): " + why);
+  } catch (const json::out_of_range& e) {
+    // "number overflow parsing '1e400'": the number as written, and where it first appears.
+    const std::string why = e.what();
+    const std::size_t open = why.find('\'');
+    const std::size_t close = why.rfind('\'');
+    const std::string number =
+        open != std::string::npos && close > open ? why.substr(open + 1, close - open - 1) : "";
+    const std::size_t at = number.empty() ? std::string_view::npos : text.find(number);
+    throw SceneFileError(origin + ":" +
+                         (at == std::string_view::npos ? "" : line_column(text, at) + ":") + " " +
+                         pointer_at(frames) + ": the number " + (number.empty() ? "" : number + " ") +
+                         "is out of the range of a double (at most about 1.8e308 in size)");
+  }
 }
 
 }  // namespace
 
-SceneFile parse_scene_file(std::string_view text, const std::string& origin) {
-  json doc;
-  try {
-    doc = json::parse(text, nullptr, true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& e) {
-    // Line and column of the byte where parsing stopped (e.byte counts from 1).
-    const std::size_t at = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
-    std::size_t line = 1;
-    std::size_t column = 1;
-    for (std::size_t i = 0; i < at; ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        column = 1;
-      } else {
-        ++column;
-      }
+// Levenshtein distance, for "did you mean" suggestions.
+namespace {
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
     }
-    std::string why = e.what();
-    const std::size_t cut = why.find("syntax error");
-    if (cut != std::string::npos) why = why.substr(cut);
-    throw SceneFileError(origin + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                         ": not valid JSON (comments are allowed): " + why);
   }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::string nearest_name(std::string_view word, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t best_distance = std::string::npos;
+  for (const std::string& c : candidates) {
+    const std::size_t d = edit_distance(word, c);
+    if (d < best_distance) {
+      best = c;
+      best_distance = d;
+    }
+  }
+  return best;
+}
+
+SceneFile parse_scene_file(std::string_view text, const std::string& origin) {
+  const json doc = parse_json_text(text, origin);
   validate_against_schema(origin, doc);
 
   SceneFile file;

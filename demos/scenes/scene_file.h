@@ -3,7 +3,9 @@
 // of truth; docs/scene-files.md describes it). A file is checked in three passes, each
 // error naming the file, the JSON pointer of the bad value (/bodies/3/mass_kg), the value and
 // what is allowed:
-//   1. syntax (nlohmann-json, comments allowed): the line and column;
+//   1. syntax (nlohmann-json, comments allowed): the line and column; also refused there, with
+//      the pointer: nesting deeper than kMaxSceneFileDepth, a key twice in one object, a number
+//      out of the range of a double, and a NUL byte or anything else after the document;
 //   2. the schema (valijson): types, ranges, required and unknown keys (an unknown key names the
 //      nearest known one, so that a typo never falls back to a default silently);
 //   3. the engine's own checks: the parameter table for world parameters, make_body for bodies,
@@ -65,6 +67,11 @@ SceneFile read_scene_file(const std::filesystem::path& path);
 
 /// The largest scene file read (bytes): 64 MiB, about 300,000 bodies written out in full.
 inline constexpr std::uintmax_t kMaxSceneFileBytes = 64u << 20;
+
+/// The deepest nesting of objects and arrays a scene file may have (count): a scene file needs 4
+/// (the file, "bodies", a body, its "position_m"); deeper text is refused before it is built, so
+/// that no message or check recurses through it.
+inline constexpr std::size_t kMaxSceneFileDepth = 32;
 
 /// The scene a SceneFile describes, named `name`: populate adds its bodies and rods, its metrics
 /// are FileSceneMetrics, summary its name and description. The Scene's views point into `file`

@@ -158,7 +158,9 @@ const Scene* find_scene(std::string_view name) {
   const std::size_t cut = name.rfind('_');
   if (cut == std::string_view::npos || cut + 1 >= name.size()) return nullptr;
   const std::string_view digits = name.substr(cut + 1);
-  if (digits.size() > 6 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+  // Exactly as the scene is named: digits only, no leading zero (stack_01 is not stack_1).
+  if (digits.size() > 6 || (digits.size() > 1 && digits[0] == '0') ||
+      !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
     return nullptr;
   }
   static std::mutex mutex;

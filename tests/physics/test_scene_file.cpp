@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cfenv>
 #include <cmath>
 #include <functional>
 #include <string>
@@ -264,4 +265,42 @@ TEST_CASE("random_SEED is the random scene with that seed", "[scene_file]") {
   CHECK(find_scene("random_x") == nullptr);
   CHECK(find_scene("random_18446744073709551616") == nullptr);  // 2^64
   CHECK(find_scene("random_18446744073709551615") != nullptr);
+}
+
+TEST_CASE("scene file text past what JSON allows is refused with the line, column and pointer",
+          "[scene_file]") {
+  SECTION("nesting far deeper than a scene file needs: refused before it is built") {
+    const std::string text = "{\"bodies\": " + std::string(100000, '[') +
+                             std::string(100000, ']') + "}";
+    const std::string e = error_of(text);
+    CHECK(e.find("test.json: /bodies/0/0") == 0);
+    CHECK(e.find("nested deeper than " + std::to_string(kMaxSceneFileDepth)) != std::string::npos);
+    CHECK(e.size() < 400);  // a bounded message, however deep the text
+  }
+  SECTION("a number past the largest double") {
+    // The parser's strtod overflows on purpose here: that overflow is not trapped (fp_trap.cpp).
+    const int trapped = fegetexcept();
+    fedisableexcept(FE_OVERFLOW);
+    const std::string e = error_of("{\n  \"world\": {\"dt_s\": 1e400}\n}");
+    feenableexcept(trapped);
+    CHECK(e.find("test.json:2:21: /world/dt_s: the number 1e400 is out of the range") == 0);
+  }
+  SECTION("a key twice in one object: neither value is taken silently") {
+    const std::string e = error_of("{\n  \"world\": {\"beta\": 0.1,\n    \"beta\": 0.3}\n}");
+    CHECK(e.find("test.json:3:5: /world/beta: the key \"beta\" a second time") == 0);
+  }
+  SECTION("the same key in two objects is allowed") {
+    CHECK_NOTHROW(parse_scene_file(kValid, "test.json"));
+  }
+  SECTION("a NUL byte and what follows it") {
+    const std::string text = std::string(kValid) + std::string(1, '\0') + "garbage";
+    const std::string e = error_of(text);
+    CHECK(e.find("test.json:") == 0);
+    CHECK(e.find("a NUL byte") != std::string::npos);
+  }
+  SECTION("text after the document") {
+    const std::string e = error_of(std::string(kValid) + " {}");
+    CHECK(e.find("not valid JSON") != std::string::npos);
+    CHECK(e.find("expected end of input") != std::string::npos);
+  }
 }

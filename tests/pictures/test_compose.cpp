@@ -99,3 +99,18 @@ TEST_CASE("fit_panels needs a font size and a grid", "[compose]") {
   page.rows = 0;
   CHECK_THROWS_AS(fit_panels(page, 640, 360), std::invalid_argument);
 }
+
+TEST_CASE("time captions tell frames apart and stay near their time", "[compose]") {
+  using cps::cli::time_caption;
+  // Frames 1/60 s apart (render --fps 60): three decimals, within a twentieth of the spacing.
+  CHECK(time_caption(1.0 / 60.0, 1.0 / 60.0) == "t = 0.017 s");
+  // Panels 0.5 s apart: the two decimals every caption has at least.
+  CHECK(time_caption(0.5, 0.5) == "t = 0.50 s");
+  // Every frame of 10 s at 600 fps (the pendulum wave's own step) prints apart from the others.
+  std::vector<std::string> captions;
+  for (int k = 0; k <= 6000; ++k) captions.push_back(time_caption(k / 600.0, 1.0 / 600.0));
+  for (std::size_t k = 1; k < captions.size(); ++k) {
+    INFO(captions[k - 1] << " / " << captions[k]);
+    REQUIRE(captions[k - 1] != captions[k]);
+  }
+}

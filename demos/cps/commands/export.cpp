@@ -313,6 +313,11 @@ ExportPlan plan_export(const ExportOptions& o, int argc, char** argv) {
   check_steps(o.scene, seconds, run.world.def().dt);
   // Sample k at t_k = k / fps, k = 0 .. floor(seconds * fps).
   const double frames = std::floor(seconds * o.fps + 1e-9) + 1.0;
+  if (frames < 2.0) {
+    throw UsageError("--seconds " + shortest_decimal(seconds) + " at --fps " +
+                     shortest_decimal(o.fps) + " is one sample, the start: the next would be at " +
+                     shortest_decimal(1.0 / o.fps) + " s; give more --seconds or a higher --fps");
+  }
   if (frames > kMaxFrames) {
     throw UsageError(std::to_string(static_cast<long long>(frames)) +
                      " samples (--seconds x --fps) is more than the " +

@@ -37,10 +37,10 @@ std::vector<double> parse_times(const std::string& text) {
       throw UsageError("--times " + text + ": an empty entry; give times in seconds separated by "
                        "commas, e.g. --times 0,0.5,2");
     }
-    const std::optional<double> parsed = parse_decimal(entry);
+    const std::optional<double> parsed = parse_decimal(entry, /*allow_fraction=*/true);
     if (!parsed) {
-      throw UsageError("--times: " + quoted + " is not a decimal number; give times in seconds, "
-                       "e.g. --times 0,0.5,2");
+      throw UsageError("--times: " + quoted + " is not a decimal number or fraction; give times "
+                       "in seconds, e.g. --times 0,0.5,2 or 0,1/60,1/30");
     }
     const double t = *parsed;
     if (!std::isfinite(t)) {
@@ -98,6 +98,18 @@ std::string subfigure_letter(std::size_t k) {
   return "(" + letters + ")";
 }
 
+namespace {
+
+// The smallest gap (s) between two of the figure's times, for the decimals of their captions;
+// 0.01 s (two decimals) for one time.
+double time_spacing(const std::vector<double>& times) {
+  double spacing = 0.01;
+  for (std::size_t k = 1; k < times.size(); ++k) spacing = std::min(spacing, times[k] - times[k - 1]);
+  return spacing;
+}
+
+}  // namespace
+
 ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer) {
   const scenes::Scene& scene = *spec.scene;
   std::vector<scenes::Run> runs;
@@ -125,7 +137,7 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
       render::Image panel = renderer.draw(overlay_draw_list(worlds, style));
       draw_border(panel);
       out.panels.push_back(std::move(panel));
-      texts.push_back(time_caption(runs.front().world.time()));
+      texts.push_back(time_caption(runs.front().world.time(), time_spacing(spec.times)));
     }
     // The legend even without labels: without it the colours mean nothing. It has a strip of
     // its own below the panels.
@@ -138,7 +150,7 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
         render::Image panel = renderer.draw(draw_list(runs[r].world, style));
         draw_border(panel);
         out.panels.push_back(std::move(panel));
-        std::string text = time_caption(runs[r].world.time());
+        std::string text = time_caption(runs[r].world.time(), time_spacing(spec.times));
         if (!spec.variants[r].label.empty()) text += "\n" + spec.variants[r].label;
         texts.push_back(text);
       }
@@ -460,7 +472,8 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
   add_seed_option(*sub, o->scene);
   sub->add_option("--times", o->times,
                   "simulated times of the columns (s), comma separated, finite, >= 0, "
-                  "increasing, e.g. 0,0.5,2; required except for 'paper'");
+                  "increasing, decimals or fractions, e.g. 0,0.5,2 or 0,1/60,1/30; required "
+                  "except for 'paper'");
   sub->add_option("--compare", o->compare,
                   "PARAM=V1,V2,...: one row per value, 2 to 6 values of a world parameter (" +
                       comparable_list() + "), each checked as its own option is; a choice alone "

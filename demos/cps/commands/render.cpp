@@ -57,9 +57,10 @@ std::string frame_name(long long k) {
 
 namespace {
 
-// A panel's caption in a frame: its label (if any), then the time t (s) on a line of its own.
-std::string frame_caption(const std::string& label, double t) {
-  return (label.empty() ? std::string() : label + "\n") + time_caption(t);
+// A panel's caption in a frame: its label (if any), then the time t (s) on a line of its own,
+// with the decimals that tell frames `spacing` s apart.
+std::string frame_caption(const std::string& label, double t, double spacing) {
+  return (label.empty() ? std::string() : label + "\n") + time_caption(t, spacing);
 }
 
 }  // namespace
@@ -88,7 +89,8 @@ FigurePage frame_page(const RenderJob& job, const std::vector<std::string>& labe
   page.width = job.frame_width;
   page.height = job.frame_height;
   for (std::size_t p = 0; p < panels; ++p) {
-    page.panels.push_back({nullptr, "", frame_caption(labels.empty() ? std::string() : labels[p], t)});
+    page.panels.push_back({nullptr, "", frame_caption(labels.empty() ? std::string() : labels[p], t,
+                                                          job.speed / job.fps)});
   }
   // A last row that the variants do not fill: its empty cells have no caption.
   for (std::size_t p = panels; p < static_cast<std::size_t>(page.rows * page.columns); ++p) {
@@ -164,7 +166,7 @@ long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, cons
       FigurePage page = *base;
       for (std::size_t p = 0; p < pictures.size(); ++p) {
         page.panels[p].image = &pictures[p];
-        page.panels[p].text = frame_caption(labels[p], worlds[p]->time());
+        page.panels[p].text = frame_caption(labels[p], worlds[p]->time(), job.speed / job.fps);
       }
       writer.write(job.folder / frame_name(k), compose_page_pixels(page, *layout));
     }
@@ -298,6 +300,13 @@ void check_render_work(const RenderOptions& o, const PixelSize& size, const Scen
   const std::string name(job.scene->name);
   for (const scenes::Run& run : job.runs) check_steps(name, job.spec.seconds, run.world.def().dt);
   const long long frames = frame_count(job.spec);
+  if (frames < 2) {
+    throw UsageError(name + ": --seconds " + shortest_decimal(job.spec.seconds) + " at --fps " +
+                     shortest_decimal(o.fps) + " (--speed " + shortest_decimal(job.spec.speed) +
+                     ") is one frame, the start: the first frame after it would be at " +
+                     shortest_decimal(job.spec.speed / job.spec.fps) +
+                     " s; give more --seconds or a higher --fps (cps figure draws one moment)");
+  }
   if (static_cast<double>(frames) > kMaxFrames) {
     throw UsageError(name + ": " + std::to_string(frames) +
                      " frames (--seconds x --fps / --speed) is more than the " +

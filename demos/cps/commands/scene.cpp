@@ -36,6 +36,9 @@ int run_scene(const SceneOptions& o, int argc, char** argv) {
   if (path.filename().empty() || path.filename() == "." || path.filename() == "..") {
     throw UsageError("--out " + o.out + ": give a file name (FILE.json), not a folder");
   }
+  if (path.extension() != ".json" || path.stem().empty()) {
+    throw UsageError("--out " + o.out + ": give a file name ending in .json (a scene file)");
+  }
   const nlohmann::json info =
       run_info("scene", argc, argv, {{"scene", scene->name}, {"out", o.out}});
   const OutputPlan plan =

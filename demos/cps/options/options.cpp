@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <functional>
@@ -40,8 +41,9 @@ CLI::Validator decimal_in(double lo, double hi, bool lo_open, const std::string&
 
 void add_seconds_option(CLI::App& cmd, std::optional<double>& seconds, const std::string& limits) {
   cmd.add_option("--seconds", seconds,
-                 "simulated time (s) in (0, 1e5]; default: the scene's; " + limits)
-      ->check(decimal_in(0.0, kMaxSeconds, true, "s"));
+                 "simulated time (s) in (0, 1e5], a decimal or a fraction such as 1/2; default: the "
+                 "scene's; " + limits)
+      ->transform(decimal_in(0.0, kMaxSeconds, true, "s", /*allow_fraction=*/true));
 }
 
 const CLI::Validator kNotEmpty(
@@ -51,6 +53,14 @@ const CLI::Validator kNotEmpty(
     "");
 
 void check_steps(const std::string& what, double seconds, double dt) {
+  if (seconds > 0.0 && std::llround(seconds / dt) < 1) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "%s: %.6g s at dt = %.6g s is less than one step; give --seconds of at least "
+                  "dt (%.6g s) or a smaller --dt",
+                  what.c_str(), seconds, dt, dt);
+    throw UsageError(text);
+  }
   const double steps = std::ceil(seconds / dt);
   if (steps > kMaxSteps) {
     char text[200];
@@ -110,21 +120,23 @@ std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
   } catch (const scenes::SceneFileError& e) {
     throw UsageError(e.what());
   }
-  std::string known;
-  for (const scenes::Scene& s : scenes::all_scenes()) known += std::string(known.empty() ? "" : ", ") + std::string(s.name);
-  std::string examples;
-  for (const std::string_view e : scenes::example_scene_names()) {
-    examples += (examples.empty() ? "" : ", ") + std::string(e);
+  // A scaled family's name with a size it does not have: say the family's range.
+  for (const std::string_view help : scenes::scaled_families()) {
+    const std::string family(help.substr(0, help.find("_N")));
+    if (name.rfind(family + "_", 0) == 0 && name.size() > family.size() + 1 &&
+        std::isdigit(static_cast<unsigned char>(name[family.size() + 1]))) {
+      throw UsageError("unknown scene '" + name + "': the scaled scenes " + std::string(help) +
+                       " are named with N in that range, without leading zeros");
+    }
   }
-  std::string families;
-  for (const std::string_view f : scenes::scaled_families()) {
-    families += (families.empty() ? "" : ", ") + std::string(f);
-  }
-  throw UsageError("unknown scene '" + name + "'; the scenes are: " + known +
-                   " (or 'all' for the paper's scenes, 'stress' for the stress scenes); the "
-                   "example scene files " + examples + "; random_SEED (the random scene with "
-                   "that seed); the scaled scenes " + families +
-                   "; or the path of a scene file ending in .json; 'cps list' describes them");
+  std::vector<std::string> known = {"all", "stress"};
+  for (const scenes::Scene& s : scenes::all_scenes()) known.emplace_back(s.name);
+  for (const std::string_view e : scenes::example_scene_names()) known.emplace_back(e);
+  throw UsageError("unknown scene '" + name + "'; did you mean '" +
+                   scenes::nearest_name(name, known) +
+                   "'? ('cps list' shows the paper's and stress scenes, the example scene files, "
+                   "random_SEED and the scaled families; or give the path of a scene file ending "
+                   "in .json)");
 }
 
 std::string with_seed(const std::string& scene, std::uint64_t seed) {

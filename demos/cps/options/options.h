@@ -47,7 +47,8 @@ void add_seconds_option(CLI::App& cmd, std::optional<double>& seconds, const std
 extern const CLI::Validator kNotEmpty;
 
 /// Throws UsageError naming the run, the steps it would take and kMaxSteps when seconds / dt
-/// (s / s) exceeds kMaxSteps.
+/// (s / s) exceeds kMaxSteps, and naming dt when seconds > 0 rounds to no step at all (a run
+/// takes round(seconds / dt) steps). seconds = 0 (a figure at the start only) takes none.
 void check_steps(const std::string& what, double seconds, double dt);
 
 /// Scenes named on the command line: "all", "stress", one scene name (see scenes::find_scene:

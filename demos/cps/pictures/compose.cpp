@@ -249,9 +249,14 @@ cairo_status_t append(void* closure, const unsigned char* data, unsigned int len
 
 }  // namespace
 
-std::string time_caption(double t) {
-  char text[48];
-  std::snprintf(text, sizeof text, "t = %.2f s", t);
+std::string time_caption(double t, double spacing) {
+  // Rounding to d decimals is monotone with a step of 10^-d, so times 10^-d apart already print
+  // differently; one decimal more keeps each within a twentieth of the spacing of its value
+  // (1/60 s prints 0.017, not 0.02).
+  int decimals = 2;
+  while (decimals < 9 && std::pow(10.0, -decimals) > 0.1 * spacing * (1.0 + 1e-9)) ++decimals;
+  char text[64];
+  std::snprintf(text, sizeof text, "t = %.*f s", decimals, t);
   return text;
 }
 

@@ -29,8 +29,11 @@ FigureFormat parse_figure_format(std::string_view text);
 /// The file name extension of `format`, with the dot (".png", ".pdf", ".svg").
 std::string_view figure_extension(FigureFormat format);
 
-/// A panel's time as its caption says it: "t = 1.25 s" (t in s, two decimals).
-std::string time_caption(double t);
+/// A panel's time as its caption says it: "t = 1.25 s" (t in s), with the fewest decimals, at
+/// least 2 and at most 9, whose last place is at most a tenth of `spacing` (s, > 0: the time
+/// between frames or panels), so that neighbours print apart and near their value (frames 1/60 s
+/// apart: "t = 0.017 s", "t = 0.033 s"). No errors.
+std::string time_caption(double t, double spacing = 0.01);
 
 /// One panel of a figure page: the rendered scene and its caption.
 struct PagePanel {

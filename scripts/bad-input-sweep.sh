@@ -107,7 +107,7 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
   case $kind in
     seconds)  # (0, 1e5] s, a fraction allowed, at least one step of the scene's dt
       printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 1e-300 100001 1/0 0/1 -1/60 1//60 1/ nan/1 ;;
-    fps) printf '%s\n' "$NUM_COMMON" -1 0 1e-400 1001 1/2 ;;           # (0, 1000]
+    fps) printf '%s\n' "$NUM_COMMON" -1 0 1e-400 1e-300 9e-6 1001 1/2 ;;  # [1e-5, 1000]
     orbit) printf '%s\n' "$NUM_COMMON" -36001 36001 -1e5 1/2 ;;        # [-36000, 36000]
     speed) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 100.5 101 1/2 ;;  # (0, 100] s/s
     fov) printf '%s\n' "$NUM_COMMON" -1 0 1 170 180 1e-400 1/2 ;;       # (1, 170) deg
@@ -241,19 +241,20 @@ EXTRA=(
 CONTROLS=(
   "list"
   "simulate stack --seconds 0.1"
-  "simulate stack --seconds 5e-324"
+  "simulate stack --seconds 0.0084 --dt 1/60"  # rounds to one step, the fewest a run takes
+  "simulate stack --seconds 1/60"
   "simulate stack --seconds 0.1 --dt 1/60 --beta 1e-320 --friction 0 --iterations 10000"
   "report --list-runs --out out"
   "report intersecting_stack --run intersecting_stack.pgs.baumgarte.fixed.it1.ss1.ws0.8 --out out"
   "report push --quick --out out"
   "render stack --seconds 0.1 --fps 10 --size 16x16 --out out"
-  "render stack --seconds 0.1 --fps 5e-324 --size 16x16 --out out --orbit -36000"
+  "render stack --seconds 0.1 --fps 1e-5 --size 16x16 --out out --orbit -36000"
   "figure stack --times 0,0.1 --size 16x16 --out out/f.png"
   "render stack --seconds 0.1 --fps 10 --size 300x160 --compare beta=0,0.5,1 --out out"
   "render stack --seconds 0.1 --fps 10 --size 160x160 --compare dt=1/60,1/120 --overlay --out out"
   "figure stack --times 0 --size 16x16 --compare push --overlay --out out/f.png"
   "export stack --seconds 0.1 --fps 10 --out out/s.glb"
-  "export pendulum_grid --seconds 0.1 --fps 5e-324 --out out/p.glb"
+  "export pendulum_grid --seconds 0.1 --fps 1e-5 --out out/p.glb"
 )
 
 # ---------------------------------------------------------------------------------------------

@@ -160,7 +160,7 @@ TEST_CASE("bad arguments exit with 2, name the problem and write nothing", "[cli
   const fs::path dir = fresh_dir("bad");
   std::vector<Case> cases = {
       {"render nosuchscene", "unknown scene 'nosuchscene'"},
-      {"simulate nosuchscene", "stack"},  // lists the scenes that exist
+      {"simulate nosuchscene", "'cps list' shows"},  // the nearest name, and where the list is
       {"render stack --size 12x", "--size"},
       {"render stack --size 8x8", "[16, 8192]"},
       {"render stack --fps 0", "--fps"},

@@ -1,7 +1,7 @@
 // Lower limits that mean something and names taken exactly, through the cps command as a user
-// runs it: a run of at least one step, a render or export of more than its first frame, a scene
-// file written as .json, scaled scene names without leading zeros, and "did you mean" for a
-// mistyped scene. Each refused with exit 2, nothing written.
+// runs it: a run of at least one step, a frame rate of one frame in the longest run or more, a
+// scene file written as .json, scaled scene names without leading zeros, and "did you mean" for
+// a mistyped scene or option. Each refused with exit 2, nothing written.
 #include "cli_support.h"
 
 #include <catch2/catch.hpp>
@@ -28,14 +28,14 @@ void check_refused(const std::string& args, const std::string& says) {
 
 }  // namespace
 
-TEST_CASE("a run is at least one step and a render or export more than its first frame",
+TEST_CASE("a run is at least one step, and a frame rate at least one frame a longest run",
           "[cli][limits]") {
   // 1e-300 s is no step of dt = 1/60 s: refused, not a run of 0 steps with exit 0.
   check_refused("simulate stack --seconds 1e-300", "less than one step");
   check_refused("simulate stack --seconds 0.008", "less than one step");  // rounds to 0 steps
-  // One frame every 1e300 s of a 0.1 s run: only the start would be drawn.
-  check_refused("render stack --seconds 0.1 --fps 1e-300 --size 32x32 --out out", "one frame");
-  check_refused("export stack --seconds 0.1 --fps 1e-300 --out out/s.glb", "one sample");
+  // One frame every 1e300 s: longer than any run may last (1e5 s).
+  check_refused("render stack --seconds 0.1 --fps 1e-300 --size 32x32 --out out", "--fps");
+  check_refused("export stack --seconds 0.1 --fps 1e-300 --out out/s.glb", "--fps");
   // The controls: one step, and the first frame after the start.
   const fs::path dir = fresh_dir("cps_limits_ok");
   CHECK(run_cps("simulate stack --seconds 0.01", dir).exit_code == 0);  // rounds to 1 step

@@ -313,11 +313,6 @@ ExportPlan plan_export(const ExportOptions& o, int argc, char** argv) {
   check_steps(o.scene, seconds, run.world.def().dt);
   // Sample k at t_k = k / fps, k = 0 .. floor(seconds * fps).
   const double frames = std::floor(seconds * o.fps + 1e-9) + 1.0;
-  if (frames < 2.0) {
-    throw UsageError("--seconds " + shortest_decimal(seconds) + " at --fps " +
-                     shortest_decimal(o.fps) + " is one sample, the start: the next would be at " +
-                     shortest_decimal(1.0 / o.fps) + " s; give more --seconds or a higher --fps");
-  }
   if (frames > kMaxFrames) {
     throw UsageError(std::to_string(static_cast<long long>(frames)) +
                      " samples (--seconds x --fps) is more than the " +
@@ -555,10 +550,10 @@ Command add_export(CLI::App& app, int argc, char** argv) {
   add_seconds_option(*sub, o->seconds,
                      "at most 1e7 steps (--seconds / --dt) and 1e5 samples (--seconds x --fps)");
   sub->add_option("--fps", o->fps,
-                  "animation samples per simulated second, in (0, 1000]; sample k is the state "
+                  "animation samples per simulated second, in [1e-5, 1000]; sample k is the state "
                   "after the physics step nearest to k / fps s, and tools interpolate between "
                   "samples (LINEAR)")
-      ->check(decimal_in(0.0, kMaxFps, true, "samples/s"))
+      ->check(decimal_in(1.0 / kMaxSeconds, kMaxFps, false, "samples/s"))
       ->capture_default_str();
   sub->add_option("--out", o->out,
                   "the glTF 2.0 binary to write (FILE.glb): a mesh per body, rods as cylinders, "

@@ -101,10 +101,12 @@ std::string subfigure_letter(std::size_t k) {
 namespace {
 
 // The smallest gap (s) between two of the figure's times, for the decimals of their captions;
-// 0.01 s (two decimals) for one time.
+// 0.1 s (two decimals) for one time.
 double time_spacing(const std::vector<double>& times) {
-  double spacing = 0.01;
-  for (std::size_t k = 1; k < times.size(); ++k) spacing = std::min(spacing, times[k] - times[k - 1]);
+  double spacing = 0.1;
+  for (std::size_t k = 1; k < times.size(); ++k) {
+    spacing = k == 1 ? times[1] - times[0] : std::min(spacing, times[k] - times[k - 1]);
+  }
   return spacing;
 }
 

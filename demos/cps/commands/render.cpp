@@ -300,13 +300,6 @@ void check_render_work(const RenderOptions& o, const PixelSize& size, const Scen
   const std::string name(job.scene->name);
   for (const scenes::Run& run : job.runs) check_steps(name, job.spec.seconds, run.world.def().dt);
   const long long frames = frame_count(job.spec);
-  if (frames < 2) {
-    throw UsageError(name + ": --seconds " + shortest_decimal(job.spec.seconds) + " at --fps " +
-                     shortest_decimal(o.fps) + " (--speed " + shortest_decimal(job.spec.speed) +
-                     ") is one frame, the start: the first frame after it would be at " +
-                     shortest_decimal(job.spec.speed / job.spec.fps) +
-                     " s; give more --seconds or a higher --fps (cps figure draws one moment)");
-  }
   if (static_cast<double>(frames) > kMaxFrames) {
     throw UsageError(name + ": " + std::to_string(frames) +
                      " frames (--seconds x --fps / --speed) is more than the " +
@@ -563,10 +556,10 @@ Command add_render(CLI::App& app, int argc, char** argv) {
   add_seconds_option(*sub, o->seconds,
                      "at most 1e7 physics steps, 1e5 frames and 64 GiB of pixels a render");
   sub->add_option("--fps", o->fps,
-                  "frames per second of video, in (0, 1000]; frames are --speed / --fps "
+                  "frames per second of video, in [1e-5, 1000]; frames are --speed / --fps "
                   "simulated seconds apart (so with --speed 1, frames per simulated second)")
       ->capture_default_str()
-      ->check(decimal_in(0.0, kMaxFps, true, "frames/s"));
+      ->check(decimal_in(1.0 / kMaxSeconds, kMaxFps, false, "frames/s"));
   sub->add_option("--speed", o->speed,
                   "simulated seconds per second of video, in (0, 100] (0.25: slow motion, 4: "
                   "fast); frame k shows the physics step nearest to k x speed / fps s, and the "

@@ -24,11 +24,5 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # The random piles run 200 seeds in the Release tests; 50 here (under the sanitizers the 200 took
 # 189 s of a 27.4-minute .ci/run).
 export CPS_RANDOM_SEEDS=${CPS_RANDOM_SEEDS:-50}
-# --repeat until-pass:2: a test that fails is run once more. LeakSanitizer's tracer can crash at
-# exit after a test has passed ("Tracer caught signal 11 ... LeakSanitizer has encountered a
-# fatal error", a known fault of the sanitizer runtime: github.com/google/sanitizers/issues/1353);
-# seen once in a fresh-clone run (2026-11-23, the backend test, its 27 assertions passed) and in
-# none of 50 runs of that test since. A test that fails twice fails CI; the Release run above
-# runs every test once, without retries.
-ctest --test-dir build-asan --output-on-failure --parallel "$(nproc)" -LE sweep --repeat until-pass:2 \
+ctest --test-dir build-asan --output-on-failure --parallel "$(nproc)" -LE sweep \
   -E "cps report's quick funnel sweep|cps report writes CSVs with units|cps report push --quick compares|cps report never overwrites a foreign report|after warm-up a step of every paper scene allocates nothing|for 600 s"

@@ -12,7 +12,9 @@
 # Each command line (nproc of them at a time, or SWEEP_JOBS; SWEEP_TIMEOUT, SWEEP_VERBOSE=1 to
 # list every verdict) runs in a fresh temporary folder (its cwd, with a few fixture files:
 # `file` and `file.png` regular files, `adir`, `adir.json` and `dir.png` folders, scene files
-# `bad.json` (a box without half_extents_m) and `notjson.json`) under `timeout 20` and a
+# `bad.json` (a box without half_extents_m) and `notjson.json`, valid ones `a/x.json` and
+# `b/x.json` of one stem, and `prior/`, a/x.json's render and figure made in another folder)
+# under `timeout 20` and a
 # 1 GiB address-space cap (prlimit --as; see choose_cap below), stdout and stderr captured.
 # A bad command line PASSES when cps exits 2 with a message on stderr that names the option or
 # the value, and wrote nothing (no new file in the cwd or in its TMPDIR, fixture files
@@ -91,6 +93,8 @@ declare -A BASE=(
 )
 RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
 MERGE_SRC=$root/merge-src                              # a complete sweep, made below
+PRIOR=$root/prior                    # a/x.json (a valid scene file) and its render into out/x
+DROP='{"seconds": 0.2, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0}, {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1, "position_m": [0, 0.6, 0]}]}'
 BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick;report push --quick"
 BASE['report:--run']='report --out out'
 BASE['report:--merge']='report --out out'
@@ -235,6 +239,12 @@ EXTRA=(
   "push/--seed|report push --seed 3 --out out"
   "--rendering/--quick|bench --rendering=false --quick=junk"
   "samples/--fps/--seconds|export stack --seconds 1e5 --fps 1000 --out out/s.glb"
+  # Scene-file paths: another file of the same stem into a folder that holds a/x.json's render
+  # (both named), and a command's own input as its output (even with --force).
+  "a/x.json/b/x.json|render b/x.json --seconds 0.1 --fps 10 --size 16x16 --out prior"
+  "a/x.json/b/x.json|figure b/x.json --times 0 --size 16x16 --out prior/x.png"
+  "input/x.json|simulate a/x.json --seconds 0.1 --trace a/x.json --force"
+  "input/x.json|scene a/x.json --out a/x.json --force"
 )
 
 # Valid command lines (some at the edges of the ranges): each must exit 0.
@@ -248,6 +258,8 @@ CONTROLS=(
   "report intersecting_stack --run intersecting_stack.pgs.baumgarte.fixed.it1.ss1.ws0.8 --out out"
   "report push --quick --out out"
   "render stack --seconds 0.1 --fps 10 --size 16x16 --out out"
+  "render ./b/../a/x.json --seconds 0.1 --fps 10 --size 16x16 --out out"  # '..' in a scene path
+  "render $PRIOR/a/x.json --seconds 0.1 --fps 10 --size 16x16 --out out"  # an absolute one
   "render stack --seconds 0.1 --fps 1e-5 --size 16x16 --out out --orbit -36000"
   "figure stack --times 0,0.1 --size 16x16 --out out/f.png"
   "render stack --seconds 0.1 --fps 10 --size 300x160 --compare beta=0,0.5,1 --out out"
@@ -306,6 +318,10 @@ run_cps() {
   mkdir -p "$d/cwd/adir" "$d/cwd/dir.png" "$d/cwd/adir.json" "$d/tmp"
   printf '{"bodies": [{"shape": "box", "mass_kg": 1}]}\n' > "$d/cwd/bad.json"  # no half_extents_m
   printf 'not json\n' > "$d/cwd/notjson.json"
+  mkdir -p "$d/cwd/a" "$d/cwd/b"
+  printf '%s\n' "$DROP" > "$d/cwd/a/x.json"
+  printf '%s\n' "$DROP" > "$d/cwd/b/x.json"
+  [[ ! -d $PRIOR/out ]] || cp -a "$PRIOR/out" "$d/cwd/prior"
   printf 'not written by cps\n' > "$d/cwd/file"
   printf 'not a png, not written by cps\n' > "$d/cwd/file.png"
   local before
@@ -543,6 +559,12 @@ snapshot_dir() { (shopt -s dotglob nullglob; stat -c '%n|%s|%y' "$1"/*); }
 merge_before=$(snapshot_dir "$MERGE_SRC")
 
 has_command() { [[ " ${COMMANDS[*]} " == *" $1 "* ]]; }
+# The scene file a/x.json rendered and drawn into out/ (copied into each case's cwd as prior/).
+mkdir -p "$PRIOR/a"
+printf '%s\n' "$DROP" > "$PRIOR/a/x.json"
+(cd "$PRIOR" && timeout "$TIMEOUT" "$CPS" render a/x.json --seconds 0.1 --fps 10 --size 16x16 --out out &&
+  if has_command figure; then timeout "$TIMEOUT" "$CPS" figure a/x.json --times 0 --size 16x16 --out out/x.png; fi) \
+  > /dev/null 2>&1 || true
 for line in "${CONTROLS[@]}"; do
   read -ra words <<< "$line"
   has_command "${words[0]}" && control "${words[@]}"

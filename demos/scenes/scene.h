@@ -95,7 +95,6 @@ struct Scene {
   BenchTraits bench;
   /// How `cps report` runs and judges the scene.
   ReportTraits report;
-
   /// The simulated time of each run of `cps report` (s): report.horizon_s, or default_seconds.
   double report_horizon_s() const { return report.horizon_s.value_or(default_seconds); }
   /// The time of `cps report`'s trajectory error (s): report.trajectory_time_s, or 1 s, or the
@@ -123,10 +122,16 @@ std::span<const Scene> all_scenes();
 /// pyramid_N (a pyramid of about N boxes, 1..20000), funnel_N (N balls, 1..20000),
 /// pendulum_wave_N (N pendulums, 1..20000), pendulum_grid_N (an N x N grid, 1..100); and a name
 /// ending in ".json", a scene file loaded from that path (scene_file.h; the scene is called by
-/// the path as given). The returned pointer stays valid for the whole program. Throws
-/// SceneFileError (scene_file.h, a std::invalid_argument) for a scene file that cannot be read
-/// or is not valid.
+/// the path as given, its outputs by output_name). The returned pointer stays valid for the
+/// whole program. Throws SceneFileError (scene_file.h, a std::invalid_argument) for a scene file
+/// that cannot be read or is not valid.
 const Scene* find_scene(std::string_view name);
+
+/// The name of a scene's output files and folders (`cps render`'s OUT/NAME/ and its video, a
+/// figure's default file, the report's files): its name, except for a scene file loaded from a
+/// path, whose outputs are named by scene_file_output_name (scene_file.h), never by the path as
+/// typed. No errors.
+std::string_view output_name(const Scene& scene);
 
 /// The candidate nearest to `word` by edit distance (Levenshtein; the first on a tie), for "did
 /// you mean" in messages; "" when there are no candidates. No errors.

@@ -660,6 +660,34 @@ SceneFile read_scene_file(const std::filesystem::path& path) {
   return parse_scene_file(text.str(), origin);
 }
 
+namespace {
+
+bool title_name(std::string_view n) {
+  if (n.empty() || n.size() > 64 || n.front() == '.' || n.front() == '-') return false;
+  for (const char c : n) {
+    const auto u = static_cast<unsigned char>(c);
+    if (!(std::isalnum(u) || c == '_' || c == '-' || c == '.' || u >= 0x80)) return false;
+  }
+  return true;
+}
+
+bool usable_stem(std::string_view n) {
+  if (n.empty() || n.size() > 200 || n.front() == '.') return false;
+  for (const char c : n) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f || c == '/' || c == '\\') return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string scene_file_output_name(const SceneFile& file, const std::filesystem::path& path) {
+  if (title_name(file.name)) return file.name;
+  const std::string stem = path.stem().string();
+  return usable_stem(stem) ? stem : std::string("scene");
+}
+
 Scene scene_of(const SceneFile& file, std::string_view name) {
   Scene s;
   s.name = name;
@@ -689,6 +717,7 @@ struct Registry {
   std::mutex mutex;
   std::deque<SceneFile> files;
   std::deque<std::string> names;
+  std::deque<std::string> output_names;
   std::deque<Scene> scenes;
   std::deque<std::vector<std::optional<Vec3>>> colours;  // by scene, as scenes
 
@@ -698,9 +727,10 @@ struct Registry {
     }
     return nullptr;
   }
-  const Scene* add(SceneFile file, std::string name) {
+  const Scene* add(SceneFile file, std::string name, std::string output_name) {
     files.push_back(std::move(file));
     names.push_back(std::move(name));
+    output_names.push_back(std::move(output_name));
     scenes.push_back(scene_of(files.back(), names.back()));
     colours.emplace_back();
     for (const FileBody& b : files.back().bodies) colours.back().push_back(b.colour);
@@ -728,7 +758,9 @@ const Scene* load_scene_file(std::string_view path) {
   Registry& r = registry();
   const std::lock_guard<std::mutex> lock(r.mutex);
   if (const Scene* s = r.find(path)) return s;
-  return r.add(read_scene_file(std::filesystem::path(path)), std::string(path));
+  SceneFile file = read_scene_file(std::filesystem::path(path));
+  std::string output = scene_file_output_name(file, std::filesystem::path(path));
+  return r.add(std::move(file), std::string(path), std::move(output));
 }
 
 std::span<const std::string_view> example_scene_names() { return example_names(); }
@@ -746,7 +778,17 @@ const Scene* find_example_scene(std::string_view name) {
   Registry& r = registry();
   const std::lock_guard<std::mutex> lock(r.mutex);
   if (const Scene* s = r.find(name)) return s;
-  return r.add(parse_scene_file(text, "assets/scenes/" + std::string(name) + ".json"), std::string(name));
+  return r.add(parse_scene_file(text, "assets/scenes/" + std::string(name) + ".json"), std::string(name),
+               std::string(name));
+}
+
+std::string_view output_name(const Scene& scene) {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  for (std::size_t i = 0; i < r.scenes.size(); ++i) {
+    if (&r.scenes[i] == &scene) return r.output_names[i];
+  }
+  return scene.name;
 }
 
 std::span<const std::optional<Vec3>> body_colours(const Scene& scene) {

@@ -78,6 +78,13 @@ inline constexpr std::size_t kMaxSceneFileDepth = 32;
 /// and `name`, which must outlive it (load_scene_file keeps them for the program's life).
 Scene scene_of(const SceneFile& file, std::string_view name);
 
+/// The name of a scene file's outputs (output_name in scene.h): its "name" when that is 1 to 64
+/// bytes of letters, digits, '_', '-', '.' or non-ASCII UTF-8 that does not begin with '.' or
+/// '-' ("cradle"); else the stem of `path` (the file name without ".json", spaces and unicode
+/// kept) when that is a usable file name (not empty, no control character, not beginning with
+/// '.', at most 200 bytes); else "scene". Never the path as typed. No errors.
+std::string scene_file_output_name(const SceneFile& file, const std::filesystem::path& path);
+
 /// The scene file at `path` (a name ending in ".json"), loaded once and kept for the program's
 /// life; the Scene is named `path` as given. Throws SceneFileError for a file that cannot be read
 /// or is not valid. Thread safe.

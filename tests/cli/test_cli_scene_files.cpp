@@ -107,7 +107,9 @@ TEST_CASE("a scene file renders", "[cli][scene_file]") {
   const Result r = run_cps("render chain.json --seconds 0.1 --fps 10 --size 64x48 --out out", dir);
   INFO(r.err);
   CHECK(r.exit_code == 0);
-  CHECK(fs::exists(dir / "out" / "chain.json" / "frame_000000.png"));
+  // Named by the file's "name" (chain_hit), never by the path as typed.
+  CHECK(fs::exists(dir / "out" / "chain_hit" / "frame_000000.png"));
+  CHECK_FALSE(fs::exists(dir / "out" / "chain.json"));
 }
 #endif
 
@@ -120,16 +122,17 @@ TEST_CASE("cps report takes a scene file in a folder and writes its files in --o
         R"({"seconds": 0.25, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0},
             {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1,
              "position_m": [0, 0.6, 0]}]})");
-  // One run, as --list-runs prints it: its CSV is named after the file, not the folder.
+  // One run, as --list-runs prints it: its CSV is named after the file's stem (it has no
+  // "name"), not the folder or the path.
   const Result one = run_cps("report scenes/drop.json --run scenes/drop.json.pgs.baumgarte.fixed.it4.ss1 --out one", dir);
   INFO(one.err);
   REQUIRE(one.exit_code == 0);
-  CHECK(fs::exists(dir / "one" / "drop.json.pgs.baumgarte.fixed.it4.ss1.csv"));
+  CHECK(fs::exists(dir / "one" / "drop.pgs.baumgarte.fixed.it4.ss1.csv"));
   // The whole quick sweep: report.md links the CSV that is there.
   const Result all = run_cps("report scenes/drop.json --quick --out all", dir);
   INFO(all.err);
   REQUIRE(all.exit_code == 0);
-  CHECK(fs::exists(dir / "all" / "drop.json.csv"));
-  CHECK(slurp(dir / "all" / "report.md").find("(drop.json.csv)") != std::string::npos);
+  CHECK(fs::exists(dir / "all" / "drop.csv"));
+  CHECK(slurp(dir / "all" / "report.md").find("(drop.csv)") != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "all" / "scenes"));
 }

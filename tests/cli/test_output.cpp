@@ -105,10 +105,18 @@ nlohmann::json manifest(const fs::path& folder) {
 
 const nlohmann::json k_info = {{"command", "test"}};
 
+// plan_output for `files` in `folder`, written by the command "test" (no scene).
+OutputPlan plan_for(const fs::path& folder, const std::vector<std::string>& files, bool force,
+                    FolderUse use = FolderUse::exclusive, const std::string& option = "--out",
+                    const std::string& command = "test") {
+  return cps::cli::plan_output(
+      {.folder = folder, .files = files, .command = command, .use = use, .option = option, .force = force});
+}
+
 // Plans, begins, writes `files` (each holding its own name) and ends one run into `folder`.
 void one_run(const fs::path& folder, const std::vector<std::string>& files, FolderUse use,
              bool force = false) {
-  const OutputPlan plan = cps::cli::plan_output(folder, files, force, use);
+  const OutputPlan plan = plan_for(folder, files, force, use);
   cps::cli::begin_output(plan, k_info);
   for (const std::string& f : files) cps::cli::write_text_atomic(folder / f, f);
   cps::cli::end_output(plan, k_info);
@@ -146,7 +154,7 @@ std::string interrupted_run(const fs::path& folder, const std::vector<std::strin
   if (pid == 0) {
     close(pipe_fd[0]);
     try {
-      const OutputPlan plan = cps::cli::plan_output(folder, files, true, use);
+      const OutputPlan plan = plan_for(folder, files, true, use);
       cps::cli::begin_output(plan, k_info);
       auto* file = new AtomicFile(folder / files.front());  // never destroyed: no clean-up
       file->write("partial");
@@ -256,41 +264,41 @@ TEST_CASE("plan_output refuses foreign targets and unusable folders before writi
   write_text(folder / "notes.txt", "mine");
   // Exclusive: any foreign entry; named, with what to do.
   const std::string exclusive = usage_error([&] {
-    cps::cli::plan_output(folder, {"frame_000000.png"}, false, FolderUse::exclusive);
+    plan_for(folder, {"frame_000000.png"}, false, FolderUse::exclusive);
   });
   CHECK(exclusive.find("notes.txt") != std::string::npos);
   CHECK(exclusive.find("--force") != std::string::npos);
-  CHECK_NOTHROW(cps::cli::plan_output(folder, {"frame_000000.png"}, true, FolderUse::exclusive));
+  CHECK_NOTHROW(plan_for(folder, {"frame_000000.png"}, true, FolderUse::exclusive));
   // Shared: other entries are no concern; a foreign target is refused, naming it.
-  CHECK_NOTHROW(cps::cli::plan_output(folder, {"f.png"}, false, FolderUse::shared));
+  CHECK_NOTHROW(plan_for(folder, {"f.png"}, false, FolderUse::shared));
   const std::string shared = usage_error(
-      [&] { cps::cli::plan_output(folder, {"notes.txt"}, false, FolderUse::shared, "--trace"); });
+      [&] { plan_for(folder, {"notes.txt"}, false, FolderUse::shared, "--trace"); });
   CHECK(shared.find((folder / "notes.txt").string()) != std::string::npos);
   CHECK(shared.find("--trace") != std::string::npos);
-  CHECK_NOTHROW(cps::cli::plan_output(folder, {"notes.txt"}, true, FolderUse::shared));
+  CHECK_NOTHROW(plan_for(folder, {"notes.txt"}, true, FolderUse::shared));
   // A foreign run.json is foreign too.
   write_text(folder / "run.json", "{\"someone\": \"else\"}");
-  CHECK(usage_error([&] { cps::cli::plan_output(folder, {"f.png"}, false, FolderUse::shared); })
+  CHECK(usage_error([&] { plan_for(folder, {"f.png"}, false, FolderUse::shared); })
             .find("run.json") != std::string::npos);
   // A target that is a folder: refused even with force.
   fs::create_directories(folder / "f.png");
-  CHECK(usage_error([&] { cps::cli::plan_output(folder, {"f.png"}, true, FolderUse::shared); })
+  CHECK(usage_error([&] { plan_for(folder, {"f.png"}, true, FolderUse::shared); })
             .find("f.png") != std::string::npos);
   // Names that are not plain file names, or run.json.
   for (const std::string bad : {"", ".", "..", "a/b", "run.json"}) {
     INFO("'" << bad << "'");
-    CHECK_THROWS_AS(cps::cli::plan_output(folder, {bad}, true, FolderUse::shared), UsageError);
+    CHECK_THROWS_AS(plan_for(folder, {bad}, true, FolderUse::shared), UsageError);
   }
   // The folder is a file, or below one.
   write_text(dir.path / "somefile", "x");
   for (const fs::path& f : {dir.path / "somefile", dir.path / "somefile" / "x" / "y"}) {
     INFO(f);
     const std::string message =
-        usage_error([&] { cps::cli::plan_output(f, {"a.png"}, true, FolderUse::exclusive); });
+        usage_error([&] { plan_for(f, {"a.png"}, true, FolderUse::exclusive); });
     CHECK(message.find((dir.path / "somefile").string()) != std::string::npos);
   }
   // A missing folder below a folder is fine: begin_output creates it.
-  CHECK_NOTHROW(cps::cli::plan_output(dir.path / "new" / "deeper", {"a.png"}, false));
+  CHECK_NOTHROW(plan_for(dir.path / "new" / "deeper", {"a.png"}, false));
   CHECK(slurp(folder / "notes.txt") == "mine");
   CHECK_FALSE(fs::exists(dir.path / "new"));
 }
@@ -343,7 +351,7 @@ TEST_CASE("the leftovers of an interrupted own run are removed, similar foreign 
 
     if (use == FolderUse::exclusive) {
       const std::string refused = usage_error(
-          [&] { cps::cli::plan_output(folder, {"a.png", "b.png"}, false, use); });
+          [&] { plan_for(folder, {"a.png", "b.png"}, false, use); });
       for (const std::string& f : foreign) CHECK(refused.find(f) != std::string::npos);
       CHECK(refused.find(leftover + ",") == std::string::npos);  // the leftover is not foreign
       CHECK(refused.find(leftover + ":") == std::string::npos);
@@ -374,7 +382,7 @@ TEST_CASE("a run killed while it wrote its first run.json leaves a temporary the
   // The same name with content that does not name that run: foreign.
   const std::string other = cps::cli::temporary_name("run.json", "ffeeddccbbaa9988");
   write_text(dir.path / other, dead_run.dump());
-  CHECK(usage_error([&] { cps::cli::plan_output(dir.path, {"a.png"}, false); })
+  CHECK(usage_error([&] { plan_for(dir.path, {"a.png"}, false); })
             .find("1 file(s)") != std::string::npos);
   one_run(dir.path, {"a.png"}, FolderUse::exclusive, true);
   CHECK(entries(dir.path) == std::vector<std::string>{"a.png", "run.json", other});
@@ -394,7 +402,7 @@ TEST_CASE("a run still writing a shared folder keeps its temporaries and its fil
     close(to_parent[0]);
     int code = 0;
     try {
-      const OutputPlan plan = cps::cli::plan_output(dir.path, {"slow.csv"}, false, FolderUse::shared);
+      const OutputPlan plan = plan_for(dir.path, {"slow.csv"}, false, FolderUse::shared);
       cps::cli::begin_output(plan, k_info);
       AtomicFile file(dir.path / "slow.csv");
       file.write("first half, ");
@@ -419,7 +427,7 @@ TEST_CASE("a run still writing a shared folder keeps its temporaries and its fil
   const std::string child_tmp = cps::cli::temporary_name("slow.csv", token);
   REQUIRE(fs::exists(dir.path / child_tmp));
   // An exclusive run is refused while another writes the folder.
-  CHECK(usage_error([&] { cps::cli::plan_output(dir.path, {"x.png"}, false); })
+  CHECK(usage_error([&] { plan_for(dir.path, {"x.png"}, false); })
             .find("another cps run") != std::string::npos);
   one_run(dir.path, {"fast.csv"}, FolderUse::shared);
   CHECK(fs::exists(dir.path / child_tmp));  // not removed: its run still runs
@@ -435,4 +443,43 @@ TEST_CASE("a run still writing a shared folder keeps its temporaries and its fil
   CHECK(manifest(dir.path)["files"] == nlohmann::json({"slow.csv", "fast.csv"}));
   CHECK(manifest(dir.path)["complete"] == true);
   CHECK(entries(dir.path) == std::vector<std::string>{"fast.csv", "run.json", "slow.csv"});
+}
+
+TEST_CASE("run.json records who wrote each file and its hash: edits are foreign, other commands' "
+          "files are kept", "[output]") {
+  TempDir dir("records");
+  const fs::path folder = dir.path / "out";
+  // Two commands share a folder: "a" writes x.txt, "b" writes y.txt.
+  auto run = [&](const std::string& command, const std::string& file, FolderUse use, bool force) {
+    const OutputPlan plan = plan_for(folder, {file}, force, use, "--out", command);
+    cps::cli::begin_output(plan, k_info);
+    cps::cli::write_text_atomic(folder / file, command + " wrote " + file);
+    cps::cli::end_output(plan, k_info);
+    return plan;
+  };
+  run("a", "x.txt", FolderUse::shared, false);
+  run("b", "y.txt", FolderUse::shared, false);
+  const nlohmann::json m = manifest(folder);
+  CHECK(m["written"]["x.txt"]["command"] == "a");
+  CHECK(m["written"]["y.txt"]["xxh3_64"].get<std::string>().size() == 16);
+  // An exclusive run of "a" keeps b's file (neither stale nor foreign) and lists it.
+  const OutputPlan exclusive = run("a", "z.txt", FolderUse::exclusive, false);
+  CHECK(exclusive.stale == std::vector<std::string>{"x.txt"});
+  CHECK(exclusive.kept == std::vector<std::string>{"y.txt"});
+  CHECK(slurp(folder / "y.txt") == "b wrote y.txt");
+  CHECK_FALSE(fs::exists(folder / "x.txt"));
+  // "a" may not replace b's file, even with force.
+  for (const bool force : {false, true}) {
+    CHECK(usage_error([&] { plan_for(folder, {"y.txt"}, force, FolderUse::shared, "--out", "a"); })
+              .find("written by cps b") != std::string::npos);
+  }
+  // b's file edited: foreign to b, named as changed; force replaces it.
+  write_text(folder / "y.txt", "edited");
+  CHECK(usage_error([&] { plan_for(folder, {"y.txt"}, false, FolderUse::shared, "--out", "b"); })
+            .find("changed since cps wrote it") != std::string::npos);
+  CHECK_NOTHROW(plan_for(folder, {"y.txt"}, true, FolderUse::shared, "--out", "b"));
+  // A command's input is never its target, even with force.
+  cps::cli::note_input(folder / "z.txt");
+  CHECK(usage_error([&] { plan_for(folder, {"z.txt"}, true, FolderUse::shared, "--out", "a"); })
+            .find("input of this command") != std::string::npos);
 }

@@ -326,8 +326,13 @@ ExportPlan plan_export(const ExportOptions& o, int argc, char** argv) {
                                   {"out", o.out},
                                   {"overrides", overrides_json(o.overrides)},
                                   {"parameters", parameters_json(run.world.def())}});
-  OutputPlan output = plan_output(path.parent_path(), {path.filename().string()}, o.force,
-                                  FolderUse::shared, "--out");
+  const std::string file = path.filename().string();
+  OutputPlan output = plan_output({.folder = path.parent_path(),
+                                   .files = {file},
+                                   .command = "export",
+                                   .use = FolderUse::shared,
+                                   .scenes = {{file, scene_source(*scene)}},
+                                   .force = o.force});
   return {scene, std::move(run), path, static_cast<std::size_t>(frames), std::move(info), std::move(output)};
 }
 

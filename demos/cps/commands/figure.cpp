@@ -129,8 +129,8 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
   page.panel_width = renderer.width();
   page.panel_height = renderer.height();
   page.labels = spec.label;
-  page.title = spec.caption.empty() ? std::string(scene.name)
-                                    : spec.caption + ": " + std::string(scene.name);
+  page.title = spec.caption.empty() ? std::string(scenes::output_name(scene))
+                                    : spec.caption + ": " + std::string(scenes::output_name(scene));
   std::vector<std::string> texts;
   // Reading order: row by row, each row left to right in time.
   if (spec.overlay) {
@@ -340,7 +340,8 @@ std::vector<PlannedFigure> plan_paper_figures(const FigureOptions& o, const Pixe
   return figures;
 }
 
-// The file of a scene's figure: --out, or out/figures/SCENE[-compare-...][-overlay].EXT. Sets
+// The file of a scene's figure: --out, or out/figures/NAME[-compare-...][-overlay].EXT (NAME:
+// the scene's output_name, never a scene file's path as typed). Sets
 // spec.format: --format, else the format --out's extension names (.pdf, .svg), else png. Throws
 // UsageError if --out's extension is not the format's.
 fs::path figure_file(const FigureOptions& o, std::optional<FigureFormat> format, FigureSpec& spec) {
@@ -354,7 +355,8 @@ fs::path figure_file(const FigureOptions& o, std::optional<FigureFormat> format,
   const std::string ext(figure_extension(spec.format));
   const fs::path file =
       o.out.empty()
-          ? fs::path("out/figures") / (o.scene + comparison_suffix(spec.comparison, o.overlay) + ext)
+          ? fs::path("out/figures") / (std::string(scenes::output_name(*spec.scene)) +
+                                       comparison_suffix(spec.comparison, o.overlay) + ext)
           : fs::path(o.out);
   if (file.extension() != ext) {
     throw UsageError("--out " + file.string() + ": the figure is a " + ext.substr(1) +
@@ -428,13 +430,21 @@ FigurePlan plan_figure(const FigureOptions& o, int argc, char** argv) {
   // and its sidecar are checked before anything is rendered.
   const fs::path folder = plan.figures.front().png.parent_path();
   std::vector<std::string> files;
+  std::map<std::string, std::string> scenes;
   nlohmann::json names = nlohmann::json::array();
   for (const PlannedFigure& p : plan.figures) {
     files.push_back(p.png.filename().string());
     files.push_back(sidecar_path(p.png).filename().string());
     names.push_back(p.png.filename().string());
+    scenes.emplace(files.end()[-2], scene_source(*p.spec.scene));
+    scenes.emplace(files.back(), scene_source(*p.spec.scene));
   }
-  plan.output = plan_output(folder, files, o.force, FolderUse::shared);
+  plan.output = plan_output({.folder = folder,
+                             .files = files,
+                             .command = "figure",
+                             .use = FolderUse::shared,
+                             .scenes = std::move(scenes),
+                             .force = o.force});
   plan.info = run_info("figure", argc, argv, {{"scene", o.scene}, {"figures", names}});
   return plan;
 }

@@ -253,7 +253,9 @@ SceneRender scene_runs(const RenderOptions& o, const scenes::Scene& scene,
     job.runs.push_back(make_run_or_usage_error(scene, v.overrides));
     // --overlay: the legend names the variants; the label, the scene (with --label).
     std::string label = o.overlay ? "" : v.label;
-    if (o.label) label = std::string(scene.name) + (label.empty() ? "" : "\n" + label);
+    if (o.label) {
+      label = std::string(scenes::output_name(scene)) + (label.empty() ? "" : "\n" + label);
+    }
     job.labels.push_back(label);
   }
   return job;
@@ -281,7 +283,8 @@ RenderJob frames_spec(const RenderOptions& o, const RenderPlan& plan, const scen
   spec.seconds = o.seconds.value_or(scene.default_seconds);
   spec.fps = o.fps;
   spec.speed = o.speed;
-  spec.folder = fs::path(o.out) / (std::string(scene.name) + comparison_suffix(plan.comparison, o.overlay));
+  spec.folder = fs::path(o.out) / (std::string(scenes::output_name(scene)) +
+                                   comparison_suffix(plan.comparison, o.overlay));
   spec.columns = plan.grid.columns;
   spec.frame_width = plan.size.width / plan.grid.columns * plan.grid.columns;
   spec.frame_height = plan.size.height / plan.grid.rows * plan.grid.rows;
@@ -350,8 +353,17 @@ void plan_scene(const RenderOptions& o, const RenderPlan& plan, SceneRender& job
   const long long frames = frame_count(job.spec);
   std::vector<std::string> files;
   files.reserve(static_cast<std::size_t>(frames));
-  for (long long k = 0; k < frames; ++k) files.push_back(frame_name(k));
-  job.output = plan_output(job.spec.folder, std::move(files), o.force);
+  std::map<std::string, std::string> scenes;
+  for (long long k = 0; k < frames; ++k) {
+    files.push_back(frame_name(k));
+    scenes.emplace(files.back(), scene_source(*job.scene));
+  }
+  job.output = plan_output({.folder = job.spec.folder,
+                            .files = std::move(files),
+                            .command = "render",
+                            .use = FolderUse::exclusive,
+                            .scenes = std::move(scenes),
+                            .force = o.force});
 }
 
 // --video: the videos go to OUT/, beside the frames folders, which holds other files too (other
@@ -359,12 +371,19 @@ void plan_scene(const RenderOptions& o, const RenderPlan& plan, SceneRender& job
 void plan_videos(const RenderOptions& o, int argc, char** argv, RenderPlan& plan) {
   if (o.video.empty()) return;
   std::vector<std::string> names;
+  std::map<std::string, std::string> scenes;
   nlohmann::json folders = nlohmann::json::array();
   for (const SceneRender& job : plan.scenes) {
     names.push_back(job.spec.folder.filename().string() + "." + o.video);
+    scenes.emplace(names.back(), scene_source(*job.scene));
     folders.push_back(job.spec.folder.filename().string());
   }
-  plan.video_output = plan_output(fs::path(o.out), names, o.force, FolderUse::shared);
+  plan.video_output = plan_output({.folder = fs::path(o.out),
+                                   .files = names,
+                                   .command = "render",
+                                   .use = FolderUse::shared,
+                                   .scenes = std::move(scenes),
+                                   .force = o.force});
   plan.video_info = run_info("render", argc, argv,
                              {{"video", o.video}, {"fps", o.fps}, {"frames_folders", folders}});
 }

@@ -41,8 +41,13 @@ int run_scene(const SceneOptions& o, int argc, char** argv) {
   }
   const nlohmann::json info =
       run_info("scene", argc, argv, {{"scene", scene->name}, {"out", o.out}});
-  const OutputPlan plan =
-      plan_output(path.parent_path(), {path.filename().string()}, o.force, FolderUse::shared, "--out");
+  const std::string name = path.filename().string();
+  const OutputPlan plan = plan_output({.folder = path.parent_path(),
+                                       .files = {name},
+                                       .command = "scene",
+                                       .use = FolderUse::shared,
+                                       .scenes = {{name, scene_source(*scene)}},
+                                       .force = o.force});
   begin_output(plan, info);
   write_json_atomic(path, file);
   end_output(plan, info);

@@ -27,8 +27,12 @@ nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 TraceWriter::TraceWriter(std::filesystem::path path, bool force, nlohmann::json info)
     : path_(std::move(path)), info_(std::move(info)) {
-  plan_ = plan_output(path_.parent_path(), {path_.filename().string()}, force, FolderUse::shared,
-                      "--trace");
+  plan_ = plan_output({.folder = path_.parent_path(),
+                       .files = {path_.filename().string()},
+                       .command = "simulate",
+                       .use = FolderUse::shared,
+                       .option = "--trace",
+                       .force = force});
   begin_output(plan_, info_);
   file_.emplace(path_);
   file_->write(kTraceHeader);

@@ -1,5 +1,6 @@
 #include "options/options.h"
 
+#include "output/output.h"
 #include "scene_file.h"
 
 #include <CLI/CLI.hpp>
@@ -116,7 +117,10 @@ std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
     return selected;
   }
   try {
-    if (const scenes::Scene* s = scenes::find_scene(name)) return {s};
+    if (const scenes::Scene* s = scenes::find_scene(name)) {
+      if (name.ends_with(".json")) note_input(name);  // never an output of this command
+      return {s};
+    }
   } catch (const scenes::SceneFileError& e) {
     throw UsageError(e.what());
   }

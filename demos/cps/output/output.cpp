@@ -9,6 +9,7 @@
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <xxhash.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -16,6 +17,7 @@
 #include <ctime>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -97,13 +99,47 @@ bool plain_name(const std::string& name) {
   return !name.empty() && name.find('/') == std::string::npos && name != "." && name != "..";
 }
 
+// What run.json records of one file cps wrote ("" where it does not say: a manifest of an
+// older cps, or a file of a run that did not end).
+struct FileRecord {
+  std::string command;  // the command that wrote it
+  std::string scene;    // scene_source of the scene it shows
+  std::string hash;     // XXH3-64 of its content, 16 hex digits
+};
+using Records = std::map<std::string, FileRecord>;
+
 // What an output folder's run.json says, if it is cps's.
 struct Manifest {
   bool present = false;               // an entry named run.json exists (of any kind)
   bool ours = false;                  // a regular file holding a cps manifest
   std::vector<std::string> files;     // listed, in order (plain names only)
+  Records written;                    // records of listed files
   std::vector<RunId> unfinished;      // runs that began and did not end
 };
+
+// XXH3-64 of the file's content as 16 hex digits, or "" if it cannot be read.
+std::string content_hash(const fs::path& p) {
+  const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0) return {};
+  XXH3_state_t* state = XXH3_createState();
+  XXH3_64bits_reset(state);
+  std::string buffer(1 << 16, '\0');
+  bool ok = true;
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer.data(), buffer.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) ok = false;
+    if (n <= 0) break;
+    XXH3_64bits_update(state, buffer.data(), static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  const XXH64_hash_t h = XXH3_64bits_digest(state);
+  XXH3_freeState(state);
+  if (!ok) return {};
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
 
 // The plain names (a manifest never reaches outside its folder) of a JSON array, run.json and
 // duplicates left out.
@@ -127,6 +163,16 @@ Manifest parse_manifest(const nlohmann::json& j) {
   }
   m.ours = true;
   m.files = names_of(j["files"]);
+  if (j.contains("written") && j["written"].is_object()) {
+    for (const std::string& name : m.files) {
+      if (!j["written"].contains(name) || !j["written"][name].is_object()) continue;
+      const nlohmann::json& r = j["written"][name];
+      const auto text = [&r](const char* key) {
+        return r.contains(key) && r[key].is_string() ? r[key].get<std::string>() : std::string();
+      };
+      m.written[name] = {text("command"), text("scene"), text("xxh3_64")};
+    }
+  }
   if (j.contains("unfinished_runs") && j["unfinished_runs"].is_array()) {
     for (const nlohmann::json& r : j["unfinished_runs"]) {
       if (!r.is_object() || !r.contains("run_token") || !r["run_token"].is_string()) continue;
@@ -303,57 +349,217 @@ std::vector<std::string> still_listed(const fs::path& folder, const std::vector<
 }
 
 void write_manifest(const fs::path& folder, const nlohmann::json& info, bool complete,
-                    const std::vector<std::string>& files, const std::vector<RunId>& unfinished) {
+                    const std::vector<std::string>& files, const Records& records,
+                    const std::vector<RunId>& unfinished) {
   nlohmann::json j = info;
   j["tool"] = k_tool;
   j["complete"] = complete;
   j["files"] = files;
+  nlohmann::json written = nlohmann::json::object();
+  for (const std::string& name : files) {
+    const auto r = records.find(name);
+    if (r == records.end()) continue;
+    nlohmann::json entry = nlohmann::json::object();
+    if (!r->second.command.empty()) entry["command"] = r->second.command;
+    if (!r->second.scene.empty()) entry["scene"] = r->second.scene;
+    if (!r->second.hash.empty()) entry["xxh3_64"] = r->second.hash;
+    written[name] = entry;
+  }
+  j["written"] = written;
   nlohmann::json runs = nlohmann::json::array();
   for (const RunId& r : unfinished) runs.push_back(to_json(r));
   j["unfinished_runs"] = runs;
   write_json_atomic(folder / k_manifest_name, j);
 }
 
+// The inputs of this command (note_input).
+struct Inputs {
+  std::mutex mutex;
+  std::vector<fs::path> paths;
+};
+
+Inputs& inputs() {
+  static Inputs i;
+  return i;
+}
+
 }  // namespace
 
-OutputPlan plan_output(const fs::path& folder, std::vector<std::string> files, bool force,
-                       FolderUse use, std::string_view option) {
-  for (const std::string& name : files) {
+void note_input(const fs::path& path) {
+  Inputs& i = inputs();
+  const std::lock_guard<std::mutex> lock(i.mutex);
+  i.paths.push_back(path);
+}
+
+namespace {
+
+// Throws UsageError if `target` is one of this command's inputs (the same file by any path).
+void check_not_input(const fs::path& target, std::string_view option) {
+  Inputs& i = inputs();
+  const std::lock_guard<std::mutex> lock(i.mutex);
+  for (const fs::path& input : i.paths) {
+    std::error_code ec;
+    if (fs::equivalent(target, input, ec) && !ec) {
+      throw UsageError(target.string() + " is an input of this command (" + input.string() +
+                       "); cps never writes over its own input, even with --force; choose "
+                       "another " + std::string(option));
+    }
+  }
+}
+
+// What plan_output found of the entries that are not cps's own (or not this command's to replace).
+struct Findings {
+  std::vector<std::string> foreign;   // not written by cps, or changed since
+  std::vector<std::string> replaced;  // foreign files with a target's name
+  std::vector<std::string> changed;   // listed, but their content is not what cps wrote
+  std::vector<std::string> other_scene;  // targets an earlier run wrote for another scene, explained
+};
+
+std::string label_changed(const std::vector<std::string>& names,
+                          const std::vector<std::string>& changed) {
+  std::vector<std::string> shown;
+  for (const std::string& n : names) {
+    const bool edited = std::find(changed.begin(), changed.end(), n) != changed.end();
+    shown.push_back(edited ? n + " (changed since cps wrote it)" : n);
+  }
+  return joined(shown);
+}
+
+[[noreturn]] void refuse_foreign(const OutputRequest& r, const Manifest& manifest,
+                                 const Findings& f) {
+  const std::string where = display(r.folder);
+  const std::string record = (r.folder / k_manifest_name).string();
+  const bool only_changed = f.changed.size() == f.foreign.size();
+  const std::string why = !manifest.present ? "there is no cps run.json in " + where
+                          : !manifest.ours  ? record + " is not cps's record of its files"
+                          : only_changed    ? record + " records another content"
+                                            : record + " does not list " +
+                                                  (f.foreign.size() == 1 ? "it" : "them");
+  if (r.use == FolderUse::exclusive) {
+    throw UsageError(
+        "output folder " + where + " holds " + std::to_string(f.foreign.size()) +
+        " file(s) that no earlier cps run wrote there as they are (" +
+        label_changed(f.foreign, f.changed) + ": " + why +
+        "); nothing was written. Choose another " + r.option +
+        ", or add --force to write into it anyway: --force keeps those files untouched" +
+        (f.replaced.empty() ? std::string()
+                            : ", except that a file with the name of one cps writes there (" +
+                                  joined(f.replaced) + ") is replaced") +
+        ".");
+  }
+  std::vector<std::string> paths;
+  for (const std::string& n : f.foreign) paths.push_back((r.folder / n).string());
+  const bool one = f.foreign.size() == 1;
+  throw UsageError(label_changed(paths, [&] {
+                     std::vector<std::string> c;
+                     for (const std::string& n : f.changed) c.push_back((r.folder / n).string());
+                     return c;
+                   }()) +
+                   (one ? " exists" : " exist") + " and no earlier cps run wrote " +
+                   (one ? "it" : "them") + " there as " + (one ? "it is" : "they are") + " (" +
+                   why + "); nothing was written. Choose another " + r.option +
+                   ", or add --force to replace " + (one ? "it" : "them") +
+                   " (--force replaces only files with the names cps writes; every other file "
+                   "is kept untouched).");
+}
+
+// Sorts one existing entry `name` of the folder into the plan (stale, kept) or the findings.
+// Throws UsageError for a target that is not a file or that another command wrote.
+void classify(const OutputRequest& r, const Manifest& manifest, const Leftovers& leftovers,
+              const std::set<std::string>& targets, const std::string& name, OutputPlan& plan,
+              Findings& f) {
+  const fs::path p = r.folder / name;
+  struct stat st {};
+  if (::lstat(p.c_str(), &st) != 0) return;  // gone meanwhile
+  const bool regular = S_ISREG(st.st_mode);
+  const bool target = targets.count(name) != 0;
+  if (target && !regular && !S_ISLNK(st.st_mode)) {
+    throw UsageError(p.string() + " exists and is not a file; cps writes a file of that name "
+                     "there and replaces only files, even with --force; move it away, or "
+                     "choose another " + r.option);
+  }
+  if (name == k_manifest_name) {
+    if (!manifest.ours) {
+      f.foreign.push_back(name);
+      f.replaced.push_back(name);
+    }
+    return;
+  }
+  const bool listed =
+      std::find(manifest.files.begin(), manifest.files.end(), name) != manifest.files.end();
+  if (regular && manifest.ours && listed) {
+    const auto found = manifest.written.find(name);
+    const FileRecord record = found == manifest.written.end() ? FileRecord{} : found->second;
+    if (record.hash.empty() || content_hash(p) == record.hash) {
+      if (!record.command.empty() && record.command != r.command) {
+        if (target) {
+          throw UsageError(p.string() + " was written by cps " + record.command + "; cps " +
+                           r.command + " writes a file of that name there and never replaces "
+                           "another command's file, even with --force; choose another " + r.option);
+        }
+        if (r.use == FolderUse::exclusive) plan.kept.push_back(name);
+        return;
+      }
+      const auto scene = r.scenes.find(name);
+      if (target && scene != r.scenes.end() && !scene->second.empty() && !record.scene.empty() &&
+          record.scene != scene->second) {
+        if (!r.force) {
+          f.other_scene.push_back(p.string() + " (an earlier cps run wrote it for " + record.scene +
+                                  "; this run writes it for " + scene->second + ")");
+        }
+        return;
+      }
+      if (!target && r.use == FolderUse::exclusive) plan.stale.push_back(name);
+      return;
+    }
+    f.changed.push_back(name);
+  } else if (regular && leftovers.contains(name)) {
+    return;
+  }
+  f.foreign.push_back(name);
+  if (target) f.replaced.push_back(name);
+}
+
+}  // namespace
+
+OutputPlan plan_output(const OutputRequest& r) {
+  const fs::path& folder = r.folder;
+  for (const std::string& name : r.files) {
     if (!plain_name(name) || name == k_manifest_name) {
       throw UsageError("cannot write a file named '" + name + "' in " + display(folder) +
                        (name == k_manifest_name ? " (run.json is cps's record of that folder)" : "") +
-                       "; choose another " + std::string(option));
+                       "; choose another " + r.option);
     }
   }
   OutputPlan plan;
   plan.folder = folder;
-  plan.use = use;
-  plan.files = std::move(files);
-  check_folder(folder, option);
+  plan.use = r.use;
+  plan.command = r.command;
+  plan.files = r.files;
+  plan.scenes = r.scenes;
+  check_folder(folder, r.option);
   std::error_code ec;
   if (!fs::is_directory(folder.empty() ? fs::path(".") : folder, ec)) return plan;  // created later
 
-  const Manifest manifest = read_manifest(folder);
-  const std::set<std::string> own = manifest.ours
-                                        ? std::set<std::string>(manifest.files.begin(), manifest.files.end())
-                                        : std::set<std::string>();
   std::set<std::string> targets(plan.files.begin(), plan.files.end());
   targets.insert(k_manifest_name);
+  for (const std::string& t : targets) check_not_input(folder / t, r.option);
+  const Manifest manifest = read_manifest(folder);
 
-  if (use == FolderUse::exclusive && !force) {
-    for (const RunId& r : manifest.unfinished) {
-      if (still_running(r) && r.token != run_token()) {
-        throw UsageError("another cps run (pid " + std::to_string(r.pid) + " on " + r.host +
+  if (r.use == FolderUse::exclusive && !r.force) {
+    for (const RunId& run : manifest.unfinished) {
+      if (still_running(run) && run.token != run_token()) {
+        throw UsageError("another cps run (pid " + std::to_string(run.pid) + " on " + run.host +
                          ") is writing into " + display(folder) +
-                         "; wait for it to end, or choose another " + std::string(option) +
+                         "; wait for it to end, or choose another " + r.option +
                          " (or add --force if that run has ended: its files are then kept)");
       }
     }
   }
   // Each existing target (and, for an exclusive folder, each other entry) is the earlier runs'
-  // own, their leftover, or foreign.
+  // own, their leftover, another command's, or foreign.
   std::vector<std::string> names;
-  if (use == FolderUse::exclusive) {
+  if (r.use == FolderUse::exclusive) {
     for (const fs::directory_entry& e : fs::directory_iterator(folder.empty() ? fs::path(".") : folder)) {
       names.push_back(e.path().filename().string());
     }
@@ -365,62 +571,18 @@ OutputPlan plan_output(const fs::path& folder, std::vector<std::string> files, b
   }
   std::sort(names.begin(), names.end());
   const Leftovers leftovers(folder, manifest);
-  std::vector<std::string> foreign;
-  std::vector<std::string> replaced;  // foreign files with a target's name
+  Findings findings;
   for (const std::string& name : names) {
-    const fs::path p = folder / name;
-    struct stat st {};
-    if (::lstat(p.c_str(), &st) != 0) continue;  // gone meanwhile
-    const bool regular = S_ISREG(st.st_mode);
-    const bool target = targets.count(name) != 0;
-    if (target && !regular && !S_ISLNK(st.st_mode)) {
-      throw UsageError(p.string() + " exists and is not a file; cps writes a file of that name "
-                       "there and replaces only files, even with --force; move it away, or "
-                       "choose another " + std::string(option));
-    }
-    if (name == k_manifest_name) {
-      if (!manifest.ours) {
-        foreign.push_back(name);
-        replaced.push_back(name);
-      }
-      continue;
-    }
-    if (regular && own.count(name) != 0) {
-      if (!target && use == FolderUse::exclusive) plan.stale.push_back(name);
-      continue;
-    }
-    if (regular && leftovers.contains(name)) continue;
-    foreign.push_back(name);
-    if (target) replaced.push_back(name);
+    classify(r, manifest, leftovers, targets, name, plan, findings);
   }
-  if (force || foreign.empty()) return plan;
-
-  const std::string where = display(folder);
-  const std::string record = (folder / k_manifest_name).string();
-  const std::string why = !manifest.present ? "there is no cps run.json in " + where
-                          : !manifest.ours  ? record + " is not cps's record of its files"
-                                            : record + " does not list " +
-                                                  (foreign.size() == 1 ? "it" : "them");
-  if (use == FolderUse::exclusive) {
-    throw UsageError(
-        "output folder " + where + " holds " + std::to_string(foreign.size()) +
-        " file(s) that no earlier cps run wrote there (" + joined(foreign) + ": " + why +
-        "); nothing was written. Choose another " + std::string(option) +
-        ", or add --force to write into it anyway: --force keeps those files untouched" +
-        (replaced.empty() ? std::string()
-                          : ", except that a file with the name of one cps writes there (" +
-                                joined(replaced) + ") is replaced") +
-        ".");
+  if (!findings.other_scene.empty()) {
+    const std::string them = findings.other_scene.size() == 1 ? "it" : "them";
+    throw UsageError(joined(findings.other_scene) + ": two scenes with one name; nothing was "
+                     "written. Rename one (its file, or its \"name\"), choose another " + r.option +
+                     ", or add --force to replace " + them + ".");
   }
-  std::vector<std::string> paths;
-  for (const std::string& n : foreign) paths.push_back((folder / n).string());
-  throw UsageError(joined(paths) + (foreign.size() == 1 ? " exists" : " exist") +
-                   " and no earlier cps run wrote " + (foreign.size() == 1 ? "it" : "them") +
-                   " there (" + why + "); nothing was written. Choose another " +
-                   std::string(option) + ", or add --force to replace " +
-                   (foreign.size() == 1 ? "it" : "them") +
-                   " (--force replaces only files with the names cps writes; every other file "
-                   "is kept untouched).");
+  if (r.force || findings.foreign.empty()) return plan;
+  refuse_foreign(r, manifest, findings);
 }
 
 void begin_output(const OutputPlan& plan, const nlohmann::json& info) {
@@ -452,11 +614,16 @@ void begin_output(const OutputPlan& plan, const nlohmann::json& info) {
   unfinished.push_back(me);
   std::vector<std::string> files = plan.files;
   if (plan.use == FolderUse::exclusive) {
-    files = united(files, present_files(folder, plan.stale));
+    files = united(files, present_files(folder, united(plan.stale, plan.kept)));
   } else if (manifest.ours) {
     files = united(still_listed(folder, manifest.files, unfinished), files);
   }
-  write_manifest(folder, info, false, files, unfinished);
+  Records records = manifest.written;
+  for (const std::string& name : plan.files) {
+    const auto scene = plan.scenes.find(name);
+    records[name] = {plan.command, scene == plan.scenes.end() ? std::string() : scene->second, ""};
+  }
+  write_manifest(folder, info, false, files, records, unfinished);
 }
 
 void end_output(const OutputPlan& plan, const nlohmann::json& info) {
@@ -475,11 +642,20 @@ void end_output(const OutputPlan& plan, const nlohmann::json& info) {
   for (const RunId& r : manifest.unfinished) {
     if (r.token != run_token()) unfinished.push_back(r);
   }
-  std::vector<std::string> files = present_files(folder, plan.files);
-  if (plan.use == FolderUse::shared && manifest.ours) {
+  const std::vector<std::string> written = present_files(folder, plan.files);
+  std::vector<std::string> files = written;
+  if (plan.use == FolderUse::exclusive) {
+    files = united(files, present_files(folder, plan.kept));
+  } else if (manifest.ours) {
     files = united(still_listed(folder, manifest.files, unfinished), files);
   }
-  write_manifest(folder, info, unfinished.empty(), files, unfinished);
+  Records records = manifest.written;
+  for (const std::string& name : written) {
+    const auto scene = plan.scenes.find(name);
+    records[name] = {plan.command, scene == plan.scenes.end() ? std::string() : scene->second,
+                     content_hash(folder / name)};
+  }
+  write_manifest(folder, info, unfinished.empty(), files, records, unfinished);
 }
 
 void write_json_atomic(const fs::path& path, const nlohmann::json& j) {
@@ -530,6 +706,15 @@ nlohmann::json parameters_json(const WorldDef& def) {
   nlohmann::json j = nlohmann::json::object();
   for (const Parameter& p : world_parameters()) j[std::string(p.json_key)] = parameter_json(p, p.get(def));
   return j;
+}
+
+std::string scene_source(const scenes::Scene& scene) {
+  const std::string name(scene.name);
+  if (!name.ends_with(".json")) return "scene " + name;
+  std::error_code ec;
+  fs::path path = fs::weakly_canonical(fs::absolute(name, ec), ec);
+  if (ec) path = fs::absolute(name, ec);
+  return "file " + path.string();
 }
 
 const char* engine_version() { return CPS_ENGINE_VERSION; }

@@ -1,11 +1,15 @@
 #pragma once
 // The output rule of the cps command: every file cps writes (frames, videos, figures, traces,
 // reports, run.json) goes through this module.
-//  - Every target is checked before anything is written (plan_output). A file that no earlier
-//    cps run listed in its folder's run.json is foreign: a run that would replace one is refused
-//    (UsageError, exit 2) naming it. --force (the `force` argument) lets a run replace a foreign
-//    file that has exactly the name of one of its targets; no other foreign file is ever
-//    removed, truncated, renamed or opened for writing, with or without it.
+//  - Every target is checked before anything is written (plan_output). Each folder's run.json
+//    records, for every file a cps run wrote there, the command that wrote it, the scene it shows
+//    and its content's XXH3-64 hash. A file is cps's own only while it is listed there and its
+//    content still has that hash; anything else (an unlisted file, a file edited since) is
+//    foreign, and a run that would replace a foreign file is refused (UsageError, exit 2) naming
+//    it. --force (the `force` field) lets a run replace a foreign file, or a file of another
+//    scene, that has exactly the name of one of its targets; a file another command wrote is
+//    never replaced, with or without it, and no other file is ever removed, truncated, renamed
+//    or opened for writing. A target is never an input of the same command (note_input).
 //  - Every file is written to a temporary of this run, created exclusively, checked and renamed
 //    (atomic_file.h): a reader sees the old file or the new one, never a part, and a failed write
 //    names the target and the OS's reason.
@@ -19,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -44,39 +49,68 @@ enum class FolderUse {
   shared,
 };
 
+/// What one command asks to write into one folder.
+struct OutputRequest {
+  std::filesystem::path folder;    ///< may not exist yet; "" is the current folder
+  std::vector<std::string> files;  ///< plain names (no '/', not "." or "..", not run.json)
+  /// The command that writes them ("render", "figure", "simulate", "export", "scene",
+  /// "report"): recorded per file; a file another command wrote is never replaced, nor removed
+  /// as an exclusive folder's stale file.
+  std::string command;
+  FolderUse use = FolderUse::exclusive;
+  /// The scene each file shows ("" or absent: none; see scene_source): a target that an earlier
+  /// run wrote for another scene is refused without force, naming both.
+  std::map<std::string, std::string> scenes;
+  std::string option = "--out";  ///< the option that names the folder, for messages
+  /// --force: foreign files (and other scenes' files) with a target's name are replaced.
+  bool force = false;
+};
+
 /// What one run will write into one folder, decided (and checked) before anything is written.
 struct OutputPlan {
   std::filesystem::path folder;          ///< may not exist yet; "" is the current folder
   FolderUse use = FolderUse::exclusive;  ///< how runs share it
+  std::string command;                   ///< OutputRequest::command
   std::vector<std::string> files;  ///< names (in `folder`) this run writes, run.json aside
-  std::vector<std::string> stale;  ///< exclusive: earlier runs' files this run does not rewrite
+  std::map<std::string, std::string> scenes;  ///< OutputRequest::scenes
+  std::vector<std::string> stale;  ///< exclusive: earlier runs' files (this command's) not rewritten
+  std::vector<std::string> kept;   ///< exclusive: other commands' files, left and listed
 };
 
-/// Checks that `folder` may receive `files` (plain names: no '/', not "." or "..", not
-/// run.json) and returns the plan. Reads only; writes nothing. Throws UsageError (exit 2), naming
-/// the path and what to do (`option`, e.g. "--out" or "--trace", names the option to change):
-///  - `folder` exists and is not a folder, or it is missing and its nearest existing ancestor is
-///    not a folder (`--out somefile/x`) or cannot be written into (no write or search
+/// Registers `path` as an input of this command (a scene file it reads): plan_output refuses a
+/// target that is this file (the same inode, by any path), with or without force. Thread-safe.
+void note_input(const std::filesystem::path& path);
+
+/// Checks that `request.folder` may receive `request.files` and returns the plan. Reads only
+/// (hashing the folder's own files); writes nothing. Throws UsageError (exit 2), naming the path
+/// and what to do (`request.option` names the option to change):
+///  - a file name that is not plain, or run.json;
+///  - the folder exists and is not a folder, or it is missing and its nearest existing ancestor
+///    is not a folder (`--out somefile/x`) or cannot be written into (no write or search
 ///    permission: checked with access(2), so not for root);
+///  - a target is an input of this command (note_input), even with `force`;
 ///  - a target, or run.json, exists and is not a regular file or a symbolic link (a folder of
 ///    that name), even with `force`;
-///  - without `force`: a target, or run.json, exists and no earlier cps run wrote it (it is not
-///    listed in the folder's run.json, or run.json is not cps's); for an exclusive folder, also
-///    any other entry no earlier run wrote (a few are named, with their count);
+///  - a target exists and another command wrote it (run.json says so), even with `force`;
+///  - without `force`: a target, or run.json, exists and is foreign: no earlier cps run wrote it
+///    (it is not listed in the folder's run.json, or run.json is not cps's), or its content
+///    changed since (its hash is not the one recorded); for an exclusive folder, also any other
+///    entry that is foreign (a few are named, with their count);
+///  - without `force`: a target exists that an earlier run wrote for another scene (both named);
 ///  - exclusive, without `force`: another cps run that may still be running (run.json lists it
 ///    as unfinished, and it ran on another host, or its process, same pid and start time, is
 ///    alive) is writing into the folder.
 /// Leftover temporaries of an interrupted cps run (see begin_output) are the run's own, not
 /// foreign. A missing folder is fine: begin_output creates it.
-OutputPlan plan_output(const std::filesystem::path& folder, std::vector<std::string> files,
-                       bool force, FolderUse use = FolderUse::exclusive,
-                       std::string_view option = "--out");
+OutputPlan plan_output(const OutputRequest& request);
 
 /// Starts writing a planned folder: creates it (and its parents), then, under an exclusive
 /// flock(2) of the folder (best effort: skipped where the file system has none), removes the
 /// leftover temporaries of interrupted runs and writes run.json with `info` (see run_info),
 /// "tool": "cps", "complete": false, "files" (this run's targets, and the earlier runs' files
-/// still present: an interrupted run remains recognised as cps's own by the next one) and
+/// still present: an interrupted run remains recognised as cps's own by the next one),
+/// "written" (the earlier files' records; this run's targets with their command and scene but
+/// no hash until end_output, so that an interrupted run's files stay its own) and
 /// "unfinished_runs" (each {"run_token", "pid", "host", "start", "files"}: this run's, and those
 /// of other runs that may still be writing). A leftover is a file named temporary_name(F, T)
 /// where T is the token of an unfinished run that is no longer running (same host, and its pid
@@ -88,10 +122,11 @@ void begin_output(const OutputPlan& plan, const nlohmann::json& info);
 
 /// After the run wrote its files (after begin_output): under the lock, removes `stale`
 /// (exclusive), then rewrites run.json with `info`, this run taken off "unfinished_runs",
-/// "complete": true if no run is left on it, and "files": exclusive, this run's targets;
-/// shared, every file listed before or by this run that still exists (or that a run still
-/// writing will write). Throws std::runtime_error
-/// naming the path on failure.
+/// "complete": true if no run is left on it, "files": exclusive, this run's targets and the
+/// other commands' files kept; shared, every file listed before or by this run that still
+/// exists (or that a run still writing will write); and "written": for each listed file the
+/// command, the scene and the XXH3-64 of its content as this run left it (this run's targets
+/// are hashed now). Throws std::runtime_error naming the path on failure.
 void end_output(const OutputPlan& plan, const nlohmann::json& info);
 
 /// Writes `j` (indented, with a final newline) to `path` atomically (write_text_atomic). Throws
@@ -103,6 +138,10 @@ void write_json_atomic(const std::filesystem::path& path, const nlohmann::json& 
 /// outside git), "date_utc": ISO 8601 (YYYY-MM-DDTHH:MM:SSZ), "parameters": parameters}.
 nlohmann::json run_info(const std::string& command, int argc, char** argv,
                         const nlohmann::json& parameters);
+
+/// The scene a file shows, as run.json records it: "scene NAME" for a built-in scene or example,
+/// "file PATH" for a scene file (its absolute path, symbolic links resolved). No errors.
+std::string scene_source(const scenes::Scene& scene);
 
 /// One parameter's value as JSON: a number, a bool, [x, y, z], or a choice's name.
 nlohmann::json parameter_json(const Parameter& p, const ParameterValue& v);

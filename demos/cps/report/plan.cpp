@@ -183,7 +183,13 @@ std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, 
 }
 
 std::string file_stem(const std::string& scene) {
-  return scene.find('/') == std::string::npos ? scene : fs::path(scene).filename().string();
+  if (!scene.ends_with(".json")) return scene;
+  try {
+    if (const scenes::Scene* s = scenes::find_scene(scene)) return std::string(scenes::output_name(*s));
+  } catch (const std::invalid_argument&) {
+    // A scene file that is gone (a merged CSV's): its stem.
+  }
+  return fs::path(scene).stem().string();
 }
 
 std::string run_file_name(const RunSpec& spec) {

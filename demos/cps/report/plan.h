@@ -81,9 +81,10 @@ bool is_paper_push(const Choice& push);
 /// paper methods, 24 + 8 = 32 runs per scene).
 std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, bool quick);
 
-/// The name a scene's files start with: the scene's name, or for a scene file given by a path
-/// with folders ("runs/drop.json") its file name ("drop.json"), so that no file lands in another
-/// folder. One report holds one scene file, so file names stay distinct within it.
+/// The name a scene's files start with: scenes::output_name, never a scene file's path as typed
+/// ("runs/drop.json" gives its "name", else "drop"; a scene file that can no longer be read, its
+/// stem), so that no file lands in another folder. One report holds one scene file, so file
+/// names stay distinct within it. No errors.
 std::string file_stem(const std::string& scene);
 
 /// The CSV file name of one run (`cps report --run ID`): its id with the scene part as

@@ -26,8 +26,16 @@ struct ReportOutput {
 
   ReportOutput(const fs::path& out, const std::vector<std::string>& scenes, bool force,
                nlohmann::json run)
-      : main(plan_output(out, report_files(scenes), force, FolderUse::shared)),
-        plots(plan_output(out / "plots", plot_files(scenes), force, FolderUse::shared)),
+      : main(plan_output({.folder = out,
+                          .files = report_files(scenes),
+                          .command = "report",
+                          .use = FolderUse::shared,
+                          .force = force})),
+        plots(plan_output({.folder = out / "plots",
+                           .files = plot_files(scenes),
+                           .command = "report",
+                           .use = FolderUse::shared,
+                           .force = force})),
         info(std::move(run)) {}
 
   template <class Body>
@@ -76,7 +84,8 @@ int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& sc
 
 int run_one(const SweepOutput& to, const RunSpec& spec) {
   const std::string file = run_file_name(spec);
-  const OutputPlan plan = plan_output(to.out, {file}, to.force, FolderUse::shared);
+  const OutputPlan plan = plan_output(
+      {.folder = to.out, .files = {file}, .command = "report", .use = FolderUse::shared, .force = to.force});
   const RunResult result = execute_in_sweep(to, spec);
   begin_output(plan, to.info);
   write_results(to.out / file, {result});

@@ -62,7 +62,7 @@ declare -A KIND=(
   ['simulate:scene']=scene_one ['render:scene']=scene_many ['figure:scene']=scene_figure
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
-  ['export:scene']=scene_one ['export:--out']=out_glb
+  ['export:scene']=scene_one ['export:--out']=out_glb ['*:--max-work']=max_work
 )
 
 # The world parameters' kinds come from the parameter table itself (`cps parameters --format
@@ -113,6 +113,9 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
       printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 1e-300 100001 1/0 0/1 -1/60 1//60 1/ nan/1 ;;
     fps) printf '%s\n' "$NUM_COMMON" -1 0 1e-400 1e-300 9e-6 1001 1/2 ;;  # [1e-5, 1000]
     orbit) printf '%s\n' "$NUM_COMMON" -36001 36001 -1e5 1/2 ;;        # [-36000, 36000]
+    max_work)  # [1, 1e18] body-iterations: NUM_COMMON but its 1e12 and 4294967297, which are allowed
+      printf '%s\n' "$NUM_COMMON" | grep -vx -e 1e12 -e 4294967297
+      printf '%s\n' 0 -1 0.5 1e-400 1e19 1e400 1/2 ;;
     speed) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 100.5 101 1/2 ;;  # (0, 100] s/s
     fov) printf '%s\n' "$NUM_COMMON" -1 0 1 170 180 1e-400 1/2 ;;       # (1, 170) deg
     point)  # X,Y,Z in m, each finite with |value| <= 1e6
@@ -245,6 +248,23 @@ EXTRA=(
   "a/x.json/b/x.json|figure b/x.json --times 0 --size 16x16 --out prior/x.png"
   "input/x.json|simulate a/x.json --seconds 0.1 --trace a/x.json --force"
   "input/x.json|scene a/x.json --out a/x.json --force"
+  # The work budget (bodies x steps x substeps x iterations, --max-work) and an export's samples
+  # x bodies: each refused before any step.
+  "--max-work/3.6e+14|simulate stack --push soft --soft-substeps 1000 --iterations 10000 --seconds 1e5"
+  "--max-work|simulate pyramid_20000 --seconds 1e5"
+  "--max-work/9000|simulate stack --seconds 1 --max-work 8999"
+  "--max-work|simulate stack --seconds 0.1 --trace t.csv --max-work 1"
+  "--max-work|render stack --seconds 0.1 --fps 10 --size 16x16 --out out --max-work 1"
+  "--max-work/3600|render stack --seconds 0.1 --fps 10 --size 300x160 --compare iterations=1,100 --out out --max-work 1000"
+  "--max-work|figure stack --times 0,0.1 --size 16x16 --out out/f.png --max-work 1"
+  "--max-work|export stack --seconds 0.1 --fps 10 --out out/s.glb --max-work 1"
+  "--max-work|report --run $RUN_ID --out out --max-work 1"
+  "--max-work|report intersecting_stack --list-runs --out out --max-work 1"
+  "--max-work|report intersecting_stack --quick --out out --max-work 1"
+  "--max-work|report push --quick --out out --max-work 1"
+  "--max-work|bench --quick --scene intersecting_stack --max-work 1"
+  "MiB/--fps|export funnel_2000 --seconds 99.989 --fps 1000 --out out/f.glb"
+  "MiB/--fps|export pendulum_wave_2000 --seconds 4 --fps 1000 --out out/p.glb"
 )
 
 # Valid command lines (some at the edges of the ranges): each must exit 0.
@@ -267,6 +287,9 @@ CONTROLS=(
   "figure stack --times 0 --size 16x16 --compare push --overlay --out out/f.png"
   "export stack --seconds 0.1 --fps 10 --out out/s.glb"
   "export pendulum_grid --seconds 0.1 --fps 1e-5 --out out/p.glb"
+  "simulate stack --seconds 1 --max-work 9000"  # exactly the run's work
+  "simulate stack --seconds 0.1 --push soft --soft-substeps 1000 --iterations 10000"
+  "report intersecting_stack --list-runs --out out --max-work 1e18"
 )
 
 # ---------------------------------------------------------------------------------------------

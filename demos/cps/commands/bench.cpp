@@ -95,6 +95,27 @@ int window_steps(const scenes::Scene& scene, bool quick) {
   return std::max(1, static_cast<int>(std::lround(seconds / dt)));
 }
 
+// Timed repeats of a window of `steps` steps (see physics_table): at least 5, and enough that
+// the timed steps add up to 3 s of a 60 Hz scene (1 s quick).
+int window_repeats(int steps, bool quick) {
+  const int timed_steps = quick ? 60 : 180;
+  return std::max(5, (timed_steps + steps - 1) / steps);
+}
+
+// Refuses (UsageError, check_work) a scene of the physics table whose stepping would pass
+// max_work (body-iterations): for each of the two assemblies, the steps to the window's start
+// and the window once untimed and `repeats` times timed.
+void check_bench_work(const scenes::Scene& scene, bool quick, double max_work) {
+  const scenes::Run run = make_run_or_usage_error(scene, {});
+  const WorldDef& def = run.world.def();
+  const int steps = window_steps(scene, quick);
+  const double per_assembly =
+      std::round(scene.bench.start_s / def.dt) + (window_repeats(steps, quick) + 1.0) * steps;
+  check_work("its steps (both assemblies, to the window, then through it once untimed and at "
+             "each timed repeat)", run.world.bodies().size(), def,
+             2.0 * per_assembly * def.dt, max_work, "time a shorter or smaller scene, or raise --max-work");
+}
+
 // Least-squares slope of log(time) against log(bodies).
 double log_log_slope(const std::vector<std::pair<double, double>>& points) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
@@ -235,6 +256,7 @@ struct BenchOptions {
   bool rendering = false;  // only the rendering table
   bool json = false;       // one JSON document on stdout instead of Markdown tables
   std::vector<std::string> scenes;  // only these scenes, physics table only (empty: every table)
+  double max_work = kDefaultMaxWork;  // body-iterations a --scene may step
 };
 
 // The physics table's scenes: the paper's, then scaled ones (larger ones unless quick).
@@ -272,7 +294,7 @@ nlohmann::json physics_table(const std::vector<std::string>& names, bool quick, 
     const int steps = window_steps(scene, quick);
     const double dt = scene.world_def().dt;
     const double start = scene.bench.start_s;
-    const int repeats = std::max(5, (timed_steps + steps - 1) / steps);
+    const int repeats = window_repeats(steps, quick);
     std::fprintf(stderr, "bench: %s\n", name.c_str());
     const StepCost e = step_cost(scene, Assembly::explicit_matrices, start, steps, repeats);
     const StepCost m = step_cost(scene, Assembly::matrix_free, start, steps, repeats);
@@ -416,7 +438,10 @@ int run_bench(const BenchOptions& o) {
   std::vector<std::string> names;
   for (const std::string& name : o.scenes) {
     try {
-      for (const scenes::Scene* scene : select_scenes(name)) names.emplace_back(scene->name);
+      for (const scenes::Scene* scene : select_scenes(name)) {
+        check_bench_work(*scene, o.quick, o.max_work);
+        names.emplace_back(scene->name);
+      }
     } catch (const UsageError& e) {
       throw UsageError(std::string("--scene ") + name + ": " + e.what());
     }
@@ -457,6 +482,7 @@ Command add_bench(CLI::App& app) {
                   "repeatable): the physics table alone, each scene over its window")
       ->check(kNotEmpty);
   add_seed_option(*sub, o->scenes);
+  add_max_work_option(*sub, o->max_work);
   return {sub, [o] { return run_bench(*o); }};
 }
 

@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -45,6 +46,15 @@ constexpr int kRodSegments = 16;
 /// Width / height of the camera's picture: that of `cps render`'s default 1280x720 frames.
 constexpr double kAspect = 16.0 / 9.0;
 
+/// Bytes one sample of the animation holds (floats): its time (4), a body's translation and
+/// rotation (28), a rod's translation, rotation and scale (40).
+constexpr double kSampleTimeBytes = 4.0;
+constexpr double kSampleBodyBytes = 28.0;
+constexpr double kSampleRodBytes = 40.0;
+/// Most bytes of animation samples an export may hold: 512 MiB. Building the file holds them
+/// about 4.5 times over (the samples, the glTF buffer, the serialised file), so about 2.3 GiB.
+constexpr double kMaxSampleBytes = 536870912.0;
+
 // The options of `cps export`.
 struct ExportOptions {
   std::string scene;
@@ -52,6 +62,7 @@ struct ExportOptions {
   double fps = 30.0;              // samples per simulated second
   std::string out;
   bool force = false;
+  double max_work = kDefaultMaxWork;  // body-iterations
   scenes::Overrides overrides;
 };
 
@@ -292,7 +303,7 @@ struct ExportPlan {
   const scenes::Scene* scene = nullptr;
   scenes::Run run;
   std::filesystem::path path;  // --out, FILE.glb
-  std::size_t samples = 0;     // floor(seconds x fps) + 1, at most kMaxFrames
+  std::size_t samples = 0;     // floor(seconds x fps) + 1, at most kMaxFrames and kMaxSampleBytes
   nlohmann::json info;         // the folder's run.json
   OutputPlan output;
 };
@@ -311,6 +322,8 @@ ExportPlan plan_export(const ExportOptions& o, int argc, char** argv) {
   scenes::Run run = make_run_or_usage_error(*scene, o.overrides);
   const double seconds = o.seconds.value_or(scene->default_seconds);
   check_steps(o.scene, seconds, run.world.def().dt);
+  check_work(o.scene, run.world.bodies().size(), run.world.def(), seconds, o.max_work,
+             lower_run_options(run.world.def()));
   // Sample k at t_k = k / fps, k = 0 .. floor(seconds * fps).
   const double frames = std::floor(seconds * o.fps + 1e-9) + 1.0;
   if (frames > kMaxFrames) {
@@ -318,6 +331,21 @@ ExportPlan plan_export(const ExportOptions& o, int argc, char** argv) {
                      " samples (--seconds x --fps) is more than the " +
                      std::to_string(static_cast<long long>(kMaxFrames)) +
                      " an export may write; give fewer --seconds or a lower --fps");
+  }
+  const double bodies = static_cast<double>(run.world.bodies().size());
+  const double rods = static_cast<double>(run.world.distances().size());
+  const double sample_bytes =
+      frames * (kSampleTimeBytes + kSampleBodyBytes * bodies + kSampleRodBytes * rods);
+  if (sample_bytes > kMaxSampleBytes) {
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "%.0f samples x (%.0f B + %.0f bodies x %.0f B + %.0f rods x %.0f B) is %.0f MiB of "
+                  "animation samples, more than the %.0f MiB an export may hold (building the "
+                  "file takes about 4.5 times that in memory); give fewer --seconds or a lower "
+                  "--fps",
+                  frames, kSampleTimeBytes, bodies, kSampleBodyBytes, rods, kSampleRodBytes,
+                  sample_bytes / 1048576.0, kMaxSampleBytes / 1048576.0);
+    throw UsageError(o.scene + ": " + text);
   }
   nlohmann::json info = run_info("export", argc, argv,
                                  {{"scene", scene->name},
@@ -553,7 +581,8 @@ Command add_export(CLI::App& app, int argc, char** argv) {
       ->required();
   add_seed_option(*sub, o->scene);
   add_seconds_option(*sub, o->seconds,
-                     "at most 1e7 steps (--seconds / --dt) and 1e5 samples (--seconds x --fps)");
+                     "at most 1e7 steps (--seconds / --dt), 1e5 samples (--seconds x --fps) and "
+                     "512 MiB of samples (samples x (28 B a body + 40 B a rod))");
   sub->add_option("--fps", o->fps,
                   "animation samples per simulated second, in [1e-5, 1000]; sample k is the state "
                   "after the physics step nearest to k / fps s, and tools interpolate between "
@@ -571,6 +600,7 @@ Command add_export(CLI::App& app, int argc, char** argv) {
                 "let --out replace a file of that name that no earlier cps run wrote (the "
                 "folder's run.json lists the files cps wrote there; those are replaced without "
                 "it); any other file is never touched");
+  add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
   return {sub, [o, argc, argv] { return run_export(*o, argc, argv); }};
 }

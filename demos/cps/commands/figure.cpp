@@ -283,6 +283,7 @@ struct FigureOptions {
   View view;  // --camera, --contacts, --rods, --orbit
   bool label = true;
   std::string backend = "osmesa";
+  double max_work = kDefaultMaxWork;  // body-iterations a run
 };
 
 // A figure as planned: what it shows and the file it goes to (its sidecar beside it).
@@ -394,13 +395,15 @@ PlannedFigure plan_scene_figure(const FigureOptions& o, const PixelSize& size,
 }
 
 // Bounds a figure's work before anything is written: each variant's physics steps to the last
-// time (check_steps), its view (an --eye on the target; "fit" frames as built here, so this costs
+// time (check_steps) and solver work (check_work, max_work in body-iterations), its view (an --eye on the target; "fit" frames as built here, so this costs
 // no pre-run), and the panels' grid at most 16384 pixels a side (the caption strips add a few
 // lines of text per row). Throws UsageError.
-void check_figure_work(const PlannedFigure& p, const PixelSize& size) {
+void check_figure_work(const PlannedFigure& p, const PixelSize& size, double max_work) {
   for (const Variant& v : p.spec.variants) {
     const scenes::Run run = make_run_or_usage_error(*p.spec.scene, v.overrides);
     check_steps(std::string(p.spec.scene->name), p.spec.times.back(), run.world.def().dt);
+    check_work(std::string(p.spec.scene->name), run.world.bodies().size(), run.world.def(),
+               p.spec.times.back(), max_work, lower_run_options(run.world.def(), "an earlier last --times"));
     resolve_style(*p.spec.scene, run.world, p.spec.view,
                   static_cast<float>(size.width) / static_cast<float>(size.height));
   }
@@ -425,7 +428,7 @@ FigurePlan plan_figure(const FigureOptions& o, int argc, char** argv) {
   } else {
     plan.figures.push_back(plan_scene_figure(o, plan.size, format));
   }
-  for (const PlannedFigure& p : plan.figures) check_figure_work(p, plan.size);
+  for (const PlannedFigure& p : plan.figures) check_figure_work(p, plan.size, o.max_work);
   // The figures' folder collects figures of many runs (output.h, FolderUse::shared): each PNG
   // and its sidecar are checked before anything is rendered.
   const fs::path folder = plan.figures.front().png.parent_path();
@@ -518,6 +521,7 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
                   "else llvmpipe)")
       ->capture_default_str()
       ->check(CLI::IsMember({"osmesa", "egl"}));
+  add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
   add_view_options(*sub, o->view, o->label, /*label_default=*/true);
   return {sub, [o, argc, argv] { return run_figure(*o, argc, argv); }};

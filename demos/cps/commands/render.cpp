@@ -197,6 +197,7 @@ struct RenderOptions {
   std::string video;
   View view;  // --camera, --contacts, --rods, --orbit
   bool label = false;
+  double max_work = kDefaultMaxWork;  // body-iterations a run
 };
 
 // One scene of a render as planned: a run and a caption label per variant, its frames, where
@@ -297,11 +298,15 @@ RenderJob frames_spec(const RenderOptions& o, const RenderPlan& plan, const scen
 }
 
 // The work is bounded before anything is drawn or written: each run's physics steps
-// (check_steps), the frames (kMaxFrames) and the pixels drawn (kMaxPixelBytes, 3 bytes a pixel
+// (check_steps) and solver work (check_work, --max-work), the frames (kMaxFrames) and the pixels drawn (kMaxPixelBytes, 3 bytes a pixel
 // of --size). Throws UsageError.
 void check_render_work(const RenderOptions& o, const PixelSize& size, const SceneRender& job) {
   const std::string name(job.scene->name);
-  for (const scenes::Run& run : job.runs) check_steps(name, job.spec.seconds, run.world.def().dt);
+  for (const scenes::Run& run : job.runs) {
+    check_steps(name, job.spec.seconds, run.world.def().dt);
+    check_work(name, run.world.bodies().size(), run.world.def(), job.spec.seconds, o.max_work,
+               lower_run_options(run.world.def()));
+  }
   const long long frames = frame_count(job.spec);
   if (static_cast<double>(frames) > kMaxFrames) {
     throw UsageError(name + ": " + std::to_string(frames) +
@@ -603,6 +608,7 @@ Command add_render(CLI::App& app, int argc, char** argv) {
                 "write into an output folder that holds files no earlier cps run wrote there: "
                 "those files are kept, never removed or changed, except that a file with exactly "
                 "the name of one cps writes (a frame, run.json, OUT/SCENE.mp4) is replaced");
+  add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
   sub->add_option("--backend", o->backend,
                   "OpenGL context: osmesa (libOSMesa, CPU) or egl (headless EGL: GPU if any, "

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <map>
 #include <memory>
 
 namespace cps::cli {
@@ -27,7 +28,24 @@ struct ReportOptions {
   std::vector<std::string> merge;
   std::string run;
   bool force = false;
+  double max_work = kDefaultMaxWork;  // body-iterations a run
 };
+
+// Refuses (UsageError, check_work) the first of `runs` whose work to its scene's report horizon
+// passes max_work (body-iterations), before any of them runs. Bodies are counted once a scene.
+void check_runs_work(const std::vector<RunSpec>& runs, double max_work) {
+  std::map<std::string, std::size_t> bodies;
+  for (const RunSpec& r : runs) {
+    const scenes::Scene& scene = r.scene_def();
+    auto it = bodies.find(r.scene);
+    if (it == bodies.end()) {
+      it = bodies.emplace(r.scene, make_run_or_usage_error(scene, {}).world.bodies().size()).first;
+    }
+    check_work("run " + r.id(), it->second, scenes::world_def_with(scene, r.overrides()),
+               scene.report_horizon_s(), max_work,
+               "give a run with fewer substeps or iterations, or raise --max-work");
+  }
+}
 
 // The absolute path of this executable, for commands that must run anywhere.
 std::string self_path() {
@@ -51,7 +69,8 @@ std::vector<const scenes::Scene*> report_scenes(const std::string& name) {
 // `cps report push`: refuses the sweeps' options, then runs the push methods side by side.
 int run_push(const ReportOptions& o, const nlohmann::json& info) {
   const char* sweep_only = !o.run.empty() ? "--run" : !o.merge.empty() ? "--merge"
-                           : o.list        ? "--list-runs" : nullptr;
+                           : o.list        ? "--list-runs"
+                           : o.max_work != kDefaultMaxWork ? "--max-work" : nullptr;
   if (sweep_only) {
     throw UsageError(std::string("report push: ") + sweep_only +
                      " applies to the sweeps (a scene, 'all' or 'stress'), not to the push "
@@ -73,12 +92,18 @@ int run_report(const ReportOptions& o, int argc, char** argv) {
   if (!o.run.empty()) {
     const RunSpec spec = RunSpec::parse(o.run);
     report_scenes(o.scene);  // the sweep it belongs to must be one
+    check_runs_work({spec}, o.max_work);
     return run_one(to, spec);
   }
   const std::vector<const scenes::Scene*> scenes = report_scenes(o.scene);
+  const std::vector<RunSpec> runs = plan_runs(scenes, o.quick);
+  check_runs_work(runs, o.max_work);
   if (o.list) {
-    for (const std::string& line : run_commands(self_path(), to, plan_runs(scenes, o.quick))) {
-      std::printf("%s\n", line.c_str());
+    // Each run's command carries a --max-work given here.
+    const std::string budget =
+        o.max_work != kDefaultMaxWork ? " --max-work " + shortest_decimal(o.max_work) : "";
+    for (const std::string& line : run_commands(self_path(), to, runs)) {
+      std::printf("%s%s\n", line.c_str(), line.rfind("#", 0) == 0 ? "" : budget.c_str());
     }
     return 0;
   }
@@ -124,6 +149,7 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                   "execute one run by its id (see --list-runs); the scene argument and --quick "
                   "name the sweep it belongs to, recorded in its CSV for --merge")
       ->check(kNotEmpty);
+  add_max_work_option(*sub, o->max_work);
   run->excludes(merge)->excludes(list);
   merge->excludes(list);
   sub->add_flag("--force", o->force,

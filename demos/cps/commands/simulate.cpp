@@ -115,6 +115,7 @@ struct SimulateOptions {
   std::string trace;
   bool force = false;
   std::string expect_hash;
+  double max_work = kDefaultMaxWork;  // body-iterations
   scenes::Overrides overrides;
 };
 
@@ -154,6 +155,8 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
   scenes::Run r = make_run_or_usage_error(*scene, o.overrides);
   const double seconds = o.seconds.value_or(scene->default_seconds);
   check_steps(o.scene, seconds, r.world.def().dt);
+  check_work(o.scene, r.world.bodies().size(), r.world.def(), seconds, o.max_work,
+             lower_run_options(r.world.def()));
   std::optional<TraceWriter> trace;
   if (!o.trace.empty()) {
     trace.emplace(o.trace, o.force,
@@ -218,6 +221,7 @@ Command add_simulate(CLI::App& app, int argc, char** argv) {
                   "another state, print both hashes and exit 1 (a CI check that the physics "
                   "did not change)")
       ->check(kNotEmpty);
+  add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
   return {sub, [o, argc, argv] { return run_simulate(*o, argc, argv); }};
 }

@@ -73,6 +73,60 @@ void check_steps(const std::string& what, double seconds, double dt) {
   }
 }
 
+namespace {
+
+// A count as text: whole below 1e7 ("6000000"), else 3 significant digits ("3.6e+14").
+std::string count_text(double n) {
+  char text[40];
+  if (n < 1e7) {
+    std::snprintf(text, sizeof text, "%.0f", n);
+  } else {
+    std::snprintf(text, sizeof text, "%.3g", n);
+  }
+  return text;
+}
+
+double substeps_of(const WorldDef& def) {
+  return def.push == PushMode::soft ? static_cast<double>(def.soft_substeps) : 1.0;
+}
+
+}  // namespace
+
+double run_work(std::size_t bodies, const WorldDef& def, double seconds) {
+  const double steps = std::round(seconds / def.dt);
+  return static_cast<double>(bodies) * steps * substeps_of(def) *
+         static_cast<double>(def.iterations);
+}
+
+void add_max_work_option(CLI::App& cmd, double& max_work) {
+  cmd.add_option("--max-work", max_work,
+                 "work budget of a run in body-iterations (bodies x steps x substeps of the push "
+                 "method x solver iterations), in [1, 1e18]; default " +
+                     shortest_decimal(kDefaultMaxWork) +
+                     "; a run past it is refused before any work (exit 2)")
+      ->type_name("N")
+      ->transform(decimal_in(1.0, kMaxMaxWork, false, "body-iterations"));
+}
+
+std::string lower_run_options(const WorldDef& def, const std::string& shorter) {
+  return "give " + shorter + ", a larger --dt, fewer --iterations" +
+         (def.push == PushMode::soft ? std::string(" or --soft-substeps") : std::string()) +
+         ", or raise --max-work";
+}
+
+void check_work(const std::string& what, std::size_t bodies, const WorldDef& def, double seconds,
+                double max_work, const std::string& lower) {
+  const double work = run_work(bodies, def, seconds);
+  if (!(work > max_work)) return;
+  const double substeps = substeps_of(def);
+  throw UsageError(what + ": " + count_text(static_cast<double>(bodies)) + " bodies x " +
+                   count_text(std::round(seconds / def.dt)) + " steps x " +
+                   count_text(substeps) + (substeps == 1.0 ? " substep" : " substeps") + " x " +
+                   count_text(def.iterations) + " iterations is " + count_text(work) +
+                   " body-iterations of work, more than the budget of " + count_text(max_work) +
+                   " body-iterations a run may take (--max-work); " + lower);
+}
+
 std::string option_help(const Parameter& p) {
   std::string help(p.help);
   help += "; " + p.allowed() + "; default: the scene's";

@@ -32,6 +32,12 @@ inline constexpr double kMaxFrames = 1.0e5;   ///< frames in one render folder
 /// are smaller; this bounds the drawing work.
 inline constexpr double kMaxPixelBytes = 68719476736.0;
 
+/// Default work budget of one run (body-iterations, see run_work), the default of --max-work.
+/// Typical runs: 9e4 (the stack), 1.5e9 (pendulum_wave_20000); docs/commands.md says why 1e11.
+inline constexpr double kDefaultMaxWork = 1.0e11;
+/// Largest --max-work (body-iterations).
+inline constexpr double kMaxMaxWork = 1.0e18;
+
 /// CLI11 validator for a decimal number (parse_decimal: no hex, no trailing text; a fraction such
 /// as 1/60 when allow_fraction) in [lo, hi], or (lo, hi] when lo_open, in `unit`. It hands CLI11
 /// the number written back in decimal, so CLI11 converts exactly the value checked. Its message
@@ -45,6 +51,26 @@ void add_seconds_option(CLI::App& cmd, std::optional<double>& seconds, const std
 
 /// CLI11 validator that refuses an empty value ("--out ''").
 extern const CLI::Validator kNotEmpty;
+
+/// The work of a run, in body-iterations: bodies x steps x substeps x iterations, where steps is
+/// round(seconds / def.dt), substeps is def.soft_substeps for the soft step (push soft) and 1
+/// otherwise, and iterations is def.iterations. bodies: the world's bodies after populate
+/// (static ones too). seconds >= 0 (s). A measure of the solver's cost, not a time. No errors.
+double run_work(std::size_t bodies, const WorldDef& def, double seconds);
+
+/// Adds --max-work N (body-iterations in [1, kMaxMaxWork], default kDefaultMaxWork) to a
+/// stepping command: the work budget of each of its runs.
+void add_max_work_option(CLI::App& cmd, double& max_work);
+
+/// Throws UsageError when run_work(bodies, def, seconds) exceeds max_work (body-iterations),
+/// naming the run (`what`), the factors and the estimate, the budget and --max-work, and
+/// `lower`: what to change instead ("give fewer --seconds ..."). No work is done.
+void check_work(const std::string& what, std::size_t bodies, const WorldDef& def, double seconds,
+                double max_work, const std::string& lower);
+
+/// `lower` for check_work in a command that takes the world options: `shorter` (how to shorten
+/// the run), --dt, --iterations, and --soft-substeps when def's push is soft.
+std::string lower_run_options(const WorldDef& def, const std::string& shorter = "fewer --seconds");
 
 /// Throws UsageError naming the run, the steps it would take and kMaxSteps when seconds / dt
 /// (s / s) exceeds kMaxSteps, and naming dt when seconds > 0 rounds to no step at all (a run

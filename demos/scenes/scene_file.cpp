@@ -800,6 +800,15 @@ std::span<const std::optional<Vec3>> body_colours(const Scene& scene) {
   return {};
 }
 
+bool is_file_scene(const Scene& scene) {
+  Registry& r = registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  for (const Scene& s : r.scenes) {
+    if (&s == &scene) return true;
+  }
+  return false;
+}
+
 std::vector<std::string> body_names(const Scene& scene) {
   Registry& r = registry();
   const std::lock_guard<std::mutex> lock(r.mutex);

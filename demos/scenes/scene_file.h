@@ -104,6 +104,10 @@ std::string_view example_scene_text(std::string_view name);
 /// renderer's palette): a scene file's "color"s; empty for a scene that is not a loaded file.
 std::span<const std::optional<Vec3>> body_colours(const Scene& scene);
 
+/// True for a scene loaded from a file (load_scene_file) or an example file (find_example_scene);
+/// false for a built-in scene. No errors.
+bool is_file_scene(const Scene& scene);
+
 /// The names of a scene's bodies by body index (a scene file's "name"s, "" where a body has
 /// none); empty for a scene that is not a loaded file.
 std::vector<std::string> body_names(const Scene& scene);

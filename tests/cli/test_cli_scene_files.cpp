@@ -5,6 +5,12 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#ifdef CPS_HAVE_RENDERER
+#include "cps/render/renderer.h"
+#endif
+
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -136,3 +142,109 @@ TEST_CASE("cps report takes a scene file in a folder and writes its files in --o
   CHECK(slurp(dir / "all" / "report.md").find("(drop.csv)") != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "all" / "scenes"));
 }
+
+namespace {
+
+// Newton's cradle: five 1 kg balls of radius 0.1 m on 1 m rods, touching, the first raised 60
+// degrees, restitution 1, the default push (Baumgarte).
+const char* kCradle = R"({"name": "cradle", "seconds": 4, "world": {"restitution": 1},
+  "bodies": [
+    {"shape": "sphere", "name": "b0", "radius_m": 0.1, "mass_kg": 1, "position_m": [-1.2660254037844387, 1.5, 0]},
+    {"shape": "sphere", "name": "b1", "radius_m": 0.1, "mass_kg": 1, "position_m": [-0.2, 1, 0]},
+    {"shape": "sphere", "name": "b2", "radius_m": 0.1, "mass_kg": 1, "position_m": [0, 1, 0]},
+    {"shape": "sphere", "name": "b3", "radius_m": 0.1, "mass_kg": 1, "position_m": [0.2, 1, 0]},
+    {"shape": "sphere", "name": "b4", "radius_m": 0.1, "mass_kg": 1, "position_m": [0.4, 1, 0]}],
+  "rods": [
+    {"body_a": "b0", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [-0.4, 2, 0], "length_m": 1},
+    {"body_a": "b1", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [-0.2, 2, 0], "length_m": 1},
+    {"body_a": "b2", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [0, 2, 0], "length_m": 1},
+    {"body_a": "b3", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [0.2, 2, 0], "length_m": 1},
+    {"body_a": "b4", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [0.4, 2, 0], "length_m": 1}]})";
+
+}  // namespace
+
+TEST_CASE("a bouncing cradle under the default push warns that its energy rose, split does not",
+          "[cli][scene_file][energy_rise]") {
+  const fs::path dir = cli_test::fresh_dir("cps_cli_scene_files_energy");
+  write(dir / "cradle.json", kCradle);
+  const Result warned = run_cps("simulate cradle.json --json", dir);
+  INFO(warned.err);
+  CHECK(warned.exit_code == 0);
+  CHECK(json::parse(warned.out)["steps"] == 240);  // stdout is the summary alone
+  CHECK(warned.err.find("cps: warning: cradle.json: the energy (kinetic + potential) rose") == 0);
+  CHECK(warned.err.find("--push baumgarte") != std::string::npos);
+  CHECK(warned.err.find("try --push split") != std::string::npos);
+  CHECK(std::count(warned.err.begin(), warned.err.end(), '\n') == 1);  // one line
+  // The fix it names removes the rise.
+  const Result fixed = run_cps("simulate cradle.json --push split", dir);
+  INFO(fixed.err);
+  CHECK(fixed.exit_code == 0);
+  CHECK(fixed.err.find("warning") == std::string::npos);
+  // A paper scene that loses energy (the stack lands and stands) does not warn.
+  const Result stack = run_cps("simulate stack", dir);
+  CHECK(stack.exit_code == 0);
+  CHECK(stack.err.find("warning") == std::string::npos);
+#ifdef CPS_HAVE_RENDERER
+  // render and figure watch their runs too, and write the same files as without the warning.
+  const Result render = run_cps("render cradle.json --seconds 2 --fps 2 --size 32x32 --out out", dir);
+  INFO(render.err);
+  CHECK(render.exit_code == 0);
+  CHECK(render.err.find("cps: warning: cradle.json: the energy") != std::string::npos);
+  CHECK(fs::exists(dir / "out" / "cradle.json" / "frame_000004.png"));
+  const Result figure = run_cps("figure cradle.json --times 0,2 --size 32x32 --out f.png --compare push=baumgarte,split", dir);
+  INFO(figure.err);
+  CHECK(figure.exit_code == 0);
+  CHECK(figure.err.find("cps: warning: cradle.json (push = baumgarte): the energy") != std::string::npos);
+  CHECK(figure.err.find("(push = split)") == std::string::npos);
+#endif
+}
+
+#ifdef CPS_HAVE_RENDERER
+namespace {
+
+// Pixels of `image` that are clearly red (the thrown ball's colour, lit or in shade): red above
+// 60 and above twice green and blue; the sky and the grey ground are not.
+int red_pixels(const cps::render::Image& image) {
+  int count = 0;
+  for (std::size_t i = 0; i + 2 < image.pixels.size(); i += 3) {
+    const int r = image.pixels[i];
+    const int g = image.pixels[i + 1];
+    const int b = image.pixels[i + 2];
+    if (r > 60 && r > 2 * g && r > 2 * b) ++count;
+  }
+  return count;
+}
+
+}  // namespace
+
+TEST_CASE("a scene file without a camera keeps its moving bodies in every frame",
+          "[cli][scene_file][camera]") {
+  // A red ball of radius 0.5 m thrown at 8 m/s sideways and 5 m/s up from a grey box at rest: it
+  // lands near x = 8 m after 1 s and rolls on, about 14 m away at 2 s, far outside the framing of
+  // the bodies as built (about 10 m across around the origin).
+  const fs::path dir = cli_test::fresh_dir("cps_cli_scene_files_fit");
+  write(dir / "throw.json",
+        R"({"seconds": 2, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0},
+            {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1,
+             "position_m": [0, 0.5, 0], "color": "#808080"},
+            {"shape": "sphere", "radius_m": 0.5, "mass_kg": 1, "position_m": [1.5, 0.5, 0],
+             "velocity_mps": [8, 5, 0], "color": "#ff0000"}]})");
+  const Result fit = run_cps("render throw.json --fps 4 --size 160x120 --out fit", dir);
+  INFO(fit.err);
+  REQUIRE(fit.exit_code == 0);
+  CHECK(json::parse(slurp(dir / "fit" / "throw.json" / "run.json"))["parameters"]["camera"] == "fit");
+  // The framing as built (the default before scene files were fitted) loses the ball: the check
+  // below can fail.
+  const Result as_built = run_cps("render throw.json --fps 4 --size 160x120 --camera auto --out auto", dir);
+  REQUIRE(as_built.exit_code == 0);
+  int lost_as_built = 0;
+  for (int k = 0; k <= 8; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%06d.png", k);
+    INFO(name);
+    CHECK(red_pixels(cps::render::read_png(dir / "fit" / "throw.json" / name)) >= 4);
+    if (red_pixels(cps::render::read_png(dir / "auto" / "throw.json" / name)) == 0) ++lost_as_built;
+  }
+  CHECK(lost_as_built >= 2);
+}
+#endif

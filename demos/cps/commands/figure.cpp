@@ -4,6 +4,7 @@
 #include "output/output.h"
 #include "pictures/overlay.h"
 #include "options/view_options.h"
+#include "energy_rise.h"
 
 #include "cps/render/image_ops.h"
 
@@ -115,12 +116,17 @@ double time_spacing(const std::vector<double>& times) {
 ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer) {
   const scenes::Scene& scene = *spec.scene;
   std::vector<scenes::Run> runs;
-  for (const Variant& v : spec.variants) runs.push_back(make_run_or_usage_error(scene, v.overrides));
+  std::vector<std::shared_ptr<const scenes::EnergyRiseTracker>> energy;  // per variant
+  for (const Variant& v : spec.variants) {
+    runs.push_back(make_run_or_usage_error(scene, v.overrides));
+    energy.push_back(scenes::watch_energy_rise(runs.back()));
+  }
 
   const float aspect = static_cast<float>(renderer.width()) / static_cast<float>(renderer.height());
   std::vector<const World*> worlds;
   for (const scenes::Run& run : runs) worlds.push_back(&run.world);
-  const DrawStyle style = resolve_style(scene, worlds, spec.view, aspect, spec.times.back());
+  const DrawStyle style =
+      resolve_style(scene, worlds, scene_view(scene, spec.view), aspect, spec.times.back());
 
   ComposedFigure out;
   FigurePage& page = out.page;
@@ -157,6 +163,9 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
         texts.push_back(text);
       }
     }
+  }
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    scenes::print_energy_rise_warning(scene.name, spec.variants[r].label, runs[r].world.def(), *energy[r]);
   }
   const bool lettered = out.panels.size() > 1;
   for (std::size_t k = 0; k < out.panels.size(); ++k) {
@@ -208,7 +217,7 @@ nlohmann::json figure_json(const FigureSpec& spec, const PageLayout& layout, int
           {"panels_px", panels},
           {"font", {{"family", "DejaVu Sans"}, {"size_px", layout.font_size},
                     {"rule", "max(10, panel height / 24) px; 1 px = 1 pt in PDF and SVG"}}},
-          {"camera", spec.view.camera},
+          {"camera", scene_view(*spec.scene, spec.view).camera},
           {"camera_preset",
            preset ? nlohmann::json{{"eye_m", {preset->eye.x(), preset->eye.y(), preset->eye.z()}},
                                    {"target_m", {preset->target.x(), preset->target.y(), preset->target.z()}},

@@ -7,6 +7,7 @@
 #include "pictures/overlay.h"
 #include "pictures/video.h"
 #include "options/view_options.h"
+#include "energy_rise.h"
 
 #include "cps/render/image_ops.h"
 
@@ -205,6 +206,7 @@ struct RenderOptions {
 struct SceneRender {
   const scenes::Scene* scene = nullptr;
   std::vector<scenes::Run> runs;
+  std::vector<std::shared_ptr<const scenes::EnergyRiseTracker>> energy;  // per variant
   std::vector<std::string> labels;  // per variant: its caption's label
   RenderJob spec;                   // seconds, fps, speed, folder, grid, frame size, legend
   std::pair<int, int> scene_px;     // the scene's size in each panel (frame_layout)
@@ -252,6 +254,7 @@ SceneRender scene_runs(const RenderOptions& o, const scenes::Scene& scene,
   job.scene = &scene;
   for (const Variant& v : variants) {
     job.runs.push_back(make_run_or_usage_error(scene, v.overrides));
+    job.energy.push_back(scenes::watch_energy_rise(job.runs.back()));
     // --overlay: the legend names the variants; the label, the scene (with --label).
     std::string label = o.overlay ? "" : v.label;
     if (o.label) {
@@ -352,7 +355,7 @@ void plan_scene(const RenderOptions& o, const RenderPlan& plan, SceneRender& job
   place_panels(o, o.overlay ? 1 : plan.variants.size(), job);
   std::vector<const World*> worlds;
   for (const scenes::Run& run : job.runs) worlds.push_back(&run.world);
-  job.style = resolve_style(*job.scene, worlds, o.view,
+  job.style = resolve_style(*job.scene, worlds, scene_view(*job.scene, o.view),
                             static_cast<float>(job.scene_px.first) / static_cast<float>(job.scene_px.second),
                             job.spec.seconds);
   const long long frames = frame_count(job.spec);
@@ -467,7 +470,7 @@ nlohmann::json frames_info(const RenderOptions& o, const RenderPlan& plan, const
        {"compare", comparison_json(plan.comparison, o.overlay)},
        {"layout", layout},
        {"backend", o.backend},
-       {"camera", o.view.camera},
+       {"camera", scene_view(*job.scene, o.view).camera},
        {"camera_resolved", camera_json(job.style.camera)},
        {"eye_m", o.view.eye ? nlohmann::json{o.view.eye->x(), o.view.eye->y(), o.view.eye->z()}
                             : nlohmann::json(nullptr)},
@@ -506,6 +509,9 @@ long long write_frames(const RenderOptions& o, const RenderPlan& plan, SceneRend
   Progress progress("render " + job.spec.folder.filename().string(), frame_count(job.spec), "frames");
   const long long frames = render_frames(job.style, panels, job.spec, renderer, writer, &progress);
   end_output(job.output, info);
+  for (std::size_t v = 0; v < job.runs.size(); ++v) {
+    scenes::print_energy_rise_warning(job.scene->name, plan.variants[v].label, job.runs[v].world.def(), *job.energy[v]);
+  }
   std::printf("%s: %lld frames in %s\n", job.spec.folder.filename().c_str(), frames, job.spec.folder.c_str());
   return frames;
 }

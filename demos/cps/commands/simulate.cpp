@@ -4,6 +4,7 @@
 #include "options/options.h"
 #include "output/output.h"
 #include "options/progress.h"
+#include "energy_rise.h"
 #include "state_hash.h"
 
 #include <CLI/CLI.hpp>
@@ -170,8 +171,10 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
   // Steps on stderr, only once the run has taken 2 s (short runs and --json stay clean).
   Progress progress("simulate " + o.scene, std::llround(seconds / r.world.def().dt), "steps", 2.0);
   r.metrics = std::make_unique<ProgressMetrics>(std::move(r.metrics), progress);
+  const auto energy = scenes::watch_energy_rise(r);  // the warning below; changes no output
   const nlohmann::json summary = simulate(*scene, r, seconds, trace ? &*trace : nullptr);
   progress.finish();
+  scenes::print_energy_rise_warning(scene->name, "", r.world.def(), *energy);
   if (trace) {
     const long rows = trace->finish();
     std::cerr << "trace: " << rows << " rows (" << r.world.bodies().size()

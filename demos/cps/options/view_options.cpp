@@ -61,7 +61,8 @@ void add_view_options(CLI::App& cmd, View& view, bool& label, bool label_default
                std::string("write scene, variant and time (s) on each picture; default: ") +
                    (label_default ? "on (--no-label leaves the pictures bare)" : "off (variants of --compare are always labelled)"));
   cmd.add_option("--camera", view.camera,
-                 "view: preset (the scene's own), auto (framed on the bodies as built), fit "
+                 "view: preset (the scene's own; fit for a scene file without a camera), auto "
+                 "(framed on the bodies as built), fit "
                  "(framed on every body over the whole run: a headless pre-run of the same "
                  "length, all --compare variants, seen from the preset's direction), front, side "
                  "or top (the preset's target from the same distance)")

@@ -269,6 +269,13 @@ nlohmann::json camera_json(const render::Camera& c) {
 
 std::span<const std::string_view> camera_names() { return kCameraNames; }
 
+View scene_view(const scenes::Scene& scene, View view) {
+  if (view.camera == "preset" && !view.preset && !scene.camera && scenes::is_file_scene(scene)) {
+    view.camera = "fit";
+  }
+  return view;
+}
+
 DrawStyle resolve_style(const scenes::Scene& scene, const World& as_built, const View& view,
                         float aspect) {
   const World* worlds[] = {&as_built};

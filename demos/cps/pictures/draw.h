@@ -116,11 +116,18 @@ render::DrawList draw_list(const World& world, const DrawStyle& style);
 nlohmann::json camera_json(const render::Camera& camera);
 
 /// The names `--camera` takes: "preset" (the scene's own view; for a scene without one, the
-/// automatic framing), "auto" (frame the bodies as built), "fit" (frame every body over the
+/// automatic framing, and for a scene file without a "camera" in `cps render` and `cps figure`,
+/// "fit": see scene_view), "auto" (frame the bodies as built), "fit" (frame every body over the
 /// whole run: the bounds of a headless pre-run, see run_bounds, seen from the preset's
 /// direction), and "front", "side", "top": the preset's target seen from the same distance
 /// along +z, along +x, and from above.
 std::span<const std::string_view> camera_names();
+
+/// The view `cps render` and `cps figure` draw `scene` with: `view`, except that the default
+/// --camera preset on a scene file (scenes::is_file_scene) without a "camera" and without
+/// view.preset becomes "fit", so that bodies that move far (a thrown ball) stay in the picture
+/// over the whole run; a built-in scene keeps its preset or its framing as built. No errors.
+View scene_view(const scenes::Scene& scene, View view);
 
 /// The one place a scene's pictures get their camera and style: the camera that view.camera
 /// names (see camera_names()) for `scene`, whose preset is view.preset if set, else the scene's

@@ -1,0 +1,171 @@
+// The energy watch: the largest rise of KE + PE above the start, against the energy scale of
+// EnergyRise (energy_rise.h), and the warning that names the push method and the fix.
+#include "energy_rise.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace cps::scenes {
+
+double EnergyRise::rise_J() const { return std::max(0.0, max_J - start_J); }
+
+double EnergyRise::fraction() const {
+  const double rise = rise_J();
+  if (!(rise > 0.0)) return 0.0;
+  return scale_J > 0.0 ? rise / scale_J : kInfinity;
+}
+
+bool EnergyRise::warns() const { return fraction() > kEnergyRiseWarnFraction; }
+
+void EnergyRiseTracker::observe(const World& world) {
+  const auto& bodies = world.bodies();
+  const Vec3& g = world.def().gravity;
+  const double g_norm = g.norm();
+  const Vec3 up = g_norm > 0.0 ? Vec3(-g / g_norm) : Vec3::Zero();
+  double kinetic = 0.0;
+  double potential = 0.0;
+  for (const Body& b : bodies) {
+    if (b.is_static()) continue;
+    kinetic += b.kinetic_energy();
+    potential -= b.mass * g.dot(b.x);
+  }
+  const double energy = kinetic + potential;
+  if (!std::isfinite(energy)) {
+    rise_.nonfinite = true;
+    return;
+  }
+  if (!started_) {
+    started_ = true;
+    g_ = g_norm;
+    start_kinetic_J_ = kinetic;
+    rise_.start_J = energy;
+    rise_.max_J = energy;
+    rise_.max_time_s = world.time();
+    mass_.assign(bodies.size(), 0.0);
+    start_h_.assign(bodies.size(), 0.0);
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      const Body& b = bodies[i];
+      if (b.is_static()) continue;
+      mass_[i] = b.mass;
+      start_h_[i] = up.dot(b.x);
+      const double r = b.shape.kind == ShapeKind::sphere ? b.shape.radius : b.shape.half_extents.norm();
+      size_J_ += b.mass * g_norm * r;
+    }
+    lowest_h_ = start_h_;
+    previous_x_.assign(bodies.size(), Vec3::Zero());
+    previous_time_s_ = world.time();
+  }
+  // Bodies are only ever added before a run starts; a world that grew is measured by its first
+  // bodies.
+  const std::size_t n = std::min(bodies.size(), lowest_h_.size());
+  if (world.time() > previous_time_s_) {
+    // The lift of the positions' own correction: x2 - x1 - v2 dt against gravity (0 for the
+    // Baumgarte push, whose positions move with the stored momenta).
+    const double dt = world.def().dt;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (mass_[i] == 0.0) continue;
+      const Vec3 dx_push = bodies[i].x - previous_x_[i] - bodies[i].velocity() * dt;
+      rise_.lift_J += std::max(0.0, -mass_[i] * g.dot(dx_push));
+    }
+  }
+  previous_time_s_ = world.time();
+  if (!world.rows().empty()) rise_.constrained = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    previous_x_[i] = bodies[i].x;
+    if (mass_[i] > 0.0) lowest_h_[i] = std::min(lowest_h_[i], up.dot(bodies[i].x));
+  }
+  if (energy - rise_.lift_J > rise_.max_J) {
+    rise_.max_J = energy - rise_.lift_J;
+    rise_.max_time_s = world.time();
+  }
+}
+
+EnergyRise EnergyRiseTracker::result() const {
+  EnergyRise out = rise_;
+  double available = start_kinetic_J_;
+  for (std::size_t i = 0; i < mass_.size(); ++i) available += mass_[i] * g_ * (start_h_[i] - lowest_h_[i]);
+  out.scale_J = std::max(available, size_J_);
+  return out;
+}
+
+namespace {
+
+// Forwards to the scene's own metrics and feeds the tracker.
+class EnergyRiseMetrics final : public Metrics {
+ public:
+  EnergyRiseMetrics(std::unique_ptr<Metrics> inner, std::shared_ptr<EnergyRiseTracker> tracker)
+      : inner_(std::move(inner)), tracker_(std::move(tracker)) {}
+  void observe(const World& world) override {
+    inner_->observe(world);
+    tracker_->observe(world);
+  }
+  nlohmann::json report() const override { return inner_->report(); }
+
+ private:
+  std::unique_ptr<Metrics> inner_;
+  std::shared_ptr<EnergyRiseTracker> tracker_;
+};
+
+// What to try instead of `push`, with why, for the warning; `constrained`: EnergyRise's.
+std::string fix_for(PushMode push, bool constrained) {
+  if (!constrained) {
+    return "no contact or rod acted, so no push did: the rise is the integrator's (no gyroscopic "
+           "term: a body spinning about an axis that is not a principal one changes its kinetic "
+           "energy at constant angular momentum, docs/conventions.md); no --push changes it";
+  }
+  switch (push) {
+    case PushMode::baumgarte:
+      return "the paper's push factor keeps its push beta d / dt in the velocities, so every "
+             "overlap and rod error it corrects comes back as motion (Sec. 5.3); try --push split "
+             "(Sec. 8.1: the push moves the positions, the momenta come from a solve without it; "
+             "\"push\": \"split\" in a scene file's \"world\")";
+    case PushMode::soft:
+      return "the soft rows are springs that store and return energy; try --push split (Sec. 8.1; "
+             "\"push\": \"split\" in a scene file's \"world\")";
+    default:
+      return "this push keeps itself out of the momenta, so the rise comes from the solve: try a "
+             "smaller --dt or more --iterations";
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<const EnergyRiseTracker> watch_energy_rise(Run& run) {
+  auto tracker = std::make_shared<EnergyRiseTracker>();
+  tracker->observe(run.world);
+  run.metrics = std::make_unique<EnergyRiseMetrics>(std::move(run.metrics), tracker);
+  return tracker;
+}
+
+std::string energy_rise_warning(std::string_view what, const WorldDef& def, const EnergyRise& rise) {
+  if (!rise.warns()) return {};
+  char share[64];
+  if (std::isfinite(rise.fraction())) {
+    std::snprintf(share, sizeof share, "%.0f %%", 100.0 * rise.fraction());
+  } else {
+    std::snprintf(share, sizeof share, "from nothing");
+  }
+  char numbers[256];
+  std::snprintf(numbers, sizeof numbers,
+                "+%.3g J at t = %.3g s; 100 %% = %.3g J, the start's energy above the bodies' "
+                "lowest points or their size, see docs/findings.md",
+                rise.rise_J(), rise.max_time_s, rise.scale_J);
+  std::string push(name_of(def.push));
+  char limit[32];
+  std::snprintf(limit, sizeof limit, "%.0f %%", 100.0 * kEnergyRiseWarnFraction);
+  return std::string(what) + ": the energy (kinetic + potential) rose " + share +
+         " above its start (" + numbers + ") with nothing driving the scene, more than the " +
+         limit + " that warns; the push is --push " + push + ": " + fix_for(def.push, rise.constrained);
+}
+
+void print_energy_rise_warning(std::string_view scene, std::string_view label, const WorldDef& def,
+                               const EnergyRiseTracker& tracker) {
+  const std::string_view first_line = label.substr(0, label.find('\n'));
+  std::string what(scene);
+  if (!first_line.empty()) what += " (" + std::string(first_line) + ")";
+  const std::string warning = energy_rise_warning(what, def, tracker.result());
+  if (!warning.empty()) std::fprintf(stderr, "cps: warning: %s\n", warning.c_str());
+}
+
+}  // namespace cps::scenes

@@ -1,0 +1,107 @@
+#pragma once
+// The energy watch of `cps simulate`, `cps render` and `cps figure`: whether a run's total
+// mechanical energy rose above its start with nothing driving the scene, and the one-line warning
+// that says so. docs/findings.md, "Energy that rises with nothing driving it", tells the story
+// and the numbers; the definitions are here.
+//
+// Nothing drives any scene of cps: the engine has no kinematic or animated bodies (a static body
+// has m^-1 = 0 and never moves) and the only external force is gravity, whose work is counted in
+// the potential. So a rise of KE + PE above its start is energy the step made: the push kept in
+// the velocities (Baumgarte, Sec. 5.3) or a solve that did not converge.
+
+#include "scene.h"
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cps::scenes {
+
+/// The rise that warns, as a fraction (dimensionless) of the energy scale of EnergyRise: a run
+/// whose KE + PE ever exceeds its start by more than this fraction of the scale gets the warning.
+/// Typical 0.5. Chosen far above what the paper's scenes gain at their defaults where the push
+/// does not throw bodies (stack, funnel, pendulum_grid 0, pendulum_wave 0.0015) and below what a
+/// bouncing scene under the Baumgarte push gains (the Newton's cradle of the tests: 4.7 in 4 s,
+/// 21 in 10 s; the intersecting stack: 12.6).
+inline constexpr double kEnergyRiseWarnFraction = 0.5;
+
+/// What the watch measured over a run; energies in J, times in s. E = KE + PE with the
+/// potential PE = -sum m g . x of the movable bodies (datum x = 0), as FileSceneMetrics.
+struct EnergyRise {
+  double start_J = 0.0;  ///< E at the start (the world as it was when the watch began)
+  /// The largest E - lift of any step (finite states only): the energy less what the positions'
+  /// own corrections lifted so far (lift_J), so that a push that moves bodies out of an overlap
+  /// without giving them velocity (split, split-impulse, ngs, soft) is not counted as a gain
+  double max_J = 0.0;
+  double max_time_s = 0.0;  ///< the world's time at that step (s)
+  /// The potential energy the positions' own corrections added up to the last step (J, >= 0):
+  /// the sum over steps and movable bodies of max(0, -m g . (x2 - x1 - v2 dt)), the lift of the
+  /// part of each step's move that is not the stored velocity's (stress.h, W_split). 0 for the
+  /// Baumgarte push, whose positions move with the stored momenta.
+  double lift_J = 0.0;
+  /// The energy scale the rise is measured against (J, >= 0): the larger of
+  ///  - the start's energy above the bodies' lowest points: KE(0) + sum_i m_i |g| (h_i(0) - min_t
+  ///    h_i(t)), h = height along -g; what the run could turn into motion without any gain,
+  ///    independent of the datum (a cradle hanging at 100 m has the scale of one at 1 m), and
+  ///  - the bodies' own size: sum_i m_i |g| r_i, r_i the radius of body i's bounding sphere (box:
+  ///    |half extents|); the floor for bodies that start at rest and never fall, whose first
+  ///    term is 0 (a resting box pushed up by its own size doubles the scale).
+  double scale_J = 0.0;
+  bool nonfinite = false;  ///< a state was not finite (the rise is measured up to it)
+  /// A step of the run had constraint rows (contacts or rods); without any, no push acted and a
+  /// rise is the integrator's own (the warning then says so instead of naming a push).
+  bool constrained = false;
+
+  /// max_J - start_J (J, >= 0).
+  double rise_J() const;
+  /// rise_J() / scale_J (dimensionless); +inf for a rise from a scale of 0 (no motion and no
+  /// gravity at the start), 0 when nothing rose.
+  double fraction() const;
+  /// fraction() > kEnergyRiseWarnFraction.
+  bool warns() const;
+};
+
+/// Keeps the running maximum of E, the start, and each movable body's lowest height over a run.
+/// observe() the world as built, then after every step. No errors; states that are not finite
+/// are skipped (and set EnergyRise::nonfinite).
+class EnergyRiseTracker {
+ public:
+  void observe(const World& world);
+  /// The measurements so far (all 0 before the first observe()).
+  EnergyRise result() const;
+
+ private:
+  bool started_ = false;
+  EnergyRise rise_;
+  double start_kinetic_J_ = 0.0;
+  double g_ = 0.0;                  // |g| (m/s^2)
+  std::vector<double> mass_;        // kg, by body index; 0 for static bodies
+  std::vector<double> start_h_;     // m, height along -g at the start
+  std::vector<double> lowest_h_;    // m, lowest height so far
+  std::vector<Vec3> previous_x_;    // m, positions at the last observe()
+  double previous_time_s_ = 0.0;    // s, the world's time then
+  double size_J_ = 0.0;             // sum m |g| r (J)
+};
+
+/// Wraps run.metrics so that every step also feeds a tracker, which has already observed the
+/// world as it is now; returns the tracker (read it after the run). The metrics report as before.
+std::shared_ptr<const EnergyRiseTracker> watch_energy_rise(Run& run);
+
+/// The warning for a run of scene `what` (the scene's name, with a variant's label if any) with
+/// world parameters `def`: "" when the rise does not warn (EnergyRise::warns), else one line
+/// without a newline, e.g.
+///   "chain.json: the energy (kinetic + potential) rose 1870 % above its start (+93 J at
+///    t = 9.7 s; 100 % = 5 J, ...) with nothing driving the scene, under --push baumgarte (...);
+///    try --push split (...)"
+/// naming the push method in use and the fix to try for it (docs/findings.md). No errors.
+std::string energy_rise_warning(std::string_view what, const WorldDef& def, const EnergyRise& rise);
+
+/// Prints energy_rise_warning as "cps: warning: ..." and a newline on stderr when the tracked run
+/// warns, naming it `scene`, or "scene (label)" with the first line of a --compare variant's
+/// non-empty `label` ("push = baumgarte").
+/// Writes nothing else: no file and no exit code depends on it.
+void print_energy_rise_warning(std::string_view scene, std::string_view label, const WorldDef& def,
+                               const EnergyRiseTracker& tracker);
+
+}  // namespace cps::scenes

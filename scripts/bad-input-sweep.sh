@@ -95,6 +95,8 @@ RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
 MERGE_SRC=$root/merge-src                              # a complete sweep, made below
 PRIOR=$root/prior                    # a/x.json (a valid scene file) and its render into out/x
 DROP='{"seconds": 0.2, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0}, {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1, "position_m": [0, 0.6, 0]}]}'
+MERGE_DUP=$root/merge-dup  # a copy of its CSV: every run twice with MERGE_SRC, made below
+MERGE_NAN=$root/merge-nan  # its first run with us_per_step nan, made below
 BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick;report push --quick"
 BASE['report:--run']='report --out out'
 BASE['report:--merge']='report --out out'
@@ -240,6 +242,9 @@ EXTRA=(
   "push/--merge|report push --merge $MERGE_SRC --out out"
   "push/--list-runs|report push --list-runs --out out"
   "push/--seed|report push --seed 3 --out out"
+  "twice|report --merge $MERGE_SRC $MERGE_SRC --out out"
+  "again in|report --merge $MERGE_SRC $MERGE_DUP --out out"
+  "us_per_step: 'nan'|report --merge $MERGE_NAN --out out"
   "--rendering/--quick|bench --rendering=false --quick=junk"
   "samples/--fps/--seconds|export stack --seconds 1e5 --fps 1000 --out out/s.glb"
   # Scene-file paths: another file of the same stem into a folder that holds a/x.json's render
@@ -578,6 +583,11 @@ if ! compgen -G "$MERGE_SRC/*.csv" > /dev/null; then
   CONTROL_FAILS+=("cps report intersecting_stack --quick --out DIR wrote no CSV")
   echo "CONTROL FAILED: cps report intersecting_stack --quick --out DIR wrote no CSV"
 fi
+mkdir -p "$MERGE_DUP" "$MERGE_NAN"
+cp "$MERGE_SRC/intersecting_stack.csv" "$MERGE_DUP/copy.csv" 2> /dev/null
+awk -F, -v OFS=, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "us_per_step") c = i }
+                  NR == 2 { $c = "nan" } NR <= 2' "$MERGE_SRC/intersecting_stack.csv" \
+  > "$MERGE_NAN/nan.csv" 2> /dev/null
 snapshot_dir() { (shopt -s dotglob nullglob; stat -c '%n|%s|%y' "$1"/*); }
 merge_before=$(snapshot_dir "$MERGE_SRC")
 

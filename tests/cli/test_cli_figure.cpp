@@ -371,6 +371,29 @@ TEST_CASE("cps render --label writes the captions in a strip below the scene, ne
   CHECK(ink > 100);
 }
 
+TEST_CASE("cps figure on a full disk leaves no sidecar without its figure", "[cli][figure][output]") {
+  const fs::path dir = fresh_dir("full_disk");
+  const std::string args = "figure stack --times 0,0.5 --size 160x90 --format pdf --out f.pdf";
+  // Room enough: the sidecar is smaller than the limit below, the PDF larger.
+  fs::create_directories(dir / "room");
+  REQUIRE(cps_run(args, dir / "room").exit_code == 0);
+  REQUIRE(fs::file_size(dir / "room/f.pdf") > 16384);
+  REQUIRE(fs::file_size(dir / "room/f.pdf.json") < 8192);
+  // Every file limited to 16 KiB (SIGXFSZ ignored: a write past it fails with EFBIG, as one on a
+  // full disk fails with ENOSPC).
+  fs::create_directories(dir / "full");
+  const Result r = run_cps(args, dir / "full", "trap '' XFSZ; prlimit --fsize=16384");
+  INFO(r.err);
+  CHECK(r.exit_code == 1);
+  CHECK(r.err.find("cannot write f.pdf: File too large") != std::string::npos);
+  std::vector<std::string> left;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "full")) {
+    left.push_back(e.path().filename().string());
+  }
+  CHECK(left == std::vector<std::string>{"run.json"});  // no f.pdf.json, no temporary
+  fs::remove_all(dir);
+}
+
 TEST_CASE("cps figure rejects a bad --format with exit 2, naming it, and writes nothing",
           "[cli][figure][format]") {
   const fs::path dir = fresh_dir("bad_format");

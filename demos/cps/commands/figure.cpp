@@ -1,6 +1,7 @@
 #include "commands/figure.h"
 
 #include "command.h"
+#include "output/atomic_file.h"
 #include "output/output.h"
 #include "pictures/overlay.h"
 #include "options/view_options.h"
@@ -240,8 +241,16 @@ nlohmann::json figure_json(const FigureSpec& spec, const PageLayout& layout, int
 }
 
 void write_figure(const fs::path& file, const std::string& bytes, const nlohmann::json& sidecar) {
-  write_json_atomic(sidecar_path(file), sidecar);
-  write_text_atomic(file, bytes);
+  // Both written out and closed (hand_over) before either is renamed, the figure first: no
+  // sidecar without its figure.
+  AtomicFile figure(file);
+  figure.write(bytes);
+  figure.hand_over();
+  AtomicFile record(sidecar_path(file));
+  record.write(sidecar.dump(2) + "\n");
+  record.hand_over();
+  figure.commit();
+  record.commit();
 }
 
 const std::vector<PaperFigure>& paper_figures() {

@@ -93,10 +93,11 @@ std::filesystem::path sidecar_path(const std::filesystem::path& png);
 /// world parameters with units).
 nlohmann::json figure_json(const FigureSpec& spec, const PageLayout& layout, int argc, char** argv);
 
-/// Writes the sidecar and then the figure's bytes (compose_page), each atomically
-/// (write_json_atomic, write_text_atomic: a temporary of this run, renamed). The folder must
-/// exist (begin_output creates it; the caller checked both files with plan_output first).
-/// Throws std::runtime_error "cannot write PATH: REASON" on failure.
+/// Writes the figure's bytes (compose_page) and its sidecar (indented JSON), each to a temporary
+/// of this run (AtomicFile), and renames the sidecar only after the figure: a failed write (a
+/// full disk) leaves neither new file and no temporary, never a sidecar without its figure. The
+/// folder must exist (begin_output creates it; the caller checked both files with plan_output
+/// first). Throws std::runtime_error "cannot write PATH: REASON" on failure.
 void write_figure(const std::filesystem::path& file, const std::string& bytes,
                   const nlohmann::json& sidecar);
 

@@ -6,6 +6,7 @@
 #include "options/options.h"
 #include "output/output.h"
 #include "report/push/report.h"
+#include "report/result.h"
 #include "report/sweep.h"
 
 #include <CLI/CLI.hpp>
@@ -143,7 +144,9 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                   "combine the CSV files below these folders into one report in --out; if runs "
                   "of the sweeps they belong to are missing, it names them on stderr, writes the "
                   "report marked INCOMPLETE at the top (and in every diagram's title) and exits "
-                  "with 1")
+                  "with 1; refused (exit 2, nothing written): a run id found twice, a folder "
+                  "given twice, a cell that is not finite, and CSVs estimated past " +
+                  std::to_string(kMergeMemoryLimit >> 20) + " MiB of memory")
       ->check(kNotEmpty);
   CLI::Option* run = sub->add_option("--run", o->run,
                   "execute one run by its id (see --list-runs); the scene argument and --quick "

@@ -215,11 +215,16 @@ class Leftovers {
   Leftovers(const fs::path& folder, const Manifest& m) : folder_(folder) {
     for (const RunId& r : m.unfinished) {
       if (still_running(r)) continue;
+      ended_.insert(r.token);
       std::set<std::string>& names = dead_[r.token];
       names.insert(r.files.begin(), r.files.end());
       names.insert(k_manifest_name);
     }
   }
+
+  // True if the unfinished run `token` had ended when this was made (a run ending later is
+  // still taken as running, so that its temporaries stay recognised by the next run).
+  bool ended(const std::string& token) const { return ended_.count(token) != 0; }
 
   // True if `name` is the temporary of one of the files (or run.json) of a run that ended
   // unfinished, or a temporary of run.json whose own content names such a run.
@@ -246,6 +251,7 @@ class Leftovers {
  private:
   fs::path folder_;
   std::map<std::string, std::set<std::string>> dead_;  // token -> names of its temporaries
+  std::set<std::string> ended_;                         // tokens of the runs that ended
 };
 
 // An exclusive flock(2) on a folder while it lives; none where the file system refuses one.
@@ -607,7 +613,9 @@ void begin_output(const OutputPlan& plan, const nlohmann::json& info) {
   }
   std::vector<RunId> unfinished;
   for (const RunId& r : manifest.unfinished) {
-    if (r.token != run_token() && still_running(r)) unfinished.push_back(r);
+    // The same verdict as the removal's: a run that ends meanwhile stays listed, else its
+    // temporaries would never be removed.
+    if (r.token != run_token() && !leftovers.ended(r.token)) unfinished.push_back(r);
   }
   RunId me = this_run();
   me.files = plan.files;

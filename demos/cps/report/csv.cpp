@@ -32,9 +32,10 @@ CsvTable read_csv(const std::filesystem::path& file) {
   std::getline(in, line);
   std::stringstream header(line);
   for (std::string c; std::getline(header, c, ',');) table.columns.push_back(c);
-  while (std::getline(in, line)) {
+  for (std::size_t number = 2; std::getline(in, line); ++number) {
     if (line.empty()) continue;
     std::stringstream cells(line);
+    table.lines.push_back(number);
     std::vector<std::string>& row = table.rows.emplace_back();
     for (std::size_t c = 0; c < table.columns.size(); ++c) {
       std::string cell;

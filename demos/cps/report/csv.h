@@ -17,6 +17,9 @@ namespace cps::cli {
 struct CsvTable {
   std::vector<std::string> columns;
   std::vector<std::vector<std::string>> rows;
+  /// The line of its file (1-based; the header is line 1) of each row, as read_csv reads them;
+  /// empty for a table made in memory.
+  std::vector<std::size_t> lines;
 
   /// The index of `column` in `columns`, or columns.size() if the table has no such column.
   std::size_t column_index(std::string_view column) const;
@@ -25,7 +28,8 @@ struct CsvTable {
 };
 
 /// Reads `file`: its first line is the header, each further non-empty line a row, split at
-/// commas (missing cells at the end of a line are ""; cells past the header's count dropped).
+/// commas (missing cells at the end of a line are ""; cells past the header's count dropped),
+/// with its line number in `lines`.
 /// Throws std::runtime_error "cannot read FILE" if it cannot be opened.
 CsvTable read_csv(const std::filesystem::path& file);
 

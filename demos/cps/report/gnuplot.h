@@ -8,11 +8,6 @@
 
 namespace cps::cli {
 
-/// Runs gnuplot on `script` (a file). Throws std::runtime_error naming the script, gnuplot's exit
-/// status and the first 400 characters of its output if it fails (saying to install
-/// gnuplot-nox when it is missing).
-void run_gnuplot(const std::filesystem::path& script);
-
 /// `s` as a gnuplot string: in single quotes, a quote inside doubled.
 std::string gp_text(const std::string& s);
 
@@ -32,9 +27,16 @@ struct GnuplotFraming {
 
 /// Writes `script` (atomically): per picture, framing.before_each, its terminal line, "set output
 /// 'TEMPORARY'" and `body` (the drawing commands), then framing.after_each; framing.at_end last.
-/// Runs gnuplot on it, then renames each temporary onto its picture's file. Throws
-/// std::runtime_error if a file cannot be written or gnuplot fails (see run_gnuplot); the
-/// pictures are then left as they were.
+/// Each TEMPORARY is an AtomicFile of the picture's file handed over to gnuplot (atomic_file.h),
+/// so the pictures must be listed in their folder's output plan (output.h). Runs gnuplot (found
+/// on PATH; killed if this thread ends first) on the script, checks each picture (not empty; by
+/// its extension, a .png with the PNG signature and its IEND chunk at the end, an .svg holding
+/// "<svg" and ended by "</svg>", a .pdf starting with "%PDF-" with "%%EOF" in its last 1 KiB),
+/// then renames every temporary onto its file. Throws std::runtime_error "cannot write PICTURE:
+/// REASON" if a file cannot be written, gnuplot fails (REASON: its exit status and the first 400
+/// characters of its output, and for exit 127 to install gnuplot-nox) or a picture is incomplete
+/// (a full disk: gnuplot exits 0 after a failed write); no picture is then replaced and no
+/// temporary is left.
 void draw_pictures(const std::filesystem::path& script, const std::vector<GnuplotPicture>& pictures,
                    const std::string& body, const GnuplotFraming& framing);
 

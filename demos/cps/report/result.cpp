@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <set>
+#include <stdexcept>
 #include <utility>
 
 namespace cps::cli {
@@ -61,6 +64,34 @@ std::optional<int> parse_count(const std::string& text) {
   return n;
 }
 
+// What a cell's text is as a number: all of it a finite number (strtod), all of it a number
+// that is not finite ("nan", "inf", "1e999"), or not a number.
+enum class NumberText { finite, non_finite, not_number };
+
+NumberText number_text(const std::string& text) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  if (end == begin || *end != '\0') return NumberText::not_number;
+  return std::isfinite(v) ? NumberText::finite : NumberText::non_finite;
+}
+
+// Why the non-empty cell `text` cannot be in column `column` of a report CSV, or "": a number
+// column (a measure, a metric, warm_start) holds a finite number, diverged and quick hold 0 or
+// 1, and no cell holds a number that is not finite (the CSVs write none: number()).
+std::string bad_cell(const std::string& column, const std::string& text) {
+  const NumberText kind = number_text(text);
+  if (kind == NumberText::non_finite) {
+    return "is not finite (a report CSV holds finite numbers; a measure without a value is an "
+           "empty cell)";
+  }
+  const bool numeric = number_field(column) != nullptr || column == "warm_start" ||
+                       column.rfind(kMetricPrefix, 0) == 0;
+  if (numeric && kind == NumberText::not_number) return "is not a number";
+  if ((column == "diverged" || column == "quick") && text != "0" && text != "1") return "is not 0 or 1";
+  return "";
+}
+
 // Sets the column `column` of `r` from its non-empty cell `text`. False for a count that is not
 // one.
 bool set_cell(RunResult& r, const std::string& column, const std::string& text) {
@@ -97,16 +128,20 @@ bool set_cell(RunResult& r, const std::string& column, const std::string& text) 
   return true;
 }
 
-// Row `row` of `table` as a result. Throws UsageError naming `source` for a count that is not
-// one or a missing setting.
+// Row `row` of `table` as a result. Throws UsageError naming `source`, the line, the column and
+// the cell for a cell it cannot hold (bad_cell) or a count that is not one, and for a missing
+// setting.
 RunResult result_of_row(const CsvTable& table, std::size_t row, const std::string& source) {
   RunResult r;
+  const std::size_t line = row < table.lines.size() ? table.lines[row] : row + 2;
   for (std::size_t c = 0; c < table.columns.size(); ++c) {
     const std::string& text = table.rows[row][c];
     if (text.empty()) continue;
-    if (!set_cell(r, table.columns[c], text)) {
-      throw UsageError("--merge: " + source + ": '" + text + "' in column " + table.columns[c] +
-                       " is not a count");
+    std::string why = bad_cell(table.columns[c], text);
+    if (why.empty() && !set_cell(r, table.columns[c], text)) why = "is not a count";
+    if (!why.empty()) {
+      throw UsageError("--merge: " + source + " line " + std::to_string(line) + ", column " +
+                       table.columns[c] + ": '" + text + "' " + why);
     }
   }
   for (const char* setting : {"solver", "push", "friction_model", "iterations", "substeps", "diverged"}) {
@@ -214,8 +249,72 @@ void write_results(const fs::path& file, const std::vector<RunResult>& results) 
   write_csv(file, results_table(results));
 }
 
+namespace {
+
+// The size of the CSVs a merge reads, counted before any is parsed.
+struct MergeSize {
+  std::uintmax_t bytes = 0;  // of the files
+  std::uintmax_t rows = 0;   // non-empty lines after each header
+  std::uintmax_t cells = 0;  // rows x their file's header columns (read_csv makes every cell)
+  std::uintmax_t estimate() const { return bytes + cells * kMergeBytesPerCell; }
+};
+
+std::string mib(std::uintmax_t bytes) {
+  return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB";
+}
+
+// Adds `file` to `size` (reading it in blocks, nothing kept). Throws UsageError once the
+// estimate passes kMergeMemoryLimit, so a huge file is not read to its end.
+void add_size(MergeSize& size, const fs::path& file, std::size_t file_count) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + file.string());
+  std::vector<char> block(1 << 16);
+  bool header = true;
+  bool in_row = false;
+  std::uintmax_t columns = 1;
+  const auto end_row = [&] {
+    if (in_row) {
+      ++size.rows;
+      size.cells += columns;
+    }
+    in_row = false;
+  };
+  for (;;) {
+    in.read(block.data(), static_cast<std::streamsize>(block.size()));
+    const std::size_t n = static_cast<std::size_t>(in.gcount());
+    if (n == 0) break;
+    size.bytes += n;
+    for (std::size_t i = 0; i < n; ++i) {
+      const char c = block[i];
+      if (header) {
+        if (c == '\n') header = false;
+        else if (c == ',') ++columns;
+      } else if (c == '\n') {
+        end_row();
+      } else {
+        in_row = true;
+      }
+    }
+    if (size.estimate() + (header ? columns * kMergeBytesPerCell : 0) > kMergeMemoryLimit) {
+      throw UsageError("--merge: the CSV files below the given folders hold at least " +
+                       std::to_string(size.rows) + " rows, " + std::to_string(size.cells) +
+                       " cells and " + std::to_string(size.bytes) + " bytes (read up to " +
+                       file.string() + ", file " + std::to_string(file_count) +
+                       "): merging them would take at least " + mib(size.estimate()) +
+                       " of memory (" + std::to_string(kMergeBytesPerCell) +
+                       " bytes per cell, plus the text); the limit is " + mib(kMergeMemoryLimit) +
+                       ". Merge fewer runs at once, e.g. one sweep's folder");
+    }
+  }
+  end_row();
+}
+
+}  // namespace
+
 std::vector<RunResult> read_results(const std::vector<fs::path>& dirs) {
-  std::vector<RunResult> results;
+  // Every CSV once, with the folder it was found below.
+  std::vector<std::pair<fs::path, fs::path>> sources;  // file, given folder
+  std::map<fs::path, fs::path> seen;                    // canonical file -> given folder
   for (const fs::path& dir : dirs) {
     if (!fs::is_directory(dir)) {
       throw UsageError("--merge " + dir.string() + ": no such folder (give folders holding the "
@@ -231,7 +330,34 @@ std::vector<RunResult> read_results(const std::vector<fs::path>& dirs) {
     }
     std::sort(files.begin(), files.end());
     for (const fs::path& file : files) {
-      for (RunResult& r : results_of(read_csv(file), file.string())) results.push_back(std::move(r));
+      const auto [it, fresh] = seen.emplace(fs::weakly_canonical(file), dir);
+      if (!fresh) {
+        throw UsageError("--merge: " + file.string() + " is below both " + it->second.string() +
+                         " and " + dir.string() + " (a folder given twice, or one inside "
+                         "another): its runs would be merged twice; give each folder once");
+      }
+      sources.emplace_back(file, dir);
+    }
+  }
+  MergeSize size;
+  for (std::size_t k = 0; k < sources.size(); ++k) add_size(size, sources[k].first, k + 1);
+
+  std::vector<RunResult> results;
+  std::map<std::string, std::pair<std::string, std::size_t>> first;  // run id -> file, line
+  for (const auto& [file, dir] : sources) {
+    const CsvTable table = read_csv(file);
+    std::vector<RunResult> rows = results_of(table, file.string());
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const std::size_t line = k < table.lines.size() ? table.lines[k] : k + 2;
+      const std::string id = rows[k].id();
+      const auto [it, fresh] = first.emplace(id, std::make_pair(file.string(), line));
+      if (!fresh) {
+        throw UsageError("--merge: run " + id + " is in " + it->second.first + " line " +
+                         std::to_string(it->second.second) + " and again in " + file.string() +
+                         " line " + std::to_string(line) +
+                         "; each run may be merged once: remove one of them");
+      }
+      results.push_back(std::move(rows[k]));
     }
   }
   return results;

@@ -1,0 +1,393 @@
+// cps report --merge and the output rule, run as a user runs it: gnuplot's plots on a full disk
+// (a file size limit: RLIMIT_FSIZE with SIGXFSZ ignored, so a write past it fails with EFBIG as
+// one on a full disk fails with ENOSPC), a gnuplot that fails, the temporaries of a killed run,
+// and the merge's refusals of duplicate runs, non-finite cells and too much data.
+#include "cli_support.h"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using cli_test::Result;
+using cli_test::run_cps;
+using cli_test::slurp;
+
+fs::path fresh_dir(const std::string& name) { return cli_test::fresh_dir("cps_cli_report_output_" + name); }
+
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+// Two runs of the stack's sweep (their CSVs in dir/runs): a merge of them draws three diagrams.
+void two_runs(const fs::path& dir) {
+  for (const char* id : {"stack.pgs.split.fixed.it4.ss1", "stack.jacobi.split.fixed.it4.ss1"}) {
+    REQUIRE(run_cps(std::string("report stack --run ") + id + " --out runs", dir).exit_code == 0);
+  }
+}
+
+// The names of the files in `folder` (not below it) that end with `suffix`.
+std::vector<std::string> files_ending(const fs::path& folder, const std::string& suffix) {
+  std::vector<std::string> names;
+  if (!fs::is_directory(folder)) return names;
+  for (const fs::directory_entry& e : fs::directory_iterator(folder)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      names.push_back(name);
+    }
+  }
+  return names;
+}
+
+// The environment prefix of run_cps that limits every file cps (and gnuplot) writes to `bytes`.
+std::string file_size_limit(int bytes) {
+  return "trap '' XFSZ; prlimit --fsize=" + std::to_string(bytes);
+}
+
+// A fake gnuplot in dir/fake (put first on PATH) running `body` (sh; $1 is the script).
+std::string fake_gnuplot(const fs::path& dir, const std::string& body) {
+  const fs::path fake = dir / "fake";
+  fs::create_directories(fake);
+  write_text(fake / "gnuplot", "#!/bin/sh\n" + body);
+  fs::permissions(fake / "gnuplot", fs::perms::owner_all);
+  return "PATH='" + fake.string() + "':\"$PATH\"";
+}
+
+// sh lines that make each "set output 'FILE'" of the script $1 hold `content`.
+std::string each_output(const std::string& content) {
+  return "sed -n \"s/^set output '\\(.*\\)'$/\\1/p\" \"$1\" | while IFS= read -r f; do "
+         "printf '" + content + "' > \"$f\"; done\n";
+}
+
+// As each_output, with the content (printf formats) by the file's extension.
+std::string each_output_by_type(const std::string& png, const std::string& svg, const std::string& pdf) {
+  return "sed -n \"s/^set output '\\(.*\\)'$/\\1/p\" \"$1\" | while IFS= read -r f; do case $f in "
+         "*.png.*) printf '" + png + "' > \"$f\";; *.svg.*) printf '" + svg + "' > \"$f\";; "
+         "*.pdf.*) printf '" + pdf + "' > \"$f\";; esac; done\n";
+}
+
+// True once process `pid` is gone or a zombie.
+bool ended(pid_t pid) {
+  if (::kill(pid, 0) != 0 && errno == ESRCH) return true;
+  const std::string stat = slurp("/proc/" + std::to_string(pid) + "/stat");
+  const std::size_t paren = stat.rfind(')');
+  return paren == std::string::npos || (paren + 2 < stat.size() && stat[paren + 2] == 'Z');
+}
+
+// Waits (up to `limit`, polling) until `done` holds; returns whether it did.
+template <class Done>
+bool wait_for(Done&& done, std::chrono::seconds limit) {
+  const auto until = std::chrono::steady_clock::now() + limit;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
+
+std::string host_name() {
+  char name[256] = {};
+  REQUIRE(::gethostname(name, sizeof name - 1) == 0);
+  return name;
+}
+
+// A process id that surely ended: a child that exited and was reaped.
+pid_t ended_pid() {
+  const pid_t pid = ::fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return pid;
+}
+
+}  // namespace
+
+TEST_CASE("report --merge on a full disk names the plot and leaves no plot, part or temporary",
+          "[cli][report][output]") {
+  const fs::path dir = fresh_dir("full");
+  two_runs(dir);
+  // Unlimited, every picture is larger than the limit below.
+  REQUIRE(run_cps("report --merge runs --out whole", dir).exit_code == 1);  // INCOMPLETE
+  for (const char* ext : {".png", ".svg", ".pdf"}) {
+    REQUIRE(files_ending(dir / "whole", ext).size() == 3);
+    for (const std::string& name : files_ending(dir / "whole", ext)) {
+      INFO(name);
+      CHECK(fs::file_size(dir / "whole" / name) > 12288);
+    }
+  }
+  const Result r = run_cps("report --merge runs --out out", dir, file_size_limit(12288));
+  INFO(r.err);
+  CHECK(r.exit_code == 1);
+  CHECK(r.err.find("cannot write out/stack_trajectory_error_m.png: a truncated PNG") != std::string::npos);
+  for (const char* ext : {".png", ".svg", ".pdf", ".tmp"}) {
+    INFO(ext);
+    CHECK(files_ending(dir / "out", ext).empty());
+    CHECK(files_ending(dir / "out/plots", ext).empty());
+  }
+  // The rerun with room writes them all.
+  CHECK(run_cps("report --merge runs --out out", dir).exit_code == 1);
+  CHECK(files_ending(dir / "out", ".pdf").size() == 3);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("report --merge checks gnuplot's status and its pictures before they take their names",
+          "[cli][report][output]") {
+  const fs::path dir = fresh_dir("fake");
+  two_runs(dir);
+  SECTION("gnuplot fails after writing parts: its reason is named, no part is kept") {
+    const std::string path = fake_gnuplot(dir, each_output("partial") +
+                                                    "echo 'fake gnuplot: no room for the plot'\n"
+                                                    "exit 1\n");
+    const Result r = run_cps("report --merge runs --out out", dir, path);
+    INFO(r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(r.err.find("out/stack_trajectory_error_m.png") != std::string::npos);
+    CHECK(r.err.find("exit 1") != std::string::npos);
+    CHECK(r.err.find("fake gnuplot: no room for the plot") != std::string::npos);
+  }
+  SECTION("gnuplot exits 0 with empty files (as on a full disk)") {
+    const std::string path = fake_gnuplot(dir, each_output("") + "exit 0\n");
+    const Result r = run_cps("report --merge runs --out out", dir, path);
+    INFO(r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(r.err.find("cannot write out/stack_trajectory_error_m.png: gnuplot wrote an empty file") !=
+          std::string::npos);
+  }
+  SECTION("gnuplot exits 0 with files that are not pictures") {
+    const std::string path = fake_gnuplot(dir, each_output("%%PDF-1.5") + "exit 0\n");
+    const Result r = run_cps("report --merge runs --out out", dir, path);
+    INFO(r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(r.err.find("cannot write out/stack_trajectory_error_m.png: not a PNG") != std::string::npos);
+  }
+  // A whole PNG (signature, IEND), then an SVG or a PDF cut short.
+  const std::string png = "\\211PNG\\r\\n\\032\\n\\0\\0\\0\\0IEND\\256B\\140\\202";
+  SECTION("gnuplot exits 0 with an SVG cut short") {
+    const std::string path = fake_gnuplot(
+        dir, each_output_by_type(png, "<svg width=\"1100\"><g>", "%%PDF-1.5 ... %%%%EOF") + "exit 0\n");
+    const Result r = run_cps("report --merge runs --out out", dir, path);
+    INFO(r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(r.err.find("cannot write out/stack_trajectory_error_m.svg: a truncated SVG") != std::string::npos);
+  }
+  SECTION("gnuplot exits 0 with a PDF cut short") {
+    const std::string path = fake_gnuplot(
+        dir, each_output_by_type(png, "<svg width=\"1100\"></svg>\\n", "%%PDF-1.5 1 0 obj") + "exit 0\n");
+    const Result r = run_cps("report --merge runs --out out", dir, path);
+    INFO(r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(r.err.find("cannot write out/stack_trajectory_error_m.pdf: a truncated PDF") != std::string::npos);
+  }
+  for (const char* ext : {".png", ".svg", ".pdf", ".tmp"}) {
+    INFO(ext);
+    CHECK(files_ending(dir / "out", ext).empty());
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("the temporaries of a killed report --merge are removed by the next merge, nothing else",
+          "[cli][report][output]") {
+  const fs::path dir = fresh_dir("leftover");
+  two_runs(dir);
+  // A merge killed while it wrote: run.json lists it unfinished (a process that ended) with its
+  // files, and their temporaries remain, in OUT and OUT/plots.
+  const std::string token = "0123456789abcdef";
+  const std::vector<std::string> main_files = {"report.md", "stack.csv", "stack_trajectory_error_m.png",
+                                               "stack_trajectory_error_m.svg", "stack_trajectory_error_m.pdf"};
+  const std::vector<std::string> plot_files = {"stack_trajectory_error_m.dat", "stack_trajectory_error_m.gp"};
+  const pid_t dead = ended_pid();
+  const auto killed_run = [&](const fs::path& folder, const std::vector<std::string>& files) {
+    fs::create_directories(folder);
+    const nlohmann::json run = {{"run_token", token}, {"pid", dead}, {"host", host_name()},
+                                {"start", 0}, {"files", files}};
+    write_text(folder / "run.json", nlohmann::json{{"tool", "cps"}, {"complete", false}, {"files", files},
+                                                   {"unfinished_runs", {run}}}.dump(2));
+    for (const std::string& f : files) write_text(folder / (f + "." + token + ".tmp"), "part");
+  };
+  killed_run(dir / "out", main_files);
+  killed_run(dir / "out/plots", plot_files);
+  // Files that look alike but are not that run's: kept.
+  const std::vector<std::string> foreign = {"notes.txt", "stack_trajectory_error_m.png.fedcba9876543210.tmp",
+                                            "other.png." + token + ".tmp"};
+  for (const std::string& f : foreign) write_text(dir / "out" / f, "mine");
+
+  const Result r = run_cps("report --merge runs --out out", dir);
+  INFO(r.err);
+  CHECK(r.exit_code == 1);  // INCOMPLETE
+  for (const std::string& f : main_files) CHECK_FALSE(fs::exists(dir / "out" / (f + "." + token + ".tmp")));
+  for (const std::string& f : plot_files) CHECK_FALSE(fs::exists(dir / "out/plots" / (f + "." + token + ".tmp")));
+  for (const std::string& f : foreign) CHECK(slurp(dir / "out" / f) == "mine");
+  CHECK(files_ending(dir / "out", ".tmp").size() == 2);  // the two foreign ones
+  CHECK(files_ending(dir / "out/plots", ".tmp").empty());
+  CHECK(fs::file_size(dir / "out/stack_trajectory_error_m.pdf") > 1000);
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(dir / "out/run.json"));
+  CHECK(manifest["complete"] == true);
+  CHECK(manifest["unfinished_runs"].empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a killed report --merge leaves no gnuplot writing, and the next merge removes its "
+          "temporaries", "[cli][report][output]") {
+  const fs::path dir = fresh_dir("killed");
+  two_runs(dir);
+  // gnuplot records its pid and waits, as a slow one would, in the first diagram.
+  const std::string path = fake_gnuplot(dir, "echo $$ > '" + (dir / "gnuplot.pid").string() +
+                                                 "'\nexec sleep 120\n");
+  const std::string command = "cd '" + dir.string() + "' && " + path + " exec '" CPS_EXE
+                              "' report --merge runs --out out > /dev/null 2>&1";
+  const pid_t cps = ::fork();
+  REQUIRE(cps >= 0);
+  if (cps == 0) {
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  pid_t gnuplot = 0;
+  const bool started = wait_for(
+      [&] {
+        const std::string text = slurp(dir / "gnuplot.pid");
+        if (text.empty() || text.back() != '\n') return false;
+        gnuplot = std::stoi(text);
+        return true;
+      },
+      std::chrono::seconds(60));
+  ::kill(cps, SIGKILL);
+  int status = 0;
+  ::waitpid(cps, &status, 0);
+  REQUIRE(started);
+  CHECK(files_ending(dir / "out", ".tmp").size() == 3);  // the first diagram's pictures
+  // gnuplot ends with cps (it would write the temporaries after the next run removed them).
+  const bool gone = wait_for([&] { return ended(gnuplot); }, std::chrono::seconds(20));
+  if (!gone) ::kill(gnuplot, SIGKILL);
+  CHECK(gone);
+  const Result r = run_cps("report --merge runs --out out", dir);
+  INFO(r.err);
+  CHECK(r.exit_code == 1);  // INCOMPLETE
+  CHECK(files_ending(dir / "out", ".tmp").empty());
+  CHECK(files_ending(dir / "out/plots", ".tmp").empty());
+  CHECK(files_ending(dir / "out", ".pdf").size() == 3);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("report --merge refuses a run twice, naming the id and both files, and writes nothing",
+          "[cli][report]") {
+  const fs::path dir = fresh_dir("duplicates");
+  two_runs(dir);
+  SECTION("one folder twice") {
+    for (const char* twice : {"runs runs", "runs ./runs/", "runs . "}) {
+      INFO(twice);
+      const Result r = run_cps(std::string("report --merge ") + twice + " --out out", dir);
+      CHECK(r.exit_code == 2);
+      CHECK(r.err.find("runs/stack.jacobi.split.fixed.it4.ss1.csv is below both") != std::string::npos);
+      CHECK(r.err.find("give each folder once") != std::string::npos);
+    }
+  }
+  SECTION("the same run in two files") {
+    fs::create_directories(dir / "again");
+    fs::copy_file(dir / "runs/stack.pgs.split.fixed.it4.ss1.csv", dir / "again/copy.csv");
+    const Result r = run_cps("report --merge runs again --out out", dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("run stack.pgs.split.fixed.it4.ss1 is in runs/stack.pgs.split.fixed.it4.ss1.csv "
+                     "line 2 and again in again/copy.csv line 2") != std::string::npos);
+  }
+  SECTION("the same run twice in one file") {
+    const std::string csv = slurp(dir / "runs/stack.pgs.split.fixed.it4.ss1.csv");
+    fs::create_directories(dir / "twice");
+    write_text(dir / "twice/a.csv", csv + "\n" + csv.substr(csv.find('\n') + 1));
+    const Result r = run_cps("report --merge twice --out out", dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("is in twice/a.csv line 2 and again in twice/a.csv line 4") != std::string::npos);
+  }
+  CHECK_FALSE(fs::exists(dir / "out"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("report --merge refuses a cell that is not finite, naming file, line, column and value",
+          "[cli][report]") {
+  const fs::path dir = fresh_dir("non_finite");
+  two_runs(dir);
+  const std::string csv = slurp(dir / "runs/stack.pgs.split.fixed.it4.ss1.csv");
+  const std::string header = csv.substr(0, csv.find('\n'));
+  const std::string row = csv.substr(csv.find('\n') + 1);
+  // Replaces the cell of `column` in the row.
+  const auto with = [&](const std::string& column, const std::string& value) {
+    std::vector<std::string> names, cells;
+    std::stringstream h(header), r(row.substr(0, row.find('\n')));
+    for (std::string c; std::getline(h, c, ',');) names.push_back(c);
+    for (std::string c; std::getline(r, c, ',');) cells.push_back(c);
+    std::string out;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      out += (i ? "," : "") + (names[i] == column ? value : cells[i]);
+    }
+    return header + "\n\n" + out + "\n";  // an empty line: the row is on line 3
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"trajectory_error_m", "nan"}, {"wall_s_per_sim_s", "inf"}, {"metric.creep_m", "-inf"},
+      {"residual_max_N", "1e999"},   {"warm_start", "NaN"},       {"solver", "nan"},
+      {"penetration_max_m", "0.1x"}, {"diverged", "2"}};
+  for (const auto& [column, value] : cases) {
+    INFO(column << " = " << value);
+    fs::remove_all(dir / "bad");
+    fs::create_directories(dir / "bad");
+    write_text(dir / "bad/a.csv", with(column, value));
+    const Result r = run_cps("report --merge bad --out out", dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("bad/a.csv line 3, column " + column + ": '" + value + "'") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "out"));
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("report --merge bounds its memory by its cells, not by a count of rows or columns",
+          "[cli][report]") {
+  const fs::path dir = fresh_dir("too_much");
+  fs::create_directories(dir / "wide");
+  fs::create_directories(dir / "tall");
+  fs::create_directories(dir / "fits");
+  // 100 rows of 11,000 columns, and 1,100,000 rows of 1 column: each 1.1 million cells, past
+  // the limit (256 MiB at 256 bytes per cell: 1,048,576 cells), however few rows or columns.
+  std::string wide = "scene,solver,push,friction_model,iterations,substeps,diverged";
+  for (int c = 0; c < 11000; ++c) wide += ",x" + std::to_string(c);
+  wide += "\n";
+  for (int i = 1; i <= 100; ++i) wide += "stack,pgs,baumgarte,fixed," + std::to_string(i) + ",1,0\n";
+  write_text(dir / "wide/a.csv", wide);
+  std::string tall = "scene\n";
+  for (int i = 0; i < 1100000; ++i) tall += "x\n";
+  write_text(dir / "tall/a.csv", tall);
+  for (const char* folder : {"wide", "tall"}) {
+    INFO(folder);
+    const Result r = run_cps(std::string("report --merge ") + folder + " --out out", dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("cells") != std::string::npos);
+    CHECK(r.err.find("the limit is 256 MiB") != std::string::npos);
+    CHECK(r.err.find("would take at least 2") != std::string::npos);  // 25x or 26x MiB
+    CHECK_FALSE(fs::exists(dir / "out"));
+  }
+  // 100 rows of 1,000 columns: read (and refused for its settings, not its size).
+  std::string fits = "scene,solver";
+  for (int c = 0; c < 1000; ++c) fits += ",x" + std::to_string(c);
+  fits += "\n";
+  for (int i = 1; i <= 100; ++i) fits += "stack,pgs\n";
+  write_text(dir / "fits/a.csv", fits);
+  const Result r = run_cps("report --merge fits --out out", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("a row without push") != std::string::npos);
+  fs::remove_all(dir);
+}

@@ -190,7 +190,7 @@ TEST_CASE("a bouncing cradle under the default push warns that its energy rose, 
   INFO(render.err);
   CHECK(render.exit_code == 0);
   CHECK(render.err.find("cps: warning: cradle.json: the energy") != std::string::npos);
-  CHECK(fs::exists(dir / "out" / "cradle.json" / "frame_000004.png"));
+  CHECK(fs::exists(dir / "out" / "cradle" / "frame_000004.png"));
   const Result figure = run_cps("figure cradle.json --times 0,2 --size 32x32 --out f.png --compare push=baumgarte,split", dir);
   INFO(figure.err);
   CHECK(figure.exit_code == 0);
@@ -232,7 +232,7 @@ TEST_CASE("a scene file without a camera keeps its moving bodies in every frame"
   const Result fit = run_cps("render throw.json --fps 4 --size 160x120 --out fit", dir);
   INFO(fit.err);
   REQUIRE(fit.exit_code == 0);
-  CHECK(json::parse(slurp(dir / "fit" / "throw.json" / "run.json"))["parameters"]["camera"] == "fit");
+  CHECK(json::parse(slurp(dir / "fit" / "throw" / "run.json"))["parameters"]["camera"] == "fit");
   // The framing as built (the default before scene files were fitted) loses the ball: the check
   // below can fail.
   const Result as_built = run_cps("render throw.json --fps 4 --size 160x120 --camera auto --out auto", dir);
@@ -242,8 +242,8 @@ TEST_CASE("a scene file without a camera keeps its moving bodies in every frame"
     char name[32];
     std::snprintf(name, sizeof name, "frame_%06d.png", k);
     INFO(name);
-    CHECK(red_pixels(cps::render::read_png(dir / "fit" / "throw.json" / name)) >= 4);
-    if (red_pixels(cps::render::read_png(dir / "auto" / "throw.json" / name)) == 0) ++lost_as_built;
+    CHECK(red_pixels(cps::render::read_png(dir / "fit" / "throw" / name)) >= 4);
+    if (red_pixels(cps::render::read_png(dir / "auto" / "throw" / name)) == 0) ++lost_as_built;
   }
   CHECK(lost_as_built >= 2);
 }

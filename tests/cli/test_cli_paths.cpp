@@ -177,3 +177,26 @@ TEST_CASE("a file cps wrote and the user edited is foreign, and a command never 
   CHECK(r.exit_code == 2);
   CHECK(slurp(dir / "f/fig.png") == "my own picture");
 }
+
+TEST_CASE("report runs of two scene files of one name into one --out are refused, and a merge "
+          "never writes over the CSVs it reads", "[cli][output][paths][report]") {
+  const fs::path dir = fresh_dir("report");
+  write_text(dir / "a/x.json", drop_scene(""));
+  write_text(dir / "b/x.json", drop_scene(""));
+  Result r = run_cps("report a/x.json --run a/x.json.pgs.baumgarte.fixed.it4.ss1 --out o", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const fs::path csv = dir / "o/x.pgs.baumgarte.fixed.it4.ss1.csv";
+  const std::string first = slurp(csv);
+  r = run_cps("report b/x.json --run b/x.json.pgs.baumgarte.fixed.it4.ss1 --out o", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("two scenes with one name") != std::string::npos);
+  CHECK(slurp(csv) == first);
+  // A whole report folder merged into itself: its x.csv is both read and written.
+  REQUIRE(run_cps("report a/x.json --quick --out q", dir).exit_code == 0);
+  const std::string table = slurp(dir / "q/x.csv");
+  r = run_cps("report --merge q --out q", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("input of this command") != std::string::npos);
+  CHECK(slurp(dir / "q/x.csv") == table);
+}

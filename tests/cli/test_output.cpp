@@ -109,8 +109,13 @@ const nlohmann::json k_info = {{"command", "test"}};
 OutputPlan plan_for(const fs::path& folder, const std::vector<std::string>& files, bool force,
                     FolderUse use = FolderUse::exclusive, const std::string& option = "--out",
                     const std::string& command = "test") {
-  return cps::cli::plan_output(
-      {.folder = folder, .files = files, .command = command, .use = use, .option = option, .force = force});
+  return cps::cli::plan_output({.folder = folder,
+                                .files = files,
+                                .command = command,
+                                .use = use,
+                                .scenes = {},
+                                .option = option,
+                                .force = force});
 }
 
 // Plans, begins, writes `files` (each holding its own name) and ends one run into `folder`.

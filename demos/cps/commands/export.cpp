@@ -359,7 +359,7 @@ ExportPlan plan_export(const ExportOptions& o, int argc, char** argv) {
                                    .files = {file},
                                    .command = "export",
                                    .use = FolderUse::shared,
-                                   .scenes = {{file, scene_source(*scene)}},
+                                   .scenes = {{file, scene_source(scene->name)}},
                                    .force = o.force});
   return {scene, std::move(run), path, static_cast<std::size_t>(frames), std::move(info), std::move(output)};
 }

@@ -457,8 +457,8 @@ FigurePlan plan_figure(const FigureOptions& o, int argc, char** argv) {
     files.push_back(p.png.filename().string());
     files.push_back(sidecar_path(p.png).filename().string());
     names.push_back(p.png.filename().string());
-    scenes.emplace(files.end()[-2], scene_source(*p.spec.scene));
-    scenes.emplace(files.back(), scene_source(*p.spec.scene));
+    scenes.emplace(files.end()[-2], scene_source(p.spec.scene->name));
+    scenes.emplace(files.back(), scene_source(p.spec.scene->name));
   }
   plan.output = plan_output({.folder = folder,
                              .files = files,

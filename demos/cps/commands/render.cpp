@@ -364,7 +364,7 @@ void plan_scene(const RenderOptions& o, const RenderPlan& plan, SceneRender& job
   std::map<std::string, std::string> scenes;
   for (long long k = 0; k < frames; ++k) {
     files.push_back(frame_name(k));
-    scenes.emplace(files.back(), scene_source(*job.scene));
+    scenes.emplace(files.back(), scene_source(job.scene->name));
   }
   job.output = plan_output({.folder = job.spec.folder,
                             .files = std::move(files),
@@ -383,7 +383,7 @@ void plan_videos(const RenderOptions& o, int argc, char** argv, RenderPlan& plan
   nlohmann::json folders = nlohmann::json::array();
   for (const SceneRender& job : plan.scenes) {
     names.push_back(job.spec.folder.filename().string() + "." + o.video);
-    scenes.emplace(names.back(), scene_source(*job.scene));
+    scenes.emplace(names.back(), scene_source(job.scene->name));
     folders.push_back(job.spec.folder.filename().string());
   }
   plan.video_output = plan_output({.folder = fs::path(o.out),

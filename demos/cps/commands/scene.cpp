@@ -46,7 +46,7 @@ int run_scene(const SceneOptions& o, int argc, char** argv) {
                                        .files = {name},
                                        .command = "scene",
                                        .use = FolderUse::shared,
-                                       .scenes = {{name, scene_source(*scene)}},
+                                       .scenes = {{name, scene_source(scene->name)}},
                                        .force = o.force});
   begin_output(plan, info);
   write_json_atomic(path, file);

@@ -32,6 +32,7 @@ TraceWriter::TraceWriter(std::filesystem::path path, bool force, nlohmann::json 
                        .files = {path_.filename().string()},
                        .command = "simulate",
                        .use = FolderUse::shared,
+                       .scenes = {},
                        .option = "--trace",
                        .force = force});
   begin_output(plan_, info_);

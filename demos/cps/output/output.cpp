@@ -716,8 +716,8 @@ nlohmann::json parameters_json(const WorldDef& def) {
   return j;
 }
 
-std::string scene_source(const scenes::Scene& scene) {
-  const std::string name(scene.name);
+std::string scene_source(std::string_view scene_name) {
+  const std::string name(scene_name);
   if (!name.ends_with(".json")) return "scene " + name;
   std::error_code ec;
   fs::path path = fs::weakly_canonical(fs::absolute(name, ec), ec);

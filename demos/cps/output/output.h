@@ -139,9 +139,10 @@ void write_json_atomic(const std::filesystem::path& path, const nlohmann::json& 
 nlohmann::json run_info(const std::string& command, int argc, char** argv,
                         const nlohmann::json& parameters);
 
-/// The scene a file shows, as run.json records it: "scene NAME" for a built-in scene or example,
-/// "file PATH" for a scene file (its absolute path, symbolic links resolved). No errors.
-std::string scene_source(const scenes::Scene& scene);
+/// The scene a file shows, as run.json records it, from the scene's name as typed (Scene::name):
+/// "scene NAME" for a built-in scene or example, "file PATH" for a scene file (a name ending in
+/// ".json": its absolute path, symbolic links resolved, from the current folder). No errors.
+std::string scene_source(std::string_view scene_name);
 
 /// One parameter's value as JSON: a number, a bool, [x, y, z], or a choice's name.
 nlohmann::json parameter_json(const Parameter& p, const ParameterValue& v);

@@ -1,6 +1,7 @@
 #include "report/result.h"
 
 #include "options/options.h"
+#include "output/output.h"
 
 #include <algorithm>
 #include <charconv>
@@ -337,6 +338,7 @@ std::vector<RunResult> read_results(const std::vector<fs::path>& dirs) {
                          "another): its runs would be merged twice; give each folder once");
       }
       sources.emplace_back(file, dir);
+      note_input(file);  // never an output of this merge
     }
   }
   MergeSize size;

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <set>
 
 namespace cps::cli {
@@ -16,25 +17,46 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The scene (scene_source) of each of `files` (made by `files_of` from scene names) that belongs
+// to one scene; the files of every scene (report.md, mass_ratio.csv) are left out.
+template <class FilesOf>
+std::map<std::string, std::string> scenes_of_files(const std::vector<std::string>& scenes,
+                                                   FilesOf files_of) {
+  const std::vector<std::string> common = files_of(std::vector<std::string>{});
+  std::map<std::string, std::string> out;
+  for (const std::string& scene : scenes) {
+    for (const std::string& f : files_of(std::vector<std::string>{scene})) {
+      if (std::find(common.begin(), common.end(), f) == common.end()) out.emplace(f, scene_source(scene));
+    }
+  }
+  return out;
+}
+
 // The report's two folders (OUT and OUT/plots, both shared: see output.h), checked for the
 // report of `scenes` before any work; write() then begins them, calls `body` and ends them, so
-// that each folder's run.json lists what was written.
+// that each folder's run.json lists what was written. With `record_scenes`, each scene's files
+// record it (a file of another scene of one name is then refused); a merge's scenes are names
+// typed in other runs, so it records none.
 struct ReportOutput {
   OutputPlan main;
   OutputPlan plots;
   nlohmann::json info;
 
   ReportOutput(const fs::path& out, const std::vector<std::string>& scenes, bool force,
-               nlohmann::json run)
+               nlohmann::json run, bool record_scenes)
       : main(plan_output({.folder = out,
                           .files = report_files(scenes),
                           .command = "report",
                           .use = FolderUse::shared,
+                          .scenes = record_scenes ? scenes_of_files(scenes, report_files)
+                                                  : std::map<std::string, std::string>{},
                           .force = force})),
         plots(plan_output({.folder = out / "plots",
                            .files = plot_files(scenes),
                            .command = "report",
                            .use = FolderUse::shared,
+                           .scenes = record_scenes ? scenes_of_files(scenes, plot_files)
+                                                   : std::map<std::string, std::string>{},
                            .force = force})),
         info(std::move(run)) {}
 
@@ -69,7 +91,7 @@ std::vector<std::string> scenes_of(const std::vector<RunResult>& runs) {
 
 int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& scenes) {
   const std::vector<RunSpec> runs = plan_runs(scenes, to.quick);
-  ReportOutput output(to.out, scene_names(scenes), to.force, to.info);
+  ReportOutput output(to.out, scene_names(scenes), to.force, to.info, /*record_scenes=*/true);
   std::vector<RunResult> results;
   Progress progress("report " + to.sweep, static_cast<long long>(runs.size()), "runs");
   for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -84,8 +106,12 @@ int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& sc
 
 int run_one(const SweepOutput& to, const RunSpec& spec) {
   const std::string file = run_file_name(spec);
-  const OutputPlan plan = plan_output(
-      {.folder = to.out, .files = {file}, .command = "report", .use = FolderUse::shared, .force = to.force});
+  const OutputPlan plan = plan_output({.folder = to.out,
+                                       .files = {file},
+                                       .command = "report",
+                                       .use = FolderUse::shared,
+                                       .scenes = {{file, scene_source(spec.scene)}},
+                                       .force = to.force});
   const RunResult result = execute_in_sweep(to, spec);
   begin_output(plan, to.info);
   write_results(to.out / file, {result});
@@ -136,7 +162,7 @@ int merge_report(const SweepOutput& to, const std::vector<fs::path>& dirs) {
   if (runs.empty()) throw UsageError("--merge: no report CSV found below the given folders");
   std::size_t planned = 0;
   const std::vector<std::string> missing = missing_runs(runs, planned);
-  ReportOutput output(to.out, scenes_of(runs), to.force, to.info);
+  ReportOutput output(to.out, scenes_of(runs), to.force, to.info, /*record_scenes=*/false);
   output.write([&] { write_report(to.out, runs, mass_ratio_study(), missing, planned); });
   if (missing.empty()) {
     std::printf("merged %zu runs into %s/report.md\n", runs.size(), to.out.c_str());

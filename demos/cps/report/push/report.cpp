@@ -330,12 +330,17 @@ CsvTable push_table(const PushPlan& plan, const std::vector<MethodResults>& resu
 
 int run_push_report(const fs::path& out, bool quick, bool force, const nlohmann::json& info) {
   // Every target checked before any work.
-  const OutputPlan main = plan_output(
-      {.folder = out, .files = push_report_files(), .command = "report", .use = FolderUse::shared, .force = force});
+  const OutputPlan main = plan_output({.folder = out,
+                                       .files = push_report_files(),
+                                       .command = "report",
+                                       .use = FolderUse::shared,
+                                       .scenes = {},
+                                       .force = force});
   const OutputPlan plots = plan_output({.folder = out / "plots",
                                         .files = push_plot_files(),
                                         .command = "report",
                                         .use = FolderUse::shared,
+                                        .scenes = {},
                                         .force = force});
   const PushPlan plan = plan_push_report(quick);
   const auto started = std::chrono::steady_clock::now();

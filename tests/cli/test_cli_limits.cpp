@@ -7,6 +7,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <string>
 
@@ -18,9 +20,11 @@ using cli_test::run_cps;
 namespace {
 
 // Exit 2, a message that contains `says`, and an empty working folder `folder` (nothing written).
+// The folder's name carries the process id: ctest runs each test case in a process of its own,
+// in parallel.
 void check_refused(const std::string& args, const std::string& says,
                    const std::string& folder = "cps_limits") {
-  const fs::path dir = fresh_dir(folder);
+  const fs::path dir = fresh_dir(folder + "_" + std::to_string(::getpid()));
   const Result r = run_cps(args, dir);
   INFO("cps " << args << "\nstderr: " << r.err);
   CHECK(r.exit_code == 2);

@@ -63,6 +63,8 @@ declare -A KIND=(
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
   ['export:scene']=scene_one ['export:--out']=out_glb ['*:--max-work']=max_work
+  ['diff:a']=png_in ['diff:b']=png_in ['diff:--out']=out_folder
+  ['diff:--threshold']='param:real:0:255:0:levels' ['diff:--tolerance']='param:real:0:100:0:%'
 )
 
 # The world parameters' kinds come from the parameter table itself (`cps parameters --format
@@ -90,6 +92,7 @@ declare -A BASE=(
   [scene]='scene stack --out out/s.json'
   [export]='export stack --seconds 0.1 --fps 10 --out out/s.glb'
   [parameters]='parameters --format tsv'
+  [diff]='diff prior/x/frame_000000.png prior/x/frame_000000.png --out out'
 )
 RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.03 s
 MERGE_SRC=$root/merge-src                              # a complete sweep, made below
@@ -158,6 +161,8 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         push=split,split push=sideways,split "beta=0.1,,0.2" beta=0.1,0.2, "beta=0.1, 0.2" \
         beta==0.1,0.2 iterations=1,0 iterations=1,1.5 dt=0,1/60 dt=1/0,1/60 \
         "beta=0.1;0.2" iterations=1,2,3,4,5,6,7 ;;
+    png_in)  # not a PNG file, or a file beside a folder (the base's other input is a PNG)
+      printf '%s\n' "" nosuch.png file file.png dir.png adir bad.json ;;
     out_folder)  # cannot be a folder: an existing file, a path under a file, a device
       printf '%s\n' "" file file/sub /dev/null ;;
     out_png)  # not a PNG path that can be written

@@ -62,6 +62,7 @@ int run(int argc, char** argv) {
       cli::add_render(app, argc, argv),
       cli::add_figure(app, argc, argv),
       cli::add_export(app, argc, argv),
+      cli::add_diff(app, argc, argv),
 #endif
   };
 

@@ -1,0 +1,208 @@
+// `cps diff A B`: two PNG files, or two frame folders, compared frame by frame with a tolerance
+// (pictures/image_diff.h); a diff picture for each frame past it; exit 0 within, 1 past.
+#include "command.h"
+#include "options/options.h"
+#include "output/output.h"
+#include "pictures/image_diff.h"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace cps::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A channel differs when |a - b| exceeds this (levels of 255). Typical 8: llvmpipe's output
+/// moves by a few levels between CPUs and Mesa versions (docs/commands.md, `diff`).
+constexpr double kDefaultThresholdLevels = 8.0;
+/// A frame passes while at most this percentage of its pixels differ. Typical 0.1 %.
+constexpr double kDefaultTolerancePercent = 0.1;
+
+struct DiffOptions {
+  std::string a;
+  std::string b;
+  double threshold = kDefaultThresholdLevels;  // levels
+  double tolerance = kDefaultTolerancePercent; // % of a frame's pixels
+  std::string out = "out/diff";
+  bool force = false;
+};
+
+// One pair of frames: its name and the two paths (either missing when a folder lacks it).
+struct FramePair {
+  std::string name;
+  std::optional<fs::path> a;
+  std::optional<fs::path> b;
+};
+
+std::vector<std::string> png_names(const fs::path& folder) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
+    if (e.is_regular_file() && e.path().extension() == ".png") names.push_back(e.path().filename().string());
+    if (static_cast<double>(names.size()) > kMaxFrames) {
+      throw UsageError(folder.string() + ": more than " +
+                       std::to_string(static_cast<long long>(kMaxFrames)) +
+                       " PNG files; cps diff compares at most that many frames");
+    }
+  }
+  if (ec) throw UsageError(folder.string() + ": cannot be read: " + ec.message());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// The frames to compare: one pair for two files, the union of the PNG names for two folders.
+// Throws UsageError for a missing path, a file beside a folder, or folders without PNG files.
+std::vector<FramePair> frame_pairs(const DiffOptions& o) {
+  const fs::path a(o.a);
+  const fs::path b(o.b);
+  for (const fs::path& p : {a, b}) {
+    std::error_code ec;
+    if (!fs::exists(p, ec)) {
+      throw UsageError(p.string() + ": no such file or folder (give two PNG files or two frame "
+                       "folders)");
+    }
+  }
+  const bool a_dir = fs::is_directory(a);
+  const bool b_dir = fs::is_directory(b);
+  if (a_dir != b_dir) {
+    throw UsageError((a_dir ? a : b).string() + " is a folder and " + (a_dir ? b : a).string() +
+                     " is not: give two PNG files or two frame folders");
+  }
+  if (!a_dir) return {{a.filename().string(), a, b}};
+  const std::vector<std::string> in_a = png_names(a);
+  const std::vector<std::string> in_b = png_names(b);
+  if (in_a.empty() && in_b.empty()) {
+    throw UsageError(a.string() + " and " + b.string() + " hold no PNG files (give two frame "
+                     "folders of cps render, or two PNG files)");
+  }
+  std::set<std::string> all(in_a.begin(), in_a.end());
+  all.insert(in_b.begin(), in_b.end());
+  std::vector<FramePair> pairs;
+  for (const std::string& n : all) {
+    FramePair p{n, std::nullopt, std::nullopt};
+    if (std::binary_search(in_a.begin(), in_a.end(), n)) p.a = a / n;
+    if (std::binary_search(in_b.begin(), in_b.end(), n)) p.b = b / n;
+    pairs.push_back(p);
+  }
+  return pairs;
+}
+
+render::Image read_or_usage_error(const fs::path& p) {
+  try {
+    return render::read_png(p);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(std::string(e.what()) + " (cps diff compares PNG files)");
+  }
+}
+
+std::string diff_name(const std::string& frame) {
+  return fs::path(frame).stem().string() + "-diff.png";
+}
+
+int run_diff(const DiffOptions& o, int argc, char** argv) {
+  // --out is checked before any work, though it is written only for frames past the tolerance.
+  plan_output({.folder = fs::path(o.out), .files = {}, .command = "diff", .use = FolderUse::shared,
+               .scenes = {}, .force = o.force});
+  const std::vector<FramePair> pairs = frame_pairs(o);
+  std::vector<std::string> failed;   // frames past the tolerance, both present and of one size
+  long long within = 0;
+  long long missing = 0;
+  for (const FramePair& p : pairs) {
+    if (!p.a || !p.b) {
+      std::printf("%s: only in %s\n", p.name.c_str(), (p.a ? o.a : o.b).c_str());
+      ++missing;
+      continue;
+    }
+    note_input(*p.a);
+    note_input(*p.b);
+    const render::Image ia = read_or_usage_error(*p.a);
+    const render::Image ib = read_or_usage_error(*p.b);
+    const ImageDiff d = compare_images(ia, ib, o.threshold);
+    if (!d.same_size) {
+      std::printf("%s: sizes differ (%dx%d and %dx%d)\n", p.name.c_str(), ia.width, ia.height,
+                  ib.width, ib.height);
+      ++missing;
+      continue;
+    }
+    const bool ok = d.past_percent() <= o.tolerance;
+    std::printf("%s: max %d levels, mean %.4f, %lld pixels past %g levels (%.4f %%): %s\n",
+                p.name.c_str(), d.max_abs, d.mean_abs, d.past, o.threshold, d.past_percent(),
+                ok ? "within" : "PAST the tolerance");
+    if (ok) {
+      ++within;
+    } else {
+      failed.push_back(p.name);
+    }
+  }
+  const std::string rule = "at most " + shortest_decimal(o.tolerance) + " % of a frame's pixels past " +
+                           shortest_decimal(o.threshold) + " levels";
+  if (!failed.empty()) {
+    std::vector<std::string> files;
+    for (const std::string& f : failed) files.push_back(diff_name(f));
+    const OutputPlan plan = plan_output({.folder = fs::path(o.out),
+                                         .files = files,
+                                         .command = "diff",
+                                         .use = FolderUse::shared,
+                                         .scenes = {},
+                                         .force = o.force});
+    const nlohmann::json info = run_info("diff", argc, argv,
+                                         {{"a", o.a}, {"b", o.b}, {"threshold_levels", o.threshold},
+                                          {"tolerance_percent", o.tolerance}});
+    begin_output(plan, info);
+    for (const FramePair& p : pairs) {
+      if (std::find(failed.begin(), failed.end(), p.name) == failed.end()) continue;
+      const render::Image picture =
+          diff_picture(render::read_png(*p.a), render::read_png(*p.b), o.threshold);
+      write_file_atomic(fs::path(o.out) / diff_name(p.name), render::encode_png(picture));
+    }
+    end_output(plan, info);
+  }
+  const long long total = static_cast<long long>(pairs.size());
+  if (failed.empty() && missing == 0) {
+    std::printf("cps diff: %lld of %lld frames within the tolerance (%s)\n", within, total, rule.c_str());
+    return 0;
+  }
+  std::printf("cps diff: %zu of %lld frames past the tolerance (%s), %lld unmatched (missing or of "
+              "another size)%s\n",
+              failed.size(), total, rule.c_str(), missing,
+              failed.empty() ? "" : ("; the diff pictures are in " + o.out).c_str());
+  return 1;
+}
+
+}  // namespace
+
+Command add_diff(CLI::App& app, int argc, char** argv) {
+  auto o = std::make_shared<DiffOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "diff", "compare two PNG files or two frame folders with a tolerance: exit 0 within, 1 past");
+  sub->add_option("a", o->a, "a PNG file, or a frame folder")->required()->check(kNotEmpty);
+  sub->add_option("b", o->b, "the PNG file or frame folder to compare it with")->required()->check(kNotEmpty);
+  sub->add_option("--threshold", o->threshold,
+                  "a channel differs when |a - b| exceeds this many levels of 255, in [0, 255]")
+      ->transform(decimal_in(0.0, 255.0, false, "levels"))
+      ->default_str(shortest_decimal(kDefaultThresholdLevels));
+  sub->add_option("--tolerance", o->tolerance,
+                  "a frame passes while at most this percentage of its pixels differ, in [0, 100]")
+      ->transform(decimal_in(0.0, 100.0, false, "%"))
+      ->default_str(shortest_decimal(kDefaultTolerancePercent));
+  sub->add_option("--out", o->out,
+                  "folder for the diff pictures of the frames past the tolerance (FRAME-diff.png: "
+                  "the differing pixels in red)")
+      ->check(kNotEmpty)
+      ->default_str("out/diff");
+  sub->add_flag("--force", o->force,
+                "replace diff pictures that no cps run wrote (the output rule, docs/commands.md)");
+  return {sub, [o, argc, argv] { return run_diff(*o, argc, argv); }};
+}
+
+}  // namespace cps::cli

@@ -1,0 +1,97 @@
+// `cps diff` as CI uses it: identical renders pass (exit 0, nothing written), changed ones fail
+// (exit 1) with a diff picture per frame past the tolerance, unmatched frames fail, bad input
+// exits 2.
+#include "cps/render/renderer.h"
+
+#include "cli_support.h"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using cli_test::Result;
+using cli_test::run_cps;
+
+fs::path fresh_dir(const std::string& name) { return cli_test::fresh_dir("cps_cli_diff_test_" + name); }
+
+const std::string k_frames = " --seconds 1 --fps 2 --size 96x72";
+
+long long red_pixels(const cps::render::Image& image) {
+  long long n = 0;
+  for (std::size_t p = 0; p < image.pixels.size(); p += 3) {
+    if (image.pixels[p] == 255 && image.pixels[p + 1] == 0 && image.pixels[p + 2] == 0) ++n;
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("cps diff passes two renders of one run and writes nothing", "[cli][diff]") {
+  const fs::path dir = fresh_dir("same");
+  REQUIRE(run_cps("render intersecting_stack" + k_frames + " --out a", dir).exit_code == 0);
+  REQUIRE(run_cps("render intersecting_stack" + k_frames + " --out b", dir).exit_code == 0);
+  const Result r = run_cps("diff a/intersecting_stack b/intersecting_stack", dir);
+  INFO(r.out << r.err);
+  CHECK(r.exit_code == 0);
+  CHECK(r.out.find("3 of 3 frames within the tolerance") != std::string::npos);
+  CHECK(r.out.find("max 0 levels") != std::string::npos);  // llvmpipe, twice on one machine: equal
+  CHECK_FALSE(fs::exists(dir / "out"));
+  // One file against itself, and the EGL backend against OSMesa where both run here.
+  CHECK(run_cps("diff a/intersecting_stack/frame_000001.png a/intersecting_stack/frame_000001.png", dir)
+            .exit_code == 0);
+  if (run_cps("render intersecting_stack" + k_frames + " --backend egl --out e", dir).exit_code == 0) {
+    CHECK(run_cps("diff a/intersecting_stack e/intersecting_stack", dir).exit_code == 0);
+  }
+}
+
+TEST_CASE("cps diff fails a changed push and a changed camera, with a picture of where", "[cli][diff]") {
+  const fs::path dir = fresh_dir("changed");
+  REQUIRE(run_cps("render intersecting_stack" + k_frames + " --out a", dir).exit_code == 0);
+  REQUIRE(run_cps("render intersecting_stack" + k_frames + " --push split --out b", dir).exit_code == 0);
+  REQUIRE(run_cps("render intersecting_stack" + k_frames + " --fov 40 --out c", dir).exit_code == 0);
+  // The first frame is the start, the same under both pushes; the later ones are not.
+  Result r = run_cps("diff a/intersecting_stack b/intersecting_stack --out d", dir);
+  INFO(r.out << r.err);
+  CHECK(r.exit_code == 1);
+  CHECK(r.out.find("frame_000000.png: max 0 levels") != std::string::npos);
+  CHECK(r.out.find("2 of 3 frames past the tolerance") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "d/frame_000000-diff.png"));
+  const cps::render::Image picture = cps::render::read_png(dir / "d/frame_000002-diff.png");
+  CHECK(picture.width == 96);
+  CHECK(red_pixels(picture) > 96 * 72 / 1000);  // more than the 0.1 % the tolerance allows
+  // Another field of view changes every frame.
+  r = run_cps("diff a/intersecting_stack c/intersecting_stack --out d2", dir);
+  CHECK(r.exit_code == 1);
+  CHECK(r.out.find("3 of 3 frames past the tolerance") != std::string::npos);
+  // A looser tolerance passes what it allows: every pixel.
+  CHECK(run_cps("diff a/intersecting_stack c/intersecting_stack --tolerance 100 --out d3", dir).exit_code == 0);
+}
+
+TEST_CASE("cps diff fails unmatched frames and refuses bad input", "[cli][diff]") {
+  const fs::path dir = fresh_dir("bad");
+  REQUIRE(run_cps("render stack" + k_frames + " --out a", dir).exit_code == 0);
+  REQUIRE(run_cps("render stack --seconds 0.5 --fps 2 --size 96x72 --out b", dir).exit_code == 0);
+  REQUIRE(run_cps("render stack --seconds 0.5 --fps 2 --size 64x48 --out c", dir).exit_code == 0);
+  Result r = run_cps("diff a/stack b/stack", dir);
+  CHECK(r.exit_code == 1);
+  CHECK(r.out.find("frame_000002.png: only in a/stack") != std::string::npos);
+  r = run_cps("diff b/stack c/stack", dir);
+  CHECK(r.exit_code == 1);
+  CHECK(r.out.find("sizes differ (96x72 and 64x48)") != std::string::npos);
+  std::ofstream(dir / "not.png") << "not a picture";
+  for (const char* bad : {"diff a/stack nosuch", "diff a/stack a/stack/frame_000000.png",
+                                 "diff not.png a/stack/frame_000000.png",
+                                 "diff a/stack b/stack --threshold 256", "diff a/stack b/stack --tolerance -1"}) {
+    INFO(bad);
+    r = run_cps(bad, dir);
+    CHECK(r.exit_code == 2);
+    CHECK_FALSE(r.err.empty());
+  }
+  CHECK_FALSE(fs::exists(dir / "out"));
+}

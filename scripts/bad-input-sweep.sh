@@ -63,7 +63,8 @@ declare -A KIND=(
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
   ['export:scene']=scene_one ['export:--out']=out_glb ['*:--max-work']=max_work
-  ['diff:a']=png_in ['diff:b']=png_in ['diff:--out']=out_folder
+  # The sweep puts a positional's bad value in the first place, so reference's values cover frames.
+  ['diff:reference']=png_in ['diff:frames']=skip ['diff:--out']=out_folder
   ['diff:--threshold']='param:real:0:255:0:levels' ['diff:--tolerance']='param:real:0:100:0:%'
 )
 

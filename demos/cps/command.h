@@ -61,7 +61,7 @@ Command add_figure(CLI::App& app, int argc, char** argv);
 /// argc and argv are recorded in the folder's run.json.
 Command add_export(CLI::App& app, int argc, char** argv);
 
-/// `cps diff A B`: two PNG files or two frame folders compared with a tolerance (per frame the
+/// `cps diff REFERENCE FRAMES`: two PNG files or two frame folders compared with a tolerance (per frame the
 /// largest and mean channel difference and the pixels past a threshold), a diff picture for each
 /// frame past it; exit 0 within, 1 past, 2 for usage errors. argc and argv go to run.json.
 Command add_diff(CLI::App& app, int argc, char** argv);

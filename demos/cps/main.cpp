@@ -8,11 +8,37 @@
 
 #include <CLI/CLI.hpp>
 
+#ifdef CPS_HAVE_RENDERER
+#include "cps/render/renderer.h"
+#endif
+
 #include <iostream>
 #include <string>
 #include <vector>
 
 namespace {
+
+// `cps --version`: the build, and with the renderer each backend's context here (GL version and
+// renderer: Mesa's and LLVM's versions for llvmpipe) or why it has none, and which one
+// --backend auto takes.
+std::string version_text() {
+  std::string text = std::string("cps ") + cps::cli::engine_version();
+#ifdef CPS_HAVE_RENDERER
+  std::string chosen;
+  for (const cps::render::Backend b : {cps::render::Backend::osmesa, cps::render::Backend::egl}) {
+    const std::string name(cps::render::backend_name(b));
+    try {
+      cps::render::Renderer r(16, 16, b);
+      text += "\nrenderer: " + r.context_description();
+      if (chosen.empty()) chosen = name;
+    } catch (const std::exception& e) {
+      text += "\nrenderer: " + name + ": unavailable: " + e.what();
+    }
+  }
+  text += "\n--backend auto: " + (chosen.empty() ? std::string("none (neither backend renders here)") : chosen);
+#endif
+  return text;
+}
 
 using namespace cps;
 
@@ -50,7 +76,7 @@ std::string unknown_option_message(CLI::App& app, int argc, char** argv,
 int run(int argc, char** argv) {
   CLI::App app{"cps: the constraint based physics solver of Tamis & Maggiore (2015)"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("cps ") + cli::engine_version());
+  app.set_version_flag("--version", version_text);
   std::vector<cli::Command> commands = {
       cli::add_list(app),
       cli::add_simulate(app, argc, argv),

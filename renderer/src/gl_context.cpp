@@ -44,6 +44,22 @@ GlContext::GlContext(Backend backend, int width, int height) : backend_(backend)
   switch (backend) {
     case Backend::osmesa: impl_ = make_osmesa_context(width, height); break;
     case Backend::egl: impl_ = make_egl_context(width, height); break;
+    case Backend::automatic:
+      try {
+        impl_ = make_osmesa_context(width, height);
+        backend_ = Backend::osmesa;
+      } catch (const std::runtime_error& osmesa) {
+        release_current();
+        try {
+          impl_ = make_egl_context(width, height);
+          backend_ = Backend::egl;
+        } catch (const std::runtime_error& egl) {
+          throw std::runtime_error(std::string("cps::render: --backend auto: neither backend can "
+                                               "render here. osmesa: ") +
+                                   osmesa.what() + ". egl: " + egl.what());
+        }
+      }
+      break;
   }
   if (!impl_) throw std::invalid_argument("cps::render: unknown backend");
   t_current_context = impl_.get();

@@ -7,8 +7,10 @@
 
 #include "osmesa_context.h"
 
+#if CPS_HAVE_OSMESA_HEADERS
 #include <GL/osmesa.h>
 #include <dlfcn.h>
+#endif
 
 #include <cstdint>
 #include <mutex>
@@ -29,6 +31,7 @@ extern "C" const char* __lsan_default_suppressions() {
 }
 #endif
 
+#if CPS_HAVE_OSMESA_HEADERS
 namespace cps::render {
 namespace {
 
@@ -170,3 +173,18 @@ std::unique_ptr<OffscreenContext> make_osmesa_context(int width, int height) {
 }
 
 }  // namespace cps::render
+
+#else  // built without GL/osmesa.h
+
+namespace cps::render {
+
+std::unique_ptr<OffscreenContext> make_osmesa_context(int, int) {
+  throw std::runtime_error(
+      "cps::render: osmesa backend: this cps was built without OSMesa's header GL/osmesa.h "
+      "(Debian: libosmesa6-dev), so the osmesa backend is left out; --backend auto and egl render "
+      "through EGL");
+}
+
+}  // namespace cps::render
+
+#endif

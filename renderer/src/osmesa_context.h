@@ -14,7 +14,8 @@ namespace cps::render {
 /// buffer of width x height pixels (each in [1, 8192], checked by the caller) with a 24-bit depth
 /// buffer. The context is current on return. Throws std::runtime_error naming the step that failed:
 /// libOSMesa not found (install libosmesa6, or use the EGL backend: upstream Mesa dropped OSMesa in
-/// 25.1), context creation, binding the buffer, or a GL version below 3.3.
+/// 25.1), context creation, binding the buffer, or a GL version below 3.3; or, in a build without
+/// GL/osmesa.h (CPS_HAVE_OSMESA_HEADERS 0), always, saying that the backend was left out.
 std::unique_ptr<OffscreenContext> make_osmesa_context(int width, int height);
 
 }  // namespace cps::render

@@ -133,12 +133,18 @@ Backend Renderer::backend() const { return impl_->context.backend(); }
 std::string Renderer::context_description() { return impl_->context.description(); }
 
 std::string_view backend_name(Backend backend) {
-  return backend == Backend::egl ? "egl" : "osmesa";
+  switch (backend) {
+    case Backend::osmesa: return "osmesa";
+    case Backend::egl: return "egl";
+    case Backend::automatic: return "auto";
+  }
+  return "?";
 }
 
 std::optional<Backend> parse_backend(std::string_view name) {
-  if (name == "osmesa") return Backend::osmesa;
-  if (name == "egl") return Backend::egl;
+  for (const Backend b : {Backend::osmesa, Backend::egl, Backend::automatic}) {
+    if (name == backend_name(b)) return b;
+  }
   return std::nullopt;
 }
 

@@ -115,13 +115,13 @@ TEST_CASE("cps render --compare with three values of beta lays out 3 labelled pa
   const nlohmann::json manifest = nlohmann::json::parse(slurp(folder / "run.json"));
   const std::vector<Rect> at = panels_of(manifest);
   REQUIRE(at.size() == 3);
-  for (const Rect& r : at) {
+  for (const Rect& cell : at) {
     // Each scene in its cell, with a caption strip below it that holds its label and time.
-    CHECK(r.width > 100);
-    CHECK(r.width <= 160);
-    CHECK(r.height > 100);
-    CHECK(r.y + r.height < 240 - 24);
-    CHECK(ink_in(last, r.x, r.x + r.width, r.y + r.height, 240) > 50);
+    CHECK(cell.width > 100);
+    CHECK(cell.width <= 160);
+    CHECK(cell.height > 100);
+    CHECK(cell.y + cell.height < 240 - 24);
+    CHECK(ink_in(last, cell.x, cell.x + cell.width, cell.y + cell.height, 240) > 50);
   }
   // At t = 1 s: beta = 0.05 still pushes the cubes apart slowly, 0.5 has thrown them out; a few
   // grey levels on average is a different picture (the same picture differs by 0).

@@ -156,7 +156,7 @@ int run_diff(const DiffOptions& o, int argc, char** argv) {
                                          .scenes = {},
                                          .force = o.force});
     const nlohmann::json info = run_info("diff", argc, argv,
-                                         {{"a", o.a}, {"b", o.b}, {"threshold_levels", o.threshold},
+                                         {{"reference", o.a}, {"frames", o.b}, {"threshold_levels", o.threshold},
                                           {"tolerance_percent", o.tolerance}});
     begin_output(plan, info);
     for (const FramePair& p : pairs) {
@@ -185,8 +185,12 @@ Command add_diff(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<DiffOptions>();
   CLI::App* sub = app.add_subcommand(
       "diff", "compare two PNG files or two frame folders with a tolerance: exit 0 within, 1 past");
-  sub->add_option("a", o->a, "a PNG file, or a frame folder")->required()->check(kNotEmpty);
-  sub->add_option("b", o->b, "the PNG file or frame folder to compare it with")->required()->check(kNotEmpty);
+  sub->add_option("reference", o->a, "the baseline: a PNG file, or a frame folder")
+      ->required()
+      ->check(kNotEmpty);
+  sub->add_option("frames", o->b, "the PNG file or frame folder compared with it")
+      ->required()
+      ->check(kNotEmpty);
   sub->add_option("--threshold", o->threshold,
                   "a channel differs when |a - b| exceeds this many levels of 255, in [0, 255]")
       ->transform(decimal_in(0.0, 255.0, false, "levels"))

@@ -300,7 +300,7 @@ struct FigureOptions {
   scenes::Overrides overrides;
   View view;  // --camera, --contacts, --rods, --orbit
   bool label = true;
-  std::string backend = "osmesa";
+  std::string backend = "auto";
   double max_work = kDefaultMaxWork;  // body-iterations a run
 };
 
@@ -474,7 +474,10 @@ FigurePlan plan_figure(const FigureOptions& o, int argc, char** argv) {
 // std::runtime_error from the renderer or a write.
 int execute_figure(const FigureOptions& o, const FigurePlan& plan, int argc, char** argv) {
   render::Renderer renderer(plan.size.width, plan.size.height, *render::parse_backend(o.backend));
-  begin_output(plan.output, plan.info);
+  nlohmann::json info = plan.info;
+  info["parameters"]["renderer"] = {{"backend", render::backend_name(renderer.backend())},
+                                    {"context", renderer.context_description()}};
+  begin_output(plan.output, info);
   for (const PlannedFigure& p : plan.figures) {
     const ComposedFigure figure = render_figure(p.spec, renderer);
     write_figure(p.png, compose_page(figure.page, p.spec.format, figure.layout),
@@ -483,7 +486,7 @@ int execute_figure(const FigureOptions& o, const FigurePlan& plan, int argc, cha
                 figure.layout.height, p.spec.format == FigureFormat::png ? "pixels" : "points",
                 p.spec.times.size(), p.spec.variants.size(), sidecar_path(p.png).filename().c_str());
   }
-  end_output(plan.output, plan.info);
+  end_output(plan.output, info);
   return 0;
 }
 
@@ -535,10 +538,10 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
                 "run wrote them (run.json lists the files cps wrote there); any other file in "
                 "the folder is never touched");
   sub->add_option("--backend", o->backend,
-                  "OpenGL context: osmesa (libOSMesa, CPU) or egl (headless EGL: GPU if any, "
-                  "else llvmpipe)")
+                  "OpenGL context: osmesa (libOSMesa, CPU), egl (headless EGL: GPU if any, "
+                  "else llvmpipe), or auto (osmesa where libOSMesa loads, else egl)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"osmesa", "egl"}));
+      ->check(CLI::IsMember({"auto", "osmesa", "egl"}));
   add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
   add_view_options(*sub, o->view, o->label, /*label_default=*/true);

@@ -194,7 +194,7 @@ struct RenderOptions {
   bool overlay = false;
   bool force = false;
   scenes::Overrides overrides;
-  std::string backend = "osmesa";
+  std::string backend = "auto";
   std::string video;
   View view;  // --camera, --contacts, --rods, --orbit
   bool label = false;
@@ -504,7 +504,9 @@ long long write_frames(const RenderOptions& o, const RenderPlan& plan, SceneRend
   std::vector<Panel> panels;
   for (std::size_t v = 0; v < plan.variants.size(); ++v) panels.push_back({&job.runs[v], job.labels[v]});
   const nlohmann::json notes = spacing_notes(job);
-  const nlohmann::json info = frames_info(o, plan, job, notes, argc, argv);
+  nlohmann::json info = frames_info(o, plan, job, notes, argc, argv);
+  info["parameters"]["renderer"] = {{"backend", render::backend_name(renderer.backend())},
+                                    {"context", renderer.context_description()}};
   begin_output(job.output, info);
   Progress progress("render " + job.spec.folder.filename().string(), frame_count(job.spec), "frames");
   const long long frames = render_frames(job.style, panels, job.spec, renderer, writer, &progress);
@@ -617,10 +619,10 @@ Command add_render(CLI::App& app, int argc, char** argv) {
   add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
   sub->add_option("--backend", o->backend,
-                  "OpenGL context: osmesa (libOSMesa, CPU) or egl (headless EGL: GPU if any, "
-                  "else llvmpipe)")
+                  "OpenGL context: osmesa (libOSMesa, CPU), egl (headless EGL: GPU if any, "
+                  "else llvmpipe), or auto (osmesa where libOSMesa loads, else egl)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"osmesa", "egl"}));
+      ->check(CLI::IsMember({"auto", "osmesa", "egl"}));
   sub->add_option("--video", o->video,
                   "after the frames, assemble them with ffmpeg into OUT/SCENE.mp4 (H.264) or "
                   "OUT/SCENE.gif")

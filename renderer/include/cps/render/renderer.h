@@ -24,18 +24,21 @@ struct Image {
 
 /// How the renderer gets its OpenGL context. Both render headless, without any window system.
 enum class Backend {
-  /// OSMesa (libOSMesa, Mesa's llvmpipe on the CPU): the default. Upstream Mesa removed OSMesa
-  /// in 25.1; Debian 12 ships it (libosmesa6).
+  /// OSMesa (libOSMesa, Mesa's llvmpipe on the CPU). Upstream Mesa removed OSMesa in 25.1;
+  /// Debian 12 ships it (libosmesa6).
   osmesa,
   /// EGL without a surface: Mesa's surfaceless platform (GPU render node, else llvmpipe), or an
   /// EGL device (e.g. NVIDIA's driver). Needs libEGL.so.1 and a vendor driver (libegl-mesa0).
   egl,
+  /// The default: OSMesa where its context can be made (the library loads), else EGL; chosen
+  /// when the context is created, so one binary renders on machines with either library.
+  automatic,
 };
 
-/// "osmesa" or "egl".
+/// "osmesa", "egl" or "auto".
 std::string_view backend_name(Backend backend);
 
-/// The backend named `name` ("osmesa", "egl"), or nullopt for any other text.
+/// The backend named `name` ("osmesa", "egl", "auto"), or nullopt for any other text.
 std::optional<Backend> parse_backend(std::string_view name);
 
 /// Owns one OpenGL context and its frame buffer of width x height pixels (both in [1, 8192]).
@@ -43,17 +46,18 @@ std::optional<Backend> parse_backend(std::string_view name);
 /// Not copyable; one renderer per thread (renderers of either backend may be used in turn).
 class Renderer {
  public:
-  /// Creates the context (OpenGL 3.3 core or newer) through `backend`. Throws
-  /// std::invalid_argument for a size out of range, std::runtime_error if the backend cannot
-  /// create a context (the message names the step that failed) or a shader fails to build (the
-  /// message holds the GL info log).
-  Renderer(int width, int height, Backend backend = Backend::osmesa);
+  /// Creates the context (OpenGL 3.3 core or newer) through `backend` (automatic: OSMesa, else
+  /// EGL). Throws std::invalid_argument for a size out of range, std::runtime_error if the
+  /// backend cannot create a context (the message names the step that failed; for automatic,
+  /// each backend's reason) or a shader fails to build (the message holds the GL info log).
+  Renderer(int width, int height, Backend backend = Backend::automatic);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
   int width() const;
   int height() const;
+  /// The backend that made the context: osmesa or egl, never automatic.
   Backend backend() const;
   /// The backend, GL version and renderer, e.g. "osmesa: OpenGL 4.5 (Core Profile) Mesa 22.3.6,
   /// llvmpipe (LLVM 15.0.6, 256 bits)".

@@ -95,6 +95,7 @@ struct Scene {
   BenchTraits bench;
   /// How `cps report` runs and judges the scene.
   ReportTraits report;
+
   /// The simulated time of each run of `cps report` (s): report.horizon_s, or default_seconds.
   double report_horizon_s() const { return report.horizon_s.value_or(default_seconds); }
   /// The time of `cps report`'s trajectory error (s): report.trajectory_time_s, or 1 s, or the

@@ -143,30 +143,14 @@ TEST_CASE("cps report takes a scene file in a folder and writes its files in --o
   CHECK_FALSE(fs::exists(dir / "all" / "scenes"));
 }
 
-namespace {
-
-// Newton's cradle: five 1 kg balls of radius 0.1 m on 1 m rods, touching, the first raised 60
-// degrees, restitution 1, the default push (Baumgarte).
-const char* kCradle = R"({"name": "cradle", "seconds": 4, "world": {"restitution": 1},
-  "bodies": [
-    {"shape": "sphere", "name": "b0", "radius_m": 0.1, "mass_kg": 1, "position_m": [-1.2660254037844387, 1.5, 0]},
-    {"shape": "sphere", "name": "b1", "radius_m": 0.1, "mass_kg": 1, "position_m": [-0.2, 1, 0]},
-    {"shape": "sphere", "name": "b2", "radius_m": 0.1, "mass_kg": 1, "position_m": [0, 1, 0]},
-    {"shape": "sphere", "name": "b3", "radius_m": 0.1, "mass_kg": 1, "position_m": [0.2, 1, 0]},
-    {"shape": "sphere", "name": "b4", "radius_m": 0.1, "mass_kg": 1, "position_m": [0.4, 1, 0]}],
-  "rods": [
-    {"body_a": "b0", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [-0.4, 2, 0], "length_m": 1},
-    {"body_a": "b1", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [-0.2, 2, 0], "length_m": 1},
-    {"body_a": "b2", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [0, 2, 0], "length_m": 1},
-    {"body_a": "b3", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [0.2, 2, 0], "length_m": 1},
-    {"body_a": "b4", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [0.4, 2, 0], "length_m": 1}]})";
-
-}  // namespace
+// Newton's cradle: five 1 kg balls on 1 m rods, touching, the first raised 60 degrees,
+// restitution 1, the default push (Baumgarte).
+const fs::path kCradle = CPS_TEST_DATA "/cradle.json";
 
 TEST_CASE("a bouncing cradle under the default push warns that its energy rose, split does not",
           "[cli][scene_file][energy_rise]") {
   const fs::path dir = cli_test::fresh_dir("cps_cli_scene_files_energy");
-  write(dir / "cradle.json", kCradle);
+  fs::copy_file(kCradle, dir / "cradle.json");
   const Result warned = run_cps("simulate cradle.json --json", dir);
   INFO(warned.err);
   CHECK(warned.exit_code == 0);

@@ -13,21 +13,10 @@ using namespace cps::scenes;
 
 namespace {
 
-// Newton's cradle: five 1 kg balls of radius 0.1 m on 1 m rods from fixed points 0.2 m apart
-// (touching), the first raised 60 degrees (0.5 m: 5 J above its lowest point), restitution 1.
-const char* kCradle = R"({"name": "cradle", "seconds": 4, "world": {"restitution": 1},
-  "bodies": [
-    {"shape": "sphere", "name": "b0", "radius_m": 0.1, "mass_kg": 1, "position_m": [-1.2660254037844387, 1.5, 0]},
-    {"shape": "sphere", "name": "b1", "radius_m": 0.1, "mass_kg": 1, "position_m": [-0.2, 1, 0]},
-    {"shape": "sphere", "name": "b2", "radius_m": 0.1, "mass_kg": 1, "position_m": [0, 1, 0]},
-    {"shape": "sphere", "name": "b3", "radius_m": 0.1, "mass_kg": 1, "position_m": [0.2, 1, 0]},
-    {"shape": "sphere", "name": "b4", "radius_m": 0.1, "mass_kg": 1, "position_m": [0.4, 1, 0]}],
-  "rods": [
-    {"body_a": "b0", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [-0.4, 2, 0], "length_m": 1},
-    {"body_a": "b1", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [-0.2, 2, 0], "length_m": 1},
-    {"body_a": "b2", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [0, 2, 0], "length_m": 1},
-    {"body_a": "b3", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [0.2, 2, 0], "length_m": 1},
-    {"body_a": "b4", "point_a_m": [0, 0, 0], "body_b": null, "point_b_m": [0.4, 2, 0], "length_m": 1}]})";
+// Newton's cradle (tests/data/cradle.json): five 1 kg balls of radius 0.1 m on 1 m rods from
+// fixed points 0.2 m apart (touching), the first raised 60 degrees (0.5 m: 5 J above its lowest
+// point), restitution 1.
+const std::string kCradle = CPS_TEST_DATA "/cradle.json";
 
 // The watch's result over `seconds` (s) of `scene` with `overrides`.
 EnergyRise watched(const Scene& scene, double seconds, const Overrides& overrides = {}) {
@@ -60,7 +49,7 @@ TEST_CASE("a free fall never rises, and its scale is the height it fell", "[ener
 
 TEST_CASE("a bouncing cradle gains under the Baumgarte push and warns; under split it does not",
           "[energy_rise]") {
-  const SceneFile file = parse_scene_file(kCradle, "cradle.json");
+  const SceneFile file = read_scene_file(kCradle);
   const Scene scene = scene_of(file, "cradle.json");
   const EnergyRise baumgarte = watched(scene, 4.0);
   INFO("baumgarte: rise " << baumgarte.rise_J() << " J of " << baumgarte.scale_J << " J");

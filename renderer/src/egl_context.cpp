@@ -18,6 +18,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cps::render {
@@ -224,12 +225,14 @@ class EglContext final : public OffscreenContext {
   int height() const override { return height_; }
 
  private:
+  /// The displays to try, in order: enumerated hardware devices (a GPU: NVIDIA's driver offers
+  /// only these), then Mesa's surfaceless platform (a render node, else llvmpipe), then the
+  /// software devices (EGL_MESA_device_software). A GPU thus wins over llvmpipe when GLVND has
+  /// both vendors; without a GPU the order is surfaceless first, as before.
   std::vector<Candidate> find_candidates() const {
-    std::vector<Candidate> out;
-    if (api_.GetPlatformDisplayEXT == nullptr) return out;
-    if (has_extension(api_.client_extensions, "EGL_MESA_platform_surfaceless")) {
-      out.push_back({"Mesa surfaceless platform", EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY});
-    }
+    std::vector<Candidate> hardware;
+    std::vector<Candidate> software;
+    if (api_.GetPlatformDisplayEXT == nullptr) return hardware;
     if (api_.QueryDevicesEXT != nullptr &&
         has_extension(api_.client_extensions, "EGL_EXT_platform_device")) {
       EGLint count = 0;
@@ -239,15 +242,24 @@ class EglContext final : public OffscreenContext {
           devices.resize(static_cast<std::size_t>(count));
           for (std::size_t i = 0; i < devices.size(); ++i) {
             std::string name = "EGL device " + std::to_string(i);
+            std::string ext;
             if (api_.QueryDeviceStringEXT != nullptr) {
-              const char* ext = api_.QueryDeviceStringEXT(devices[i], EGL_EXTENSIONS);
-              if (ext != nullptr && *ext != '\0') name += " (" + std::string(ext) + ")";
+              const char* e = api_.QueryDeviceStringEXT(devices[i], EGL_EXTENSIONS);
+              if (e != nullptr) ext = e;
             }
-            out.push_back({name, EGL_PLATFORM_DEVICE_EXT, devices[i]});
+            if (!ext.empty()) name += " (" + ext + ")";
+            const bool is_software = has_extension(ext, "EGL_MESA_device_software");
+            (is_software ? software : hardware)
+                .push_back({name, EGL_PLATFORM_DEVICE_EXT, devices[i]});
           }
         }
       }
     }
+    std::vector<Candidate> out = std::move(hardware);
+    if (has_extension(api_.client_extensions, "EGL_MESA_platform_surfaceless")) {
+      out.push_back({"Mesa surfaceless platform", EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY});
+    }
+    out.insert(out.end(), software.begin(), software.end());
     return out;
   }
 

@@ -1,8 +1,9 @@
 #pragma once
-// Private: the EGL backend, headless and without any window system or pbuffer: a display of
-// Mesa's surfaceless platform (EGL_MESA_platform_surfaceless: a GPU render node when there is one,
-// llvmpipe otherwise) or, failing that, of an enumerated device (EGL_EXT_device_enumeration +
-// EGL_EXT_platform_device: how NVIDIA's driver renders headless), an OpenGL 3.3 core context made
+// Private: the EGL backend, headless and without any window system or pbuffer: a display of an
+// enumerated hardware device (EGL_EXT_device_enumeration + EGL_EXT_platform_device: how NVIDIA's
+// driver renders headless), else of Mesa's surfaceless platform (EGL_MESA_platform_surfaceless: a
+// GPU render node when there is one, llvmpipe otherwise), else of a software device (Mesa's
+// EGL_MESA_device_software, llvmpipe), an OpenGL 3.3 core context made
 // current with no surface (EGL_KHR_surfaceless_context), drawing into its own framebuffer object.
 // All EGL calls live in egl_context.cpp.
 

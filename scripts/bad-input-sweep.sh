@@ -58,7 +58,8 @@ declare -A KIND=(
   ['*:--eye']=point ['*:--target']=point ['*:--fov']=fov
   ['*:--size']=size ['*:--times']=times
   ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png ['figure:--format']=choice
-  ['*:--trace']=trace ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
+  ['*:--trace']=trace ['*:--energy']=trace ['simulate:--energy-every']='param:integer:1:10000000:0:steps'
+  ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
   ['simulate:scene']=scene_one ['render:scene']=scene_many ['figure:scene']=scene_figure
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
@@ -242,6 +243,10 @@ EXTRA=(
   "--overlay|figure paper --overlay"
   "steps/--times/--dt|figure stack --times 0,1e5 --dt 1e-6 --size 16x16 --out out/f.png"
   "--trace/adir|simulate stack --seconds 0.1 --trace adir --force"
+  "--energy/adir|simulate stack --seconds 0.1 --energy adir --force"
+  "--energy/--trace|simulate stack --seconds 0.1 --energy t.csv --trace ./t.csv"
+  "--energy-every/--energy|simulate stack --seconds 0.1 --energy-every 2"
+  "--energy-every|simulate stack --seconds 1e5 --dt 0.01 --energy e.csv --max-work 1e18"
   "--run/--merge|report --merge $MERGE_SRC --run $RUN_ID --out out"
   "--run/--list-runs|report --list-runs --run $RUN_ID --out out"
   "push/--run|report push --run $RUN_ID --out out"
@@ -284,6 +289,7 @@ CONTROLS=(
   "simulate stack --seconds 0.1"
   "simulate stack --seconds 0.0084 --dt 1/60"  # rounds to one step, the fewest a run takes
   "simulate stack --seconds 1/60"
+  "simulate stack --seconds 0.1 --energy e.csv --energy-every 10000000 --trace t.csv"
   "simulate stack --seconds 0.1 --dt 1/60 --beta 1e-320 --friction 0 --iterations 10000"
   "report --list-runs --out out"
   "report intersecting_stack --run intersecting_stack.pgs.baumgarte.fixed.it1.ss1.ws0.8 --out out"

@@ -18,19 +18,25 @@ double EnergyRise::fraction() const {
 
 bool EnergyRise::warns() const { return fraction() > kEnergyRiseWarnFraction; }
 
+MechanicalEnergy mechanical_energy(const World& world) {
+  const Vec3& g = world.def().gravity;
+  MechanicalEnergy e;
+  for (const Body& b : world.bodies()) {
+    if (b.is_static()) continue;
+    e.kinetic_J += b.kinetic_energy();
+    e.potential_J -= b.mass * g.dot(b.x);
+  }
+  return e;
+}
+
 void EnergyRiseTracker::observe(const World& world) {
   const auto& bodies = world.bodies();
   const Vec3& g = world.def().gravity;
   const double g_norm = g.norm();
   const Vec3 up = g_norm > 0.0 ? Vec3(-g / g_norm) : Vec3::Zero();
-  double kinetic = 0.0;
-  double potential = 0.0;
-  for (const Body& b : bodies) {
-    if (b.is_static()) continue;
-    kinetic += b.kinetic_energy();
-    potential -= b.mass * g.dot(b.x);
-  }
-  const double energy = kinetic + potential;
+  const MechanicalEnergy now = mechanical_energy(world);
+  const double kinetic = now.kinetic_J;
+  const double energy = now.total_J();
   if (!std::isfinite(energy)) {
     rise_.nonfinite = true;
     return;

@@ -26,6 +26,21 @@ namespace cps::scenes {
 /// 21 in 10 s; the intersecting stack: 12.6).
 inline constexpr double kEnergyRiseWarnFraction = 0.5;
 
+/// The mechanical energy of a world's movable bodies (J): kinetic_J = sum 1/2 m |v|^2 + 1/2 w . I w
+/// (translational plus rotational), potential_J = -sum m g . x (gravity; datum x = 0, the origin:
+/// for the default g = (0, -10, 0) the plane y = 0, the built-in scenes' ground). Static bodies
+/// never move and are left out.
+struct MechanicalEnergy {
+  double kinetic_J = 0.0;
+  double potential_J = 0.0;
+  /// kinetic_J + potential_J (J).
+  double total_J() const { return kinetic_J + potential_J; }
+};
+
+/// The energy of `world` as it is now (see MechanicalEnergy). No errors; a state that is not
+/// finite gives values that are not finite.
+MechanicalEnergy mechanical_energy(const World& world);
+
 /// What the watch measured over a run; energies in J, times in s. E = KE + PE with the
 /// potential PE = -sum m g . x of the movable bodies (datum x = 0), as FileSceneMetrics.
 struct EnergyRise {

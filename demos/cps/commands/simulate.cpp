@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <cmath>
@@ -26,17 +27,73 @@ nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
-TraceWriter::TraceWriter(std::filesystem::path path, bool force, nlohmann::json info)
-    : path_(std::move(path)), info_(std::move(info)) {
-  plan_ = plan_output({.folder = path_.parent_path(),
-                       .files = {path_.filename().string()},
-                       .command = "simulate",
-                       .use = FolderUse::shared,
-                       .scenes = {},
-                       .option = "--trace",
-                       .force = force});
-  begin_output(plan_, info_);
-  file_.emplace(path_);
+long long energy_rows(long long steps, long long every) {
+  return steps / every + 1 + (steps % every != 0 ? 1 : 0);
+}
+
+SimulateFiles::SimulateFiles(std::vector<SimulateTarget> targets, bool force)
+    : targets_(std::move(targets)) {
+  namespace fs = std::filesystem;
+  const auto request = [&](const fs::path& folder, std::vector<std::string> files,
+                           const std::string& option) {
+    return plan_output({.folder = folder,
+                        .files = std::move(files),
+                        .command = "simulate",
+                        .use = FolderUse::shared,
+                        .scenes = {},
+                        .option = option,
+                        .force = force});
+  };
+  // Each target alone first, so that a refusal names its own option.
+  for (const SimulateTarget& t : targets_) {
+    request(t.path.parent_path(), {t.path.filename().string()}, t.option);
+  }
+  // Then one plan per folder (the same folder by any path), with every target it receives.
+  std::vector<fs::path> folders;                // absolute, normal
+  std::vector<std::vector<std::size_t>> group;  // the targets of each folder
+  for (std::size_t i = 0; i < targets_.size(); ++i) {
+    const fs::path folder = targets_[i].path.parent_path();
+    std::error_code ec;
+    fs::path key = fs::weakly_canonical(fs::absolute(folder.empty() ? fs::path(".") : folder), ec);
+    if (ec) key = fs::absolute(folder.empty() ? fs::path(".") : folder).lexically_normal();
+    std::size_t k = 0;
+    while (k < folders.size() && folders[k] != key) ++k;
+    if (k == folders.size()) {
+      folders.push_back(key);
+      group.emplace_back();
+    }
+    for (const std::size_t j : group[k]) {
+      if (targets_[j].path.filename() == targets_[i].path.filename()) {
+        throw UsageError(targets_[i].option + " " + targets_[i].path.string() + ": the same file as " +
+                         targets_[j].option + " " + targets_[j].path.string() +
+                         "; give each option its own file");
+      }
+    }
+    group[k].push_back(i);
+  }
+  for (const std::vector<std::size_t>& g : group) {
+    std::vector<std::string> names;
+    std::string options;
+    for (const std::size_t i : g) {
+      names.push_back(targets_[i].path.filename().string());
+      options += (options.empty() ? "" : " or ") + targets_[i].option;
+    }
+    plans_.push_back(request(targets_[g.front()].path.parent_path(), names, options));
+  }
+}
+
+void SimulateFiles::begin(const nlohmann::json& info) {
+  info_ = info;
+  for (const OutputPlan& plan : plans_) begin_output(plan, info_);
+  for (const SimulateTarget& t : targets_) files_.push_back(std::make_unique<AtomicFile>(t.path));
+}
+
+void SimulateFiles::finish() {
+  for (const std::unique_ptr<AtomicFile>& f : files_) f->commit();
+  for (const OutputPlan& plan : plans_) end_output(plan, info_);
+}
+
+TraceWriter::TraceWriter(AtomicFile& file) : file_(&file) {
   file_->write(kTraceHeader);
   file_->write("\n");
 }
@@ -60,24 +117,47 @@ void TraceWriter::write(const World& world) {
   }
 }
 
-long TraceWriter::finish() {
-  file_->commit();
-  end_output(plan_, info_);
-  return rows_;
+EnergyWriter::EnergyWriter(AtomicFile& file, long long every) : file_(&file), every_(every) {
+  file_->write(kEnergyHeader);
+  file_->write("\n");
+}
+
+void EnergyWriter::write(const World& world) {
+  if (static_cast<long long>(world.counters().steps) % every_ == 0) row(world);
+}
+
+void EnergyWriter::write_last(const World& world) {
+  if (static_cast<long long>(world.counters().steps) != last_step_) row(world);
+}
+
+void EnergyWriter::row(const World& world) {
+  last_step_ = static_cast<long long>(world.counters().steps);
+  const scenes::MechanicalEnergy e = scenes::mechanical_energy(world);
+  char text[320];
+  const int n = std::snprintf(text, sizeof text, "%lld,%.9g,%.12g,%.12g,%.12g,%.9g,%.9g\n",
+                              last_step_, world.time(), e.kinetic_J, e.potential_J, e.total_J(),
+                              scenes::deepest_contact(world), scenes::max_rod_error(world));
+  file_->write(std::string_view(text, static_cast<std::size_t>(std::min<int>(n, sizeof text - 1))));
+  ++rows_;
 }
 
 nlohmann::json simulate(const scenes::Scene& scene, scenes::Run& run, double seconds,
-                        TraceWriter* trace) {
+                        TraceWriter* trace, EnergyWriter* energy) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  if (trace == nullptr) {
+  if (trace == nullptr && energy == nullptr) {
     run.advance_to(seconds);
   } else {
-    trace->write(run.world);
+    const auto write = [&] {
+      if (trace != nullptr) trace->write(run.world);
+      if (energy != nullptr) energy->write(run.world);
+    };
+    write();
     while (run.world.time() + 0.5 * run.world.def().dt < seconds) {  // as Run::advance_to
       run.step();
-      trace->write(run.world);
+      write();
     }
+    if (energy != nullptr) energy->write_last(run.world);
   }
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
 
@@ -115,6 +195,8 @@ struct SimulateOptions {
   std::optional<double> seconds;  // s; default: the scene's
   bool json = false;
   std::string trace;
+  std::string energy;
+  std::optional<long long> energy_every;  // steps; default 1
   bool force = false;
   std::string expect_hash;
   double max_work = kDefaultMaxWork;  // body-iterations
@@ -159,27 +241,60 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
   check_steps(o.scene, seconds, r.world.def().dt);
   check_work(o.scene, r.world.bodies().size(), r.world.def(), seconds, o.max_work,
              lower_run_options(r.world.def()));
+  if (o.energy_every && o.energy.empty()) {
+    throw UsageError("--energy-every " + std::to_string(*o.energy_every) +
+                     ": it sets the rows of the --energy file; give --energy FILE too");
+  }
+  const long long every = o.energy_every.value_or(1);
+  const long long steps = std::llround(seconds / r.world.def().dt);
+  if (!o.energy.empty() && energy_rows(steps, every) > kMaxEnergyRows) {
+    long long fits = std::max(every, steps / (kMaxEnergyRows - 1));
+    while (energy_rows(steps, fits) > kMaxEnergyRows) ++fits;
+    throw UsageError("--energy " + o.energy + ": " + std::to_string(steps) + " steps at one row every " +
+                     std::to_string(every) + " would write " +
+                     std::to_string(energy_rows(steps, every)) + " rows, more than the " +
+                     std::to_string(kMaxEnergyRows) + " an energy file may have; give --energy-every " +
+                     std::to_string(fits) + " or more, or fewer --seconds");
+  }
+  // Every file is checked before any is written.
+  std::vector<SimulateTarget> targets;
+  if (!o.trace.empty()) targets.push_back({o.trace, "--trace"});
+  if (!o.energy.empty()) targets.push_back({o.energy, "--energy"});
+  std::optional<SimulateFiles> files;
   std::optional<TraceWriter> trace;
-  if (!o.trace.empty()) {
-    trace.emplace(o.trace, o.force,
-                  run_info("simulate", argc, argv,
-                           {{"scene", scene->name},
-                            {"seconds", seconds},
-                            {"trace", o.trace},
-                            {"overrides", overrides_json(o.overrides)},
-                            {"parameters", parameters_json(r.world.def())}}));
+  std::optional<EnergyWriter> energy_csv;
+  if (!targets.empty()) {
+    files.emplace(targets, o.force);
+    nlohmann::json info = {{"scene", scene->name},
+                           {"seconds", seconds},
+                           {"overrides", overrides_json(o.overrides)},
+                           {"parameters", parameters_json(r.world.def())}};
+    if (!o.trace.empty()) info["trace"] = o.trace;
+    if (!o.energy.empty()) {
+      info["energy"] = o.energy;
+      info["energy_every"] = every;
+    }
+    files->begin(run_info("simulate", argc, argv, info));
+    std::size_t i = 0;
+    if (!o.trace.empty()) trace.emplace(files->file(i++));
+    if (!o.energy.empty()) energy_csv.emplace(files->file(i++), every);
   }
   // Steps on stderr, only once the run has taken 2 s (short runs and --json stay clean).
   Progress progress("simulate " + o.scene, std::llround(seconds / r.world.def().dt), "steps", 2.0);
   r.metrics = std::make_unique<ProgressMetrics>(std::move(r.metrics), progress);
   const auto energy = scenes::watch_energy_rise(r);  // the warning below; changes no output
-  const nlohmann::json summary = simulate(*scene, r, seconds, trace ? &*trace : nullptr);
+  const nlohmann::json summary = simulate(*scene, r, seconds, trace ? &*trace : nullptr,
+                                          energy_csv ? &*energy_csv : nullptr);
   progress.finish();
   scenes::print_energy_rise_warning(scene->name, "", r.world.def(), *energy);
+  if (files) files->finish();
   if (trace) {
-    const long rows = trace->finish();
-    std::cerr << "trace: " << rows << " rows (" << r.world.bodies().size()
+    std::cerr << "trace: " << trace->rows() << " rows (" << r.world.bodies().size()
               << " bodies per step) in " << o.trace << "\n";
+  }
+  if (energy_csv) {
+    std::cerr << "energy: " << energy_csv->rows() << " rows (one every " << every
+              << (every == 1 ? " step" : " steps") << ", and the last) in " << o.energy << "\n";
   }
   if (o.json) {
     std::cout << summary.dump(2) << "\n";
@@ -216,8 +331,33 @@ Command add_simulate(CLI::App& app, int argc, char** argv) {
                   "velocity (rad/s); one row per body per step, step 0 = as built; missing "
                   "folders are created, and the folder's run.json lists the files cps wrote there")
       ->check(kNotEmpty);
+  sub->add_option("--energy", o->energy,
+                  "write the energy over time to this CSV: step, t (s), kinetic energy "
+                  "(translational + rotational), potential energy of gravity (datum: the origin, "
+                  "y = 0 for the default gravity) and their total (J), the deepest contact "
+                  "penetration of the step and the largest rod error (m); one row per step (or "
+                  "per --energy-every steps), step 0 = as built, at most 1e6 rows; missing "
+                  "folders are created, and the folder's run.json lists the files cps wrote there")
+      ->check(kNotEmpty);
+  sub->add_option_function<std::string>(
+         "--energy-every",
+         [o](const std::string& text) { o->energy_every = std::stoll(text); },
+         "write a row of --energy every N steps (an integer in [1, 1e7]; default 1), and the "
+         "last step")
+      ->type_name("N")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            long long v = 0;
+            const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+            if (text.empty() || ec != std::errc() || end != text.data() + text.size() || v < 1 ||
+                static_cast<double>(v) > kMaxSteps) {
+              return text + ": not allowed; give a decimal integer in [1, 10000000] (steps)";
+            }
+            return {};
+          },
+          ""));
   sub->add_flag("--force", o->force,
-                "let --trace replace a file of that name that no earlier cps run wrote (its "
+                "let --trace or --energy replace a file of that name that no earlier cps run wrote (its "
                 "folder's run.json lists the files cps wrote there; those are replaced without "
                 "it); any other file is never touched");
   sub->add_option("--expect-hash", o->expect_hash,

@@ -1,0 +1,214 @@
+// cps simulate --energy, run as a user runs it: the columns and their units, the first row against
+// the start energy computed here from the scene, the energy's drift per step against semi-implicit
+// Euler's closed form, every push method on a scene file, and the values it refuses.
+#include "cli_support.h"
+#include "push_methods.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using cli_test::fresh_dir;
+using cli_test::Result;
+using cli_test::run_cps;
+using cli_test::slurp;
+
+namespace {
+
+// The columns of an energy CSV, with their units (docs/commands.md, simulate).
+const std::vector<std::string> kColumns = {"step",    "t_s",           "kinetic_J",  "potential_J",
+                                           "total_J", "penetration_m", "rod_error_m"};
+
+// A CSV: its header and its rows of numbers.
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+};
+
+Csv read_csv(const fs::path& p) {
+  Csv csv;
+  std::ifstream in(p);
+  std::string line;
+  bool first = true;
+  while (std::getline(in, line)) {
+    std::stringstream s(line);
+    std::string cell;
+    std::vector<std::string> cells;
+    while (std::getline(s, cell, ',')) cells.push_back(cell);
+    if (first) {
+      csv.header = cells;
+      first = false;
+      continue;
+    }
+    std::vector<double> row;
+    for (const std::string& c : cells) row.push_back(std::stod(c));
+    csv.rows.push_back(row);
+  }
+  return csv;
+}
+
+void write_text(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+// One box in free fall, spinning about a principal axis, no ground: mass m (kg), half extents
+// (hx, hy, hz) (m), centre x0 (m), velocity v0 (m/s), angular velocity (0, 0, wz) (rad/s), under
+// the default gravity (0, -g, 0) with g = 10 m/s^2 and dt = 1/60 s.
+struct FreeFall {
+  double m = 2.0;
+  double hx = 0.5, hy = 0.2, hz = 0.3;
+  double x0[3] = {1.0, 50.0, -2.0};
+  double v0[3] = {0.5, 3.0, -1.0};
+  double wz = 2.0;
+  double g = 10.0;
+  double dt = 1.0 / 60.0;
+
+  std::string scene_file() const {
+    std::ostringstream s;
+    s.precision(17);
+    s << R"({"name": "fall", "seconds": 1, "world": {"dt_s": )" << dt << R"(}, "bodies": [)"
+      << R"({"shape": "box", "half_extents_m": [)" << hx << ", " << hy << ", " << hz
+      << R"(], "mass_kg": )" << m << R"(, "position_m": [)" << x0[0] << ", " << x0[1] << ", "
+      << x0[2] << R"(], "velocity_mps": [)" << v0[0] << ", " << v0[1] << ", " << v0[2]
+      << R"(], "angular_velocity_radps": [0, 0, )" << wz << "]}]}";
+    return s.str();
+  }
+  // The start's energy (J): 1/2 m |v0|^2 + 1/2 I_zz wz^2 with I_zz = m (hx^2 + hy^2) / 3 (a
+  // solid box about its z axis), and the potential m g y0 (datum y = 0).
+  double kinetic() const {
+    const double izz = m * (hx * hx + hy * hy) / 3.0;
+    return 0.5 * m * (v0[0] * v0[0] + v0[1] * v0[1] + v0[2] * v0[2]) + 0.5 * izz * wz * wz;
+  }
+  double potential() const { return m * g * x0[1]; }
+};
+
+}  // namespace
+
+TEST_CASE("cps simulate --energy: the first row is the start's energy and a free fall loses "
+          "m g^2 dt^2 / 2 a step",
+          "[cli][energy]") {
+  const fs::path dir = fresh_dir("energy_fall");
+  const FreeFall f;
+  write_text(dir / "fall.json", f.scene_file());
+  const Result r = run_cps("simulate fall.json --seconds 1 --energy e.csv", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const Csv csv = read_csv(dir / "e.csv");
+  CHECK(csv.header == kColumns);
+  const long steps = std::lround(1.0 / f.dt);
+  REQUIRE(csv.rows.size() == static_cast<std::size_t>(steps + 1));
+  // Row 0 is the scene as built, computed here from the file's numbers.
+  const std::vector<double>& first = csv.rows.front();
+  CHECK(first[0] == 0.0);
+  CHECK(first[1] == 0.0);
+  CHECK(first[2] == Approx(f.kinetic()).epsilon(1e-10));
+  CHECK(first[3] == Approx(f.potential()).epsilon(1e-10));
+  CHECK(first[4] == Approx(f.kinetic() + f.potential()).epsilon(1e-10));
+  // The drift. Semi-implicit Euler (Eqs. 3.2.1-3.2.3) gives v_k = v0 - g k dt, the exact
+  // velocity at t_k = k dt, and y_k = y0 + v0 t_k - g dt^2 k (k + 1) / 2, which is
+  // g dt^2 k / 2 below the exact y(t_k) = y0 + v0 t_k - g t_k^2 / 2. The spin about a principal
+  // axis keeps its kinetic energy. So E_k - E_0 = -m g^2 dt^2 k / 2 exactly: the bound
+  // |E(t) - E(0)| <= m g^2 dt t / 2 holds with equality. Tolerance: the CSV's 12 digits of ~1e3 J.
+  const double e0 = first[4];
+  const double printed = 1e-11 * std::abs(e0) * 10.0;  // J
+  for (const std::vector<double>& row : csv.rows) {
+    const double k = row[0];
+    INFO("step " << k);
+    REQUIRE(row.size() == kColumns.size());
+    CHECK(row[1] == Approx(k * f.dt).margin(1e-9));
+    CHECK(row[4] - e0 == Approx(-f.m * f.g * f.g * f.dt * f.dt * k / 2.0).margin(printed));
+    CHECK(row[2] + row[3] == Approx(row[4]).margin(printed));
+    CHECK(row[5] == 0.0);  // no contact
+    CHECK(row[6] == 0.0);  // no rod
+  }
+  // One row every 7 steps, and the last: steps 0, 7, ..., 56 and 60.
+  REQUIRE(run_cps("simulate fall.json --seconds 1 --energy e7.csv --energy-every 7", dir).exit_code == 0);
+  const Csv every = read_csv(dir / "e7.csv");
+  std::vector<double> listed;
+  for (const std::vector<double>& row : every.rows) listed.push_back(row[0]);
+  std::vector<double> expected;
+  for (long k = 0; k <= steps; k += 7) expected.push_back(static_cast<double>(k));
+  if (steps % 7 != 0) expected.push_back(static_cast<double>(steps));
+  CHECK(listed == expected);
+  // run.json lists both files as cps's.
+  const std::string manifest = slurp(dir / "run.json");
+  CHECK(manifest.find("\"e.csv\"") != std::string::npos);
+  CHECK(manifest.find("\"e7.csv\"") != std::string::npos);
+}
+
+TEST_CASE("cps simulate --energy with a scene file of rods under every push method",
+          "[cli][energy]") {
+  const fs::path dir = fresh_dir("energy_pushes");
+  // The Newton's cradle of tests/data: five 1 kg balls on 1 m rods, the first raised 60 degrees
+  // (y = 1.5 m), the others at y = 1 m, all at rest: E(0) = m g sum y, with the heights read
+  // from the file itself.
+  const std::string cradle = slurp(fs::path(CPS_TEST_DATA) / "cradle.json");
+  REQUIRE(!cradle.empty());
+  write_text(dir / "cradle.json", cradle);
+  double start_potential = 0.0;  // J: m g y of each ball, read from its "position_m"
+  for (std::size_t at = cradle.find("\"position_m\": ["); at != std::string::npos;
+       at = cradle.find("\"position_m\": [", at + 1)) {
+    std::stringstream s(cradle.substr(at + 15));
+    double x = 0.0, y = 0.0;
+    char comma = 0;
+    s >> x >> comma >> y;
+    start_potential += 1.0 * 10.0 * y;  // mass_kg 1, the default gravity 10 m/s^2
+  }
+  for (const std::string& push : cli_test::push_method_names()) {
+    INFO("--push " << push);
+    const Result r = run_cps("simulate cradle.json --seconds 0.5 --push " + push +
+                                 " --energy " + push + ".csv",
+                             dir);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const Csv csv = read_csv(dir / (push + ".csv"));
+    CHECK(csv.header == kColumns);
+    REQUIRE(csv.rows.size() == 31u);  // 0.5 s at the default 60 Hz, and the state as built
+    CHECK(csv.rows.front()[2] == 0.0);
+    CHECK(csv.rows.front()[3] == Approx(start_potential).epsilon(1e-10));
+    // The rods are built at their lengths: no error at the start (the file's 17 digits).
+    CHECK(csv.rows.front()[6] == Approx(0.0).margin(1e-12));
+    for (const std::vector<double>& row : csv.rows) {
+      CHECK(row[5] >= 0.0);
+      CHECK(row[6] >= 0.0);
+      CHECK(std::isfinite(row[4]));
+    }
+  }
+}
+
+TEST_CASE("cps simulate --energy refuses bad values and writes nothing", "[cli][energy]") {
+  const fs::path dir = fresh_dir("energy_bad");
+  write_text(dir / "lab.csv", "mine\n");
+  fs::create_directories(dir / "adir");
+  struct Bad {
+    std::string args;
+    std::string named;  // what the message must name
+  };
+  const std::vector<Bad> bad = {
+      {"--energy ''", "--energy"},
+      {"--energy lab.csv", "--force"},
+      {"--energy adir", "adir"},
+      {"--energy e.csv --energy-every 0", "0"},
+      {"--energy e.csv --energy-every -3", "-3"},
+      {"--energy e.csv --energy-every 1.5", "1.5"},
+      {"--energy e.csv --energy-every 1e3", "1e3"},
+      {"--energy e.csv --energy-every 10000001", "10000001"},
+      {"--energy-every 2", "--energy"},
+      {"--energy e.csv --trace ./e.csv", "--trace"},
+      // 1e5 s at dt 0.01 s is 1e7 steps: more rows than an energy file may have.
+      {"--energy e.csv --seconds 1e5 --dt 0.01 --max-work 1e18", "--energy-every"},
+  };
+  for (const Bad& b : bad) {
+    const std::string seconds = b.args.find("--seconds") == std::string::npos ? "--seconds 0.1 " : "";
+    const Result r = run_cps("simulate stack " + seconds + b.args, dir);
+    INFO(b.args << ": " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find(b.named) != std::string::npos);
+    CHECK(!fs::exists(dir / "e.csv"));
+    CHECK(!fs::exists(dir / "run.json"));
+    CHECK(slurp(dir / "lab.csv") == "mine\n");
+  }
+}

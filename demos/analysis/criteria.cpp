@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -20,6 +21,10 @@ Criteria evaluate(const StepSystem& s, const ExactSolution& exact, const Eigen::
                                 " row kinds");
   }
   Criteria out;
+  if (!lambda.allFinite()) {  // a diverged sweep: every criterion is infinite
+    const double inf = std::numeric_limits<double>::infinity();
+    return Criteria{inf, inf, false, inf, inf, inf, inf, inf, inf, inf};
+  }
   bool exact_distance = false;
   const Eigen::VectorXd nearest = exact.nearest(s, lambda, exact_distance);
   const Eigen::VectorXd d = lambda - nearest;

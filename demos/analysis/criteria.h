@@ -56,7 +56,8 @@ struct Criteria {
   double natural_map_N = 0.0;
 };
 
-/// The criteria of `lambda` (c, N) on s against `exact` (solve_exact(s)). Throws
+/// The criteria of `lambda` (c, N) on s against `exact` (solve_exact(s)); every one +inf (and
+/// lambda_error_exact false) when lambda has a non-finite entry (a diverged sweep). Throws
 /// std::invalid_argument when lambda does not have c entries.
 Criteria evaluate(const StepSystem& s, const ExactSolution& exact, const Eigen::VectorXd& lambda);
 

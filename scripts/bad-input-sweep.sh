@@ -59,6 +59,7 @@ declare -A KIND=(
   ['*:--size']=size ['*:--times']=times
   ['render:--out']=out_folder ['report:--out']=out_folder ['figure:--out']=out_png ['figure:--format']=choice
   ['*:--trace']=trace ['*:--energy']=trace ['simulate:--energy-every']='param:integer:1:10000000:0:steps'
+  ['simulate:--solver-error']=trace ['simulate:--at']=steps ['simulate:--sweeps']=sweeps
   ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
   ['simulate:scene']=scene_one ['render:scene']=scene_many ['figure:scene']=scene_figure
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
@@ -104,6 +105,8 @@ MERGE_DUP=$root/merge-dup  # a copy of its CSV: every run twice with MERGE_SRC, 
 MERGE_NAN=$root/merge-nan  # its first run with us_per_step nan, made below
 BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick;report push --quick"
 BASE['report:--run']='report --out out'
+BASE['simulate:--at']='simulate stack --seconds 0.1 --solver-error e.csv'
+BASE['simulate:--sweeps']='simulate stack --seconds 0.1 --solver-error e.csv'
 BASE['report:--merge']='report --out out'
 
 NL=$'\n'
@@ -169,6 +172,11 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
       printf '%s\n' "" file file/sub /dev/null ;;
     out_png)  # not a PNG path that can be written
       printf '%s\n' "" file.png file/f.png dir.png f.txt file /dev/null ;;
+    steps)  # comma-separated step indices of the run: [0, 5] for the base's 6 steps
+      printf '%s\n' "" , x -1 6 1,,2 1, ,1 1.5 0x1 1e3 +1 " 1" "1 " "1;2" nan 4294967297 \
+        99999999999999999999 ;;
+    sweeps)  # comma-separated sweep counts in [0, 1e6]
+      printf '%s\n' "" , x -1 1000001 1,,2 1, 1.5 0x10 1e3 +1 " 1" "1;2" nan 4294967297 ;;
     trace)  # cannot be written as a new trace
       printf '%s\n' "" file file/t.csv adir ;;
     hash)  # 16 hex digits (0x prefix allowed)
@@ -220,6 +228,9 @@ seq_csv() {  # N -> 0,1,...,N-1
 # '/'). Run only when the command exists (render and figure need the renderer).
 EXTRA=(
   "steps/--seconds/--dt|simulate stack --seconds 1e5 --dt 1e-6"
+  "--solver-error|simulate stack --seconds 0.1 --at 1"
+  "--solver-error|simulate stack --seconds 0.1 --sweeps 1"
+  "--trace/--solver-error|simulate stack --seconds 0.1 --trace e.csv --solver-error e.csv"
   "frames/--fps/--seconds|render stack --seconds 1e5 --fps 1000 --size 16x16 --out out"
   "GiB/--size|render stack --seconds 1e5 --fps 0.5 --size 8192x8192 --out out"
   "--size/--compare|render stack --size 16x16 --compare push --seconds 0.1 --fps 10 --out out"
@@ -287,6 +298,7 @@ EXTRA=(
 CONTROLS=(
   "list"
   "simulate stack --seconds 0.1"
+  "simulate stack --seconds 0.1 --solver-error e.csv --at 0,5 --sweeps 0,1000000"
   "simulate stack --seconds 0.0084 --dt 1/60"  # rounds to one step, the fewest a run takes
   "simulate stack --seconds 1/60"
   "simulate stack --seconds 0.1 --energy e.csv --energy-every 10000000 --trace t.csv"

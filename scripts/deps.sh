@@ -20,6 +20,9 @@ cps_packages=(
   poppler-utils
   # glTF 2.0 binaries of `cps export` (header only; built and read back by the tests).
   libtinygltf-dev
+  # The exact reference of a step (`cps simulate --solver-error`, demos/analysis): Siconos
+  # numerics' Lemke solver.
+  libsiconos-numerics-dev
 )
 
 cps_install_missing() {

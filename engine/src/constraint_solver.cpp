@@ -55,6 +55,12 @@ class ExplicitSolver final : public ConstraintSolver {
     sum_squares = r.squaredNorm();
   }
 
+  void system(SparseRowMatrix& A, Eigen::VectorXd& b, RowLimits& limits) const override {
+    A = soft_ ? soft_A_ : system_.A;
+    b = system_.b;
+    limits = system_.limits;
+  }
+
  private:
   std::vector<Mat3> inv_inertia_;  // n: world inverse inertia per body at prepare()
   Eigen::VectorXd v1_;  // 6n: [v_i, w_i] per body at the solve (m/s, rad/s)
@@ -83,6 +89,10 @@ class MatrixFreeSolver final : public ConstraintSolver {
                 const std::vector<double>& lambda, double& max,
                 double& sum_squares) const override {
     cps::residual(system_, rows, friction, lambda, max, sum_squares);
+  }
+
+  void system(SparseRowMatrix& A, Eigen::VectorXd& b, RowLimits& limits) const override {
+    cps::explicit_system(system_, A, b, limits);
   }
 
  private:

@@ -58,6 +58,12 @@ class ConstraintSolver {
   virtual void residual(const std::vector<ConstraintRow>& rows, FrictionModel friction,
                         const std::vector<double>& lambda, double& max,
                         double& sum_squares) const = 0;
+
+  /// The system the last solve() solved, written out explicitly (for a StepSystem): A (c x c,
+  /// 1/kg; with soft rows A + diag(gamma_j A_jj)), b (c, m/s^2) and the rows' limits. Built on
+  /// request only (the matrix-free path multiplies its packed rows out, J times M^-1 J^T), never
+  /// in a step that nobody observes. No errors.
+  virtual void system(SparseRowMatrix& A, Eigen::VectorXd& b, RowLimits& limits) const = 0;
 };
 
 /// The implementation for `assembly`: Assembly::explicit_matrices or Assembly::matrix_free.

@@ -408,4 +408,46 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   }
 }
 
+void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::VectorXd& b,
+                     RowLimits& limits) {
+  const auto c = static_cast<Eigen::Index>(s.rows.size());
+  const auto slots = 6 * static_cast<Eigen::Index>(s.w.size());  // n bodies and the fixed slot
+  // J and (M^-1 J^T)^T over the slots, 12 entries a row; the fixed slot's M^-1 j^T is 0.
+  std::vector<Eigen::Triplet<double>> j_entries;
+  std::vector<Eigen::Triplet<double>> m_entries;
+  j_entries.reserve(static_cast<std::size_t>(12 * c));
+  m_entries.reserve(static_cast<std::size_t>(12 * c));
+  limits.c_min.resize(c);
+  limits.c_max.resize(c);
+  limits.mu.resize(c);
+  limits.normal_row.resize(static_cast<std::size_t>(c));
+  for (Eigen::Index r = 0; r < c; ++r) {
+    const PackedRow& p = s.rows[static_cast<std::size_t>(r)];
+    for (int half = 0; half < 2; ++half) {
+      const Eigen::Index column = 6 * static_cast<Eigen::Index>(half == 0 ? p.a : p.b);
+      for (int k = 0; k < 6; ++k) {
+        const auto e = static_cast<std::size_t>(6 * half + k);
+        j_entries.emplace_back(r, column + k, p.j[e]);
+        m_entries.emplace_back(r, column + k, p.minv_jt[e]);
+      }
+    }
+    limits.c_min[r] = p.c_min;
+    limits.c_max[r] = p.c_max;
+    limits.mu[r] = p.mu;
+    limits.normal_row[static_cast<std::size_t>(r)] = p.normal_row;
+  }
+  SparseRowMatrix J(c, slots);
+  SparseRowMatrix MJt(c, slots);
+  J.setFromTriplets(j_entries.begin(), j_entries.end());
+  MJt.setFromTriplets(m_entries.begin(), m_entries.end());
+  A = J * SparseRowMatrix(MJt.transpose());
+  if (s.softness != nullptr) {
+    for (Eigen::Index j = 0; j < c; ++j) {
+      const double gamma = (*s.softness)[static_cast<std::size_t>(j)];
+      if (gamma > 0.0 && s.diagonal[static_cast<std::size_t>(j)] > 0.0) A.coeffRef(j, j) *= 1.0 + gamma;
+    }
+  }
+  b = Eigen::Map<const Eigen::VectorXd>(s.b.data(), c);
+}
+
 }  // namespace cps

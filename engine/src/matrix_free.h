@@ -98,4 +98,11 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
               FrictionModel friction, const std::vector<double>& lambda, double& max,
               double& sum_squares);
 
+/// The system s holds, written out: A = J M^-1 J^T (c x c, 1/kg) from the packed rows' j and
+/// M^-1 j^T, with the softness of the last solve on its diagonal (A_jj (1 + gamma_j)), b (c, m/s^2)
+/// and the limits (c each). For capturing a step (cps/step_system.h); not used by the sweeps.
+/// s must be prepared and its b filled. No errors.
+void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::VectorXd& b,
+                     RowLimits& limits);
+
 }  // namespace cps

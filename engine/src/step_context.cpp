@@ -4,6 +4,7 @@
 #include "integrator.h"
 
 #include <algorithm>
+#include <utility>
 
 namespace cps {
 
@@ -39,6 +40,8 @@ void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<d
     return;
   }
   solver->solve(rows, *bodies, f_ext, terms, s, out, start);
+  if (observer) [[unlikely]] notify_observer(s, terms, out, start);
+  ++solves_this_step;
   ++counters.solves;
   if (def->measure_residual) {
     double max;
@@ -49,6 +52,33 @@ void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<d
     residual.rows += static_cast<std::int64_t>(rows.size());
   }
   add_constraint_forces(rows, out, f_ext, f);
+}
+
+void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
+                                  const std::vector<double>& out,
+                                  const std::vector<double>* start) const {
+  StepSystem system;
+  system.step = counters.steps;
+  system.solve = solves_this_step;
+  system.terms = terms;
+  system.dt = s.dt;
+  system.solver = s.kind;
+  system.iterations = s.iterations;
+  system.friction = s.friction;
+  system.soft = s.softness != nullptr;
+  RowLimits limits;
+  solver->system(system.A, system.b, limits);
+  system.c_min = std::move(limits.c_min);
+  system.c_max = std::move(limits.c_max);
+  system.normal_row = std::move(limits.normal_row);
+  system.mu = std::move(limits.mu);
+  system.kinds.reserve(rows.size());
+  for (const ConstraintRow& row : rows) system.kinds.push_back(row.kind);
+  const auto c = static_cast<Eigen::Index>(out.size());
+  system.lambda = Eigen::Map<const Eigen::VectorXd>(out.data(), c);
+  system.initial = start != nullptr ? Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(start->data(), c))
+                                    : Eigen::VectorXd::Zero(c);
+  observer(system);
 }
 
 void StepContext::store_warm_start() {

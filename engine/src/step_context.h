@@ -13,6 +13,7 @@
 #include "cps/collision.h"
 #include "cps/constraint.h"
 #include "cps/parameters.h"
+#include "cps/step_system.h"
 #include "cps/world.h"
 
 #include <Eigen/Core>
@@ -55,6 +56,10 @@ struct StepContext {
   std::vector<double> initial_second;
   StepCounters counters;
   ResidualStats residual;
+  /// World::set_solve_observer's callback, or empty (the usual case: one branch a solve). Not
+  /// copied with the context: a copy of a world starts unobserved.
+  SolveObserver observer;
+  int solves_this_step = 0;  ///< solves made in the current step (StepSystem::solve)
 
   /// Warm starting is on (WorldDef::warm_start > 0).
   bool warm() const { return def->warm_start > 0.0; }
@@ -77,6 +82,10 @@ struct StepContext {
              const std::vector<double>* start) {
     solve(settings(def->dt), terms, out, f, start);
   }
+  /// Writes out the system of the solve that just gave `out` (c, N) from `start` (c, N, or
+  /// nullptr for 0) with settings `s` and hands it to the observer (cps/step_system.h).
+  void notify_observer(const SolveSettings& s, TargetTerms terms, const std::vector<double>& out,
+                       const std::vector<double>* start) const;
   /// With warm starting on, stores this step's lambda and lambda_second for the next step.
   void store_warm_start();
   /// Sec. 3.2 over h (s): positions with f_position, stored momenta with f_momentum (6n each).

@@ -12,6 +12,7 @@
 
 #include "cps/body.h"
 #include "cps/constraint.h"
+#include "cps/step_system.h"
 
 #include <Eigen/SparseCore>
 
@@ -21,12 +22,7 @@ namespace cps {
 
 using SparseRowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-/// Which parts of each row's target velocity enter v: the full push + bias (the ordinary solve,
-/// and the first solve of Sec. 8.1), bias only (the second solve of Sec. 8.1, v without the
-/// constraint-correcting push factor), or the push alone with the bodies taken at rest and no
-/// external force, b = push / dt (the pseudo-velocity solve of the split impulse,
-/// push/split_impulse.cpp).
-enum class TargetTerms : int { push_and_bias, bias_only, push_from_rest };
+// TargetTerms (which parts of a row's target velocity enter v) is public: cps/step_system.h.
 
 /// The target velocity v_j (m/s) of a row in a solve of these terms: push + bias, bias, or push.
 inline double target_velocity(const ConstraintRow& row, TargetTerms terms) {

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace cps {
 namespace {
@@ -90,6 +91,8 @@ int World::add_distance(const DistanceConstraint& d) {
   return static_cast<int>(distances_.size()) - 1;
 }
 
+void World::set_solve_observer(SolveObserver observer) { ctx_->observer = std::move(observer); }
+
 std::size_t World::persisting_contacts() const {
   return ctx_->warm_start && def_.warm_start > 0.0 ? ctx_->warm_start->matched_points() : 0;
 }
@@ -103,6 +106,7 @@ void World::step() {
     push_ = parameter("push").find_choice(name_of(def_.push))->make_push_method();
     push_mode_ = def_.push;
   }
+  ctx.solves_this_step = 0;
   external_forces();  // Sec. 6.1: f_ext
   collide();          // Sec. 4: manifolds
   build_rows();       // Sec. 5: rows of J, targets, limits

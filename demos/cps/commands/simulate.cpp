@@ -1,5 +1,7 @@
 #include "commands/simulate.h"
 
+#include "commands/solver_error.h"
+
 #include "command.h"
 #include "options/options.h"
 #include "output/output.h"
@@ -201,6 +203,9 @@ struct SimulateOptions {
   std::string expect_hash;
   double max_work = kDefaultMaxWork;  // body-iterations
   scenes::Overrides overrides;
+  std::string solver_error;  // --solver-error FILE.csv
+  std::string at;            // --at STEP,...
+  std::optional<std::string> sweeps;  // --sweeps K,...
 };
 
 // Metrics that also report steps done to a Progress: the hook called after every step, so a long
@@ -241,6 +246,23 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
   check_steps(o.scene, seconds, r.world.def().dt);
   check_work(o.scene, r.world.bodies().size(), r.world.def(), seconds, o.max_work,
              lower_run_options(r.world.def()));
+  if (o.solver_error.empty() && (!o.at.empty() || o.sweeps)) {
+    throw UsageError(std::string(o.at.empty() ? "--sweeps" : "--at") +
+                     " needs --solver-error FILE.csv (the file the errors go to)");
+  }
+  std::optional<SolverErrorPlan> solver_error;
+  if (!o.solver_error.empty()) {
+    for (const auto& [other, option] : {std::pair{o.trace, "--trace"}, std::pair{o.energy, "--energy"}}) {
+      if (!other.empty() && std::filesystem::path(other).lexically_normal() ==
+                                std::filesystem::path(o.solver_error).lexically_normal()) {
+        throw UsageError("--solver-error " + o.solver_error + " is also the " + option +
+                         " file: give each option its own file");
+      }
+    }
+    solver_error = plan_solver_error(o.solver_error, o.at,
+                                     o.sweeps.value_or(std::string(kDefaultSweeps)),
+                                     std::llround(seconds / r.world.def().dt));
+  }
   if (o.energy_every && o.energy.empty()) {
     throw UsageError("--energy-every " + std::to_string(*o.energy_every) +
                      ": it sets the rows of the --energy file; give --energy FILE too");
@@ -279,6 +301,17 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
     if (!o.trace.empty()) trace.emplace(files->file(i++));
     if (!o.energy.empty()) energy_csv.emplace(files->file(i++), every);
   }
+  std::optional<SolverErrorWriter> errors;
+  if (solver_error) {
+    errors.emplace(std::move(*solver_error), o.force,
+                   run_info("simulate", argc, argv,
+                            {{"scene", scene->name},
+                             {"seconds", seconds},
+                             {"solver_error", o.solver_error},
+                             {"overrides", overrides_json(o.overrides)},
+                             {"parameters", parameters_json(r.world.def())}}));
+    errors->observe(r.world);
+  }
   // Steps on stderr, only once the run has taken 2 s (short runs and --json stay clean).
   Progress progress("simulate " + o.scene, std::llround(seconds / r.world.def().dt), "steps", 2.0);
   r.metrics = std::make_unique<ProgressMetrics>(std::move(r.metrics), progress);
@@ -295,6 +328,10 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
   if (energy_csv) {
     std::cerr << "energy: " << energy_csv->rows() << " rows (one every " << every
               << (every == 1 ? " step" : " steps") << ", and the last) in " << o.energy << "\n";
+  }
+  if (errors) {
+    const long rows = errors->finish();
+    std::cerr << "solver-error: " << rows << " rows in " << o.solver_error << "\n";
   }
   if (o.json) {
     std::cout << summary.dump(2) << "\n";
@@ -357,13 +394,32 @@ Command add_simulate(CLI::App& app, int argc, char** argv) {
           },
           ""));
   sub->add_flag("--force", o->force,
-                "let --trace or --energy replace a file of that name that no earlier cps run wrote (its "
+                "let --trace, --energy or --solver-error replace a file of that name that no "
+                "earlier cps run wrote (its "
                 "folder's run.json lists the files cps wrote there; those are replaced without "
                 "it); any other file is never touched");
   sub->add_option("--expect-hash", o->expect_hash,
                   "the state_hash (16 hex digits) the run must end with: if the run ends in "
                   "another state, print both hashes and exit 1 (a CI check that the physics "
                   "did not change)")
+      ->check(kNotEmpty);
+  sub->add_option("--solver-error", o->solver_error,
+                  "write, for the steps of --at, each solve's error against its exact solution "
+                  "(Siconos' Lemke method, polished) to this CSV: step, t (s), solve, rows, "
+                  "method (exact, engine, pgs, jacobi), sweeps, then |lambda - lambda*| (N, to "
+                  "the nearest exact solution), relative, impulse error (N s), velocity error "
+                  "(m/s), Signorini force (N), velocity (m/s) and complementarity (W), friction "
+                  "violation (N), natural-map residual (N); pgs and jacobi start from 0. Missing "
+                  "folders are created; --force as for --trace")
+      ->check(kNotEmpty);
+  sub->add_option("--at", o->at,
+                  "with --solver-error: the steps whose solves are measured, comma-separated "
+                  "step indices in [0, steps - 1] (0 is the first step; default: the last)")
+      ->check(kNotEmpty);
+  sub->add_option("--sweeps", o->sweeps,
+                  "with --solver-error: the sweep counts of pgs and jacobi, comma-separated "
+                  "integers in [0, " + std::to_string(kMaxSolverErrorSweeps) + "] (default " +
+                  std::string(kDefaultSweeps) + ")")
       ->check(kNotEmpty);
   add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);

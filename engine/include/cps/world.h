@@ -19,6 +19,7 @@
 #include "cps/collision.h"
 #include "cps/constraint.h"
 #include "cps/parameters.h"
+#include "cps/step_system.h"
 
 #include <Eigen/Core>
 
@@ -115,6 +116,15 @@ class World {
   /// persisted from the step before it (same body pair and contact feature), whose rows started
   /// from the cached lambdas (count). 0 with warm starting off.
   std::size_t persisting_contacts() const;
+
+  /// Calls `observer` after every solve of A lambda = b in the following steps, with the system
+  /// that solve solved written out (cps/step_system.h: A, b, the limits, the rows' kinds, the
+  /// guess and the lambda it returned); an empty function stops it. One solve a step with the
+  /// paper's push factor, two with the single frame push factor (Sec. 8.1), more with the
+  /// substeps of the soft step. The observer runs inside World::step and must not touch the
+  /// world. A copy of the world is not observed. Unobserved, a step does nothing more than test
+  /// that the function is empty. No errors.
+  void set_solve_observer(SolveObserver observer);
 
   /// Replaces the parameters (validated first: throws std::invalid_argument and keeps the old
   /// ones on a bad value). The bodies and constraints stay as they are.

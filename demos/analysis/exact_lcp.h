@@ -1,0 +1,74 @@
+#pragma once
+// An exact solution of a captured step's bounded system (cps/step_system.h): A lambda = b with
+// c_min <= lambda <= c_max per row, a box-constrained linear complementarity problem (paper
+// Sec. 6-7, Eq. 6.2.9; the "mixed" or "boxed" LCP of Cottle, Pang & Stone 1992, Sec. 1.2).
+//
+// Fixed friction limits (FrictionModel::fixed): the box problem is turned into a standard LCP
+// (every finite bound gives a shifted variable, a two-sided row a second, slack variable; a free
+// row is split into its positive and negative parts), solved by Siconos numerics' lexicographic
+// Lemke method (lcp_lexicolemke: a pivoting method, finite for this positive semi-definite
+// matrix), then polished: the rows with a clearly non-zero post-solve w = A lambda - b are held
+// at their bound, and the others take the least-norm Newton correction of A_FF lambda_F = b_F -
+// A_FB lambda_B, which leaves the natural-map residual at round-off.
+//
+// Coupled friction limits (FrictionModel::coupled, +-mu lambda_n): the bounds are linear in
+// lambda, so the problem is still one LCP (a friction row's lambda measured from -mu lambda_n,
+// with a slack for the width 2 mu lambda_n), no longer symmetric; Lemke on it, then the polish
+// with the bounds of the current lambda, repeated while they move. Lemke is not guaranteed to
+// end at a solution of a non-symmetric LCP: solve_exact throws when the result does not pass the
+// residual check (the funnel at rest, docs/exact_reference.md).
+//
+// A = J M^-1 J^T is only positive semi-definite: a box resting on four contact points, or a pile
+// of balls with more contact rows than degrees of freedom, has many lambda that solve the
+// problem (they differ by a null vector of A), while w = A lambda - b and the contact forces on
+// each body, J^T lambda, are the same for all (a convex quadratic program's minimisers share
+// A lambda). ExactSolution::nearest gives the solution closest to any lambda, so that an
+// iterate's error is its distance to the set of exact solutions, not to an arbitrary member.
+
+#include "cps/step_system.h"
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace cps::analysis {
+
+/// The exact solution of one StepSystem, and the set of all of them (fixed friction).
+struct ExactSolution {
+  /// c, N: one exact solution (Lemke's, polished).
+  Eigen::VectorXd lambda;
+  /// c, m/s^2: w = A lambda - b, the same for every exact solution (fixed friction).
+  Eigen::VectorXd w;
+  /// How it was found, for reports: "siconos lexicolemke + polish", or "siconos lexicolemke
+  /// (coupled bounds) + polish".
+  std::string method;
+  /// Coupled friction: rounds of the polish, each with the bounds of the last lambda (0 for
+  /// fixed friction).
+  int polish_rounds = 0;
+  /// The largest natural-map residual of lambda (N; cps::natural_map_residual).
+  double residual_max = 0.0;
+  /// Rows free to move within the solution set (F: not held at a bound by a non-zero w, and
+  /// touching a movable body), by index; the others are the same in every exact solution.
+  std::vector<int> free_rows;
+  /// |F| x d, orthonormal columns: a basis of the null space of A_FF; the exact solutions are
+  /// lambda + [N z on the rows F] within the bounds (d = 0: lambda is the only one).
+  Eigen::MatrixXd null_basis;
+
+  /// The exact solution nearest `y` (c, N) in the Euclidean norm: the projection of y onto
+  /// {lambda + N z on F}, when that lies within the bounds (to round-off; `exact` is then set
+  /// true), else the projection itself with `exact` false (its distance to y is then a lower
+  /// bound of y's distance to the solutions). For coupled friction the solution set is not
+  /// described: returns lambda with exact false. Throws std::invalid_argument when y has the
+  /// wrong size.
+  Eigen::VectorXd nearest(const StepSystem& s, const Eigen::VectorXd& y, bool& exact) const;
+};
+
+/// Solves s exactly (see the file comment). Throws std::invalid_argument for a system whose
+/// sizes disagree (or a coupled friction row whose contact row is not bounded [0, inf)),
+/// std::runtime_error naming Siconos' status when its Lemke solver fails (it does not on a
+/// positive semi-definite A with a feasible box), or when the polished solution's natural-map
+/// residual is above 1e-9 of the problem's force scale (max |lambda_j|, |b_j| / A_jj; N).
+ExactSolution solve_exact(const StepSystem& s);
+
+}  // namespace cps::analysis

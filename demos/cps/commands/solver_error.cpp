@@ -1,0 +1,123 @@
+// `cps simulate --solver-error` (see solver_error.h).
+#include "commands/solver_error.h"
+
+#include "criteria.h"
+#include "exact_lcp.h"
+#include "options/options.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <iostream>
+#include <stdexcept>
+#include <utility>
+
+namespace cps::cli {
+namespace {
+
+// The comma-separated integers of `text`, each in [lo, hi]; `option` and `what` name them in
+// messages.
+std::vector<long long> parse_counts(const std::string& text, long long lo, long long hi,
+                                    const std::string& option, const std::string& what) {
+  std::vector<long long> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    long long value = 0;
+    const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
+    if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || value < lo ||
+        value > hi) {
+      throw UsageError(option + " " + text + ": '" + item + "' is not " + what +
+                       ": give comma-separated integers in [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "]");
+    }
+    out.push_back(value);
+    if (end == text.size()) break;
+    start = end + 1;
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+const char* method_name(SolverKind k) { return k == SolverKind::pgs ? "pgs" : "jacobi"; }
+
+}  // namespace
+
+SolverErrorPlan plan_solver_error(const std::string& path, const std::string& at,
+                                  const std::string& sweeps, std::int64_t total_steps) {
+  SolverErrorPlan plan;
+  plan.path = path;
+  if (total_steps < 1) throw UsageError("--solver-error: the run takes no step");
+  if (at.empty()) {
+    plan.steps = {total_steps - 1};
+  } else {
+    for (const long long s : parse_counts(at, 0, total_steps - 1, "--at", "a step of this run")) {
+      plan.steps.push_back(s);
+    }
+  }
+  for (const long long k : parse_counts(sweeps, 0, kMaxSolverErrorSweeps, "--sweeps", "a sweep count")) {
+    plan.sweeps.push_back(static_cast<int>(k));
+  }
+  return plan;
+}
+
+std::string solver_error_header() {
+  return "step,t_s,solve,rows,method,sweeps," + std::string(analysis::kCriteriaColumns);
+}
+
+SolverErrorWriter::SolverErrorWriter(SolverErrorPlan plan, bool force, nlohmann::json info)
+    : plan_(std::move(plan)), info_(std::move(info)) {
+  output_ = plan_output({.folder = plan_.path.parent_path(),
+                         .files = {plan_.path.filename().string()},
+                         .command = "simulate",
+                         .use = FolderUse::shared,
+                         .scenes = {},
+                         .option = "--solver-error",
+                         .force = force});
+  begin_output(output_, info_);
+}
+
+void SolverErrorWriter::observe(World& world) {
+  world.set_solve_observer([this](const StepSystem& s) {
+    if (std::binary_search(plan_.steps.begin(), plan_.steps.end(), s.step)) systems_.push_back(s);
+  });
+}
+
+long SolverErrorWriter::finish() {
+  std::string text = solver_error_header() + "\n";
+  long rows = 0;
+  for (const std::int64_t step : plan_.steps) {
+    const bool solved = std::any_of(systems_.begin(), systems_.end(),
+                                    [&](const StepSystem& s) { return s.step == step; });
+    if (!solved) std::cerr << "solver-error: step " << step << " had no solve (no contact or rod)\n";
+  }
+  for (const StepSystem& s : systems_) {
+    analysis::ExactSolution exact;
+    try {
+      exact = analysis::solve_exact(s);
+    } catch (const std::exception& e) {
+      throw std::runtime_error("solver-error: step " + std::to_string(s.step) + ", solve " +
+                               std::to_string(s.solve) + ": " + e.what());
+    }
+    const double t = static_cast<double>(s.step) * s.dt;
+    const auto row = [&](const char* method, int sweeps, const Eigen::VectorXd& lambda) {
+      char head[128];
+      std::snprintf(head, sizeof head, "%lld,%.9g,%d,%lld,%s,%d,", static_cast<long long>(s.step),
+                    t, s.solve, static_cast<long long>(s.rows()), method, sweeps);
+      text += head + analysis::csv_fields(analysis::evaluate(s, exact, lambda)) + "\n";
+      ++rows;
+    };
+    row("exact", 0, exact.lambda);
+    row("engine", s.iterations, s.lambda);
+    for (const SolverKind method : {SolverKind::pgs, SolverKind::jacobi}) {
+      for (const int k : plan_.sweeps) row(method_name(method), k, solve_sweeps(s, method, k));
+    }
+  }
+  write_text_atomic(plan_.path, text);
+  end_output(output_, info_);
+  return rows;
+}
+
+}  // namespace cps::cli

@@ -1,0 +1,74 @@
+#pragma once
+// `cps simulate --solver-error FILE.csv`: the systems of chosen steps captured
+// (World::set_solve_observer, cps/step_system.h), solved exactly (demos/analysis/exact_lcp.h),
+// and the engine's PGS and Jacobi sweeps (Sec. 7) at chosen counts judged against the exact
+// solution (demos/analysis/criteria.h), one CSV row per step, solve, method and sweep count.
+
+#include "output/output.h"
+
+#include "cps/step_system.h"
+#include "cps/world.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cps::cli {
+
+/// The sweep counts written when --sweeps is not given.
+inline constexpr std::string_view kDefaultSweeps = "1,2,5,10,25,100,1000";
+/// The most sweeps --sweeps accepts (count): 10^6 sweeps of a 150-row system take about 2 s.
+inline constexpr int kMaxSolverErrorSweeps = 1'000'000;
+
+/// What --solver-error asks for: the file, the steps (indices as World::counters().steps before
+/// the step: 0 is the first step; sorted, unique) and the sweep counts (sorted, unique).
+struct SolverErrorPlan {
+  std::filesystem::path path;
+  std::vector<std::int64_t> steps;
+  std::vector<int> sweeps;
+};
+
+/// Reads the options into a plan. `at`: comma-separated step indices ("": the run's last step,
+/// total_steps - 1); `sweeps`: comma-separated counts. Throws UsageError (exit 2) naming the value and
+/// what is allowed: a step outside [0, total_steps - 1], a sweep count that is not an integer in
+/// [0, kMaxSolverErrorSweeps], an empty list.
+SolverErrorPlan plan_solver_error(const std::string& path, const std::string& at,
+                                  const std::string& sweeps, std::int64_t total_steps);
+
+/// The first line of the CSV: the columns with their units (criteria.h for the criteria).
+std::string solver_error_header();
+
+/// Captures the planned steps' systems from a world and writes the CSV under the output rule
+/// (output.h: the file's folder is a shared output folder; the file is written atomically).
+class SolverErrorWriter {
+ public:
+  /// Checks the path (plan_output with option "--solver-error": UsageError if it exists and no
+  /// earlier cps run wrote it, unless `force`; a folder of that name; a folder that cannot be
+  /// written), creates the folder and records the run in its run.json (begin_output with `info`).
+  SolverErrorWriter(SolverErrorPlan plan, bool force, nlohmann::json info);
+  SolverErrorWriter(const SolverErrorWriter&) = delete;
+  SolverErrorWriter& operator=(const SolverErrorWriter&) = delete;
+
+  /// Sets world's solve observer to keep the systems of the planned steps. The writer must
+  /// outlive the steps.
+  void observe(World& world);
+  /// Solves each captured system exactly and writes one row per step, solve, method (exact,
+  /// engine, pgs, jacobi) and sweep count, then lists the file in run.json. Returns the rows
+  /// written. A planned step with no solve (no contact or rod) is named on stderr. Throws
+  /// std::runtime_error when an exact solve fails (naming the step) or the file cannot be
+  /// written.
+  long finish();
+
+ private:
+  SolverErrorPlan plan_;
+  OutputPlan output_;
+  nlohmann::json info_;
+  std::vector<StepSystem> systems_;
+};
+
+}  // namespace cps::cli

@@ -8,6 +8,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <random>
 
 namespace cps::cli {
 namespace {
@@ -213,8 +214,16 @@ void step_copy(scenes::Run& run, TimedRun& t) {
 }
 
 // One repeat of `t`: its copies made (untimed), then stepped one after another under the
-// thread's CPU clock. Returns the CPU seconds per copy.
+// thread's CPU clock. Returns the CPU seconds per copy. Before the copies are made, a block of
+// a pseudo-random size (0 to 64 KiB in 16-byte steps, from a fixed seed) is allocated and held
+// through the repeat: it moves where the worlds' buffers land on the heap, so that a repeat's
+// memory layout (cache set conflicts, 4 KiB aliasing) varies from repeat to repeat instead of
+// one layout holding for every repeat of a run in a process (Mytkowicz et al. 2009, "Producing
+// wrong data without doing anything obviously wrong"). A guard, not a measured cure: see
+// docs/benchmarks.md (Run time of cps report) for what it did and did not change here.
 double time_repeat(TimedRun& t) {
+  static std::mt19937 layout(26);
+  const std::vector<char> pad(16 * static_cast<std::size_t>(layout() % 4096), 1);
   std::vector<scenes::Run> copies;
   copies.reserve(static_cast<std::size_t>(t.copies));
   for (int k = 0; k < t.copies; ++k) copies.push_back(scenes::make_run(*t.scene, t.overrides));

@@ -65,6 +65,7 @@ declare -A KIND=(
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
   ['export:scene']=scene_one ['export:--out']=out_glb ['*:--max-work']=max_work
+  ['report:--repeats']=repeats
   # The sweep puts a positional's bad value in the first place, so reference's values cover frames.
   ['diff:reference']=png_in ['diff:frames']=skip ['diff:--out']=out_folder
   ['diff:--threshold']='param:real:0:255:0:levels' ['diff:--tolerance']='param:real:0:100:0:%'
@@ -126,6 +127,8 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     max_work)  # [1, 1e18] body-iterations: NUM_COMMON but its 1e12 and 4294967297, which are allowed
       printf '%s\n' "$NUM_COMMON" | grep -vx -e 1e12 -e 4294967297
       printf '%s\n' 0 -1 0.5 1e-400 1e19 1e400 1/2 ;;
+    repeats)  # timed repeats of a report run: a whole number in [3, 100]
+      printf '%s\n' "$NUM_COMMON" -1 0 -0 1 2 101 1000 1.5 3.0 1e1 1/2 0x3 ;;
     speed) printf '%s\n' "$NUM_COMMON" -1 0 -0 1e-400 100.5 101 1/2 ;;  # (0, 100] s/s
     fov) printf '%s\n' "$NUM_COMMON" -1 0 1 170 180 1e-400 1/2 ;;       # (1, 170) deg
     point)  # X,Y,Z in m, each finite with |value| <= 1e6
@@ -288,6 +291,9 @@ EXTRA=(
   "--max-work|report --run $RUN_ID --out out --max-work 1"
   "--max-work|report intersecting_stack --list-runs --out out --max-work 1"
   "--max-work|report intersecting_stack --quick --out out --max-work 1"
+  # Within the budget alone, past it with the error run, the warm-up and 5 repeats: 7 x 180.
+  "--repeats/1260|report --run $RUN_ID --out out --max-work 1000"
+  "--repeats|report push --quick --out out --repeats 7"
   "--max-work|report push --quick --out out --max-work 1"
   "--max-work|bench --quick --scene intersecting_stack --max-work 1"
   "MiB/--fps|export funnel_2000 --seconds 99.989 --fps 1000 --out out/f.glb"
@@ -319,6 +325,9 @@ CONTROLS=(
   "simulate stack --seconds 1 --max-work 9000"  # exactly the run's work
   "simulate stack --seconds 0.1 --push soft --soft-substeps 1000 --iterations 10000"
   "report intersecting_stack --list-runs --out out --max-work 1e18"
+  "report intersecting_stack --list-runs --out out --repeats 3"  # the ends of --repeats' range
+  "report intersecting_stack --list-runs --out out --repeats 100"
+  "report --run $RUN_ID --out out --repeats 3 --max-work 900"  # exactly (3 + 2) x 180
 )
 
 # ---------------------------------------------------------------------------------------------

@@ -572,7 +572,7 @@ TEST_CASE("every command's --help states the units of its options", "[cli][help]
   std::vector<Case> cases = {
       {"list", {"(s)"}},
       {"simulate", {"(s)", "(m)", "(m/s)", "(rad/s)", "--trace", "--force", "never touched"}},
-      {"report", {"160 runs", "warm start 0.8 and 1", "median of 3", "INCOMPLETE", "--out TEXT=out/report"}},
+      {"report", {"warm start 0.8 and 1", "--repeats N", "[3, 100]", "CPU time", "INCOMPLETE", "--out TEXT=out/report"}},
       {"bench", {"us/step"}},
   };
 #ifdef CPS_HAVE_RENDERER

@@ -339,7 +339,7 @@ TEST_CASE("report --merge refuses a cell that is not finite, naming file, line, 
     return header + "\n\n" + out + "\n";  // an empty line: the row is on line 3
   };
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"trajectory_error_m", "nan"}, {"wall_s_per_sim_s", "inf"}, {"metric.creep_m", "-inf"},
+      {"trajectory_error_m", "nan"}, {"cpu_s_per_sim_s", "inf"}, {"metric.creep_m", "-inf"},
       {"residual_max_N", "1e999"},   {"warm_start", "NaN"},       {"solver", "nan"},
       {"penetration_max_m", "0.1x"}, {"diverged", "2"}};
   for (const auto& [column, value] : cases) {

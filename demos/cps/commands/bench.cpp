@@ -3,6 +3,7 @@
 #include "command.h"
 #include "options/options.h"
 #include "output/output.h"
+#include "report/timing.h"  // thread_cpu_seconds: the physics runs on this one thread
 #include "scene.h"
 
 #ifdef CPS_HAVE_RENDERER
@@ -38,14 +39,6 @@ namespace {
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
-}
-
-// CPU time of the calling thread (s): the physics runs on this one thread, so time the machine
-// gives to other processes (this one is shared) does not count against it, as wall time would.
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 // Time and work per step of a scene over a window: microseconds (thread CPU time), constraint

@@ -8,11 +8,13 @@
 #include "report/push/report.h"
 #include "report/result.h"
 #include "report/sweep.h"
+#include "report/timing.h"
 
 #include <CLI/CLI.hpp>
 
 #include <unistd.h>
 
+#include <charconv>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -30,11 +32,34 @@ struct ReportOptions {
   std::string run;
   bool force = false;
   double max_work = kDefaultMaxWork;  // body-iterations a run
+  int repeats = kDefaultRepeats;      // timed repeats a run
 };
 
+// CLI11 validator for --repeats: a whole number (decimal digits) in [kMinRepeats, kMaxRepeats].
+// Its message names the text and the range.
+CLI::Validator repeats_in_range() {
+  const std::string range =
+      "[" + std::to_string(kMinRepeats) + ", " + std::to_string(kMaxRepeats) + "]";
+  return CLI::Validator(
+      [range](std::string& input) -> std::string {
+        int n = 0;
+        const char* last = input.c_str() + input.size();
+        const auto [end, ec] = std::from_chars(input.c_str(), last, n);
+        if (input.empty() || ec == std::errc::invalid_argument || end != last) {
+          return "'" + input + "' is not a whole number; give a count of timed repeats in " + range;
+        }
+        if (ec == std::errc::result_out_of_range || n < kMinRepeats || n > kMaxRepeats) {
+          return "'" + input + "': timed repeats per run must be in " + range;
+        }
+        return {};
+      },
+      "N in " + range);
+}
+
 // Refuses (UsageError, check_work) the first of `runs` whose work to its scene's report horizon
-// passes max_work (body-iterations), before any of them runs. Bodies are counted once a scene.
-void check_runs_work(const std::vector<RunSpec>& runs, double max_work) {
+// passes max_work (body-iterations), or whose error run, warm-up and `repeats` timed repeats
+// together do, before any of them runs. Bodies are counted once a scene.
+void check_runs_work(const std::vector<RunSpec>& runs, double max_work, int repeats) {
   std::map<std::string, std::size_t> bodies;
   for (const RunSpec& r : runs) {
     const scenes::Scene& scene = r.scene_def();
@@ -42,9 +67,19 @@ void check_runs_work(const std::vector<RunSpec>& runs, double max_work) {
     if (it == bodies.end()) {
       it = bodies.emplace(r.scene, make_run_or_usage_error(scene, {}).world.bodies().size()).first;
     }
-    check_work("run " + r.id(), it->second, scenes::world_def_with(scene, r.overrides()),
-               scene.report_horizon_s(), max_work,
+    const WorldDef def = scenes::world_def_with(scene, r.overrides());
+    check_work("run " + r.id(), it->second, def, scene.report_horizon_s(), max_work,
                "give a run with fewer substeps or iterations, or raise --max-work");
+    const double work = run_work(it->second, def, scene.report_horizon_s());
+    const double total = work * (repeats + 2);
+    if (total > max_work) {
+      throw UsageError("run " + r.id() + ": its error run, the warm-up and " +
+                       std::to_string(repeats) + " timed repeats (--repeats) are " +
+                       std::to_string(repeats + 2) + " x " + shortest_decimal(work) + " = " +
+                       shortest_decimal(total) + " body-iterations of work, more than the budget "
+                       "of " + shortest_decimal(max_work) + " body-iterations a run may take "
+                       "(--max-work); give fewer --repeats or raise --max-work");
+    }
   }
 }
 
@@ -71,7 +106,8 @@ std::vector<const scenes::Scene*> report_scenes(const std::string& name) {
 int run_push(const ReportOptions& o, const nlohmann::json& info) {
   const char* sweep_only = !o.run.empty() ? "--run" : !o.merge.empty() ? "--merge"
                            : o.list        ? "--list-runs"
-                           : o.max_work != kDefaultMaxWork ? "--max-work" : nullptr;
+                           : o.max_work != kDefaultMaxWork ? "--max-work"
+                           : o.repeats != kDefaultRepeats  ? "--repeats" : nullptr;
   if (sweep_only) {
     throw UsageError(std::string("report push: ") + sweep_only +
                      " applies to the sweeps (a scene, 'all' or 'stress'), not to the push "
@@ -83,24 +119,32 @@ int run_push(const ReportOptions& o, const nlohmann::json& info) {
 int run_report(const ReportOptions& o, int argc, char** argv) {
   nlohmann::json merged = nlohmann::json::array();
   for (const std::string& m : o.merge) merged.push_back(m);
-  const nlohmann::json info = run_info(
+  nlohmann::json info = run_info(
       "report", argc, argv,
-      {{"scene", o.scene}, {"quick", o.quick}, {"repeats", kTimingRepeats}, {"merge", merged},
+      {{"scene", o.scene}, {"quick", o.quick}, {"repeats", o.repeats}, {"merge", merged},
        {"run", o.run.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.run)}});
   if (o.scene == kPushReport) return run_push(o, info);
-  const SweepOutput to{o.scene, o.quick, o.out, o.force, info};
+  // What the times are measured on (report/timing.h); a merge's times were measured by the
+  // runs it reads, whose CSV rows say where.
+  if (o.merge.empty()) {
+    info["timing"] = {{"clock", "CLOCK_THREAD_CPUTIME_ID"},
+                      {"machine", this_machine()},
+                      {"build", this_build()},
+                      {"load_average_at_start", load_average()}};
+  }
+  const SweepOutput to{o.scene, o.quick, o.out, o.force, info, o.repeats, o.max_work};
   if (!o.merge.empty()) return merge_report(to, {o.merge.begin(), o.merge.end()});
   if (!o.run.empty()) {
     const RunSpec spec = RunSpec::parse(o.run);
     report_scenes(o.scene);  // the sweep it belongs to must be one
-    check_runs_work({spec}, o.max_work);
+    check_runs_work({spec}, o.max_work, o.repeats);
     return run_one(to, spec);
   }
   const std::vector<const scenes::Scene*> scenes = report_scenes(o.scene);
   const std::vector<RunSpec> runs = plan_runs(scenes, o.quick);
-  check_runs_work(runs, o.max_work);
+  check_runs_work(runs, o.max_work, o.repeats);
   if (o.list) {
-    // Each run's command carries a --max-work given here.
+    // Each run's command carries a --max-work given here (and --repeats: run_commands).
     const std::string budget =
         o.max_work != kDefaultMaxWork ? " --max-work " + shortest_decimal(o.max_work) : "";
     for (const std::string& line : run_commands(self_path(), to, runs)) {
@@ -134,10 +178,10 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                 "a reduced sweep: iterations 1, 4, 16, 25, 64 and 4 substeps, fixed friction "
                 "only, Jacobi for the paper's push methods only, and warm-started PGS (warm "
                 "start 0.8 and 1) at iterations 1, 4, 16, 25 with Baumgarte push; each run "
-                "timed by the median of 3 timing runs as in the full sweep (the paper's five "
-                "scenes: " + std::to_string(quick_runs) + " runs; with the two push methods "
-                "baumgarte and split, 160 runs measured 63 s on 2 cores shared with other "
-                "jobs); with 'push': the stack over 60 s and the pendulum wave over 10 s");
+                "timed by --repeats as in the full sweep (the paper's five "
+                "scenes: " + std::to_string(quick_runs) + " runs, measured 126 s with 5 "
+                "repeats on 2 cores shared with other jobs); with 'push': the stack over 60 s "
+                "and the pendulum wave over 10 s");
   CLI::Option* list = sub->add_flag("--list-runs", o->list,
                 "print one self-contained command per run, to spread the sweep over machines");
   CLI::Option* merge = sub->add_option("--merge", o->merge,
@@ -153,6 +197,17 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                   "name the sweep it belongs to, recorded in its CSV for --merge")
       ->check(kNotEmpty);
   add_max_work_option(*sub, o->max_work);
+  sub->add_option("--repeats", o->repeats,
+                  "timed repeats of each run, in [" + std::to_string(kMinRepeats) + ", " +
+                      std::to_string(kMaxRepeats) + "]: the CPU time of the stepping thread, "
+                      "after one untimed warm-up repeat, a repeat stepping a short run several "
+                      "times over to last " + shortest_decimal(kMinRepeatSeconds) + " s; the "
+                      "repeats of a sweep's runs are interleaved; the CSV gives their median and "
+                      "quartiles; the error run, the warm-up and the repeats together must stay "
+                      "within --max-work")
+      ->type_name("N")
+      ->capture_default_str()
+      ->check(repeats_in_range());
   run->excludes(merge)->excludes(list);
   merge->excludes(list);
   sub->add_flag("--force", o->force,

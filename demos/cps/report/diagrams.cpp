@@ -36,11 +36,14 @@ int push_rank(const std::string& value) {
   return i;
 }
 
-// One point of a diagram: physics time (s/s), the value drawn, and its label.
+// One point of a diagram: physics time (s/s), the value drawn, its label, and the first and
+// third quartiles of the time (s/s; the error bar, x itself where the run has none).
 struct PlotPoint {
   double x = 0.0;
   double y = 0.0;
   std::string label;
+  double x_lo = 0.0;
+  double x_hi = 0.0;
 };
 
 // One panel of a work-precision diagram: the runs of one solver, push and friction model.
@@ -135,29 +138,34 @@ Panel make_panel(const Measure& m, const std::vector<const RunResult*>& runs, Di
   std::vector<std::pair<int, PlotPoint>> it_line, ss_line;
   std::vector<std::vector<std::pair<int, PlotPoint>>> warm_lines(d.warm_factors.size());
   for (const RunResult* r : sorted) {
-    const double t = r->wall_s_per_sim_s.value_or(std::nan(""));
+    const double t = r->cpu_s_per_sim_s.value_or(std::nan(""));
     if (!(t > 0.0)) continue;
+    // The error bar: the quartiles of the time, where they are positive.
+    const double q1 = r->cpu_s_per_sim_s_q1.value_or(t), q3 = r->cpu_s_per_sim_s_q3.value_or(t);
+    const double t_lo = q1 > 0.0 ? std::min(q1, t) : t, t_hi = std::max(q3, t);
     const int it = r->iterations, ss = r->substeps;
     const double w = r->warm_start;
     const std::string label = (ss == 1 ? std::to_string(it) + " it" : std::to_string(ss) + " ss") +
                               (w != 0.0 ? ", ws " + shortest_decimal(w) : std::string());
     if (r->diverged) {
-      p.diverged.push_back({t, 0.0, label});
+      p.diverged.push_back({t, 0.0, label, t_lo, t_hi});
       d.any_diverged = true;
-      e.add_x(t);
+      e.add_x(t_lo);
+      e.add_x(t_hi);
       continue;
     }
     const double value = r->value(m.column);
     if (std::isnan(value)) continue;
     e.any_value = true;
     e.raw_min = std::min(e.raw_min, value);
-    const PlotPoint point{t, std::max(value, d.floor), label};
+    const PlotPoint point{t, std::max(value, d.floor), label, t_lo, t_hi};
     if (value < d.floor) {
       p.clamped.push_back(point);
       d.any_clamped = true;
     }
     e.y_max = std::max(e.y_max, point.y);
-    e.add_x(t);
+    e.add_x(t_lo);
+    e.add_x(t_hi);
     if (w != 0.0) {
       // Warm runs: the iteration line of their factor only (the sweep has no warm substeps).
       const auto k = std::find(d.warm_factors.begin(), d.warm_factors.end(), w);
@@ -230,7 +238,8 @@ struct Frame {
   double u(double x) const { return std::log(x / x_lo) / lu; }
   double v(double y) const { return std::log(y / y_lo) / lv; }
   PlotPoint centre(const Box& b, const std::string& label) const {
-    return {x_lo * std::exp(0.5 * (b.u0 + b.u1) * lu), y_lo * std::exp(0.5 * (b.v0 + b.v1) * lv), label};
+    const double x = x_lo * std::exp(0.5 * (b.u0 + b.u1) * lu);
+    return {x, y_lo * std::exp(0.5 * (b.v0 + b.v1) * lv), label, x, x};
   }
 };
 
@@ -322,8 +331,8 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
 }
 
 // The diagram's data: one gnuplot index block per non-empty list, in the order plot_script
-// reads them; per line x, y and a "label" (for the label lists, x and y are where the label's
-// centre goes).
+// reads them; per line x, y, the error bar's ends x_lo and x_hi, and a "label" (for the label
+// lists, x and y are where the label's centre goes).
 std::string plot_data(const Diagram& d) {
   std::ostringstream out;
   for (const Panel& p : d.panels) {
@@ -335,7 +344,9 @@ std::string plot_data(const Diagram& d) {
     }
     for (const auto* list : lists) {
       if (list->empty()) continue;
-      for (const PlotPoint& q : *list) out << q.x << " " << q.y << " \"" << q.label << "\"\n";
+      for (const PlotPoint& q : *list) {
+        out << q.x << " " << q.y << " " << q.x_lo << " " << q.x_hi << " \"" << q.label << "\"\n";
+      }
       out << "\n\n";
     }
   }
@@ -430,17 +441,18 @@ std::string panel_plot(const Panel& p, const Diagram& d, const fs::path& data, i
     parts.push_back((parts.empty() ? gp_text(data.string()) : std::string("''")) + " index " +
                     std::to_string(index++) + " " + style);
   };
-  block(p.iterations, "using 1:2 with linespoints lw 1.5 pt 7 ps 0.7 lc rgb '#1f77b4'");
+  // The lines with their error bars: the quartiles of each run's time (columns 3 and 4).
+  block(p.iterations, "using 1:2:3:4 with xerrorlines lw 1.5 pt 7 ps 0.7 lc rgb '#1f77b4'");
   for (std::size_t k = 0; k < p.warm.size(); ++k) {
-    block(p.warm[k], "using 1:2 with linespoints " + warm_line_style(k));
+    block(p.warm[k], "using 1:2:3:4 with xerrorlines " + warm_line_style(k));
   }
-  block(p.substeps, "using 1:2 with linespoints lw 1.5 dt 2 pt 5 ps 0.7 lc rgb '#e377c2'");
+  block(p.substeps, "using 1:2:3:4 with xerrorlines lw 1.5 dt 2 pt 5 ps 0.7 lc rgb '#e377c2'");
   block(p.paper, "using 1:2 with points pt 6 ps 2.2 lw 1.5 lc rgb 'black'");
   block(p.clamped, "using 1:2 with points pt 10 ps 1.6 lw 1.5 lc rgb 'black'");
-  block(p.diverged, "using 1:2 with points pt 2 ps 1.8 lw 2.5 lc rgb '#d62728'");
-  block(p.labels_it, "using 1:2:3 with labels font ',8' tc rgb '#1f77b4'");
-  block(p.labels_ss, "using 1:2:3 with labels font ',8' tc rgb '#c0399c'");
-  block(p.labels_div, "using 1:2:3 with labels font ',8' tc rgb '#d62728'");
+  block(p.diverged, "using 1:2:3:4 with xerrorbars pt 2 ps 1.8 lw 2.5 lc rgb '#d62728'");
+  block(p.labels_it, "using 1:2:5 with labels font ',8' tc rgb '#1f77b4'");
+  block(p.labels_ss, "using 1:2:5 with labels font ',8' tc rgb '#c0399c'");
+  block(p.labels_div, "using 1:2:5 with labels font ',8' tc rgb '#d62728'");
   gp << "plot ";
   for (std::size_t k = 0; k < parts.size(); ++k) gp << (k ? ", \\\n     " : "") << parts[k];
   gp << "\n";
@@ -504,7 +516,8 @@ std::string plot_script(const Diagram& d, const fs::path& data, const std::strin
        << "set size " << panel_w << ", " << panel_h << "\n"
        << "set title " << gp_text(d.panels[static_cast<std::size_t>(i)].title)
        << " font ',10' offset 0,-0.4\n"
-       << (row == rows - 1 ? "set xlabel 'physics wall time per simulated second (s/s)' "
+       << (row == rows - 1 ? "set xlabel 'physics CPU time per simulated second (s/s; "
+                             "bars: quartiles of the repeats)' "
                              "font ',9' offset 0,0.4\n"
                            : "unset xlabel\n")
        << (col == 0 ? "set ylabel " + gp_text(m.axis) + " font ',9' offset 1,0\n" : "unset ylabel\n")

@@ -2,9 +2,11 @@
 
 #include "report/mass_ratio.h"
 #include "report/run.h"
+#include "report/timing.h"
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <sstream>
 
 namespace cps::cli {
@@ -14,6 +16,41 @@ using Runs = std::vector<const RunResult*>;
 
 // The text of a run's column as its CSV has it; "" where the run has none.
 std::string text(const RunResult& r, std::string_view column) { return r.cell(column).value_or(""); }
+
+// A run's time (CPU s per simulated s, the median of its repeats); NaN where it has none.
+double time_of(const RunResult& r) { return r.value("cpu_s_per_sim_s"); }
+
+// The relative spread of a run's time: its interquartile range over its median; 0 where a
+// quartile is missing.
+double spread_of(const RunResult& r) {
+  const double q1 = r.value("cpu_s_per_sim_s_q1"), q3 = r.value("cpu_s_per_sim_s_q3");
+  const double t = time_of(r);
+  return std::isfinite(q1) && std::isfinite(q3) && t > 0.0 ? (q3 - q1) / t : 0.0;
+}
+
+// A run's time as report.md prints it: the median with the significant digits its quartiles
+// support (significant_digits).
+std::string time_text(const RunResult& r) {
+  const double t = time_of(r);
+  const double q1 = r.value("cpu_s_per_sim_s_q1"), q3 = r.value("cpu_s_per_sim_s_q3");
+  return number_with_digits(
+      t, std::isfinite(q1) && std::isfinite(q3) ? significant_digits(q1, t, q3) : 3);
+}
+
+// The ratio of run a's time to run b's with the digits their spreads support (ratio_digits),
+// and in brackets the range their quartiles allow (a's Q1 over b's Q3 to a's Q3 over b's Q1)
+// where both have them and they are two runs.
+std::string ratio_text(const RunResult& a, const RunResult& b) {
+  const int digits = ratio_digits(spread_of(a), spread_of(b));
+  std::string out = number_with_digits(time_of(a) / time_of(b), digits);
+  const double a1 = a.value("cpu_s_per_sim_s_q1"), a3 = a.value("cpu_s_per_sim_s_q3");
+  const double b1 = b.value("cpu_s_per_sim_s_q1"), b3 = b.value("cpu_s_per_sim_s_q3");
+  if (&a != &b && std::isfinite(a1) && std::isfinite(a3) && b1 > 0.0 && b3 > 0.0) {
+    out += " (" + number_with_digits(a1 / b3, digits) + " to " +
+           number_with_digits(a3 / b1, digits) + ")";
+  }
+  return out;
+}
 
 // The run at the paper's settings among `runs` (the last one), or nullptr.
 const RunResult* paper_run(const Runs& runs) {
@@ -36,7 +73,7 @@ void write_missing(std::ostream& md, const ReportContent& c) {
   md << ".\n\n";
 }
 
-// How many timing runs each run's time is the median of: "3", "1 to 3", or "the".
+// How many timed repeats each run's time is the median of: "5", "3 to 5", or "the".
 std::string repeats_text(const ReportContent& c) {
   int least = 1 << 30, most = 0;
   for (const auto& [scene, runs] : c.runs) {
@@ -50,16 +87,62 @@ std::string repeats_text(const ReportContent& c) {
   return "the";
 }
 
-// What the numbers are: time, divergence, trajectory error, residual, substeps, warm start,
-// round-off floors.
+// The distinct values of a text column of the runs (machine, build), sorted; "" left out.
+std::set<std::string> distinct(const ReportContent& c, std::string_view column) {
+  std::set<std::string> values;
+  for (const auto& [scene, runs] : c.runs) {
+    for (const RunResult* r : runs) {
+      const std::string v = text(*r, column);
+      if (!v.empty()) values.insert(v);
+    }
+  }
+  return values;
+}
+
+// Where the times were measured: the machines and builds the runs name, and the load.
+void write_timed_on(std::ostream& md, const ReportContent& c) {
+  const auto list = [&md](const std::set<std::string>& values) {
+    if (values.empty()) md << "not recorded (runs of an older build)";
+    bool first = true;
+    for (const std::string& v : values) {
+      md << (first ? "" : "; ") << "`" << v << "`";
+      first = false;
+    }
+  };
+  const std::set<std::string> machines = distinct(c, "machine"), builds = distinct(c, "build");
+  md << "- **Timed on** ";
+  list(machines);
+  md << "; **built with** ";
+  list(builds);
+  md << ".";
+  if (machines.size() > 1 || builds.size() > 1) {
+    md << " **The runs were timed on more than one machine or build: times and time ratios "
+          "across them compare the machines as much as the methods.**";
+  }
+  if (!c.load.empty()) md << " " << c.load;
+  md << "\n";
+}
+
+// What the numbers are: time and where it was measured, divergence, trajectory error, residual,
+// substeps, warm start, round-off floors.
 void write_definitions(std::ostream& md, const ReportContent& c) {
   md << "Made by `cps report` from " << c.run_count << " runs. What the numbers are:\n\n"
-     << "- **Time (s/s)**: physics wall time per simulated second, the median of "
+     << "- **Time (s/s)**: physics CPU time per simulated second (column cpu_s_per_sim_s): the "
+        "CPU time of the thread that steps (CLOCK_THREAD_CPUTIME_ID, so other processes on the "
+        "machine do not add to it), of the step alone (no metrics, no residual), the median of "
      << repeats_text(c)
-     << " timing runs of the step alone (no metrics, no residual; column timing_repeats) after "
-        "the error run as warm-up; a run whose error run took over 2 s is timed once. A "
-        "diverged run is timed until it diverged.\n"
-     << "- **Diverged**: the state stopped being finite, or a penetration or rod error passed "
+     << " timed repeats (column timing_repeats), each on a fresh world, after one untimed "
+        "warm-up repeat; a run shorter than " << number(kMinRepeatSeconds)
+     << " s of CPU is stepped several times over in each repeat (runs_per_repeat) and its "
+        "time is per run. The repeats of a sweep's runs are interleaved, a round of every run "
+        "after another, so that a change of the machine's load or clock falls on all of them "
+        "alike. The first and third quartiles of the repeats are cpu_s_per_sim_s_q1 and _q3 "
+        "(the error bars of the diagrams). Times are printed with the digits their spread "
+        "supports (one past the first that the interquartile range leaves uncertain, 2 to 4); "
+        "a time ratio with the digits of its two times' spreads together and, in brackets, the "
+        "range their quartiles allow. A diverged run is timed until it diverged.\n";
+  write_timed_on(md, c);
+  md << "- **Diverged**: the state stopped being finite, or a penetration or rod error passed "
         "the size of the largest movable body (the time: diverged_at_s). Its other measures "
         "stop there and are left out of the headline. In the diagrams it is a red x on the top "
         "edge, at its time until it diverged.\n"
@@ -94,9 +177,9 @@ const RunResult* cheapest_halving(const Runs& runs, const std::string& measure, 
   for (const RunResult* r : runs) {
     if (r->diverged) continue;
     const double e = r->value(measure);
-    const double t = r->value("wall_s_per_sim_s");
+    const double t = time_of(*r);
     if (trajectory && !(0.5 * e0 > r->value("reference_check_m"))) continue;
-    if (e <= 0.5 * e0 && std::isfinite(t) && (!best || t < best->value("wall_s_per_sim_s"))) best = r;
+    if (e <= 0.5 * e0 && std::isfinite(t) && (!best || t < time_of(*best))) best = r;
   }
   return best;
 }
@@ -112,24 +195,22 @@ void write_headline_row(std::ostream& md, const std::string& scene, const Runs& 
     return;
   }
   const double e0 = base->value(measure);
-  const double t0 = base->value("wall_s_per_sim_s");
   md << number(e0);
   if (measure == "trajectory_error_m" && e0 < base->value("reference_check_m")) {
     md << " (under its reference's own error, " << text(*base, "reference_check_m") << ")";
   }
-  md << " | " << number(t0) << " | ";
+  md << " | " << time_text(*base) << " | ";
   const RunResult* best = cheapest_halving(runs, measure, e0);
   if (!best) {
     md << "none in this sweep | | |\n";
     return;
   }
-  const double t1 = best->value("wall_s_per_sim_s");
   md << best->solver << ", " << best->push << ", " << best->friction_model << ", "
      << best->iterations << " it, " << best->substeps
      << (best->substeps == 1 ? " substep" : " substeps")
      << (best->warm_start != 0.0 ? ", warm start " + shortest_decimal(best->warm_start) : std::string())
-     << ": " << number(best->value(measure)) << " | " << number(t1) << " | " << number(t1 / t0)
-     << " |\n";
+     << ": " << number(best->value(measure)) << " | " << time_text(*best) << " | "
+     << ratio_text(*best, *base) << " |\n";
 }
 
 // The headline: per scene, the paper's settings and the cheapest run with at most half their
@@ -139,7 +220,9 @@ void write_headline(std::ostream& md, const ReportContent& c) {
      << "The cheapest run (least time) whose value of the scene's measure is at most half the "
         "value at the paper's settings, among every run of the scene (every solver, push and "
         "friction model), diverged runs left out. For the trajectory error a run counts only "
-        "if half the paper's value is above its reference's own error.\n\n"
+        "if half the paper's value is above its reference's own error. Which run is the "
+        "cheapest is decided by the medians of the times: where its time ratio's range "
+        "(brackets) reaches 1, another run of the same error may be as cheap.\n\n"
      << "| scene | measure | at the paper's settings (PGS, Baumgarte, fixed friction, 25 it, 60 Hz) "
         "| its time (s/s) | cheapest run with at most half of it | its time (s/s) | time ratio |\n"
         "|---|---|---|---|---|---|---|\n";
@@ -186,7 +269,7 @@ void write_warm_table(std::ostream& md, const std::string& scene, const Runs& ru
   md << "### Warm starting: what PGS needs to reach the paper's error\n\n";
   const RunResult* base = paper_run(runs);
   if (!base || base->diverged || std::isnan(base->value(measure)) ||
-      !(base->value("wall_s_per_sim_s") > 0.0)) {
+      !(time_of(*base) > 0.0)) {
     md << "The paper's run (PGS, Baumgarte, fixed friction, " << kPaperIterations
        << " it, 1 substep, warm start 0) is "
        << (base ? "diverged or without a value of " + label_of(measure) : std::string("not in this sweep"))
@@ -194,10 +277,9 @@ void write_warm_table(std::ostream& md, const std::string& scene, const Runs& ru
     return;
   }
   const double e0 = base->value(measure);
-  const double t0 = base->value("wall_s_per_sim_s");
   md << "The fewest iterations at the paper's other settings (PGS, Baumgarte, fixed friction, "
         "1 substep) with which a run's " << label_of(measure) << " is at most the paper's run's ("
-     << kPaperIterations << " it, warm start 0): " << number(e0) << ", in " << number(t0)
+     << kPaperIterations << " it, warm start 0): " << number(e0) << ", in " << time_text(*base)
      << " s/s. Iterations saved: " << kPaperIterations << " minus that count. Diverged runs never count.";
   if (measure == "trajectory_error_m" && e0 < base->value("reference_check_m")) {
     md << " The paper's value is under its reference's own error ("
@@ -214,9 +296,9 @@ void write_warm_table(std::ostream& md, const std::string& scene, const Runs& ru
       md << "none in this sweep | | | | |\n";
       continue;
     }
-    const double t = fewest->value("wall_s_per_sim_s");
-    md << fewest->iterations << " | " << number(fewest->value(measure)) << " | " << number(t)
-       << " | " << number(t / t0) << " | " << kPaperIterations - fewest->iterations << " |\n";
+    md << fewest->iterations << " | " << number(fewest->value(measure)) << " | "
+       << time_text(*fewest) << " | " << ratio_text(*fewest, *base) << " | "
+       << kPaperIterations - fewest->iterations << " |\n";
   }
   md << "\n";
 }
@@ -249,18 +331,28 @@ void write_scene_facts(std::ostream& md, const std::string& scene, const Runs& r
   md << ".\n";
 }
 
-// A scene's table of runs: settings, time, its primary measure, residual, penetration, rod
+// A run's quartiles of time, "Q1 to Q3", with the digits of its time; "" where it has none.
+std::string quartiles_text(const RunResult& r) {
+  const double q1 = r.value("cpu_s_per_sim_s_q1"), q3 = r.value("cpu_s_per_sim_s_q3");
+  if (!std::isfinite(q1) || !std::isfinite(q3)) return "";
+  const int digits = significant_digits(q1, time_of(r), q3);
+  return number_with_digits(q1, digits) + " to " + number_with_digits(q3, digits);
+}
+
+// A scene's table of runs: settings, time and its quartiles, its primary measure, residual, penetration, rod
 // error, and when it diverged.
 void write_run_table(std::ostream& md, const std::string& scene, const Runs& runs) {
   const std::string measure = primary_measure(scene);
   md << "| solver | push | friction | iterations | substeps | warm start | time (s/s) | "
+        "time Q1 to Q3 (s/s) | "
      << label_of(measure)
      << " | residual RMS (N) | penetration max (m) | rod error max (m) | diverged at (s) |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const RunResult* r : runs) {
     md << "| " << r->solver << " | " << r->push << " | " << r->friction_model << " | "
        << r->iterations << " | " << r->substeps << " | " << shortest_decimal(r->warm_start)
-       << " | " << text(*r, "wall_s_per_sim_s") << " | " << text(*r, measure) << " | "
+       << " | " << time_text(*r) << " | " << quartiles_text(*r) << " | "
+       << text(*r, measure) << " | "
        << text(*r, "residual_rms_N") << " | " << text(*r, "penetration_max_m") << " | "
        << text(*r, "rod_error_max_m") << " | "
        << (r->diverged ? text(*r, "diverged_at_s") : "no") << " |\n";

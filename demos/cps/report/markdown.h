@@ -28,6 +28,8 @@ struct ReportContent {
   std::size_t planned = 0;
   /// How many runs the report holds.
   std::size_t run_count = 0;
+  /// What the machine's load was while the runs were timed (a sentence), or "" (a merge).
+  std::string load;
 };
 
 /// The text of report.md. If `missing` is not empty it opens with INCOMPLETE and names the first

@@ -8,8 +8,9 @@ namespace cps::cli {
 
 void write_report(const std::filesystem::path& dir, const std::vector<RunResult>& runs,
                   const std::vector<PairRow>& pairs, const std::vector<std::string>& missing,
-                  std::size_t planned) {
+                  std::size_t planned, const std::string& load) {
   ReportContent c;
+  c.load = load;
   c.missing = missing;
   c.planned = planned;
   c.run_count = runs.size();

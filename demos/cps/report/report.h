@@ -18,10 +18,11 @@ namespace cps::cli {
 /// (report_markdown). If `missing` (run ids, of `planned`) is not empty, report.md opens with
 /// INCOMPLETE and names them, and every diagram's title says so. Throws std::runtime_error if a
 /// file cannot be written or gnuplot fails (the message says to install gnuplot-nox when it is
-/// missing; the CSVs are kept).
+/// missing; the CSVs are kept). `load` (ReportContent::load): the machine's load while the runs
+/// were timed, a sentence for report.md, or "".
 void write_report(const std::filesystem::path& dir, const std::vector<RunResult>& runs,
                   const std::vector<PairRow>& pairs, const std::vector<std::string>& missing,
-                  std::size_t planned);
+                  std::size_t planned, const std::string& load = "");
 
 /// The files write_report may write into DIR for these scenes (plain names): report.md,
 /// mass_ratio.csv, and per scene SCENE.csv and each measure's SCENE_<measure>.png, .svg and .pdf. Every

@@ -23,7 +23,9 @@ constexpr std::pair<std::string_view, NumberField> kNumberColumns[] = {
     {"dt_s", &RunResult::dt_s},
     {"horizon_s", &RunResult::horizon_s},
     {"diverged_at_s", &RunResult::diverged_at_s},
-    {"wall_s_per_sim_s", &RunResult::wall_s_per_sim_s},
+    {"cpu_s_per_sim_s", &RunResult::cpu_s_per_sim_s},
+    {"cpu_s_per_sim_s_q1", &RunResult::cpu_s_per_sim_s_q1},
+    {"cpu_s_per_sim_s_q3", &RunResult::cpu_s_per_sim_s_q3},
     {"us_per_step", &RunResult::us_per_step},
     {"trajectory_time_s", &RunResult::trajectory_time_s},
     {"trajectory_error_m", &RunResult::trajectory_error_m},
@@ -42,10 +44,12 @@ constexpr std::pair<std::string_view, NumberField> kNumberColumns[] = {
 // the sweep. Metrics and other columns follow, sorted by name.
 constexpr std::string_view kColumnOrder[] = {
     "scene", "solver", "push", "friction_model", "iterations", "substeps", "warm_start", "dt_s",
-    "horizon_s", "diverged", "diverged_at_s", "wall_s_per_sim_s", "us_per_step", "timing_repeats",
+    "horizon_s", "diverged", "diverged_at_s", "cpu_s_per_sim_s", "cpu_s_per_sim_s_q1",
+    "cpu_s_per_sim_s_q3", "us_per_step", "timing_repeats", "runs_per_repeat",
     "trajectory_time_s", "trajectory_error_m", "reference_check_m", "phase_error_deg",
     "residual_max_N", "residual_rms_N", "penetration_max_m", "penetration_rms_m",
-    "rod_error_max_m", "rod_error_rms_m", "energy_drift_rel", "sweep", "quick"};
+    "rod_error_max_m", "rod_error_rms_m", "energy_drift_rel", "sweep", "quick", "machine",
+    "build"};
 
 constexpr std::string_view kMetricPrefix = "metric.";
 
@@ -108,12 +112,14 @@ bool set_cell(RunResult& r, const std::string& column, const std::string& text) 
     r.push = text;
   } else if (column == "friction_model") {
     r.friction_model = text;
-  } else if (column == "iterations" || column == "substeps" || column == "timing_repeats") {
+  } else if (column == "iterations" || column == "substeps" || column == "timing_repeats" ||
+             column == "runs_per_repeat") {
     const std::optional<int> n = parse_count(text);
     if (!n) return false;
     if (column == "iterations") r.iterations = *n;
     if (column == "substeps") r.substeps = *n;
     if (column == "timing_repeats") r.timing_repeats = *n;
+    if (column == "runs_per_repeat") r.runs_per_repeat = *n;
   } else if (column == "warm_start") {
     const double w = parse_number(text);
     r.warm_start = std::isnan(w) ? 0.0 : w;
@@ -123,6 +129,10 @@ bool set_cell(RunResult& r, const std::string& column, const std::string& text) 
     r.sweep = text;
   } else if (column == "quick") {
     r.quick = text == "1";
+  } else if (column == "machine") {
+    r.machine = text;
+  } else if (column == "build") {
+    r.build = text;
   } else {
     r.other[column] = text;
   }
@@ -196,6 +206,11 @@ std::optional<std::string> RunResult::cell(std::string_view column) const {
   if (column == "timing_repeats") {
     return timing_repeats ? std::optional<std::string>(std::to_string(*timing_repeats)) : std::nullopt;
   }
+  if (column == "runs_per_repeat") {
+    return runs_per_repeat ? std::optional<std::string>(std::to_string(*runs_per_repeat)) : std::nullopt;
+  }
+  if (column == "machine") return machine;
+  if (column == "build") return build;
   if (column == "sweep") return sweep;
   if (column == "quick") {
     return quick ? std::optional<std::string>(*quick ? "1" : "0") : std::nullopt;

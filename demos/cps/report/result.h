@@ -37,9 +37,15 @@ struct RunResult {
   // What happened.
   bool diverged = false;                ///< the state blew up (see execute_run)
   std::optional<double> diverged_at_s;  ///< when (s); only for a diverged run
-  std::optional<double> wall_s_per_sim_s;  ///< physics wall time per simulated second (s/s)
-  std::optional<double> us_per_step;       ///< wall time per step (us)
-  std::optional<int> timing_repeats;       ///< timing runs whose median was taken
+  /// Physics CPU time per simulated second (s/s): the median over the timed repeats of the CPU
+  /// time of the thread that stepped (report/timing.h), and the repeats' first and third
+  /// quartiles.
+  std::optional<double> cpu_s_per_sim_s;
+  std::optional<double> cpu_s_per_sim_s_q1;
+  std::optional<double> cpu_s_per_sim_s_q3;
+  std::optional<double> us_per_step;       ///< the median's CPU time per step (us)
+  std::optional<int> timing_repeats;       ///< timed repeats the quartiles are taken over
+  std::optional<int> runs_per_repeat;      ///< copies of the run stepped in one timed repeat
   std::optional<double> trajectory_time_s;   ///< when positions are compared (s)
   std::optional<double> trajectory_error_m;  ///< RMS distance from the reference run (m)
   std::optional<double> reference_check_m;   ///< the reference's own error (m)
@@ -56,6 +62,10 @@ struct RunResult {
   std::optional<std::string> sweep;  ///< the scene argument: a scene, "all" or "stress"
   std::optional<bool> quick;         ///< the quick sweep
 
+  // What the time was measured on (report/timing.h; text without commas).
+  std::optional<std::string> machine;  ///< CPU model and logical CPUs (this_machine)
+  std::optional<std::string> build;    ///< compiler, build type and flags (this_build)
+
   /// The scene's numeric metrics (columns "metric.NAME", by NAME; booleans as 0 and 1).
   std::map<std::string, double> metrics;
   /// Columns this build does not know (a CSV of another build), by name, as text.
@@ -69,7 +79,7 @@ struct RunResult {
   /// iterations, 1 substep, cold start.
   bool is_paper_setting() const;
   /// The number in column `column` (a measure: "trajectory_error_m", "metric.max_speed_mps",
-  /// "wall_s_per_sim_s", ...); NaN where the run has none.
+  /// "cpu_s_per_sim_s", ...); NaN where the run has none.
   double value(std::string_view column) const;
   /// The text of column `column` as the CSV writes it; std::nullopt where the run has no such
   /// column (see RunResult).

@@ -1,16 +1,17 @@
 #include "report/run.h"
 
+#include "options/options.h"
+#include "report/timing.h"
+
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <mutex>
 #include <optional>
+#include <random>
 
 namespace cps::cli {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // A measure at the CSV's precision (see RunResult).
 double csv(double v) { return at_csv_precision(v); }
@@ -104,15 +105,14 @@ struct Spread {
   }
 };
 
-// The error run of a spec: the run itself (residuals, metrics), what was measured after every
-// step, and how long it took (s, wall clock).
+// The error run of a spec: the run itself (residuals, metrics) and what was measured after every
+// step.
 struct ErrorRun {
   scenes::Run run;
   Spread penetration;          // m, every contact of every step
   Spread rod_error;            // m, every rod of every step
   std::vector<Vec3> at_traj;   // positions at the trajectory time; empty if not reached
   std::optional<double> diverged_at;  // s
-  double wall_s = 0.0;
 };
 
 // Adds the contacts' penetrations and the rods' length errors of the world's last step.
@@ -137,8 +137,7 @@ void observe_errors(const World& world, ErrorRun& e) {
 // accuracy.
 ErrorRun error_run(const scenes::Scene& scene, scenes::Overrides o, double horizon, double t_traj) {
   o.set("measure_residual", true);
-  const auto start = Clock::now();
-  ErrorRun e{scenes::make_run(scene, o), {}, {}, {}, {}, 0.0};
+  ErrorRun e{scenes::make_run(scene, o), {}, {}, {}, {}};
   World& world = e.run.world;
   const double size_bound = largest_body_size(world);
   while (!reached(world, horizon)) {
@@ -154,7 +153,6 @@ ErrorRun error_run(const scenes::Scene& scene, scenes::Overrides o, double horiz
       break;
     }
   }
-  e.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
   return e;
 }
 
@@ -206,31 +204,36 @@ void record_errors(const ErrorRun& e, RunResult& r) {
   }
 }
 
-// Timing runs: the physics step alone, residuals off, metrics not fed; the median of `repeats`
-// runs to `until` (s) sets the run's time per simulated second and per step.
-void record_timing(const scenes::Scene& scene, scenes::Overrides o, double until, int repeats,
-                   RunResult& r) {
-  o.set("measure_residual", false);
-  std::vector<double> seconds;
-  std::int64_t steps = 0;
-  double simulated = 0.0;
-  for (int k = 0; k < repeats; ++k) {
-    scenes::Run timed = scenes::make_run(scene, o);
-    const auto start = Clock::now();
-    do {
-      timed.world.step();
-    } while (!reached(timed.world, until));
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-    steps = timed.world.counters().steps;
-    simulated = timed.world.time();
-  }
-  if (seconds.empty()) return;
-  std::sort(seconds.begin(), seconds.end());
-  const double median = seconds[seconds.size() / 2];
-  r.wall_s_per_sim_s = csv(median / simulated);
-  r.us_per_step = csv(1e6 * median / static_cast<double>(std::max<std::int64_t>(steps, 1)));
-  r.timing_repeats = static_cast<int>(seconds.size());
+// Steps a fresh copy of the timed run to its end: steps and simulated time into `t`.
+void step_copy(scenes::Run& run, TimedRun& t) {
+  do {
+    run.world.step();
+  } while (!reached(run.world, t.until_s));
+  t.steps = run.world.counters().steps;
+  t.simulated_s = run.world.time();
 }
+
+// One repeat of `t`: its copies made (untimed), then stepped one after another under the
+// thread's CPU clock. Returns the CPU seconds per copy. Before the copies are made, a block of
+// a pseudo-random size (0 to 64 KiB in 16-byte steps, from a fixed seed) is allocated and held
+// through the repeat: it moves where the worlds' buffers land on the heap, so that a repeat's
+// memory layout (cache set conflicts, 4 KiB aliasing) varies from repeat to repeat instead of
+// one layout holding for every repeat of a run in a process (Mytkowicz et al. 2009, "Producing
+// wrong data without doing anything obviously wrong"). A guard, not a measured cure: see
+// docs/benchmarks.md (Run time of cps report) for what it did and did not change here.
+double time_repeat(TimedRun& t) {
+  static std::mt19937 layout(26);
+  const std::vector<char> pad(16 * static_cast<std::size_t>(layout() % 4096), 1);
+  std::vector<scenes::Run> copies;
+  copies.reserve(static_cast<std::size_t>(t.copies));
+  for (int k = 0; k < t.copies; ++k) copies.push_back(scenes::make_run(*t.scene, t.overrides));
+  const double start = thread_cpu_seconds();
+  for (scenes::Run& run : copies) step_copy(run, t);
+  return (thread_cpu_seconds() - start) / static_cast<double>(t.copies);
+}
+
+// The most copies of a run in one repeat: a bound on the memory of the worlds made up front.
+constexpr int kMaxCopies = 1000;
 
 }  // namespace
 
@@ -244,12 +247,12 @@ bool sane_state(const World& world) {
   return true;
 }
 
-RunResult execute_run(const RunSpec& spec, int repeats) {
+MeasuredRun measure_errors(const RunSpec& spec) {
   const scenes::Scene& scene = spec.scene_def();
   const double horizon = scene.report_horizon_s();
   const bool has_trajectory = !scene.report.has_reference_solution;
   const double t_traj = std::min(scene.report_trajectory_time_s(), horizon);
-  const scenes::Overrides o = spec.overrides();
+  scenes::Overrides o = spec.overrides();
   RunResult r = result_of(spec);
   r.dt_s = csv(std::get<double>(*o.find("dt")));
   r.horizon_s = csv(horizon);
@@ -265,11 +268,52 @@ RunResult execute_run(const RunSpec& spec, int repeats) {
       r.trajectory_error_m = csv(rms_distance(e.at_traj, *ref.positions));
     }
   }
-  // The error run was the warm-up. A run whose error run took over 2 s is timed once. A
-  // diverged run is timed up to the time it diverged: what the method cost until it failed.
-  if (e.wall_s > 2.0) repeats = std::min(repeats, 1);
-  record_timing(scene, o, e.diverged_at.value_or(horizon), repeats, r);
-  return r;
+  const double until = e.diverged_at.value_or(horizon);
+  const double work = run_work(e.run.world.bodies().size(), e.run.world.def(), until);
+  o.set("measure_residual", false);
+  return {std::move(r), TimedRun{&scene, std::move(o), until, work, 1, 0, 0.0, {}}};
+}
+
+void time_runs(const std::vector<TimedRun*>& runs, int repeats, double max_work,
+               const std::function<void(long long)>& progress) {
+  long long done = 0;
+  for (TimedRun* t : runs) {
+    t->copies = 1;
+    t->repeat_s.clear();
+    const double warm_up = time_repeat(*t);  // untimed: discarded
+    const double budget = t->work > 0.0 ? max_work / (t->work * repeats) : kMaxCopies;
+    const double wanted = warm_up > 0.0 ? std::ceil(kMinRepeatSeconds / warm_up) : kMaxCopies;
+    t->copies = static_cast<int>(std::clamp(std::min(wanted, std::floor(budget)), 1.0,
+                                            static_cast<double>(kMaxCopies)));
+    progress(++done);
+  }
+  for (int round = 0; round < repeats; ++round) {
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      TimedRun& t = *runs[round % 2 == 0 ? i : runs.size() - 1 - i];
+      t.repeat_s.push_back(time_repeat(t));
+      progress(++done);
+    }
+  }
+}
+
+void record_timing(const TimedRun& t, RunResult& r) {
+  if (t.repeat_s.empty() || !(t.simulated_s > 0.0)) return;
+  const Quartiles q = quartiles(t.repeat_s);
+  r.cpu_s_per_sim_s = csv(q.median / t.simulated_s);
+  r.cpu_s_per_sim_s_q1 = csv(q.q1 / t.simulated_s);
+  r.cpu_s_per_sim_s_q3 = csv(q.q3 / t.simulated_s);
+  r.us_per_step = csv(1e6 * q.median / static_cast<double>(std::max<std::int64_t>(t.steps, 1)));
+  r.timing_repeats = static_cast<int>(t.repeat_s.size());
+  r.runs_per_repeat = t.copies;
+  r.machine = this_machine();
+  r.build = this_build();
+}
+
+RunResult execute_run(const RunSpec& spec, int repeats, double max_work) {
+  MeasuredRun m = measure_errors(spec);
+  time_runs({&m.timing}, repeats, max_work, [](long long) {});
+  record_timing(m.timing, m.result);
+  return m.result;
 }
 
 }  // namespace cps::cli

@@ -1,9 +1,14 @@
 #pragma once
 // Executing one run of the sweep: the error run (residuals, penetration, rod error, metrics,
-// trajectory error against a reference run) and the timing runs of the physics step alone.
+// trajectory error against a reference run) and the timed repeats of the physics step alone
+// (report/timing.h: CPU time of the thread, quartiles).
 
 #include "report/plan.h"
 #include "report/result.h"
+
+#include <cstdint>
+#include <functional>
+#include <vector>
 
 namespace cps::cli {
 
@@ -12,16 +17,57 @@ namespace cps::cli {
 inline constexpr int kReferenceIterations = 256;
 inline constexpr int kReferenceSubsteps = 16;
 
-/// Runs one spec: the error run (residuals measured) and `repeats` (>= 1) timing runs of the
-/// physics step alone; the wall time per simulated second is their median (timing_repeats: how
-/// many; one if the error run took over 2 s; a diverged run is timed until it diverged,
-/// diverged_at_s). The trajectory error (m) is the RMS distance of the movable bodies from a
-/// reference run (kReferenceIterations, kReferenceSubsteps) at the scene's
-/// Scene::report_trajectory_time_s(); reference_check_m (m) is the reference's distance from
-/// the same run at half its substeps, an estimate of its own error. Returns the result without
-/// the sweep (RunResult::sweep, quick), which the caller adds. Throws UsageError for an unknown
-/// scene or a bad parameter.
-RunResult execute_run(const RunSpec& spec, int repeats);
+/// The timing of one run, carried out apart from its error run so that a sweep can interleave
+/// the repeats of all its runs (time_runs): the physics step alone (residuals off, metrics not
+/// fed) from the run's start to `until_s` (s), each repeat on a fresh world. One repeat steps the
+/// run `copies` times over (kMinRepeatSeconds); `repeat_s` holds each timed repeat's CPU time of
+/// the calling thread (s) per copy.
+struct TimedRun {
+  const scenes::Scene* scene = nullptr;
+  scenes::Overrides overrides;
+  double until_s = 0.0;              ///< simulated time the run is timed to (s)
+  double work = 0.0;                 ///< body-iterations of one copy (run_work)
+  int copies = 1;                    ///< copies of the run in one repeat (>= 1)
+  std::int64_t steps = 0;            ///< steps of one copy
+  double simulated_s = 0.0;          ///< simulated time of one copy (s)
+  std::vector<double> repeat_s;      ///< per timed repeat: CPU seconds per copy
+};
+
+/// A run's error run done: its result (settings and errors, no time yet) and its timing to do.
+struct MeasuredRun {
+  RunResult result;
+  TimedRun timing;
+};
+
+/// The error run of `spec` (residuals measured) and its trajectory error: the RMS distance (m)
+/// of the movable bodies from a reference run (kReferenceIterations, kReferenceSubsteps) at the
+/// scene's Scene::report_trajectory_time_s(); reference_check_m (m) is the reference's distance
+/// from the same run at half its substeps, an estimate of its own error. The timing is set up to
+/// the horizon, or to the time the run diverged (diverged_at_s): a diverged run is timed until
+/// then, what the method cost until it failed. The result has no sweep (RunResult::sweep, quick),
+/// which the caller adds. Throws UsageError for an unknown scene or a bad parameter.
+MeasuredRun measure_errors(const RunSpec& spec);
+
+/// Times `runs` (each TimedRun of measure_errors) with `repeats` (>= 1) timed repeats each, by the
+/// CPU time of the calling thread (thread_cpu_seconds). First one untimed warm-up repeat of each
+/// run, which also sets its copies: enough for a repeat to last kMinRepeatSeconds, at most as
+/// many as keep repeats x copies x work within `max_work` (body-iterations; at least 1). Then
+/// `repeats` rounds, each timing one repeat of every run, in plan order and backwards in every
+/// other round: the repeats of the runs a report compares are spread over the same stretch of
+/// time, so that a change of the machine's load or clock speed falls on all of them alike.
+/// `progress` is called after each repeat with the repeats done so far, of runs.size() x
+/// (repeats + 1).
+void time_runs(const std::vector<TimedRun*>& runs, int repeats, double max_work,
+               const std::function<void(long long)>& progress);
+
+/// The run's time from its repeats (at least one; else nothing is set): cpu_s_per_sim_s and its
+/// quartiles cpu_s_per_sim_s_q1, _q3 (CPU seconds per simulated second), us_per_step (the median
+/// per step, us), timing_repeats and runs_per_repeat, and the machine and build (this_machine,
+/// this_build).
+void record_timing(const TimedRun& t, RunResult& r);
+
+/// One run alone: measure_errors, time_runs of it alone and record_timing.
+RunResult execute_run(const RunSpec& spec, int repeats, double max_work);
 
 /// False once the state is not finite, or a body is further than 1e6 m away or faster than
 /// 1e6 m/s: the run has blown up and goes no further.

@@ -70,9 +70,8 @@ struct ReportOutput {
   }
 };
 
-// A run's result with the sweep it belongs to.
-RunResult execute_in_sweep(const SweepOutput& to, const RunSpec& spec) {
-  RunResult r = execute_run(spec, kTimingRepeats);
+// A result with the sweep it belongs to.
+RunResult in_sweep(const SweepOutput& to, RunResult r) {
   r.sweep = to.sweep;
   r.quick = to.quick;
   return r;
@@ -92,14 +91,39 @@ std::vector<std::string> scenes_of(const std::vector<RunResult>& runs) {
 int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& scenes) {
   const std::vector<RunSpec> runs = plan_runs(scenes, to.quick);
   ReportOutput output(to.out, scene_names(scenes), to.force, to.info, /*record_scenes=*/true);
-  std::vector<RunResult> results;
-  Progress progress("report " + to.sweep, static_cast<long long>(runs.size()), "runs");
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    results.push_back(execute_in_sweep(to, runs[i]));
-    progress.update(static_cast<long long>(i + 1));
+  std::vector<MeasuredRun> measured;
+  measured.reserve(runs.size());
+  {
+    Progress progress("report " + to.sweep, static_cast<long long>(runs.size()), "runs");
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      measured.push_back(measure_errors(runs[i]));
+      progress.update(static_cast<long long>(i + 1));
+    }
+    progress.finish();
   }
-  progress.finish();
-  output.write([&] { write_report(to.out, results, mass_ratio_study(), {}, results.size()); });
+  // The timed repeats of every run, interleaved (time_runs).
+  std::vector<TimedRun*> timed;
+  for (MeasuredRun& m : measured) timed.push_back(&m.timing);
+  const std::string load_before = load_average();
+  {
+    Progress progress("report " + to.sweep + " timing",
+                      static_cast<long long>(runs.size()) * (to.repeats + 1), "repeats");
+    time_runs(timed, to.repeats, to.max_work, [&](long long done) { progress.update(done); });
+    progress.finish();
+  }
+  const std::string load_after = load_average();
+  const std::string load = "Load averages (1, 5, 15 min, /proc/loadavg) " + load_before +
+                           " when the timing began and " + load_after + " when it ended.";
+  if (output.info.contains("timing")) {
+    output.info["timing"]["load_average_timing_began"] = load_before;
+    output.info["timing"]["load_average_timing_ended"] = load_after;
+  }
+  std::vector<RunResult> results;
+  for (MeasuredRun& m : measured) {
+    record_timing(m.timing, m.result);
+    results.push_back(in_sweep(to, std::move(m.result)));
+  }
+  output.write([&] { write_report(to.out, results, mass_ratio_study(), {}, results.size(), load); });
   std::printf("%zu runs: %s/report.md\n", results.size(), to.out.c_str());
   return 0;
 }
@@ -112,7 +136,7 @@ int run_one(const SweepOutput& to, const RunSpec& spec) {
                                        .use = FolderUse::shared,
                                        .scenes = {{file, scene_source(spec.scene)}},
                                        .force = to.force});
-  const RunResult result = execute_in_sweep(to, spec);
+  const RunResult result = in_sweep(to, execute_run(spec, to.repeats, to.max_work));
   begin_output(plan, to.info);
   write_results(to.out / file, {result});
   end_output(plan, to.info);
@@ -125,7 +149,8 @@ std::vector<std::string> run_commands(const std::string& exe, const SweepOutput&
   const std::string out = to.out.string();
   for (const RunSpec& r : runs) {
     lines.push_back("'" + exe + "' report '" + to.sweep + "' --run " + r.id() + " --out '" + out +
-                    "/runs'" + (to.quick ? " --quick" : ""));
+                    "/runs'" + (to.quick ? " --quick" : "") +
+                    (to.repeats != kDefaultRepeats ? " --repeats " + std::to_string(to.repeats) : ""));
   }
   lines.push_back("# when all have finished: '" + exe + "' report --merge '" + out +
                   "/runs' --out '" + out + "'");

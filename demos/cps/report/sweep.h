@@ -4,6 +4,8 @@
 
 #include "report/plan.h"
 #include "report/result.h"
+#include "report/timing.h"
+#include "options/options.h"
 
 #include <nlohmann/json.hpp>
 
@@ -14,9 +16,6 @@
 
 namespace cps::cli {
 
-/// Timing runs per run (the median is taken), in the quick sweep as in the full one.
-inline constexpr int kTimingRepeats = 3;
-
 /// Where a sweep's outputs go and what they record.
 struct SweepOutput {
   std::string sweep;           ///< the scene argument: a scene, "all" or "stress" (RunResult::sweep)
@@ -24,22 +23,25 @@ struct SweepOutput {
   std::filesystem::path out;   ///< the output folder
   bool force = false;          ///< replace same-named foreign files (output.h)
   nlohmann::json info;         ///< run_info for the folders' run.json
+  int repeats = kDefaultRepeats;   ///< timed repeats per run (time_runs), in [kMinRepeats, kMaxRepeats]
+  double max_work = kDefaultMaxWork;  ///< work budget of a run (body-iterations, --max-work)
 };
 
-/// Runs every run of plan_runs(scenes, quick) (kTimingRepeats timing runs each, progress on
-/// stderr) and the mass ratio study, and writes the report (write_report) into `to.out` and
+/// Runs every run of plan_runs(scenes, quick) (their error runs, then to.repeats timed repeats of
+/// each, interleaved across the sweep: time_runs; progress on stderr) and the mass ratio study, and writes the report (write_report) into `to.out` and
 /// `to.out`/plots, both shared folders (output.h). Every target is checked before any work:
 /// throws UsageError naming a foreign file it would replace (without force) or an unusable
 /// folder; std::runtime_error if a file cannot be written or gnuplot fails. Prints "N runs:
 /// OUT/report.md" on stdout. Returns the exit code, 0.
 int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& scenes);
 
-/// Runs `spec` alone and writes its CSV (one row, run_file_name) into `to.out`, a shared folder,
+/// Runs `spec` alone (execute_run, to.repeats timed repeats) and writes its CSV (one row, run_file_name) into `to.out`, a shared folder,
 /// with the sweep it belongs to. Throws as run_sweep does. Returns the exit code, 0.
 int run_one(const SweepOutput& to, const RunSpec& spec);
 
 /// The commands of `--list-runs`: per run of `runs`, `'EXE' report 'SWEEP' --run ID --out
-/// 'OUT/runs'` (with --quick for a quick sweep), then a comment line with the merge command.
+/// 'OUT/runs'` (with --quick for a quick sweep, and --repeats N where to.repeats is not
+/// kDefaultRepeats), then a comment line with the merge command.
 std::vector<std::string> run_commands(const std::string& exe, const SweepOutput& to,
                                       const std::vector<RunSpec>& runs);
 

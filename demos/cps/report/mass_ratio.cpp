@@ -7,9 +7,6 @@
 namespace cps::cli {
 namespace {
 
-// The overlap (m) under which a pair that holds counts in iterations_holding: 1 cm.
-constexpr double kHoldingOverlap = 0.01;
-
 // The pair in `world` (made by scenes::populate_mass_ratio: body 1 light, body 2 heavy). Held:
 // the light cube is still between the heavy cube and the ground, that is its centre is within
 // h of the heavy cube's vertical axis (the heavy cube's centre of mass is over the light cube's
@@ -55,7 +52,7 @@ std::vector<PairRow> mass_ratio_study() {
         PairRow r{ratio, solver, push, run_pair(ratio, solver, push, kPairTableIterations, kPairSeconds), {}};
         for (int n = 1; n <= 256; n *= 2) {
           const PairOutcome q = run_pair(ratio, solver, push, n, kPairSeconds);
-          if (q.held && q.overlap_m < kHoldingOverlap) r.iterations_holding.push_back(n);
+          if (q.held && q.overlap_m < kHoldingOverlapM) r.iterations_holding.push_back(n);
         }
         rows.push_back(std::move(r));
       }

@@ -25,6 +25,9 @@ inline constexpr int kPairTableIterations = 25;
 /// held (m): h / 2 (h = scenes::kMassRatioHalfEdge), a light cube crushed by under a quarter of
 /// its edge. Squeezed out from under, the heavy cube drops to h, 2 h lower.
 inline constexpr double kHeldHeightTolerance = 0.5 * scenes::kMassRatioHalfEdge;
+/// The overlap (m) under which a pair that is stacked also counts as holding (iterations_holding,
+/// and the report's column): 1 cm, a fiftieth of the cubes' half edge.
+inline constexpr double kHoldingOverlapM = 0.01;
 
 /// The heavy cube's stacked height (m): 3 h, on the light cube, on the ground.
 inline constexpr double kStackedHeight = 3.0 * scenes::kMassRatioHalfEdge;

@@ -9,6 +9,8 @@
 #include "engines.h"
 #include "scene.h"
 
+#include "cps/step_system.h"
+
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -53,6 +55,80 @@ double us_per_step(const std::function<void()>& step, double dt, int steps) {
     blocks.push_back(1e6 * (thread_cpu_seconds() - start) / steps);
   }
   return median(blocks);
+}
+
+/// The longest chain of dependent row updates in `sweeps` sweeps of projected Gauss-Seidel
+/// (Sec. 7.2) on the system s (rows). Row j's update reads the latest lambda of every row i with
+/// A_ji != 0 (they share a movable body; through w in the matrix-free solve): rows i < j of
+/// this sweep, rows i >= j of the previous one. depth(j, k) = 1 + the largest depth of those, and
+/// the chain is the largest depth after the last sweep: the updates no processor can overlap,
+/// however many it could run at once. A chain of sweeps x rows means every update waits on the
+/// one before it.
+long dependent_chain(const StepSystem& s, int sweeps) {
+  const auto c = static_cast<std::size_t>(s.rows());
+  std::vector<long> previous(c, 0);
+  std::vector<long> now(c, 0);
+  for (int k = 0; k < sweeps; ++k) {
+    for (std::size_t j = 0; j < c; ++j) {
+      long deepest = previous[j];
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(s.A, static_cast<Eigen::Index>(j)); it; ++it) {
+        if (it.value() == 0.0) continue;
+        const auto i = static_cast<std::size_t>(it.col());
+        deepest = std::max(deepest, i < j ? now[i] : previous[i]);
+      }
+      now[j] = deepest + 1;
+    }
+    previous.swap(now);
+  }
+  return c == 0 ? 0 : *std::max_element(previous.begin(), previous.end());
+}
+
+/// What --chain prints for one scene: mean rows and dependent chain per step over the timed
+/// steps (dependent_chain over each step's solves), and us/step of cps matrix-free at 25 and at
+/// 50 sweeps.
+struct ChainRow {
+  double rows = 0.0;       ///< rows per step, all solves (count)
+  double chain = 0.0;      ///< dependent updates per step at 25 sweeps (count)
+  double chain_one = 0.0;  ///< the same at 1 sweep (count)
+  double us_50 = 0.0;      ///< us/step at 50 sweeps
+  double us_25 = 0.0;      ///< us/step at 25 sweeps
+};
+
+/// Measures a ChainRow for `scene` by the method of us_per_step (1 s untimed at the scene's
+/// settings, then 5 blocks of `steps`, median), the sweeps set after that first second. The
+/// rows and chains are counted in a third, untimed run of the same steps at 25 sweeps (the
+/// observer does not change the physics, so it sees the steps the 25-sweep run timed).
+ChainRow chain_row(const scenes::Scene& scene, int steps) {
+  ChainRow out;
+  for (const int sweeps : {50, 25, 0}) {
+    scenes::Run run = scenes::make_run(scene);
+    const double dt = run.world.def().dt;
+    for (long k = 0; static_cast<double>(k) * dt < 1.0; ++k) run.world.step();
+    WorldDef def = run.world.def();
+    def.assembly = Assembly::matrix_free;
+    def.iterations = sweeps == 0 ? 25 : sweeps;
+    run.world.set_def(def);
+    if (sweeps == 0) {
+      run.world.set_solve_observer([&](const StepSystem& s) {
+        out.rows += static_cast<double>(s.rows());
+        out.chain += static_cast<double>(dependent_chain(s, 25));
+        out.chain_one += static_cast<double>(dependent_chain(s, 1));
+      });
+      for (int k = 0; k < 5 * steps; ++k) run.world.step();
+      out.rows /= 5.0 * steps;
+      out.chain /= 5.0 * steps;
+      out.chain_one /= 5.0 * steps;
+      continue;
+    }
+    std::vector<double> blocks;
+    for (int b = 0; b < 5; ++b) {
+      const double start = thread_cpu_seconds();
+      for (int k = 0; k < steps; ++k) run.world.step();
+      blocks.push_back(1e6 * (thread_cpu_seconds() - start) / steps);
+    }
+    (sweeps == 50 ? out.us_50 : out.us_25) = median(blocks);
+  }
+  return out;
 }
 
 /// The scene family: the name without a trailing _N.
@@ -176,6 +252,9 @@ int run(int argc, char** argv) {
   app.add_option("--steps", steps, "steps per timed block (5 blocks, median)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  bool chain = false;
+  app.add_flag("--chain", chain,
+               "also print each scene's dependent chain of PGS row updates and the time a sweep costs");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -272,6 +351,32 @@ int run(int argc, char** argv) {
   std::printf("\n## Sanity at the end of the first repeat's last timed block\n\n"
               "| scene | engine | state | contact points (last step) | check |\n|---|---|---|---|---|\n%s",
               checks.c_str());
+  if (chain) {
+    std::printf("\n## The sequential sweep's dependent chain (cps matrix-free, PGS)\n\n"
+                "rows: rows per step; chain: dependent row updates per step at 25 sweeps (and at 1), both the mean over the timed steps; "
+                "a sweep: (us/step at 50 - us/step at 25) / 25 (the same rows, nearly: the scenes rest); ns per row: a "
+                "sweep's time over the rows; ns per chained update: a sweep's time over the chain a sweep adds, (chain at 25 - chain at 1) / 24. "
+                "Median of %d repeat(s).\n\n"
+                "| scene | rows | chain at 25 (at 1) | chain / (25 rows) | us/step at 25 | us/step at 50 | a sweep (us) | ns per row | ns per chained update |\n"
+                "|---|---|---|---|---|---|---|---|---|\n", repeats);
+    for (const std::string& name : names) {
+      std::vector<ChainRow> rs;
+      for (int r = 0; r < repeats; ++r) rs.push_back(chain_row(*scenes::find_scene(name), steps));
+      const auto med = [&](auto field) {
+        std::vector<double> v;
+        for (const ChainRow& c : rs) v.push_back(field(c));
+        return median(v);
+      };
+      const ChainRow& c = rs.front();
+      const double sweep = med([](const ChainRow& x) { return (x.us_50 - x.us_25) / 25.0; });
+      const double per_row = c.rows > 0 ? 1e3 * sweep / c.rows : 0.0;
+      const double per_chained = c.chain > c.chain_one ? 1e3 * 24.0 * sweep / (c.chain - c.chain_one) : 0.0;
+      std::printf("| %s | %.1f | %.1f (%.1f) | %.2f | %.1f | %.1f | %.2f | %.1f | %.1f |\n", name.c_str(),
+                  c.rows, c.chain, c.chain_one, c.rows > 0 ? c.chain / (25.0 * c.rows) : 0.0,
+                  med([](const ChainRow& x) { return x.us_25; }), med([](const ChainRow& x) { return x.us_50; }),
+                  sweep, per_row, per_chained);
+    }
+  }
   std::printf("\nLoad average (1, 5, 15 min) before: %s, after: %s (2 cores, shared).\n",
               load_before.c_str(), load_average().c_str());
   return checks.find("FAILED") == std::string::npos ? 0 : 1;

@@ -3,15 +3,29 @@
 // velocity (baumgarte) the cubes fly apart; with the single frame push factor (split) they come
 // to rest (the paper's Fig. 7 b and c, at 0.5 s).
 #include "scene.h"
+#include "stress/stress.h"
 
 #include <algorithm>
 
 namespace cps::scenes {
 namespace {
 
+// m: half the cubes' 2.4 m edge, the hard cases' leave distance (stress.h, HardCaseWatch): a cube
+// that moved sideways by half the edge of the one under it has its centre over that edge.
+constexpr double kLeaveM = 1.2;
+
+// The heights and speeds at the end, and the hard cases' measures with the column resting on the
+// ground as the resting places (the cubes start away from them, so arrival_s is when the push
+// has brought them there).
 class IntersectingStackMetrics final : public Metrics {
  public:
-  void observe(const World& world) override { world_ = &world; }
+  explicit IntersectingStackMetrics(const World& world)
+      : watch_(resting_places_stacked(world), kLeaveM) {}
+
+  void observe(const World& world) override {
+    world_ = &world;
+    watch_.observe(world);
+  }
 
   nlohmann::json report() const override {
     nlohmann::json heights = nlohmann::json::array();
@@ -25,11 +39,14 @@ class IntersectingStackMetrics final : public Metrics {
         max_speed = std::max(max_speed, b.velocity().norm());
       }
     }
-    return {{"heights_m", heights}, {"speeds_mps", speeds}, {"max_speed_mps", max_speed}};
+    nlohmann::json j = {{"heights_m", heights}, {"speeds_mps", speeds}, {"max_speed_mps", max_speed}};
+    watch_.add_to(j);
+    return j;
   }
 
  private:
   const World* world_ = nullptr;
+  HardCaseWatch watch_;
 };
 
 }  // namespace
@@ -43,7 +60,7 @@ WorldDef intersecting_stack_world_def() {
 void populate_intersecting_stack(World& world) { add_ground_and_cube_column(world, 0.0, 2.0, 5); }
 
 std::unique_ptr<Metrics> make_intersecting_stack_metrics(const World& world) {
-  return observed<IntersectingStackMetrics>(world);
+  return observed<IntersectingStackMetrics>(world, world);
 }
 
 }  // namespace cps::scenes

@@ -11,4 +11,5 @@ set(CPS_STRESS_SCENE_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/scale.cpp
   ${CMAKE_CURRENT_LIST_DIR}/degenerate.cpp
   ${CMAKE_CURRENT_LIST_DIR}/random.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/hard_cases.cpp
 )

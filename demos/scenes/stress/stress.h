@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace cps::scenes {
@@ -99,6 +100,80 @@ class EnergyMetrics : public Metrics {
   double max_penetration_ = 0.0;
 };
 
+/// The hard cases' measurements (issue 28: survival, penetration, energy injected, rod stretch,
+/// whether the scene holds), fed with the world as built and after every step. Every movable
+/// body has a resting place: where its centre lies when the scene stands as it is meant to (m;
+/// the position as built for a scene built at rest, the stacked column for one whose bodies fall
+/// or are pushed into place). A body has left its place when its centre is farther than
+/// `leave_m` (m, > 0) from it. Keys of add_to (units as suffixes):
+/// - leave_distance_m: leave_m.
+/// - arrival_s: the first observed time (s) at which every movable body is within leave_m of its
+///   resting place; 0 for a scene built at rest; null if that never happened.
+/// - survival_s: the world time (s) of the first observation after the arrival at which a body
+///   is farther than leave_m from its resting place; if none is, the time observed so far (the
+///   run's duration); 0 if the bodies never arrived.
+/// - final_displacement_m: the largest distance of a movable body from its resting place at the
+///   last observation (m).
+/// - max_penetration_m: the deepest contact of any step (deepest_contact, m).
+/// - energy_injected_J: max over the observations of E(t) - E_ref (J, >= 0), E = KE + PE
+///   (total_energy) and E_ref the larger of E(0) and the energy of the bodies at rest in their
+///   resting places, so that the lift a scene started in overlap needs to come to rest is not
+///   counted: a scene at rest that gains energy has had it made by the step.
+/// - max_rod_stretch_m: the largest |distance - length| of any rod at any observation (m; 0
+///   without rods).
+/// - mass_ratio: the largest movable mass over the smallest (dimensionless).
+/// - holds: every state was finite, the bodies arrived, and at the last observation every
+///   movable body is within leave_m of its resting place.
+/// - nan: a state was not finite (the measures stop there).
+class HardCaseWatch {
+ public:
+  /// resting_places: one per body of the world it will observe, by index (static bodies' entries
+  /// are not used); leave_m: > 0 (m). Throws std::invalid_argument for leave_m <= 0 or not finite.
+  HardCaseWatch(std::vector<Vec3> resting_places, double leave_m);
+  void observe(const World& world);
+  void add_to(nlohmann::json& j) const;
+  /// True as add_to's "holds" says.
+  bool holds() const;
+
+ private:
+  std::vector<Vec3> rest_;
+  double leave_m_;
+  double rest_energy_J_ = 0.0;
+  std::optional<double> start_energy_J_;
+  std::optional<double> arrival_s_;
+  std::optional<double> left_s_;
+  double observed_s_ = 0.0;
+  double final_displacement_m_ = 0.0;
+  double max_penetration_m_ = 0.0;
+  double max_energy_J_ = -kInfinity;
+  double max_rod_stretch_m_ = 0.0;
+  double mass_ratio_ = 1.0;
+  bool nonfinite_ = false;
+};
+
+/// Metrics of a hard case: HardCaseWatch's keys only.
+class HardCaseMetrics final : public Metrics {
+ public:
+  HardCaseMetrics(std::vector<Vec3> resting_places, double leave_m)
+      : watch_(std::move(resting_places), leave_m) {}
+  void observe(const World& world) override { watch_.observe(world); }
+  nlohmann::json report() const override;
+
+ private:
+  HardCaseWatch watch_;
+};
+
+/// Every body's position as built (m), by index: the resting places of a scene built at rest.
+std::vector<Vec3> resting_places_as_built(const World& world);
+
+/// The resting places of a column (m), by body index: each movable body, in index order, rests
+/// on the one before (the first on the ground plane y = 0) at its horizontal position as built,
+/// so body k's centre is at the height of the half heights (box half extent y, sphere radius) of
+/// the movable bodies before it, doubled, plus its own. Static bodies keep their positions.
+/// For the stack (Sec. 10.1), the intersecting stack (Sec. 10.2), stack_N and sphere_in_box;
+/// the bodies are assumed unrotated as built.
+std::vector<Vec3> resting_places_stacked(const World& world);
+
 // ---- The scenes, by file. Each populate adds its bodies to an empty world. ----
 
 // mass_ratio.cpp (see mass_ratio.h for the parametrised functions)
@@ -154,6 +229,37 @@ void populate_parallel_edges(World& world);
 void populate_edge_balance(World& world);
 void populate_touching_boxes(World& world);
 std::unique_ptr<Metrics> make_degenerate_metrics(const World& world);
+
+// hard_cases.cpp: the hard cases of issue 28 (heavy on light, a heavy rope, long runs)
+/// heavy_on_light: the static ground plane y = 0 and kHeavyOnLightCubes cubes of one density,
+/// edges kHeavyOnLightSmallestEdgeM x 2^k (k = 0 at the bottom), stacked touching, at rest.
+WorldDef heavy_on_light_world_def();
+void populate_heavy_on_light(World& world);
+std::unique_ptr<Metrics> make_heavy_on_light_metrics(const World& world);
+/// heavy_rope: the static ground plane y = 0, kHeavyRopeLinks small balls hanging straight down
+/// on rods from a fixed point 7 m up, a cube of kHeavyRopeBlockRatio x a link's mass hanging from
+/// the last by the middle of its top face, its bottom 1.15 m above the ground; at rest.
+WorldDef heavy_rope_world_def();
+void populate_heavy_rope(World& world);
+std::unique_ptr<Metrics> make_heavy_rope_metrics(const World& world);
+/// stack_20_long: stack_20 (scaled.cpp) for kLongRunSteps steps.
+void populate_stack_20_long(World& world);
+std::unique_ptr<Metrics> make_stack_20_long_metrics(const World& world);
+/// pyramid_20_rows_long: pyramid_210 (scaled.cpp: 20 rows of unit boxes) for kLongRunSteps steps.
+void populate_pyramid_20_rows_long(World& world);
+std::unique_ptr<Metrics> make_pyramid_20_rows_long_metrics(const World& world);
+
+inline constexpr int kHeavyOnLightCubes = 6;
+inline constexpr double kHeavyOnLightSmallestEdgeM = 0.1;   ///< m: the bottom cube's edge
+inline constexpr double kHeavyOnLightDensity = 1000.0;      ///< kg/m^3 (water): 1 kg to 32768 kg
+inline constexpr int kHeavyRopeLinks = 20;
+inline constexpr double kHeavyRopeLinkMassKg = 0.1;          ///< kg
+inline constexpr double kHeavyRopeLinkRadiusM = 0.05;        ///< m
+inline constexpr double kHeavyRopeRodLengthM = 0.25;         ///< m, every rod
+inline constexpr double kHeavyRopeBlockRatio = 1800.0;       ///< block mass / link mass (AVBD's HeavyRope)
+inline constexpr double kHeavyRopeBlockHalfM = 0.3;          ///< m, the block's half edge
+/// Steps of the long runs (the issue's 10,000); their default duration is this times dt = 1/60 s.
+inline constexpr int kLongRunSteps = 10000;
 
 // random.cpp
 /// Adds a random pile from `seed`: a static ground plane y = 0, then 4 to 12 bodies, each a box

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace cps::scenes {
 
@@ -99,6 +102,94 @@ nlohmann::json EnergyMetrics::report() const {
   j["final_penetration_m"] =
       world_ && !energy_.nonfinite() ? nlohmann::json(max_penetration_now(*world_)) : nlohmann::json();
   return j;
+}
+
+HardCaseWatch::HardCaseWatch(std::vector<Vec3> resting_places, double leave_m)
+    : rest_(std::move(resting_places)), leave_m_(leave_m) {
+  if (!(leave_m > 0.0) || !std::isfinite(leave_m)) {
+    throw std::invalid_argument("HardCaseWatch: leave distance " + std::to_string(leave_m) +
+                                " m; allowed: finite and > 0");
+  }
+}
+
+void HardCaseWatch::observe(const World& world) {
+  if (nonfinite_) return;
+  if (!all_finite(world)) {
+    nonfinite_ = true;  // nothing below means anything once a state is not finite
+    return;
+  }
+  const std::vector<Body>& bodies = world.bodies();
+  const Vec3& g = world.def().gravity;
+  if (!start_energy_J_) {
+    start_energy_J_ = total_energy(world);
+    double lightest = std::numeric_limits<double>::max();
+    double heaviest = 0.0;
+    for (std::size_t i = 0; i < bodies.size() && i < rest_.size(); ++i) {
+      if (bodies[i].is_static()) continue;
+      rest_energy_J_ -= bodies[i].mass * g.dot(rest_[i]);
+      lightest = std::min(lightest, bodies[i].mass);
+      heaviest = std::max(heaviest, bodies[i].mass);
+    }
+    if (heaviest > 0.0) mass_ratio_ = heaviest / lightest;
+  }
+  observed_s_ = world.time();
+  final_displacement_m_ = 0.0;
+  for (std::size_t i = 0; i < bodies.size() && i < rest_.size(); ++i) {
+    if (!bodies[i].is_static()) {
+      final_displacement_m_ = std::max(final_displacement_m_, (bodies[i].x - rest_[i]).norm());
+    }
+  }
+  const bool in_place = final_displacement_m_ <= leave_m_;
+  if (!arrival_s_ && in_place) arrival_s_ = observed_s_;
+  if (arrival_s_ && !left_s_ && !in_place) left_s_ = observed_s_;
+  max_penetration_m_ = std::max(max_penetration_m_, deepest_contact(world));
+  max_energy_J_ = std::max(max_energy_J_, total_energy(world));
+  max_rod_stretch_m_ = std::max(max_rod_stretch_m_, max_rod_error(world));
+}
+
+bool HardCaseWatch::holds() const {
+  return !nonfinite_ && arrival_s_.has_value() && final_displacement_m_ <= leave_m_;
+}
+
+void HardCaseWatch::add_to(nlohmann::json& j) const {
+  const double reference = std::max(start_energy_J_.value_or(0.0), rest_energy_J_);
+  j["leave_distance_m"] = leave_m_;
+  j["arrival_s"] = arrival_s_ ? nlohmann::json(*arrival_s_) : nlohmann::json();
+  j["survival_s"] = !arrival_s_ ? 0.0 : left_s_.value_or(observed_s_);
+  j["final_displacement_m"] = final_displacement_m_;
+  j["max_penetration_m"] = max_penetration_m_;
+  j["energy_injected_J"] = start_energy_J_ ? std::max(0.0, max_energy_J_ - reference) : 0.0;
+  j["max_rod_stretch_m"] = max_rod_stretch_m_;
+  j["mass_ratio"] = mass_ratio_;
+  j["holds"] = holds();
+  j["nan"] = nonfinite_;
+}
+
+nlohmann::json HardCaseMetrics::report() const {
+  nlohmann::json j = nlohmann::json::object();
+  watch_.add_to(j);
+  return j;
+}
+
+std::vector<Vec3> resting_places_as_built(const World& world) {
+  std::vector<Vec3> places;
+  places.reserve(world.bodies().size());
+  for (const Body& b : world.bodies()) places.push_back(b.x);
+  return places;
+}
+
+std::vector<Vec3> resting_places_stacked(const World& world) {
+  std::vector<Vec3> places = resting_places_as_built(world);
+  double top = 0.0;  // m: the top of the column so far (the ground plane y = 0 at first)
+  for (std::size_t i = 0; i < places.size(); ++i) {
+    const Body& b = world.bodies()[i];
+    if (b.is_static()) continue;
+    const double half_height =
+        b.shape.kind == ShapeKind::box ? b.shape.half_extents.y() : b.shape.radius;
+    places[i].y() = top + half_height;
+    top += 2.0 * half_height;
+  }
+  return places;
 }
 
 }  // namespace cps::scenes

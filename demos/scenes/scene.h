@@ -59,9 +59,13 @@ struct ReportTraits {
   /// Why the horizon is what it is, in one line (report.md prints it with the horizon).
   std::string_view horizon_reason = "the scene's default duration";
   /// The CSV column of the report's headline measure: the error whose value at the paper's
-  /// settings the headline quotes and tries to halve ("trajectory_error_m", "phase_error_deg",
-  /// "metric.max_speed_mps", ...).
+  /// settings the headline quotes and tries to halve, smaller being better
+  /// ("trajectory_error_m", "phase_error_deg", "rod_error_max_m", "metric.recovery_time_s", ...).
   std::string_view primary_measure = "trajectory_error_m";
+  /// Why the headline measure is this one, in one line (report.md prints it under the
+  /// headline): what it means and why smaller is better there.
+  std::string_view headline_reason =
+      "the default: the trajectory error at the trajectory time, not checked for chaos";
   /// True if the scene's metrics measure its error against a reference solution of their own
   /// (max_phase_error_deg: the pendulum wave's reduced-coordinate phases); the report then does
   /// not compute a trajectory error against a reference run.

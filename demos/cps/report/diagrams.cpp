@@ -1,6 +1,7 @@
 #include "report/diagrams.h"
 
 #include "report/gnuplot.h"
+#include "report/headline.h"
 #include "output/atomic_file.h"
 
 #include <algorithm>
@@ -57,11 +58,18 @@ struct Panel {
   std::vector<PlotPoint> paper;       // the paper's settings (25 iterations, 1 substep)
   std::vector<PlotPoint> clamped;     // values under the floor, drawn on it
   std::vector<PlotPoint> diverged;    // drawn at the top edge (y set once the range is known)
+  // Trajectory errors under their reference's own error (under_reference_error): drawn where
+  // they are, ringed with their own mark.
+  std::vector<PlotPoint> unresolved;
+  // Runs that never recovered within the horizon (ranked_value infinite): drawn at the top
+  // edge, under the diverged runs' marks' row.
+  std::vector<PlotPoint> never;
   // Labels, placed by place_labels (x, y: the label's centre): the first and last point of the
   // iteration line, the last of the substep line, every diverged run.
   std::vector<PlotPoint> labels_it;
   std::vector<PlotPoint> labels_ss;
   std::vector<PlotPoint> labels_div;
+  std::vector<PlotPoint> labels_never;
   double reference = std::nan("");    // the reference's own error (trajectory error only), or NaN
 };
 
@@ -74,6 +82,9 @@ struct Diagram {
   bool any_clamped = false;
   bool any_diverged = false;
   bool any_reference = false;
+  bool any_unresolved = false;
+  bool any_never = false;
+  std::string dt1 = "?";  // the dt of the runs at 1 substep (dt_text)
   std::vector<double> warm_factors;  // the warm start factors (> 0) of any run, ascending
   double x_lo = 0.0, x_hi = 0.0, y_lo = 0.0, y_hi = 0.0;  // y_hi: the top edge
 };
@@ -154,6 +165,15 @@ Panel make_panel(const Measure& m, const std::vector<const RunResult*>& runs, Di
       e.add_x(t_hi);
       continue;
     }
+    if (std::isinf(ranked_value(*r, m.column))) {
+      p.never.push_back({t, 0.0, label, t_lo, t_hi});
+      // The paper's run ringed on the top edge too (y set there with the never marks').
+      if (ss == 1 && it == kPaperIterations && w == 0.0) p.paper.push_back({t, 0.0, label, t, t});
+      d.any_never = true;
+      e.add_x(t_lo);
+      e.add_x(t_hi);
+      continue;
+    }
     const double value = r->value(m.column);
     if (std::isnan(value)) continue;
     e.any_value = true;
@@ -162,6 +182,10 @@ Panel make_panel(const Measure& m, const std::vector<const RunResult*>& runs, Di
     if (value < d.floor) {
       p.clamped.push_back(point);
       d.any_clamped = true;
+    }
+    if (std::string(m.column) == "trajectory_error_m" && r->under_reference_error.value_or(false)) {
+      p.unresolved.push_back(point);
+      d.any_unresolved = true;
     }
     e.y_max = std::max(e.y_max, point.y);
     e.add_x(t_lo);
@@ -212,9 +236,11 @@ void set_axes(Diagram& d, const Extent& e) {
   if (d.show_floor) y_min = std::min(y_min, d.floor / 3.0);
   d.y_lo = y_min / 3.0;
   d.y_hi = std::max(e.y_max, y_min) * 3.0;
-  if (d.any_diverged) d.y_hi *= 10.0;
+  if (d.any_diverged || d.any_never) d.y_hi *= 10.0;
   for (Panel& p : d.panels) {
     for (PlotPoint& q : p.diverged) q.y = d.y_hi;
+    for (PlotPoint& q : p.never) q.y = d.y_hi;
+    for (PlotPoint& q : p.paper) q.y = q.y > 0.0 ? q.y : d.y_hi;
   }
   d.x_lo = e.x_min / 1.5;
   d.x_hi = e.x_max * 1.5;
@@ -251,8 +277,9 @@ std::vector<Box> taken_boxes(const Panel& p, const Diagram& d, const Frame& f) {
     const double u = f.u(q.x), v = f.v(q.y);
     taken.push_back({u - grow * kPointU, u + grow * kPointU, v - grow * kPointV, v + grow * kPointV});
   };
-  for (const auto* list : {&p.iterations, &p.substeps, &p.clamped, &p.diverged, &p.paper}) {
-    for (const PlotPoint& q : *list) mark(q, list == &p.paper ? 1.7 : 1.0);
+  for (const auto* list : {&p.iterations, &p.substeps, &p.clamped, &p.diverged, &p.paper,
+                           &p.unresolved, &p.never}) {
+    for (const PlotPoint& q : *list) mark(q, list == &p.paper || list == &p.unresolved ? 1.7 : 1.0);
   }
   for (const auto& line : p.warm) {
     for (const PlotPoint& q : line) mark(q, 1.0);
@@ -297,15 +324,18 @@ PlotPoint place_label(const PlotPoint& q, bool under_only, const Frame& f, std::
 }
 
 // Places a panel's labels so that no label overlaps another label, a point mark or the frame's
-// edge: the diverged runs' labels first (left to right, under their marks), then the iteration
-// and substep lines'. The labels' positions are in data coordinates.
+// edge: the diverged runs' labels first, then those of the runs that never recovered (left to
+// right, under their marks), then the iteration and substep lines'. The labels' positions are in data coordinates.
 void place_labels(Panel& p, const Diagram& d) {
   const Frame f(d);
   std::vector<Box> taken = taken_boxes(p, d, f);
-  std::vector<PlotPoint> diverged = p.diverged;
-  std::sort(diverged.begin(), diverged.end(),
-            [](const PlotPoint& a, const PlotPoint& b) { return a.x < b.x; });
-  for (const PlotPoint& q : diverged) p.labels_div.push_back(place_label(q, true, f, taken));
+  for (const auto& [marks, labels] :
+       {std::pair{&p.diverged, &p.labels_div}, std::pair{&p.never, &p.labels_never}}) {
+    std::vector<PlotPoint> sorted = *marks;
+    std::sort(sorted.begin(), sorted.end(),
+              [](const PlotPoint& a, const PlotPoint& b) { return a.x < b.x; });
+    for (const PlotPoint& q : sorted) labels->push_back(place_label(q, true, f, taken));
+  }
   std::vector<PlotPoint> it = std::move(p.labels_it), ss = std::move(p.labels_ss);
   p.labels_it.clear();
   p.labels_ss.clear();
@@ -320,6 +350,9 @@ std::optional<Diagram> make_diagram(const Measure& m, double floor,
   Diagram d;
   d.floor = floor;
   d.warm_factors = warm_factors_of(runs);
+  for (const RunResult* r : runs) {
+    if (r->substeps == 1 && r->dt_s) d.dt1 = dt_text(*r);
+  }
   Extent e;
   for (const std::vector<const RunResult*>& panel : panel_runs(runs)) {
     d.panels.push_back(make_panel(m, panel, d, e));
@@ -338,8 +371,9 @@ std::string plot_data(const Diagram& d) {
   for (const Panel& p : d.panels) {
     std::vector<const std::vector<PlotPoint>*> lists = {&p.iterations};
     for (const auto& line : p.warm) lists.push_back(&line);
-    for (const auto* list : {&p.substeps, &p.paper, &p.clamped, &p.diverged, &p.labels_it,
-                             &p.labels_ss, &p.labels_div}) {
+    for (const auto* list : {&p.substeps, &p.paper, &p.clamped, &p.diverged, &p.unresolved,
+                             &p.never, &p.labels_it, &p.labels_ss, &p.labels_div,
+                             &p.labels_never}) {
       lists.push_back(list);
     }
     for (const auto* list : lists) {
@@ -385,9 +419,13 @@ std::string warm_line_style(std::size_t k) {
          " ps 0.8 lc rgb '" + w.colour + "'";
 }
 
-// The rows of the key under the panels (the warm lines' entries take a third) and its height
-// (pixels).
-int key_rows(const Diagram& d) { return d.warm_factors.empty() ? 2 : 3; }
+// The rows of the key under the panels (the warm lines' entries take a third; four entries to a
+// row at most) and its height (pixels).
+int key_rows(const Diagram& d) {
+  const int entries = 3 + static_cast<int>(d.warm_factors.size()) + d.any_diverged + d.show_floor +
+                      d.any_clamped + d.any_never + d.any_unresolved + d.any_reference;
+  return std::max(d.warm_factors.empty() ? 2 : 3, (entries + 3) / 4);
+}
 double key_height(const Diagram& d) { return 10.0 + 30.0 * key_rows(d); }
 
 // The script's settings shared by every panel: log axes and their ranges, x tics at 1, 2 and 5
@@ -450,9 +488,12 @@ std::string panel_plot(const Panel& p, const Diagram& d, const fs::path& data, i
   block(p.paper, "using 1:2 with points pt 6 ps 2.2 lw 1.5 lc rgb 'black'");
   block(p.clamped, "using 1:2 with points pt 10 ps 1.6 lw 1.5 lc rgb 'black'");
   block(p.diverged, "using 1:2:3:4 with xerrorbars pt 2 ps 1.8 lw 2.5 lc rgb '#d62728'");
+  block(p.unresolved, "using 1:2 with points pt 8 ps 2.2 lw 1.5 lc rgb '#b8860b'");
+  block(p.never, "using 1:2:3:4 with xerrorbars pt 3 ps 1.8 lw 2 lc rgb '#7f7f7f'");
   block(p.labels_it, "using 1:2:5 with labels font ',8' tc rgb '#1f77b4'");
   block(p.labels_ss, "using 1:2:5 with labels font ',8' tc rgb '#c0399c'");
   block(p.labels_div, "using 1:2:5 with labels font ',8' tc rgb '#d62728'");
+  block(p.labels_never, "using 1:2:5 with labels font ',8' tc rgb '#7f7f7f'");
   gp << "plot ";
   for (std::size_t k = 0; k < parts.size(); ++k) gp << (k ? ", \\\n     " : "") << parts[k];
   gp << "\n";
@@ -469,13 +510,14 @@ std::string script_key(const Diagram& d, const Measure& m, double key_h) {
      << "set xrange [0:1]\nset yrange [0:1]\n"
      << "set key center center horizontal maxrows " << key_rows(d)
      << " width 1 samplen 3 font ',9'\nplot "
-     << "NaN with linespoints lw 1.5 pt 7 lc rgb '#1f77b4' title 'iterations, 1 substep (60 Hz)'";
+     << "NaN with linespoints lw 1.5 pt 7 lc rgb '#1f77b4' title "
+     << gp_text("iterations, 1 substep (dt " + d.dt1 + ")");
   for (std::size_t k = 0; k < d.warm_factors.size(); ++k) {
     gp << ", NaN with linespoints " << warm_line_style(k) << " title "
        << gp_text("iterations, warm start " + shortest_decimal(d.warm_factors[k]));
   }
   gp << ", NaN with linespoints lw 1.5 dt 2 pt 5 lc rgb '#e377c2' title "
-        "'substeps per 1/60 s frame, 25 iterations'"
+     << gp_text("substeps per step of " + d.dt1 + ", 25 iterations")
      << ", NaN with points pt 6 ps 2 lw 1.5 lc rgb 'black' title 'the paper''s settings'";
   if (d.any_diverged) {
     gp << ", NaN with points pt 2 ps 1.5 lw 2.5 lc rgb '#d62728' title "
@@ -488,6 +530,14 @@ std::string script_key(const Diagram& d, const Measure& m, double key_h) {
   if (d.any_clamped) {
     gp << ", NaN with points pt 10 ps 1.5 lw 1.5 lc rgb 'black' title "
           "'under the floor (drawn on it)'";
+  }
+  if (d.any_never) {
+    gp << ", NaN with points pt 3 ps 1.5 lw 2 lc rgb '#7f7f7f' title "
+          "'never recovered by the horizon (on the top edge)'";
+  }
+  if (d.any_unresolved) {
+    gp << ", NaN with points pt 8 ps 2 lw 1.5 lc rgb '#b8860b' title "
+          "'below the reference''s own error: not resolved'";
   }
   if (d.any_reference) {
     gp << ", NaN with lines dt 4 lw 1.2 lc rgb '#b8860b' title "

@@ -17,8 +17,10 @@ namespace cps::cli {
 /// .gp). Panels per solver, push and friction model (pgs left, jacobi right) on shared axes; in
 /// each the iteration line (1 substep), the warm-started iteration lines, the substep line (25
 /// iterations), the paper's settings ringed, diverged runs on the top edge (at their time until
-/// they diverged), values under the measure's round-off floor (floor_of) drawn on it, and for
-/// the trajectory error the reference's own error. `title_note` is appended to the title. Returns
+/// they diverged), runs that never recovered (ranked_value infinite: headline.h) on the top edge
+/// with their own mark, values under the measure's round-off floor (floor_of) drawn on it, and
+/// for the trajectory error the reference's own error and, ringed with their own mark, the runs
+/// under it (under_reference_error). The key names the dt of the runs at 1 substep. `title_note` is appended to the title. Returns
 /// false, writing nothing, if no run that finished has a value of the measure. Throws
 /// std::runtime_error if a file cannot be written or gnuplot fails.
 bool draw_diagram(const std::filesystem::path& dir, const std::string& scene, const Measure& m,

@@ -1,5 +1,6 @@
 #include "report/markdown.h"
 
+#include "report/headline.h"
 #include "report/mass_ratio.h"
 #include "report/run.h"
 #include "report/timing.h"
@@ -50,15 +51,6 @@ std::string ratio_text(const RunResult& a, const RunResult& b) {
            number_with_digits(a3 / b1, digits) + ")";
   }
   return out;
-}
-
-// The run at the paper's settings among `runs` (the last one), or nullptr.
-const RunResult* paper_run(const Runs& runs) {
-  const RunResult* base = nullptr;
-  for (const RunResult* r : runs) {
-    if (r->is_paper_setting()) base = r;
-  }
-  return base;
 }
 
 // The INCOMPLETE notice: how many planned runs are missing, the first 20 of them by id.
@@ -168,65 +160,137 @@ void write_definitions(std::ostream& md, const ReportContent& c) {
      << "\n\n";
 }
 
-// The cheapest run (least time) among `runs`, not diverged, whose `measure` is at most half e0
-// (the paper's run's); for the trajectory error only runs whose reference's own error is under
-// half e0. nullptr if none.
-const RunResult* cheapest_halving(const Runs& runs, const std::string& measure, double e0) {
-  const bool trajectory = measure == "trajectory_error_m";
-  const RunResult* best = nullptr;
-  for (const RunResult* r : runs) {
-    if (r->diverged) continue;
-    const double e = r->value(measure);
-    const double t = time_of(*r);
-    if (trajectory && !(0.5 * e0 > r->value("reference_check_m"))) continue;
-    if (e <= 0.5 * e0 && std::isfinite(t) && (!best || t < time_of(*best))) best = r;
-  }
-  return best;
+// A ranked value as report.md prints it: "never by the horizon" for +infinity (a run that never
+// recovered), else the number.
+std::string value_text(double v) { return std::isinf(v) ? std::string("never by the horizon") : number(v); }
+
+// " (its own: 1/600 s)" where the scene's own dt (its world_def, what `cps simulate` steps
+// with) is not the run's at 1 substep; "" otherwise or for a scene this build does not know.
+std::string own_dt_note(const std::string& scene, const RunResult& r) {
+  const scenes::Scene* s = scenes::find_scene(scene);
+  if (!s || !r.dt_s || r.substeps != 1) return "";
+  RunResult own;
+  own.dt_s = s->world_def().dt;
+  const std::string t = dt_text(own);
+  return t == dt_text(r) ? std::string() : " (its own: " + t + ")";
 }
 
-// The headline row of one scene: its measure at the paper's settings and the cheapest run with
-// at most half of it.
+// The settings of a run in one line: "jacobi, split, fixed, 25 it, 4 substeps, warm start 0.8".
+std::string settings_text(const RunResult& r) {
+  return r.solver + ", " + r.push + ", " + r.friction_model + ", " + std::to_string(r.iterations) +
+         " it, " + std::to_string(r.substeps) + (r.substeps == 1 ? " substep" : " substeps") +
+         (r.warm_start != 0.0 ? ", warm start " + shortest_decimal(r.warm_start) : std::string());
+}
+
+// The headline row of one scene: its measure at the paper's settings, their dt, and the cheapest
+// run with at most half of it.
 void write_headline_row(std::ostream& md, const std::string& scene, const Runs& runs) {
   const std::string measure = primary_measure(scene);
   const RunResult* base = paper_run(runs);
   md << "| " << scene << " | " << label_of(measure) << " | ";
-  if (!base || base->diverged || std::isnan(base->value(measure))) {
-    md << (base ? "diverged or not measured" : "not in this sweep") << " | | | | |\n";
+  if (!base || base->diverged || std::isnan(ranked_value(*base, measure))) {
+    md << (base ? dt_text(*base) : std::string()) << " | "
+       << (base ? "diverged or not measured" : "not in this sweep") << " | | | | |\n";
     return;
   }
-  const double e0 = base->value(measure);
-  md << number(e0);
-  if (measure == "trajectory_error_m" && e0 < base->value("reference_check_m")) {
+  const double e0 = ranked_value(*base, measure);
+  md << dt_text(*base) << own_dt_note(scene, *base) << " | " << value_text(e0);
+  if (base->under_reference_error.value_or(false)) {
     md << " (under its reference's own error, " << text(*base, "reference_check_m") << ")";
   }
   md << " | " << time_text(*base) << " | ";
-  const RunResult* best = cheapest_halving(runs, measure, e0);
+  const RunResult* best = cheapest_halving(runs, measure, *base);
   if (!best) {
     md << "none in this sweep | | |\n";
     return;
   }
-  md << best->solver << ", " << best->push << ", " << best->friction_model << ", "
-     << best->iterations << " it, " << best->substeps
-     << (best->substeps == 1 ? " substep" : " substeps")
-     << (best->warm_start != 0.0 ? ", warm start " + shortest_decimal(best->warm_start) : std::string())
-     << ": " << number(best->value(measure)) << " | " << time_text(*best) << " | "
+  md << settings_text(*best) << " (dt " << dt_text(*best) << "): "
+     << value_text(ranked_value(*best, measure)) << " | " << time_text(*best) << " | "
      << ratio_text(*best, *base) << " |\n";
 }
 
 // The headline: per scene, the paper's settings and the cheapest run with at most half their
-// error.
+// error; then why each scene's measure is the one it is.
 void write_headline(std::ostream& md, const ReportContent& c) {
   md << "## Headline: the paper's settings and the cheapest run with at most half their error\n\n"
-     << "The cheapest run (least time) whose value of the scene's measure is at most half the "
-        "value at the paper's settings, among every run of the scene (every solver, push and "
-        "friction model), diverged runs left out. For the trajectory error a run counts only "
-        "if half the paper's value is above its reference's own error. Which run is the "
-        "cheapest is decided by the medians of the times: where its time ratio's range "
+     << "Each scene's measure is one where smaller is better (why this one: under the table). "
+        "The cheapest run (least time) whose value of it is at most half the value at the "
+        "paper's settings, among every run of the scene (every solver, push, friction model, "
+        "iteration and substep count), diverged runs left out (they are listed under "
+        "[Omissions](#omissions)). A run that never recovers ranks after every run that does, "
+        "so where the paper's run never recovers any run that does counts. For the trajectory "
+        "error only the runs measured against the paper's run's reference count (its push and "
+        "friction model: the reference is PGS at " << kReferenceIterations << " iterations and "
+     << kReferenceSubsteps << " substeps of the run's own push and friction model, and the "
+        "distances of runs of other pushes from their own references do not compare with it), "
+        "and only if half the paper's value is above that reference's own error. The paper's "
+        "settings are PGS, Baumgarte push, fixed friction, " << kPaperIterations
+     << " iterations, cold start, one step per frame, at the dt the column gives: 1/60 s, the "
+        "paper's, for the scenes of the paper (with the scene's own dt in brackets where "
+        "`cps simulate` runs it at another), the scene's own dt for the others. Which run is "
+        "the cheapest is decided by the medians of the times: where its time ratio's range "
         "(brackets) reaches 1, another run of the same error may be as cheap.\n\n"
-     << "| scene | measure | at the paper's settings (PGS, Baumgarte, fixed friction, 25 it, 60 Hz) "
+     << "| scene | measure (smaller is better) | dt | at the paper's settings (PGS, Baumgarte, "
+        "fixed friction, " << kPaperIterations << " it, 1 step per frame, cold) "
         "| its time (s/s) | cheapest run with at most half of it | its time (s/s) | time ratio |\n"
-        "|---|---|---|---|---|---|---|\n";
+        "|---|---|---|---|---|---|---|---|\n";
   for (const std::string& scene : c.scenes) write_headline_row(md, scene, c.runs.at(scene));
+  md << "\nWhy each scene's measure:\n\n";
+  for (const std::string& scene : c.scenes) {
+    const scenes::Scene* s = scenes::find_scene(scene);
+    md << "- **" << scene << "**: "
+       << (s ? std::string(s->report.headline_reason)
+             : "a scene this build does not know: the default measure, " +
+                   std::string(scenes::ReportTraits{}.headline_reason))
+       << ".\n";
+  }
+  md << "\n";
+}
+
+// The summary of the omissions: per scene, the runs the headline leaves out (diverged, without a
+// value of the scene's measure or without a time), and the runs missing from a merge.
+void write_omission_summary(std::ostream& md, const ReportContent& c) {
+  md << "## Omissions\n\n"
+     << "Runs the headline and the warm starting tables leave out: every run that diverged "
+        "(drawn in the diagrams as a red x on the top edge, at its time until it diverged) and "
+        "every run without a value of its scene's measure or without a time. Each scene's "
+        "section lists them with their settings, when and why.";
+  if (!c.missing.empty()) {
+    md << " Besides them, " << c.missing.size() << " planned runs are missing from this report "
+       << "(INCOMPLETE, above).";
+  }
+  md << "\n\n| scene | runs | diverged: not finite or far off | diverged: penetration past "
+        "body size | diverged: rod error past body size | without a value or time |\n"
+        "|---|---|---|---|---|---|\n";
+  for (const std::string& scene : c.scenes) {
+    const Runs& runs = c.runs.at(scene);
+    int blown = 0, pen = 0, rod = 0, other = 0;
+    for (const Omission& o : omissions(runs, primary_measure(scene))) {
+      const std::string why = o.run->diverged_why.value_or("");
+      if (!o.run->diverged) ++other;
+      else if (why.rfind("penetration", 0) == 0) ++pen;
+      else if (why.rfind("rod error", 0) == 0) ++rod;
+      else ++blown;
+    }
+    md << "| " << scene << " | " << runs.size() << " | " << blown << " | " << pen << " | " << rod
+       << " | " << other << " |\n";
+  }
+  md << "\n";
+}
+
+// A scene's omissions table: each run the headline leaves out, its settings, and when and why.
+void write_omissions(std::ostream& md, const std::string& scene, const Runs& runs) {
+  const std::vector<Omission> left = omissions(runs, primary_measure(scene));
+  md << "### Omissions\n\n";
+  if (left.empty()) {
+    md << "None: every run of this scene finished with a value of its measure and a time.\n\n";
+    return;
+  }
+  md << "| run | settings | dt | why left out |\n|---|---|---|---|\n";
+  for (const Omission& o : left) {
+    md << "| `" << o.run->id() << "` | " << settings_text(*o.run) << " | " << dt_text(*o.run)
+       << " | " << o.why << " |\n";
+  }
   md << "\n";
 }
 
@@ -253,7 +317,7 @@ const RunResult* fewest_reaching(const Runs& runs, double w, const std::string& 
         r->substeps != 1 || r->warm_start != w || r->diverged) {
       continue;
     }
-    if (!(r->value(measure) <= e0)) continue;
+    if (!reaches(ranked_value(*r, measure), e0)) continue;
     if (!fewest || r->iterations < fewest->iterations) fewest = r;
   }
   return fewest;
@@ -268,7 +332,7 @@ void write_warm_table(std::ostream& md, const std::string& scene, const Runs& ru
   const std::string measure = primary_measure(scene);
   md << "### Warm starting: what PGS needs to reach the paper's error\n\n";
   const RunResult* base = paper_run(runs);
-  if (!base || base->diverged || std::isnan(base->value(measure)) ||
+  if (!base || base->diverged || std::isnan(ranked_value(*base, measure)) ||
       !(time_of(*base) > 0.0)) {
     md << "The paper's run (PGS, Baumgarte, fixed friction, " << kPaperIterations
        << " it, 1 substep, warm start 0) is "
@@ -276,12 +340,16 @@ void write_warm_table(std::ostream& md, const std::string& scene, const Runs& ru
        << ": nothing to compare with.\n\n";
     return;
   }
-  const double e0 = base->value(measure);
+  const double e0 = ranked_value(*base, measure);
   md << "The fewest iterations at the paper's other settings (PGS, Baumgarte, fixed friction, "
         "1 substep) with which a run's " << label_of(measure) << " is at most the paper's run's ("
-     << kPaperIterations << " it, warm start 0): " << number(e0) << ", in " << time_text(*base)
-     << " s/s. Iterations saved: " << kPaperIterations << " minus that count. Diverged runs never count.";
-  if (measure == "trajectory_error_m" && e0 < base->value("reference_check_m")) {
+     << kPaperIterations << " it, warm start 0): " << value_text(e0) << ", in " << time_text(*base)
+     << " s/s. Iterations saved: " << kPaperIterations << " minus that count. Diverged runs never "
+        "count";
+  md << (std::isinf(e0) ? "; the paper's run never recovers, so the table gives the fewest "
+                          "iterations that do."
+                        : ".");
+  if (base->under_reference_error.value_or(false)) {
     md << " The paper's value is under its reference's own error ("
        << number(base->value("reference_check_m"))
        << " m): the counts compare differences the reference does not resolve.";
@@ -296,7 +364,7 @@ void write_warm_table(std::ostream& md, const std::string& scene, const Runs& ru
       md << "none in this sweep | | | | |\n";
       continue;
     }
-    md << fewest->iterations << " | " << number(fewest->value(measure)) << " | "
+    md << fewest->iterations << " | " << value_text(ranked_value(*fewest, measure)) << " | "
        << time_text(*fewest) << " | " << ratio_text(*fewest, *base) << " | "
        << kPaperIterations - fewest->iterations << " |\n";
   }
@@ -346,14 +414,16 @@ void write_run_table(std::ostream& md, const std::string& scene, const Runs& run
   md << "| solver | push | friction | iterations | substeps | warm start | time (s/s) | "
         "time Q1 to Q3 (s/s) | "
      << label_of(measure)
-     << " | residual RMS (N) | penetration max (m) | rod error max (m) | diverged at (s) |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+     << " | under the reference's own error | residual RMS (N) | penetration max (m) | rod error "
+        "max (m) | diverged at (s) |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const RunResult* r : runs) {
     md << "| " << r->solver << " | " << r->push << " | " << r->friction_model << " | "
        << r->iterations << " | " << r->substeps << " | " << shortest_decimal(r->warm_start)
        << " | " << time_text(*r) << " | " << quartiles_text(*r) << " | "
-       << text(*r, measure) << " | "
-       << text(*r, "residual_rms_N") << " | " << text(*r, "penetration_max_m") << " | "
+       << (std::isinf(ranked_value(*r, measure)) ? "never" : text(*r, measure)) << " | "
+       << (r->under_reference_error ? (*r->under_reference_error ? "yes: not resolved" : "no") : "")
+       << " | " << text(*r, "residual_rms_N") << " | " << text(*r, "penetration_max_m") << " | "
        << text(*r, "rod_error_max_m") << " | "
        << (r->diverged ? text(*r, "diverged_at_s") : "no") << " |\n";
   }
@@ -376,6 +446,7 @@ void write_scene(std::ostream& md, const ReportContent& c, const std::string& sc
     }
   }
   write_run_table(md, scene, runs);
+  write_omissions(md, scene, runs);
 }
 
 // "yes" when the overlap_m cell (m) is a number under kHoldingOverlapM, "no" when it is one at or
@@ -428,6 +499,7 @@ std::string report_markdown(const ReportContent& content) {
   if (!content.missing.empty()) write_missing(md, content);
   write_definitions(md, content);
   write_headline(md, content);
+  write_omission_summary(md, content);
   for (const std::string& scene : content.scenes) write_scene(md, content, scene);
   write_mass_ratios(md, content.pairs);
   return md.str();

@@ -33,11 +33,17 @@ struct ReportContent {
 };
 
 /// The text of report.md. If `missing` is not empty it opens with INCOMPLETE and names the first
-/// 20 of them. Each scene's section opens with the table "Warm starting: what PGS needs to reach
+/// 20 of them. The headline (per scene its measure, smaller being better, at the paper's settings
+/// and the run's dt, and the cheapest run with at most half of it: report/headline.h; then why
+/// each scene's measure is the one it is, ReportTraits::headline_reason) is followed by the
+/// omissions' summary (per scene the runs diverged, by cause, and those without a value or
+/// time). Each scene's section opens with the table "Warm starting: what PGS needs to reach
 /// the paper's error" (per warm start factor, 0 included: the fewest iterations at PGS,
 /// Baumgarte, fixed friction, 1 substep whose primary measure is at most the paper's run's,
 /// that run's time, its ratio to the paper run's, and the iterations saved, 25 minus the
-/// count), then its diagrams (SCENE_<measure>.png) and a table of its runs.
+/// count), then its diagrams (SCENE_<measure>.png), a table of its runs (with whether a
+/// trajectory error is under its reference's own error) and its omissions (headline.h:
+/// omissions) with their settings, dt, when and why.
 std::string report_markdown(const ReportContent& content);
 
 }  // namespace cps::cli

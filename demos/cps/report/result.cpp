@@ -44,9 +44,10 @@ constexpr std::pair<std::string_view, NumberField> kNumberColumns[] = {
 // the sweep. Metrics and other columns follow, sorted by name.
 constexpr std::string_view kColumnOrder[] = {
     "scene", "solver", "push", "friction_model", "iterations", "substeps", "warm_start", "dt_s",
-    "horizon_s", "diverged", "diverged_at_s", "cpu_s_per_sim_s", "cpu_s_per_sim_s_q1",
+    "horizon_s", "diverged", "diverged_at_s", "diverged_why", "cpu_s_per_sim_s", "cpu_s_per_sim_s_q1",
     "cpu_s_per_sim_s_q3", "us_per_step", "timing_repeats", "runs_per_repeat",
-    "trajectory_time_s", "trajectory_error_m", "reference_check_m", "phase_error_deg",
+    "trajectory_time_s", "trajectory_error_m", "reference_check_m", "under_reference_error",
+    "phase_error_deg",
     "residual_max_N", "residual_rms_N", "penetration_max_m", "penetration_rms_m",
     "rod_error_max_m", "rod_error_rms_m", "energy_drift_rel", "sweep", "quick", "machine",
     "build"};
@@ -93,7 +94,10 @@ std::string bad_cell(const std::string& column, const std::string& text) {
   const bool numeric = number_field(column) != nullptr || column == "warm_start" ||
                        column.rfind(kMetricPrefix, 0) == 0;
   if (numeric && kind == NumberText::not_number) return "is not a number";
-  if ((column == "diverged" || column == "quick") && text != "0" && text != "1") return "is not 0 or 1";
+  if ((column == "diverged" || column == "quick" || column == "under_reference_error") &&
+      text != "0" && text != "1") {
+    return "is not 0 or 1";
+  }
   return "";
 }
 
@@ -125,6 +129,10 @@ bool set_cell(RunResult& r, const std::string& column, const std::string& text) 
     r.warm_start = std::isnan(w) ? 0.0 : w;
   } else if (column == "diverged") {
     r.diverged = text == "1";
+  } else if (column == "diverged_why") {
+    r.diverged_why = text;
+  } else if (column == "under_reference_error") {
+    r.under_reference_error = text == "1";
   } else if (column == "sweep") {
     r.sweep = text;
   } else if (column == "quick") {
@@ -208,6 +216,11 @@ std::optional<std::string> RunResult::cell(std::string_view column) const {
   }
   if (column == "runs_per_repeat") {
     return runs_per_repeat ? std::optional<std::string>(std::to_string(*runs_per_repeat)) : std::nullopt;
+  }
+  if (column == "diverged_why") return diverged_why;
+  if (column == "under_reference_error") {
+    return under_reference_error ? std::optional<std::string>(*under_reference_error ? "1" : "0")
+                                 : std::nullopt;
   }
   if (column == "machine") return machine;
   if (column == "build") return build;

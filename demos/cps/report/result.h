@@ -37,6 +37,9 @@ struct RunResult {
   // What happened.
   bool diverged = false;                ///< the state blew up (see execute_run)
   std::optional<double> diverged_at_s;  ///< when (s); only for a diverged run
+  /// Why it diverged (execute_run's words, text without commas: "not finite", "penetration
+  /// 3.1 m past the largest body's size 2.4 m", ...); only for a diverged run of this build.
+  std::optional<std::string> diverged_why;
   /// Physics CPU time per simulated second (s/s): the median over the timed repeats of the CPU
   /// time of the thread that stepped (report/timing.h), and the repeats' first and third
   /// quartiles.
@@ -49,6 +52,9 @@ struct RunResult {
   std::optional<double> trajectory_time_s;   ///< when positions are compared (s)
   std::optional<double> trajectory_error_m;  ///< RMS distance from the reference run (m)
   std::optional<double> reference_check_m;   ///< the reference's own error (m)
+  /// True where trajectory_error_m is under reference_check_m: a difference the reference does
+  /// not resolve (column under_reference_error, 0 or 1); only with both.
+  std::optional<bool> under_reference_error;
   std::optional<double> phase_error_deg;     ///< the metric max_phase_error_deg (deg)
   std::optional<double> residual_max_N;      ///< largest LCP residual of any row (N)
   std::optional<double> residual_rms_N;      ///< RMS LCP residual over every row (N)
@@ -99,8 +105,8 @@ CsvTable results_table(const std::vector<RunResult>& results);
 /// or a setting (solver, push, friction_model, iterations, substeps, diverged) is missing, and
 /// naming it, the line (CsvTable::lines), the column and the cell for a count that is not one, a
 /// cell that reads as a number that is not finite ("nan", "inf", "1e999"; in any column), a
-/// number column (a measure, "metric.*", warm_start) that is not all a number, or a diverged or
-/// quick that is not 0 or 1.
+/// number column (a measure, "metric.*", warm_start) that is not all a number, or a diverged,
+/// quick or under_reference_error that is not 0 or 1.
 std::vector<RunResult> results_of(const CsvTable& table, const std::string& source);
 
 /// Writes results_table(results) to `file` atomically. Throws std::runtime_error "cannot write
@@ -122,9 +128,9 @@ inline constexpr std::uintmax_t kMergeMemoryLimit = std::uintmax_t{256} << 20;
 /// estimate (bytes + cells x kMergeBytesPerCell) and the limit if the estimate passes
 /// kMergeMemoryLimit. Throws UsageError naming a folder that does not exist; a file found below
 /// two given folders (naming both); a file that is not a report CSV (results_of); a cell that is
-/// not finite ("nan", "inf"), not a number where one is due, or not 0 or 1 in diverged or
-/// quick (naming the file, line, column and cell); and a run id found twice (naming the id and
-/// both files and lines).
+/// not finite ("nan", "inf"), not a number where one is due, or not 0 or 1 in diverged, quick
+/// or under_reference_error (naming the file, line, column and cell); and a run id found twice
+/// (naming the id and both files and lines).
 std::vector<RunResult> read_results(const std::vector<std::filesystem::path>& dirs);
 
 }  // namespace cps::cli

@@ -113,6 +113,7 @@ struct ErrorRun {
   Spread rod_error;            // m, every rod of every step
   std::vector<Vec3> at_traj;   // positions at the trajectory time; empty if not reached
   std::optional<double> diverged_at;  // s
+  std::string diverged_why;           // state_fault's words, or the bound passed
 };
 
 // Adds the contacts' penetrations and the rods' length errors of the world's last step.
@@ -137,19 +138,24 @@ void observe_errors(const World& world, ErrorRun& e) {
 // accuracy.
 ErrorRun error_run(const scenes::Scene& scene, scenes::Overrides o, double horizon, double t_traj) {
   o.set("measure_residual", true);
-  ErrorRun e{scenes::make_run(scene, o), {}, {}, {}, {}};
+  ErrorRun e{scenes::make_run(scene, o), {}, {}, {}, {}, {}};
   World& world = e.run.world;
   const double size_bound = largest_body_size(world);
   while (!reached(world, horizon)) {
     e.run.step();
-    if (!sane_state(world)) {
+    if (const std::string fault = state_fault(world); !fault.empty()) {
       e.diverged_at = world.time();
+      e.diverged_why = fault;
       break;
     }
     observe_errors(world, e);
     if (e.at_traj.empty() && reached(world, t_traj)) e.at_traj = positions(world);
     if (e.penetration.max > size_bound || e.rod_error.max > size_bound) {
       e.diverged_at = world.time();
+      const bool pen = e.penetration.max > size_bound;
+      e.diverged_why = std::string(pen ? "penetration " : "rod error ") +
+                       number(pen ? e.penetration.max : e.rod_error.max) +
+                       " m past the largest body's size " + number(size_bound) + " m";
       break;
     }
   }
@@ -175,6 +181,7 @@ void record_errors(const ErrorRun& e, RunResult& r) {
   const World& world = e.run.world;
   r.diverged = e.diverged_at.has_value();
   if (e.diverged_at) r.diverged_at_s = csv(*e.diverged_at);
+  if (e.diverged_at) r.diverged_why = e.diverged_why;
   const ResidualStats& res = world.residual();
   r.residual_max_N = csv(res.max);
   r.residual_rms_N = csv(res.rms());
@@ -237,15 +244,18 @@ constexpr int kMaxCopies = 1000;
 
 }  // namespace
 
-bool sane_state(const World& world) {
+std::string state_fault(const World& world) {
   for (const Body& b : world.bodies()) {
     if (!b.x.allFinite() || !b.p.allFinite() || !b.l.allFinite() || !b.o.coeffs().allFinite()) {
-      return false;
+      return "not finite";
     }
-    if (b.x.norm() > 1e6 || b.velocity().norm() > 1e6) return false;
+    if (b.x.norm() > 1e6) return "a body past 1e6 m from the origin";
+    if (b.velocity().norm() > 1e6) return "a body faster than 1e6 m/s";
   }
-  return true;
+  return "";
 }
+
+bool sane_state(const World& world) { return state_fault(world).empty(); }
 
 MeasuredRun measure_errors(const RunSpec& spec) {
   const scenes::Scene& scene = spec.scene_def();
@@ -266,6 +276,9 @@ MeasuredRun measure_errors(const RunSpec& spec) {
     r.reference_check_m = csv(ref.check_m);
     if (!e.at_traj.empty() && ref.positions) {
       r.trajectory_error_m = csv(rms_distance(e.at_traj, *ref.positions));
+      if (std::isfinite(ref.check_m)) {
+        r.under_reference_error = *r.trajectory_error_m < *r.reference_check_m;
+      }
     }
   }
   const double until = e.diverged_at.value_or(horizon);

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace cps::cli {
@@ -42,7 +43,10 @@ struct MeasuredRun {
 /// The error run of `spec` (residuals measured) and its trajectory error: the RMS distance (m)
 /// of the movable bodies from a reference run (kReferenceIterations, kReferenceSubsteps) at the
 /// scene's Scene::report_trajectory_time_s(); reference_check_m (m) is the reference's distance
-/// from the same run at half its substeps, an estimate of its own error. The timing is set up to
+/// from the same run at half its substeps, an estimate of its own error, and
+/// under_reference_error says whether the trajectory error is under it. A diverged run says why
+/// in diverged_why (state_fault's words, or the penetration or rod error past the largest
+/// movable body's size). The timing is set up to
 /// the horizon, or to the time the run diverged (diverged_at_s): a diverged run is timed until
 /// then, what the method cost until it failed. The result has no sweep (RunResult::sweep, quick),
 /// which the caller adds. Throws UsageError for an unknown scene or a bad parameter.
@@ -69,8 +73,12 @@ void record_timing(const TimedRun& t, RunResult& r);
 /// One run alone: measure_errors, time_runs of it alone and record_timing.
 RunResult execute_run(const RunSpec& spec, int repeats, double max_work);
 
+/// Why the state has blown up, or "" while it has not: "not finite", "a body past 1e6 m from
+/// the origin", "a body faster than 1e6 m/s" (text without commas, for diverged_why).
+std::string state_fault(const World& world);
+
 /// False once the state is not finite, or a body is further than 1e6 m away or faster than
-/// 1e6 m/s: the run has blown up and goes no further.
+/// 1e6 m/s (state_fault): the run has blown up and goes no further.
 bool sane_state(const World& world);
 
 }  // namespace cps::cli

@@ -83,9 +83,13 @@ class TemporalGaussSeidel final : public PushMethod {
     const std::vector<double>* start = ctx.warm_guess();
     for (int k = 0; k < substeps; ++k) {
       set_targets(ctx.rows, *ctx.distances, *ctx.bodies, def, h, /*relax=*/false);
+      if (k > 0) {  // the solve's start must not be its output buffer
+        detail::reserve_with_headroom(previous_, ctx.lambda_second.size());
+        previous_.assign(ctx.lambda_second.begin(), ctx.lambda_second.end());
+        start = &previous_;
+      }
       ctx.solve(biased, TargetTerms::push_and_bias, ctx.lambda_second, ctx.f_cv, start);
       ctx.integrate(ctx.f_cv, ctx.f_cv, h);
-      start = &ctx.lambda_second;
     }
     restore_momenta(*ctx.bodies);
     set_targets(ctx.rows, *ctx.distances, *ctx.bodies, def, def.dt, /*relax=*/true);
@@ -160,6 +164,7 @@ class TemporalGaussSeidel final : public PushMethod {
 
   std::vector<ContactPoint> contacts_;            // one per contact row, in row order
   std::vector<std::pair<Vec3, Vec3>> momenta_;    // n: p (N s) and l (N m s) at the step's start
+  std::vector<double> previous_;                  // c, N: the last substep's lambda
 };
 
 }  // namespace

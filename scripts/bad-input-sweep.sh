@@ -282,6 +282,8 @@ EXTRA=(
   # x bodies: each refused before any step.
   "--max-work/3.6e+14|simulate stack --push soft --soft-substeps 1000 --iterations 10000 --seconds 1e5"
   "--max-work|simulate pyramid_20000 --seconds 1e5"
+  "--tgs-substeps|simulate stack --push tgs --tgs-substeps 1000 --iterations 10000 --seconds 1e5"
+  "--xpbd-substeps|simulate stack --push xpbd --xpbd-substeps 1000 --iterations 10000 --seconds 1e5"
   "--max-work/9000|simulate stack --seconds 1 --max-work 8999"
   "--max-work|simulate stack --seconds 0.1 --trace t.csv --max-work 1"
   "--max-work|render stack --seconds 0.1 --fps 10 --size 16x16 --out out --max-work 1"
@@ -324,6 +326,8 @@ CONTROLS=(
   "export pendulum_grid --seconds 0.1 --fps 1e-5 --out out/p.glb"
   "simulate stack --seconds 1 --max-work 9000"  # exactly the run's work
   "simulate stack --seconds 0.1 --push soft --soft-substeps 1000 --iterations 10000"
+  "simulate stack --seconds 0.1 --push tgs --tgs-substeps 1000 --max-depenetration-speed 1e6"
+  "simulate stack --seconds 0.1 --push xpbd --xpbd-substeps 1000 --xpbd-compliance 1e6 --solver jacobi"
   "report intersecting_stack --list-runs --out out --max-work 1e18"
   "report intersecting_stack --list-runs --out out --repeats 3"  # the ends of --repeats' range
   "report intersecting_stack --list-runs --out out --repeats 100"

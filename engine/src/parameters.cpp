@@ -19,6 +19,8 @@ std::unique_ptr<PushMethod> make_single_frame_push();
 std::unique_ptr<PushMethod> make_split_impulse();
 std::unique_ptr<PushMethod> make_soft_step();
 std::unique_ptr<PushMethod> make_ngs();
+std::unique_ptr<PushMethod> make_tgs();
+std::unique_ptr<PushMethod> make_xpbd();
 
 namespace {
 
@@ -56,6 +58,10 @@ constexpr std::array kPushChoices = {
            /*in_paper=*/false, &make_soft_step},
     Choice{"ngs", static_cast<int>(PushMode::ngs), "Box2D v2.4", "non-linear Gauss-Seidel",
            /*in_paper=*/false, &make_ngs},
+    Choice{"tgs", static_cast<int>(PushMode::tgs), "PhysX 5", "temporal Gauss-Seidel",
+           /*in_paper=*/false, &make_tgs},
+    Choice{"xpbd", static_cast<int>(PushMode::xpbd), "Mueller et al. 2020", "extended position based dynamics",
+           /*in_paper=*/false, &make_xpbd},
 };
 constexpr std::array kSolverChoices = {
     Choice{"pgs", static_cast<int>(SolverKind::pgs), "Sec. 7.2", "projected Gauss-Seidel"},
@@ -161,7 +167,9 @@ const std::array kParameters = {
                       "frame push factor, two solves (Sec. 8.1); split-impulse: Bullet's split "
                       "impulse, the push on pseudo-velocities; soft: Box2D v3's soft step, "
                       "substeps with soft rows and relax; ngs: non-linear Gauss-Seidel position "
-                      "projection (Box2D v2.4)",
+                      "projection (Box2D v2.4); tgs: temporal Gauss-Seidel (PhysX 5), substeps with the "
+                      "push then a relax; xpbd: extended position based dynamics (Mueller et al. "
+                      "2020), substeps of positional corrections",
               .title = "constraint correction",
               .get = &get_member<&WorldDef::push>,
               .set = &set_member<&WorldDef::push>},
@@ -335,6 +343,51 @@ const std::array kParameters = {
                       "iteration; Box2D v2.4's 0.2",
               .get = &get_member<&WorldDef::max_correction>,
               .set = &set_member<&WorldDef::max_correction>},
+    Parameter{.name = "tgs_substeps",
+              .flag = "tgs-substeps",
+              .json_key = "tgs_substeps",
+              .unit = "",
+              .type = ParameterType::integer,
+              .min = 1.0,
+              .max = 1000.0,
+              .help = "push tgs: substeps per step, each a solve with the push of the current error "
+                      "(the iterations split over them), then one relax solve; PhysX's 4",
+              .get = &get_member<&WorldDef::tgs_substeps>,
+              .set = &set_member<&WorldDef::tgs_substeps>},
+    Parameter{.name = "max_depenetration_speed",
+              .flag = "max-depenetration-speed",
+              .json_key = "max_depenetration_speed_mps",
+              .unit = "m/s",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0e6,
+              .min_exclusive = true,
+              .help = "push tgs and xpbd: the fastest an overlap is pushed out; PhysX's "
+                      "maxDepenetrationVelocity, 10 as Unity sets it",
+              .get = &get_member<&WorldDef::max_depenetration_speed>,
+              .set = &set_member<&WorldDef::max_depenetration_speed>},
+    Parameter{.name = "xpbd_substeps",
+              .flag = "xpbd-substeps",
+              .json_key = "xpbd_substeps",
+              .unit = "",
+              .type = ParameterType::integer,
+              .min = 1.0,
+              .max = 1000.0,
+              .help = "push xpbd: substeps per step, each one sweep of positional corrections "
+                      "and a velocity pass; typical 20",
+              .get = &get_member<&WorldDef::xpbd_substeps>,
+              .set = &set_member<&WorldDef::xpbd_substeps>},
+    Parameter{.name = "xpbd_compliance",
+              .flag = "xpbd-compliance",
+              .json_key = "xpbd_compliance_m_per_n",
+              .unit = "m/N",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0e6,
+              .help = "push xpbd: the rods' compliance (inverse stiffness); 0 = rigid rods, as the "
+                      "source's joints",
+              .get = &get_member<&WorldDef::xpbd_compliance>,
+              .set = &set_member<&WorldDef::xpbd_compliance>},
     Parameter{.name = "collision",
               .flag = "",
               .json_key = "collision",

@@ -687,7 +687,9 @@ TEST_CASE("the push methods beyond the paper's keep the energy bound in the stif
   // so only the lift can add energy. Cold and warm started (0.8), on the scenes where energy
   // would show first: the chain's whip, heavy on light, the stack at dt = 0.1 s, the ball in the
   // box, the heavy ball on the grid.
-  for (const char* method : {"split-impulse", "soft", "ngs"}) {
+  // xpbd is not in this list: it breaks the bound (measured: a step excess of 8.8 J in chain_20,
+  // 2056 J gained in heavy_ball_grid; docs/findings.md, "TGS and XPBD").
+  for (const char* method : {"split-impulse", "soft", "ngs", "tgs"}) {
     for (const double warm : {0.0, 0.8}) {
       for (const char* name : {"chain_20", "mass_ratio_10", "stack_dt_0.1", "sphere_in_box",
                                "heavy_ball_grid"}) {
@@ -695,12 +697,15 @@ TEST_CASE("the push methods beyond the paper's keep the energy bound in the stif
         scenes::Overrides o;
         o.set("push", parameter("push").find_choice(method)->value);
         o.set("warm_start", warm);
-        if (std::string(method) == "ngs" && warm > 0.0 && std::string(name) == "stack_dt_0.1") {
+        if ((std::string(method) == "ngs" || std::string(method) == "tgs") && warm > 0.0 &&
+            std::string(name) == "stack_dt_0.1") {
           // Measured at 25 sweeps: a step excess of 0.049 J (tolerance 0.0104 J), at 100 sweeps
           // 0.005 J, at 400 0.0006 J: the residual of a velocity solve started from a stale
           // guess (each landing at dt = 0.1 s an impulse), which the position projection does
-          // not take back. Checked where the solve converges enough for the bound to apply.
-          o.set("iterations", 100);
+          // not take back. Checked where the solve converges enough for the bound to apply. tgs
+          // alike (its relax is a velocity solve from the same guess): 0.32 J at 25 sweeps,
+          // 0.0135 J at 100 (tolerance 0.011 J); checked at 400.
+          o.set("iterations", std::string(method) == "tgs" ? 400 : 100);
         }
         const CheckedRun c = run_checked(name, std::min(5.0, scene(name).default_seconds), o);
         INFO(c.metrics.dump());
@@ -718,7 +723,8 @@ TEST_CASE("random piles keep the energy bound with the push methods beyond the p
   if (const char* env = std::getenv("CPS_RANDOM_SEEDS")) seeds = std::atoi(env);
   seeds = std::max(1, seeds / 10);
   for (int seed = 0; seed < seeds; ++seed) {
-    for (const PushMode push : {PushMode::split_impulse, PushMode::soft, PushMode::ngs}) {
+    for (const PushMode push : {PushMode::split_impulse, PushMode::soft, PushMode::ngs,
+                                PushMode::tgs}) {  // xpbd: see the test above
       WorldDef def = scenes::stack_world_def();
       def.push = push;
       World world(def);

@@ -87,7 +87,16 @@ std::string count_text(double n) {
 }
 
 double substeps_of(const WorldDef& def) {
-  return def.push == PushMode::soft ? static_cast<double>(def.soft_substeps) : 1.0;
+  switch (def.push) {
+    case PushMode::soft:
+      return static_cast<double>(def.soft_substeps);
+    case PushMode::tgs:  // at most substeps x iterations biased sweeps, plus the relax's
+      return static_cast<double>(def.tgs_substeps);
+    case PushMode::xpbd:  // one sweep per substep: an upper bound
+      return static_cast<double>(def.xpbd_substeps);
+    default:
+      return 1.0;
+  }
 }
 
 }  // namespace
@@ -110,7 +119,10 @@ void add_max_work_option(CLI::App& cmd, double& max_work) {
 
 std::string lower_run_options(const WorldDef& def, const std::string& shorter) {
   return "give " + shorter + ", a larger --dt, fewer --iterations" +
-         (def.push == PushMode::soft ? std::string(" or --soft-substeps") : std::string()) +
+         (def.push == PushMode::soft   ? std::string(" or --soft-substeps")
+          : def.push == PushMode::tgs  ? std::string(" or --tgs-substeps")
+          : def.push == PushMode::xpbd ? std::string(" or --xpbd-substeps")
+                                       : std::string()) +
          ", or raise --max-work";
 }
 

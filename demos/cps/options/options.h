@@ -53,8 +53,9 @@ void add_seconds_option(CLI::App& cmd, std::optional<double>& seconds, const std
 extern const CLI::Validator kNotEmpty;
 
 /// The work of a run, in body-iterations: bodies x steps x substeps x iterations, where steps is
-/// round(seconds / def.dt), substeps is def.soft_substeps for the soft step (push soft) and 1
-/// otherwise, and iterations is def.iterations. bodies: the world's bodies after populate
+/// round(seconds / def.dt), substeps is def.soft_substeps for the soft step (push soft),
+/// def.tgs_substeps for push tgs, def.xpbd_substeps for push xpbd (upper bounds of their sweeps
+/// over iterations) and 1 otherwise, and iterations is def.iterations. bodies: the world's bodies after populate
 /// (static ones too). seconds >= 0 (s). A measure of the solver's cost, not a time. No errors.
 double run_work(std::size_t bodies, const WorldDef& def, double seconds);
 
@@ -69,7 +70,8 @@ void check_work(const std::string& what, std::size_t bodies, const WorldDef& def
                 double max_work, const std::string& lower);
 
 /// `lower` for check_work in a command that takes the world options: `shorter` (how to shorten
-/// the run), --dt, --iterations, and --soft-substeps when def's push is soft.
+/// the run), --dt, --iterations, and --soft-substeps, --tgs-substeps or --xpbd-substeps when
+/// def's push is soft, tgs or xpbd.
 std::string lower_run_options(const WorldDef& def, const std::string& shorter = "fewer --seconds");
 
 /// Throws UsageError naming the run, the steps it would take and kMaxSteps when seconds / dt

@@ -31,6 +31,10 @@ enum class PushMode {
               ///< stiffness (Hz) and damping ratio, then a relax solve without the push
   ngs,        ///< non-linear Gauss-Seidel (engine/src/push/ngs.cpp): a velocity solve without the push,
               ///< then positions moved directly to reduce the overlaps and rod errors
+  tgs,        ///< temporal Gauss-Seidel, PhysX 5's eTGS (engine/src/push/tgs.cpp): substeps of rigid
+              ///< rows with the push of the current error, then a relax solve without it
+  xpbd,       ///< extended position based dynamics for rigid bodies (engine/src/push/xpbd.cpp):
+              ///< substeps of positional corrections with compliance, then a velocity pass
 };
 
 /// The iteration used for A lambda = b.
@@ -124,6 +128,21 @@ struct WorldDef {
   /// Non-linear Gauss-Seidel only: the largest correction of one contact point or rod in one
   /// position iteration (m, > 0). Box2D v2.4's b2_maxLinearCorrection: 0.2.
   double max_correction = 0.2;
+  /// Temporal Gauss-Seidel (push tgs) only: substeps per step (count, >= 1), each a solve with
+  /// the push of the current error that moves positions and momenta; the `iterations` are split
+  /// over them. PhysX's default position iteration count (its TGS substeps): 4.
+  int tgs_substeps = 4;
+  /// Push tgs and xpbd only: the fastest an overlap is pushed out (m/s, > 0): tgs caps each
+  /// contact row's push, xpbd its pre-stabilisation. PhysX's maxDepenetrationVelocity as Unity
+  /// sets it by default: 10.
+  double max_depenetration_speed = 10.0;
+  /// XPBD (push xpbd) only: substeps per step (count, >= 1), each one sweep of positional
+  /// corrections and a velocity pass. Typical: 20 (Mueller et al. 2020 run tens of substeps of
+  /// one iteration each).
+  int xpbd_substeps = 20;
+  /// XPBD only: the rods' compliance alpha (m/N, >= 0), the inverse of their stiffness; 0 (the
+  /// default) is a rigid rod, as the source's joints; contacts are always rigid.
+  double xpbd_compliance = 0.0;
   bool collision = true;  ///< false: the bodies never collide and the collide stage is skipped
   /// true: after every solve, measure the LCP residual into World::residual(); it costs one pass
   /// over the rows per solve, so it is off unless a report asks for it.

@@ -1,0 +1,405 @@
+// Extended position based dynamics for rigid bodies: `--push xpbd`. Sources: M. Mueller, M.
+// Macklin, N. Chentanez, S. Jeschke, T.-Y. Kim, "Detailed Rigid Body Simulation with Extended
+// Position Based Dynamics" (SCA 2020; Algorithm 2 the step, Sec. 3.3 the positional correction,
+// Sec. 3.5 the contacts with static friction, Sec. 3.6 the velocity pass with dynamic friction
+// and restitution); M. Macklin, K. Storey, M. Lu, P. Terdiman, N. Chentanez, S. Jeschke, M.
+// Mueller, "Small Steps in Physics Simulation" (SCA 2019): many substeps of one iteration each;
+// M. Macklin, M. Mueller, N. Chentanez, T.-Y. Kim, "Unified Particle Physics for Real-Time
+// Applications" (SIGGRAPH 2014), pre-stabilisation (Sec. 4.4: the errors present at the start of
+// a step corrected on positions alone, so they add no velocity) and the Jacobi averaging (Sec.
+// 4.2).
+//
+// XPBD does not solve A lambda = b: it moves positions. One step of length dt is N =
+// xpbd_substeps substeps of h = dt / N; each, with x, o the bodies' positions and orientations
+// and v, w their velocities (m^-1 p, I^-1 l):
+//   1. x_prev = x, o_prev = o; the momenta take f_ext h and the bodies move over h with them
+//      (semi-implicit Euler, Eqs. 3.2.1-3.2.4: the paper's integration of Algorithm 2);
+//   2. one sweep over the contacts, then the rods (Sec. 3.3). A constraint C between points at
+//      offsets r_a, r_b from the centres of mass, along the unit axis k (the gradient of C at
+//      body b), with the generalised inverse masses
+//        w_i = m_i^-1 + (r_i x k)^T I_i^-1 (r_i x k)   (1/kg; 0 for a static body or the world)
+//      and the compliance alpha (m/N) as alpha~ = alpha / h^2, gets
+//        Delta lambda = (-C - alpha~ lambda) / (w_a + w_b + alpha~)   (kg m; lambda = 0 at the
+//      start of each substep: one iteration), applied as the positional impulse P = Delta lambda k:
+//        x_b += m_b^-1 P, o_b turned by I_b^-1 (r_b x P); x_a -= m_a^-1 P, o_a by -I_a^-1 (r_a x P)
+//      (the turn as Eq. 3.2.4's linear update, then normalised).
+//        contact: its two witness points fixed in the bodies' frames (Contact::point is midway:
+//          p_a = point + n d/2, p_b = point - n d/2, as ngs.cpp), n its normal of the start of
+//          the step (a to b, kept in the world frame), C = n . (p_b - p_a) + allowed, acted on
+//          when C < 0 (rigid: alpha = 0, as the paper's contacts), with `allowed` the overlap the
+//          point had after the pre-stabilisation below (0 once pushed out);
+//        static friction: the tangential part Delta p_t of the points' relative motion over the
+//          substep, (p_a - p_a,prev) - (p_b - p_b,prev) less its normal part, is undone (C =
+//          |Delta p_t|) if the impulse it takes is below mu lambda_n (mu: WorldDef::friction for
+//          both the static and the dynamic coefficient; lambda_n this substep's normal one);
+//        rod: u = (p_b - p_a) / |p_b - p_a|, C = |p_b - p_a| - l, alpha = xpbd_compliance;
+//   3. v = (x - x_prev) / h; w = 2 vec(o o_prev^-1) / h (negated when its real part is < 0); the
+//      momenta p = m v, l = I w with I of the new orientation;
+//   4. the velocity pass (Sec. 3.6) over every contact that acted in 2 (lambda_n > 0), with v_n
+//      = n . (u_b - u_a) the points' normal velocity (> 0: separating) and u_t their tangential
+//      one: dynamic friction applies the impulse -u_t / |u_t| min(mu lambda_n / h, |u_t| / w_t)
+//      (N s; the paper's velocity change min(h mu |f_n|, |u_t|), f_n = lambda_n / h^2, written
+//      as an impulse so that its units agree), and the normal velocity is set to
+//      max(-eps v~_n, 0), v~_n its value at the start of the substep (eps = WorldDef::restitution
+//      when -v~_n exceeds the restitution threshold, else 0; the paper uses 2 |g| h there), each as
+//      a velocity impulse (N s) Delta v / (w_a + w_b) along its direction.
+//
+// Pre-stabilisation. The paper's contacts push an overlap out in full within a substep, so an
+// overlap found by the collision becomes a velocity of depth / h (0.4 m at h = 1/1200 s: 480
+// m/s). Instead, each contact's overlap at the start of the step is moved out on positions alone
+// (Unified Particle Physics' pre-stabilisation: no velocity follows, since x_prev is taken after
+// it), to the target depth max(depth - max_depenetration_speed dt, slop) (PhysX's depenetration
+// cap), by one Gauss-Seidel sweep at the start of every substep (so N sweeps a step; one sweep
+// over the corners of a face would leave the body turned); what is left after it is the
+// `allowed` overlap of the contact in that substep. New overlap made by the motion within the
+// step is corrected in full, as the paper does.
+//
+// Contacts come from the step's collision, once per step (as the paper's Sec. 3.5, which
+// collects them once per step and follows their points through the substeps); a contact that
+// starts within the step is found at the next step; with contact_margin > 0 the collision gives
+// the near ones as speculative contacts (depth < 0), which act once they touch.
+//
+// Solvers: PGS is the paper's Gauss-Seidel sweep, each correction applied at once. Jacobi
+// computes every correction of a sweep (and of the velocity pass) from the same state and
+// applies each body's sum divided by the number of constraints that moved it (Unified Particle
+// Physics' constraint averaging). Not used: beta and the LCP solve's iterations (one sweep per
+// substep), the friction model (the friction limit is always mu lambda_n, the source's),
+// warm starting (lambda starts from 0 in every substep) and the assembly (no A is built). After
+// a step, lambda holds each row's mean force over the step (N): a contact's, its friction's
+// along the row's tangent, a rod's (positional impulses / h plus velocity impulses, over dt).
+
+#include "push_method.h"
+
+#include "../buffers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace cps {
+namespace {
+
+// Turns o by the small rotation vector theta (rad): o += 1/2 [0, theta] o, normalised.
+void turn(Quat& o, const Vec3& theta) {
+  const Quat spin(0.0, 0.5 * theta.x(), 0.5 * theta.y(), 0.5 * theta.z());
+  o.coeffs() += (spin * o).coeffs();
+  o.normalize();
+}
+
+class Xpbd final : public PushMethod {
+ public:
+  void step(StepContext& ctx) override {
+    const WorldDef& def = *ctx.def;
+    std::vector<Body>& bodies = *ctx.bodies;
+    const int substeps = def.xpbd_substeps;
+    const double h = def.dt / static_cast<double>(substeps);
+    jacobi_ = def.solver == SolverKind::jacobi;
+    ctx.lambda_second.clear();
+    detail::assign_with_headroom(ctx.lambda, ctx.rows.size(), 0.0);
+    capture(ctx.manifolds, bodies);
+    detail::resize_with_headroom(state_, bodies.size());
+    detail::resize_with_headroom(delta_, bodies.size());
+    set_prestabilisation_targets(bodies, def);
+    for (int k = 0; k < substeps; ++k) {
+      prestabilise(bodies);
+      for (std::size_t i = 0; i < bodies.size(); ++i) {
+        state_[i] = {bodies[i].x, bodies[i].o, bodies[i].velocity(), bodies[i].angular_velocity()};
+      }
+      ctx.integrate(ctx.f_ext, ctx.f_ext, h);
+      solve_positions(bodies, *ctx.distances, def, h);
+      update_velocities(bodies, h);
+      solve_velocities(bodies, def, h);
+      accumulate_forces(ctx.rows, ctx.lambda, h, def.dt);
+    }
+    ctx.store_warm_start();
+  }
+
+ private:
+  struct Point {
+    int body_a = 0;
+    int body_b = 0;
+    Vec3 local_a = Vec3::Zero();  // witness point on a, in a's frame (m)
+    Vec3 local_b = Vec3::Zero();  // witness point on b, in b's frame (m)
+    Vec3 normal = Vec3::UnitY();  // world direction from a to b
+    double target = 0.0;          // m: the depth the pre-stabilisation moves it out to
+    double allowed = 0.0;         // m: the overlap left after this substep's pre-stabilisation
+    // This substep's results: the normal and static friction positional impulses (kg m; the
+    // friction one along `tangent`), the velocity pass's impulses (N s).
+    double lambda_n = 0.0;
+    Vec3 friction = Vec3::Zero();  // static friction positional impulse on b (kg m)
+    Vec3 velocity_impulse = Vec3::Zero();  // the velocity pass's impulse on b (N s)
+  };
+  struct Saved {
+    Vec3 x = Vec3::Zero();
+    Quat o = Quat::Identity();
+    Vec3 v = Vec3::Zero();
+    Vec3 w = Vec3::Zero();
+  };
+  // A body's pending changes in a Jacobi pass: position (m) and rotation (rad), or momenta (N s,
+  // N m s) in the velocity pass, and how many constraints contributed.
+  struct Delta {
+    Vec3 linear = Vec3::Zero();
+    Vec3 angular = Vec3::Zero();
+    int count = 0;
+  };
+
+  // Records each contact point's witness points in its bodies' frames and its normal.
+  void capture(const std::vector<Manifold>& manifolds, const std::vector<Body>& bodies) {
+    points_.clear();
+    detail::reserve_with_headroom(points_, contact_point_count(manifolds));
+    for_each_contact_point(manifolds, bodies, [this](const Manifold& m, const Contact& c,
+                                                     const Body& a, const Body& b,
+                                                     const Mat3& Ra_t, const Mat3& Rb_t) {
+      Point& p = points_.emplace_back();
+      p.body_a = m.body_a;
+      p.body_b = m.body_b;
+      p.normal = c.normal;
+      p.local_a = Ra_t * (c.point + 0.5 * c.depth * c.normal - a.x);
+      p.local_b = Rb_t * (c.point - 0.5 * c.depth * c.normal - b.x);
+    });
+  }
+
+  static Vec3 world_point(const Body& body, const Vec3& local) { return body.x + body.rotation() * local; }
+
+  // Generalised inverse mass of `body` for a correction along unit k at offset r (1/kg).
+  static double inverse_mass(const Body* body, const Vec3& r, const Vec3& k) {
+    if (body == nullptr || body->is_static()) return 0.0;
+    const Vec3 rk = r.cross(k);
+    return body->inv_mass + rk.dot(body->inv_inertia_world() * rk);
+  }
+
+  // Applies the positional impulse P (kg m) at offset r to `body` (sign: +1 for b, -1 for a), at
+  // once (Gauss-Seidel) or into its Jacobi delta.
+  void move(Body* body, std::size_t index, const Vec3& r, const Vec3& P) {
+    if (body == nullptr || body->is_static()) return;
+    const Vec3 dx = body->inv_mass * P;
+    const Vec3 dtheta = body->inv_inertia_world() * r.cross(P);
+    if (jacobi_) {
+      delta_[index].linear += dx;
+      delta_[index].angular += dtheta;
+      ++delta_[index].count;
+    } else {
+      body->x += dx;
+      turn(body->o, dtheta);
+    }
+  }
+
+  // Applies the velocity impulse J (N s) at offset r to `body`.
+  void push(Body* body, std::size_t index, const Vec3& r, const Vec3& J) {
+    if (body == nullptr || body->is_static()) return;
+    if (jacobi_) {
+      delta_[index].linear += J;
+      delta_[index].angular += r.cross(J);
+      ++delta_[index].count;
+    } else {
+      body->p += J;
+      body->l += r.cross(J);
+    }
+  }
+
+  void clear_deltas() {
+    for (Delta& d : delta_) d = Delta{};
+  }
+
+  // Jacobi: applies each body's averaged delta (positions, or momenta when `momenta`).
+  void flush(std::vector<Body>& bodies, bool momenta) {
+    if (!jacobi_) return;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      const Delta& d = delta_[i];
+      if (d.count == 0) continue;
+      const double share = 1.0 / static_cast<double>(d.count);
+      if (momenta) {
+        bodies[i].p += share * d.linear;
+        bodies[i].l += share * d.angular;
+      } else {
+        bodies[i].x += share * d.linear;
+        turn(bodies[i].o, share * d.angular);
+      }
+    }
+    clear_deltas();
+  }
+
+  // One correction of C (m) along unit k between points pa on a and pb on b (either body may be
+  // null: the world), compliance alpha~ (kg^-1); returns Delta lambda (kg m).
+  double correct(Body* a, std::size_t ia, Body* b, std::size_t ib, const Vec3& pa, const Vec3& pb,
+                 const Vec3& k, double C, double alpha_tilde) {
+    const Vec3 ra = a != nullptr ? Vec3(pa - a->x) : Vec3::Zero();
+    const Vec3 rb = b != nullptr ? Vec3(pb - b->x) : Vec3::Zero();
+    const double w = inverse_mass(a, ra, k) + inverse_mass(b, rb, k) + alpha_tilde;
+    if (!(w > 0.0)) return 0.0;
+    const double dlambda = -C / w;
+    move(b, ib, rb, dlambda * k);
+    move(a, ia, ra, -dlambda * k);
+    return dlambda;
+  }
+
+  // Pre-stabilisation: each contact's target depth, the overlap it had at the start of the step
+  // less max_depenetration_speed dt (never below the slop).
+  void set_prestabilisation_targets(const std::vector<Body>& bodies, const WorldDef& def) {
+    const double cap = def.max_depenetration_speed * def.dt;
+    for (Point& p : points_) {
+      const Body& a = bodies[static_cast<std::size_t>(p.body_a)];
+      const Body& b = bodies[static_cast<std::size_t>(p.body_b)];
+      const double overlap = -p.normal.dot(world_point(b, p.local_b) - world_point(a, p.local_a));
+      p.target = std::max(overlap - cap, def.penetration_slop);
+    }
+  }
+
+  // One pre-stabilisation sweep (positions alone, before x_prev is taken): each contact deeper
+  // than its target moved out to it; then each contact's allowed overlap in the substep.
+  void prestabilise(std::vector<Body>& bodies) {
+    for (const Point& p : points_) {
+      const auto ia = static_cast<std::size_t>(p.body_a);
+      const auto ib = static_cast<std::size_t>(p.body_b);
+      const Vec3 pa = world_point(bodies[ia], p.local_a);
+      const Vec3 pb = world_point(bodies[ib], p.local_b);
+      const double C = p.normal.dot(pb - pa) + p.target;
+      if (C < 0.0) correct(&bodies[ia], ia, &bodies[ib], ib, pa, pb, p.normal, C, 0.0);
+    }
+    flush(bodies, false);
+    for (Point& p : points_) {
+      const Body& a = bodies[static_cast<std::size_t>(p.body_a)];
+      const Body& b = bodies[static_cast<std::size_t>(p.body_b)];
+      p.allowed = std::max(-p.normal.dot(world_point(b, p.local_b) - world_point(a, p.local_a)), 0.0);
+    }
+  }
+
+  // Step 2: one sweep over the contacts (with static friction), then the rods.
+  void solve_positions(std::vector<Body>& bodies, const std::vector<DistanceConstraint>& distances,
+                       const WorldDef& def, double h) {
+    for (Point& p : points_) {
+      p.lambda_n = 0.0;
+      p.friction.setZero();
+      p.velocity_impulse.setZero();
+      const auto ia = static_cast<std::size_t>(p.body_a);
+      const auto ib = static_cast<std::size_t>(p.body_b);
+      Body& a = bodies[ia];
+      Body& b = bodies[ib];
+      const Vec3 pa = world_point(a, p.local_a);
+      const Vec3 pb = world_point(b, p.local_b);
+      const double C = p.normal.dot(pb - pa) + p.allowed;
+      if (!(C < 0.0)) continue;
+      p.lambda_n = correct(&a, ia, &b, ib, pa, pb, p.normal, C, 0.0);
+      if (!(def.friction > 0.0)) continue;
+      // Static friction (Sec. 3.5): the points' tangential motion over the substep, undone when
+      // the impulse it takes stays within mu lambda_n. Gauss-Seidel reads the points after the
+      // normal correction; Jacobi the state of the sweep.
+      const Vec3 qa = world_point(a, p.local_a);
+      const Vec3 qb = world_point(b, p.local_b);
+      const Vec3 pa_prev = state_[ia].x + state_[ia].o.toRotationMatrix() * p.local_a;
+      const Vec3 pb_prev = state_[ib].x + state_[ib].o.toRotationMatrix() * p.local_b;
+      const Vec3 dp = (qa - pa_prev) - (qb - pb_prev);
+      const Vec3 dp_t = dp - p.normal.dot(dp) * p.normal;
+      const double slip = dp_t.norm();
+      if (!(slip > 0.0)) continue;
+      const Vec3 t = dp_t / slip;  // a's motion relative to b
+      const double w = inverse_mass(a.is_static() ? nullptr : &a, qa - a.x, t) +
+                       inverse_mass(b.is_static() ? nullptr : &b, qb - b.x, t);
+      if (!(w > 0.0) || !(slip / w < def.friction * p.lambda_n)) continue;
+      // -C along t moves b by +slip/w t and a by -slip/w t: the relative motion cancelled.
+      correct(&a, ia, &b, ib, qa, qb, t, -slip, 0.0);
+      p.friction = (slip / w) * t;
+    }
+    flush(bodies, false);
+    const double alpha_tilde = def.xpbd_compliance / (h * h);
+    detail::resize_with_headroom(rod_lambda_, distances.size());
+    for (std::size_t r = 0; r < distances.size(); ++r) {
+      const DistanceConstraint& d = distances[r];
+      Vec3 pa;
+      Vec3 pb;
+      distance_endpoints(d, bodies, pa, pb);
+      const Vec3 ab = pb - pa;
+      const double length = ab.norm();
+      rod_lambda_[r] = 0.0;
+      if (!(length > 1e-12)) continue;  // no axis
+      Body* a = &bodies[static_cast<std::size_t>(d.body_a)];
+      Body* b = d.body_b == kWorldBody ? nullptr : &bodies[static_cast<std::size_t>(d.body_b)];
+      rod_lambda_[r] = correct(a, static_cast<std::size_t>(d.body_a), b,
+                               b != nullptr ? static_cast<std::size_t>(d.body_b) : 0, pa, pb,
+                               ab / length, length - d.length, alpha_tilde);
+    }
+    flush(bodies, false);
+  }
+
+  // Step 3: velocities from the change of position and orientation over the substep.
+  void update_velocities(std::vector<Body>& bodies, double h) const {
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      Body& body = bodies[i];
+      if (body.is_static()) continue;
+      const Quat dq = body.o * state_[i].o.conjugate();
+      Vec3 w = 2.0 / h * dq.vec();
+      if (dq.w() < 0.0) w = -w;
+      body.p = body.mass * (body.x - state_[i].x) / h;
+      body.l = body.inv_inertia_world().inverse() * w;
+    }
+  }
+
+  // Step 4: dynamic friction and restitution on the contacts that acted.
+  void solve_velocities(std::vector<Body>& bodies, const WorldDef& def, double h) {
+    for (Point& p : points_) {
+      if (!(p.lambda_n > 0.0)) continue;
+      const auto ia = static_cast<std::size_t>(p.body_a);
+      const auto ib = static_cast<std::size_t>(p.body_b);
+      Body& a = bodies[ia];
+      Body& b = bodies[ib];
+      const Vec3 ra = world_point(a, p.local_a) - a.x;
+      const Vec3 rb = world_point(b, p.local_b) - b.x;
+      const Vec3 u = (b.velocity() + b.angular_velocity().cross(rb)) -
+                     (a.velocity() + a.angular_velocity().cross(ra));
+      const double vn = p.normal.dot(u);
+      const Vec3 ut = u - vn * p.normal;
+      Vec3 impulse = Vec3::Zero();  // on b (N s)
+      const double slide = ut.norm();
+      if (def.friction > 0.0 && slide > 0.0) {
+        const Vec3 t = ut / slide;
+        const double w = inverse_mass(&a, ra, t) + inverse_mass(&b, rb, t);
+        if (w > 0.0) impulse -= std::min(def.friction * p.lambda_n / h, slide / w) * t;
+      }
+      const Vec3 u_before = (state_[ib].v + state_[ib].w.cross(rb)) - (state_[ia].v + state_[ia].w.cross(ra));
+      const double vn_before = p.normal.dot(u_before);
+      const double eps = -vn_before > def.restitution_threshold ? def.restitution : 0.0;
+      const double target = std::max(-eps * vn_before, 0.0);
+      const double wn = inverse_mass(&a, ra, p.normal) + inverse_mass(&b, rb, p.normal);
+      if (wn > 0.0) impulse += (target - vn) / wn * p.normal;
+      push(&b, ib, rb, impulse);
+      push(&a, ia, ra, -impulse);
+      p.velocity_impulse = impulse;
+    }
+    flush(bodies, true);
+  }
+
+  // Adds this substep's share of each row's mean force over the step (N) to `lambda` (c, in
+  // the order of the rows: contact rows as the points, then two friction rows per point when
+  // friction > 0, then the rods): positional impulses / h and velocity impulses, over dt.
+  void accumulate_forces(const std::vector<ConstraintRow>& rows, std::vector<double>& lambda,
+                         double h, double dt) const {
+    const std::size_t contacts = points_.size();
+    const std::size_t rods = rod_lambda_.size();
+    if (rows.size() < contacts + rods) return;  // not the rows of these points (no error)
+    const bool friction_rows = rows.size() == 3 * contacts + rods;
+    for (std::size_t i = 0; i < contacts; ++i) {
+      const Point& p = points_[i];
+      lambda[i] += (p.lambda_n / h + p.normal.dot(p.velocity_impulse)) / dt;
+      if (!friction_rows) continue;
+      const Vec3 tangential = p.friction / h + p.velocity_impulse;
+      for (std::size_t t = 0; t < 2; ++t) {
+        const std::size_t row = contacts + 2 * i + t;
+        lambda[row] += tangential.dot(rows[row].j.segment<3>(6)) / dt;
+      }
+    }
+    const std::size_t first_rod = rows.size() - rods;
+    for (std::size_t r = 0; r < rods; ++r) lambda[first_rod + r] += rod_lambda_[r] / h / dt;
+  }
+
+  std::vector<Point> points_;
+  std::vector<Saved> state_;    // n: each body at the start of the substep
+  std::vector<Delta> delta_;    // n: Jacobi's pending changes
+  std::vector<double> rod_lambda_;  // one per rod: this substep's Delta lambda (kg m)
+  bool jacobi_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<PushMethod> make_xpbd() { return std::make_unique<Xpbd>(); }
+
+}  // namespace cps

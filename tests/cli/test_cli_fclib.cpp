@@ -254,6 +254,69 @@ TEST_CASE("export --fclib writes the resting stack's and funnel's solves as FCLI
   SECTION("funnel") { check_export("funnel", 11.0, kFunnelStep); }
 }
 
+TEST_CASE("export --fclib writes the pendulum grid's rods as the bilateral rows V, R, s",
+          "[fclib]") {
+  // Step 10 (1/6 s): the balls touch their neighbours, each hangs from its rod.
+  const std::int64_t step = 10;
+  const fs::path dir = cli_test::fresh_dir("cps-test-fclib-rods");
+  const cli_test::Result r =
+      run_cps("export pendulum_grid --seconds 0.2 --at " + std::to_string(step) + " --fclib out/p.hdf5", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const StepSystem s = capture("pendulum_grid", step);
+  const std::vector<int> rows = expected_rows(s);
+  std::vector<int> rods;
+  for (Eigen::Index j = 0; j < s.rows(); ++j) {
+    if (s.kinds[static_cast<std::size_t>(j)] == RowKind::distance) rods.push_back(static_cast<int>(j));
+  }
+  REQUIRE(!rods.empty());
+  REQUIRE(rows.size() % 3 == 0);
+  Local local(dir / "out" / "p.hdf5");
+  REQUIRE(local.p != nullptr);
+  const fclib_local& p = *local.p;
+  const int m = static_cast<int>(rows.size());
+  const int d = static_cast<int>(rods.size());
+  REQUIRE(p.W->m == m);
+  REQUIRE(p.V != nullptr);
+  REQUIRE(p.R != nullptr);
+  REQUIRE(p.V->m == m);
+  REQUIRE(p.V->n == d);
+  REQUIRE(p.R->m == d);
+  REQUIRE(p.R->n == d);
+  const Eigen::MatrixXd A(s.A);
+  const Eigen::MatrixXd V = dense(*p.V);
+  const Eigen::MatrixXd R = dense(*p.R);
+  double v_diff = 0.0;
+  double r_diff = 0.0;
+  double s_diff = 0.0;
+  double b_max = 0.0;
+  for (int k = 0; k < d; ++k) {
+    for (int i = 0; i < m; ++i) v_diff = std::max(v_diff, std::abs(V(i, k) - A(rows[i], rods[k])));
+    for (int i = 0; i < d; ++i) r_diff = std::max(r_diff, std::abs(R(i, k) - A(rods[i], rods[k])));
+    s_diff = std::max(s_diff, std::abs(p.s[k] - (-s.dt * s.b[rods[k]])));
+    b_max = std::max(b_max, std::abs(s.b[rods[k]]));
+  }
+  const double a_max = A.cwiseAbs().maxCoeff();
+  CHECK(v_diff <= kEps * a_max);
+  CHECK(r_diff <= kEps * a_max);
+  CHECK(s_diff <= kEps * s.dt * b_max);
+  // The rods' equation V^T r + R l + s = 0 is dt (A lambda - b) on the rods' rows = dt w_D: for
+  // the exact solution 0 to its round-off (1e-11 of the force scale, times dt max A_jj).
+  const analysis::ExactSolution exact = analysis::solve_exact(s);
+  Eigen::VectorXd rc(m);
+  Eigen::VectorXd l(d);
+  for (int i = 0; i < m; ++i) rc[i] = s.dt * exact.lambda[rows[i]];
+  for (int k = 0; k < d; ++k) l[k] = s.dt * exact.lambda[rods[k]];
+  const Eigen::VectorXd rod_velocity = V.transpose() * rc + R * l + Eigen::Map<const Eigen::VectorXd>(p.s, d);
+  const double v_tol = s.dt * A.diagonal().maxCoeff() * 1e-11 * force_scale(s, exact.lambda);
+  CHECK(rod_velocity.cwiseAbs().maxCoeff() <= v_tol);
+  std::printf("fclib pendulum_grid step %lld: %d contacts, %d rods, |V - A_CD| %.3g, |R - A_DD| "
+              "%.3g, |s + dt b_D| %.3g, max |V^T r + R l + s| %.3g m/s (tol %.3g)\n",
+              static_cast<long long>(step), m / 3, d, v_diff, r_diff, s_diff,
+              rod_velocity.cwiseAbs().maxCoeff(), v_tol);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("export --fclib with several steps writes one file per step", "[fclib]") {
   const fs::path dir = cli_test::fresh_dir("cps-test-fclib-steps");
   const cli_test::Result r = run_cps("export intersecting_stack --seconds 0.1 --at 5,1 --fclib out/is.hdf5", dir);

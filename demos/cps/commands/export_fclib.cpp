@@ -60,12 +60,6 @@ analysis::FclibText problem_text(const std::string& scene, const StepSystem& s,
 #endif
 
 int run_fclib_export(const FclibExportOptions& o, int argc, char** argv) {
-#ifndef CPS_HAVE_FCLIB
-  (void)argc;
-  (void)argv;
-  throw UsageError("--fclib " + o.path + ": FCLIB was left out of this build (libfclib-dev was "
-                   "not found when cps was configured; scripts/deps.sh installs it)");
-#else
   if (o.scene == "all" || o.scene == "stress") {
     throw UsageError("export takes one scene, not '" + o.scene + "'");
   }
@@ -98,6 +92,13 @@ int run_fclib_export(const FclibExportOptions& o, int argc, char** argv) {
     files.push_back(name);
     sources[name] = scene_source(scene->name);
   }
+#ifndef CPS_HAVE_FCLIB
+  // The options are checked as in a build with FCLIB, so that their errors read the same.
+  (void)argc;
+  (void)argv;
+  throw UsageError("--fclib " + o.path + ": FCLIB was left out of this build (libfclib-dev was "
+                   "not found when cps was configured; scripts/deps.sh installs it)");
+#else
   const nlohmann::json parameters = parameters_json(run.world.def());
   const nlohmann::json info = run_info("export", argc, argv,
                                        {{"scene", scene->name},

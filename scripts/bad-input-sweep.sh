@@ -11,7 +11,7 @@
 #
 # Each command line (nproc of them at a time, or SWEEP_JOBS; SWEEP_TIMEOUT, SWEEP_VERBOSE=1 to
 # list every verdict) runs in a fresh temporary folder (its cwd, with a few fixture files:
-# `file` and `file.png` regular files, `adir`, `adir.json` and `dir.png` folders, scene files
+# `file`, `file.png` and `file.hdf5` regular files, `adir`, `adir.json` and `dir.png` folders, scene files
 # `bad.json` (a box without half_extents_m) and `notjson.json`, valid ones `a/x.json` and
 # `b/x.json` of one stem, and `prior/`, a/x.json's render and figure made in another folder)
 # under `timeout 20` and a
@@ -65,6 +65,7 @@ declare -A KIND=(
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
   ['export:scene']=scene_one ['export:--out']=out_glb ['*:--max-work']=max_work
+  ['export:--fclib']=out_hdf5 ['export:--at']=steps
   ['report:--repeats']=repeats
   # The sweep puts a positional's bad value in the first place, so reference's values cover frames.
   ['diff:reference']=png_in ['diff:frames']=skip ['diff:--out']=out_folder
@@ -109,6 +110,9 @@ BASE['report:--run']='report --out out'
 BASE['simulate:--at']='simulate stack --seconds 0.1 --solver-error e.csv'
 BASE['simulate:--sweeps']='simulate stack --seconds 0.1 --solver-error e.csv'
 BASE['report:--merge']='report --out out'
+# --fclib excludes --out and --fps; intersecting_stack has contacts from its first step.
+BASE['export:--fclib']='export intersecting_stack --seconds 0.1'
+BASE['export:--at']='export intersecting_stack --seconds 0.1 --fclib out/s.hdf5'
 
 NL=$'\n'
 # Bad values shared by every number (one per line; an empty line is the empty value). Each is
@@ -199,6 +203,8 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         "$good.it1.ss1.ws 0.5" "$good.it1.ss1.WS0.5" "$good.it1.ws0.5" "$good.it1.ss1.ws1.0001" ;;
     out_glb)  # not a .glb path that can be written as a new file
       printf '%s\n' "" file file/s.glb adir .glb s.png s.GLB /dev/null . ;;
+    out_hdf5)  # not a .hdf5 path that can be written as a new file (file.hdf5: a foreign one)
+      printf '%s\n' "" file file/s.hdf5 adir .hdf5 s.h5 s.HDF5 /dev/null . file.hdf5 ;;
     out_json)  # cannot be written as a new scene file
       printf '%s\n' "" file file/s.json adir /dev/null . ;;
     seed)  # a decimal integer in [0, 2^64 - 1] (and only for the random scene)
@@ -272,6 +278,12 @@ EXTRA=(
   "us_per_step: 'nan'|report --merge $MERGE_NAN --out out"
   "--rendering/--quick|bench --rendering=false --quick=junk"
   "samples/--fps/--seconds|export stack --seconds 1e5 --fps 1000 --out out/s.glb"
+  "--at/--fclib|export stack --seconds 0.1 --at 1 --out out/s.glb"
+  "--fclib/--out|export intersecting_stack --seconds 0.1 --fclib out/s.hdf5 --out out/s.glb"
+  "--fclib/--fps|export intersecting_stack --seconds 0.1 --fclib out/s.hdf5 --fps 10"
+  "--out/--fclib|export intersecting_stack --seconds 0.1"
+  "--fclib/file.hdf5|export intersecting_stack --seconds 0.1 --fclib file.hdf5"
+  "--at/1001|export intersecting_stack --seconds 20 --fclib out/s.hdf5 --at $(seq_csv 1001)"
   # Scene-file paths: another file of the same stem into a folder that holds a/x.json's render
   # (both named), and a command's own input as its output (even with --force).
   "a/x.json/b/x.json|render b/x.json --seconds 0.1 --fps 10 --size 16x16 --out prior"
@@ -324,6 +336,8 @@ CONTROLS=(
   "figure stack --times 0 --size 16x16 --compare push --overlay --out out/f.png"
   "export stack --seconds 0.1 --fps 10 --out out/s.glb"
   "export pendulum_grid --seconds 0.1 --fps 1e-5 --out out/p.glb"
+  "export intersecting_stack --seconds 0.1 --fclib out/s.hdf5"  # skipped where FCLIB is left out
+  "export pendulum_grid --seconds 0.2 --fclib out/p.hdf5 --at 10,11 --force"  # rods: V, R, s
   "simulate stack --seconds 1 --max-work 9000"  # exactly the run's work
   "simulate stack --seconds 0.1 --push soft --soft-substeps 1000 --iterations 10000"
   "simulate stack --seconds 0.1 --push tgs --tgs-substeps 1000 --max-depenetration-speed 1e6"
@@ -389,6 +403,7 @@ run_cps() {
   [[ ! -d $PRIOR/out ]] || cp -a "$PRIOR/out" "$d/cwd/prior"
   printf 'not written by cps\n' > "$d/cwd/file"
   printf 'not a png, not written by cps\n' > "$d/cwd/file.png"
+  printf 'not an FCLIB file, not written by cps\n' > "$d/cwd/file.hdf5"
   local before
   before=$(snapshot "$d")
   (cd "$d/cwd" && TMPDIR="$d/tmp" exec timeout -k 5 "$TIMEOUT" "${CAP[@]}" "$CPS" "$@" \
@@ -415,7 +430,7 @@ snapshot() {  # every path below cwd and tmp; size and time of the fixture files
     cd "$1" || exit
     shopt -s globstar dotglob nullglob
     printf '%s\n' cwd/** tmp/**
-    stat -c '%n|%s|%y' cwd/file cwd/file.png
+    stat -c '%n|%s|%y' cwd/file cwd/file.png cwd/file.hdf5
   )
 }
 
@@ -635,8 +650,13 @@ printf '%s\n' "$DROP" > "$PRIOR/a/x.json"
 (cd "$PRIOR" && timeout "$TIMEOUT" "$CPS" render a/x.json --seconds 0.1 --fps 10 --size 16x16 --out out &&
   if has_command figure; then timeout "$TIMEOUT" "$CPS" figure a/x.json --times 0 --size 16x16 --out out/x.png; fi) \
   > /dev/null 2>&1 || true
+# FCLIB is optional: where it was left out, `cps export --help` says so and the --fclib controls
+# are skipped (its bad values are still refused, with the options checked first).
+has_fclib=1
+"$CPS" export --help 2>&1 | grep -q 'left out of this build' && has_fclib=0
 for line in "${CONTROLS[@]}"; do
   read -ra words <<< "$line"
+  [[ $has_fclib == 0 && " $line " == *" --fclib "* ]] && continue
   has_command "${words[0]}" && control "${words[@]}"
 done
 control report --merge "$MERGE_SRC" --out merged

@@ -23,6 +23,8 @@ cps_packages=(
   # The exact reference of a step (`cps simulate --solver-error`, demos/analysis): Siconos
   # numerics' Lemke solver.
   libsiconos-numerics-dev
+  # FCLIB files of `cps export --fclib` (optional: without it the option says it was left out).
+  libfclib-dev
 )
 
 cps_install_missing() {

@@ -57,7 +57,8 @@ Command add_render(CLI::App& app, int argc, char** argv);
 Command add_figure(CLI::App& app, int argc, char** argv);
 
 /// `cps export SCENE --out FILE.glb`: a run as a glTF 2.0 binary (meshes, materials in the
-/// renderer's colours, rods as cylinders, one animation sampled at --fps, the scene's camera).
+/// renderer's colours, rods as cylinders, one animation sampled at --fps, the scene's camera);
+/// or `--fclib FILE.hdf5 --at STEPS`: those steps' solves as FCLIB problems (export_fclib.h).
 /// argc and argv are recorded in the folder's run.json.
 Command add_export(CLI::App& app, int argc, char** argv);
 

@@ -3,7 +3,10 @@
 // colours as materials, the rods as cylinders, one animation of every body's and rod's pose
 // sampled at --fps, and the scene's camera. The file is built and serialised with tinygltf
 // (Debian's libtinygltf-dev) and written under the output rule (output.h).
+// `cps export SCENE --fclib FILE.hdf5 --at STEPS`: chosen steps' solves as FCLIB problems
+// (export_fclib.h).
 #include "command.h"
+#include "commands/export_fclib.h"
 #include "pictures/draw.h"
 #include "options/options.h"
 #include "output/output.h"
@@ -61,6 +64,8 @@ struct ExportOptions {
   std::optional<double> seconds;  // s; default: the scene's
   double fps = 30.0;              // samples per simulated second
   std::string out;
+  std::string fclib;  // --fclib FILE.hdf5
+  std::string at;     // --at STEP,... (with --fclib)
   bool force = false;
   double max_work = kDefaultMaxWork;  // body-iterations
   scenes::Overrides overrides;
@@ -566,6 +571,20 @@ int execute_export(const ExportOptions& o, ExportPlan& plan) {
 }
 
 int run_export(const ExportOptions& o, int argc, char** argv) {
+  if (!o.fclib.empty()) {
+    return run_fclib_export({.scene = o.scene,
+                             .seconds = o.seconds,
+                             .at = o.at,
+                             .path = o.fclib,
+                             .force = o.force,
+                             .max_work = o.max_work,
+                             .overrides = o.overrides},
+                            argc, argv);
+  }
+  if (o.out.empty()) {
+    throw UsageError("export needs --out FILE.glb (a glTF 2.0 binary) or --fclib FILE.hdf5 "
+                     "(FCLIB problems of the steps of --at)");
+  }
   ExportPlan plan = plan_export(o, argc, argv);
   return execute_export(o, plan);
 }
@@ -575,7 +594,8 @@ int run_export(const ExportOptions& o, int argc, char** argv) {
 Command add_export(CLI::App& app, int argc, char** argv) {
   auto o = std::make_shared<ExportOptions>();
   CLI::App* sub = app.add_subcommand(
-      "export", "write a run as a glTF 2.0 binary (.glb) for Blender and other 3D tools");
+      "export", "write a run as a glTF 2.0 binary (.glb) for Blender and other 3D tools, or "
+                "chosen steps' contact problems as FCLIB files (.hdf5)");
   sub->add_option("scene", o->scene,
                   "scene name (see 'cps list') or the path of a scene file (.json)")
       ->required();
@@ -583,21 +603,41 @@ Command add_export(CLI::App& app, int argc, char** argv) {
   add_seconds_option(*sub, o->seconds,
                      "at most 1e7 steps (--seconds / --dt), 1e5 samples (--seconds x --fps) and "
                      "512 MiB of samples (samples x (28 B a body + 40 B a rod))");
-  sub->add_option("--fps", o->fps,
+  CLI::Option* fps = sub->add_option("--fps", o->fps,
                   "animation samples per simulated second, in [1e-5, 1000]; sample k is the state "
                   "after the physics step nearest to k / fps s, and tools interpolate between "
                   "samples (LINEAR)")
       ->check(decimal_in(1.0 / kMaxSeconds, kMaxFps, false, "samples/s"))
       ->capture_default_str();
-  sub->add_option("--out", o->out,
+  CLI::Option* out = sub->add_option("--out", o->out,
                   "the glTF 2.0 binary to write (FILE.glb): a mesh per body, rods as cylinders, "
                   "materials in the renderer's colours, the animation and the scene's camera; "
                   "missing folders are created, and the folder's run.json lists the files cps "
                   "wrote there")
-      ->required()
       ->check(kNotEmpty);
+#ifdef CPS_HAVE_FCLIB
+  const std::string fclib_help =
+      "instead of --out: write the first solve of each step of --at as a local frictional "
+      "contact problem of FCLIB (FILE.hdf5; several steps: STEM-stepN.hdf5 beside it): W = A "
+      "(1/kg) and q = -dt b (m/s) on each contact's normal and two tangent rows, mu per contact, "
+      "rods as V, R, s (docs/exact_reference.md); --force as for --out";
+#else
+  const std::string fclib_help =
+      "instead of --out: FCLIB problems of the steps of --at (FILE.hdf5); left out of this "
+      "build (libfclib-dev was not found when cps was configured)";
+#endif
+  CLI::Option* fclib = sub->add_option("--fclib", o->fclib, fclib_help)
+                           ->check(kNotEmpty)
+                           ->excludes(out)
+                           ->excludes(fps);
+  sub->add_option("--at", o->at,
+                  "with --fclib: the steps whose solves are written, comma-separated step "
+                  "indices in [0, steps - 1] (0 is the first step; default: the last), at most " +
+                      std::to_string(kMaxFclibSteps))
+      ->check(kNotEmpty)
+      ->needs(fclib);
   sub->add_flag("--force", o->force,
-                "let --out replace a file of that name that no earlier cps run wrote (the "
+                "let --out or --fclib replace a file of that name that no earlier cps run wrote (the "
                 "folder's run.json lists the files cps wrote there; those are replaced without "
                 "it); any other file is never touched");
   add_max_work_option(*sub, o->max_work);

@@ -45,18 +45,23 @@ const char* method_name(SolverKind k) { return k == SolverKind::pgs ? "pgs" : "j
 
 }  // namespace
 
+std::vector<std::int64_t> parse_steps(const std::string& at, std::int64_t total_steps,
+                                      const std::string& option) {
+  if (total_steps < 1) throw UsageError(option + ": the run takes no step");
+  if (at.empty()) return {total_steps - 1};
+  std::vector<std::int64_t> steps;
+  for (const long long s : parse_counts(at, 0, total_steps - 1, option, "a step of this run")) {
+    steps.push_back(s);
+  }
+  return steps;
+}
+
 SolverErrorPlan plan_solver_error(const std::string& path, const std::string& at,
                                   const std::string& sweeps, std::int64_t total_steps) {
   SolverErrorPlan plan;
   plan.path = path;
   if (total_steps < 1) throw UsageError("--solver-error: the run takes no step");
-  if (at.empty()) {
-    plan.steps = {total_steps - 1};
-  } else {
-    for (const long long s : parse_counts(at, 0, total_steps - 1, "--at", "a step of this run")) {
-      plan.steps.push_back(s);
-    }
-  }
+  plan.steps = parse_steps(at, total_steps, "--at");
   for (const long long k : parse_counts(sweeps, 0, kMaxSolverErrorSweeps, "--sweeps", "a sweep count")) {
     plan.sweeps.push_back(static_cast<int>(k));
   }

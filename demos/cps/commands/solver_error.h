@@ -33,6 +33,14 @@ struct SolverErrorPlan {
   std::vector<int> sweeps;
 };
 
+/// The steps of `at` (comma-separated step indices in [0, total_steps - 1]; "" gives the run's
+/// last step, total_steps - 1), sorted and unique; `option` names the option that holds the
+/// list in messages ("--at"). Throws UsageError (exit 2) naming the value and the range for an
+/// item that is not such an integer (an empty item, a sign, a fraction), and when the run takes
+/// no step.
+std::vector<std::int64_t> parse_steps(const std::string& at, std::int64_t total_steps,
+                                      const std::string& option);
+
 /// Reads the options into a plan. `at`: comma-separated step indices ("": the run's last step,
 /// total_steps - 1); `sweeps`: comma-separated counts. Throws UsageError (exit 2) naming the value and
 /// what is allowed: a step outside [0, total_steps - 1], a sweep count that is not an integer in

@@ -25,6 +25,7 @@
 #include "passes/render_target.h"
 #include "passes/shadow_pass.h"
 
+#include <chrono>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -78,6 +79,8 @@ struct Renderer::Impl {
   LinePass line_pass;
   RenderTarget target;  // last GL member: its MSAA check reads glGetError
   FramePlan plan;       // CPU staging reused across frames
+  bool timing = false;  // set_stage_timing
+  StageTimes times;
 
   Impl(int width, int height, Backend backend) : context(backend, width, height), target(context) {
     check_gl("while creating the renderer");
@@ -91,25 +94,45 @@ struct Renderer::Impl {
     }
   }
 
-  // The frame outline at the top of this file, step by step.
+  // The frame outline at the top of this file, step by step. With stage timing on, mark(x)
+  // waits for the GL work so far and adds the time since the previous mark to x.
   Image draw(const DrawList& list) {
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point last = Clock::now();
+    const auto mark = [&](double& into, bool gl) {
+      if (!timing) return;
+      if (gl) glFinish();
+      const Clock::time_point now = Clock::now();
+      into = std::chrono::duration<double, std::milli>(now - last).count();
+      last = now;
+    };
+    times = StageTimes{};
     context.make_current();
     plan.build(list, context.width(), context.height());  // 0.
+    mark(times.plan, false);
     meshes.upload(plan.boxes, plan.spheres);
     line_pass.upload(plan.lines);
+    mark(times.upload, true);
     reset_frame_state();
     shadow_pass.draw(plan.shadow, meshes);  // 1.
+    mark(times.shadow, true);
     target.begin(plan.view.background);     // 2.
     shadow_pass.bind_map();
     body_pass.draw_opaque(plan, meshes);
+    mark(times.bodies, true);
     plane_pass.draw_opaque(plan);
+    mark(times.planes, true);
     line_pass.draw(plan);
     plane_pass.draw_translucent(plan);
     body_pass.draw_ghosts(plan, meshes);  // last: blended over everything else
     glBindVertexArray(0);
+    mark(times.overlay, true);
     target.resolve();  // 3.
+    mark(times.resolve, true);
     check_gl("while drawing a frame");
-    return target.read_back();
+    Image image = target.read_back();
+    mark(times.read_back, false);
+    return image;
   }
 };
 
@@ -155,5 +178,8 @@ std::optional<Backend> parse_backend(std::string_view name) {
 // with PCF-filtered shadow mapping (Williams 1978; Reeves et al. 1987; LearnOpenGL "Shadow
 // Mapping"), hemisphere ambient and a weak camera-relative fill light.
 Image Renderer::draw(const DrawList& list) { return impl_->draw(list); }
+
+void Renderer::set_stage_timing(bool on) { impl_->timing = on; }
+StageTimes Renderer::last_stage_times() const { return impl_->times; }
 
 }  // namespace cps::render

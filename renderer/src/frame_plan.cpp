@@ -161,30 +161,15 @@ struct ScreenBounds {
 
 }  // namespace
 
-/// Clips convex polygon `poly` (m) to the part in front of the near plane; false if none is left.
-bool FramePlan::clip_near(std::vector<glm::vec3>& poly) const {
-  const float m = glm::dot(view.forward, view.eye) + view.near_m;
-  std::vector<glm::vec3> next;
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const glm::vec3& a = poly[i];
-    const glm::vec3& b = poly[(i + 1) % poly.size()];
-    const float da = glm::dot(view.forward, a) - m;
-    const float db = glm::dot(view.forward, b) - m;
-    if (da >= 0.0f) next.push_back(a);
-    if ((da >= 0.0f) != (db >= 0.0f)) next.push_back(a + (da / (da - db)) * (b - a));
-  }
-  poly.swap(next);
-  return !poly.empty();
-}
-
 /// dynamic_rect: the screen bounds, widened by 2 pixels (multisample positions, rounding), of
 ///  - each body's axis-aligned bounding box (its mesh lies inside it), ghosts included;
 ///  - each line's ends, widened by its width (its quad and square caps reach width / sqrt 2);
-///  - on each plane drawn, the sun's shadow-map footprint: the map's square in the sun's eye
-///    space widened by 8 texels (the 3x3 filter's reach, 2.5 texels, plus lighting.glsl's normal
-///    offset, at most 3), carried along the light onto the plane and clipped to the near plane.
-///    Outside it every filter tap reads the map's border (depth 1: lit), so the plane is lit as
-///    with no shadow map at all.
+///  - on each plane drawn, where the shadow map can darken it: the bounding box of the shadow
+///    casters (the opaque bodies) carried along the light onto the plane, widened in the plane
+///    by 8 texels over |cos| of the light's incidence (the 3x3 filter's reach, 2.5 texels, plus
+///    lighting.glsl's normal offset, at most 3). Elsewhere every filter tap reads a texel no
+///    caster covers (cleared to depth 1, or the border: lit), so the plane is lit as with no
+///    shadow map at all.
 /// A point on or behind the near plane (a body or line reaching behind the eye), or a plane
 /// almost parallel to the light, makes it the whole frame.
 void FramePlan::plan_dynamic_rect() {
@@ -203,7 +188,11 @@ void FramePlan::plan_dynamic_rect() {
     b.lo = glm::min(b.lo, px - margin_px);
     b.hi = glm::max(b.hi, px + margin_px);
   };
-  const auto add_bodies = [&](const std::vector<BodyInstance>& list) {
+  // The bounding box of the shadow casters (the opaque bodies), m.
+  bool casters = false;
+  glm::vec3 clo(std::numeric_limits<float>::max());
+  glm::vec3 chi(std::numeric_limits<float>::lowest());
+  const auto add_bodies = [&](const std::vector<BodyInstance>& list, bool cast) {
     for (const BodyInstance& i : list) {
       const glm::quat q(i.orientation[3], i.orientation[0], i.orientation[1], i.orientation[2]);
       const glm::mat3 r = glm::mat3_cast(q);
@@ -211,22 +200,25 @@ void FramePlan::plan_dynamic_rect() {
       // World half extents of the rotated box: |R| half.
       const glm::vec3 e = glm::abs(r[0]) * half.x + glm::abs(r[1]) * half.y + glm::abs(r[2]) * half.z;
       const glm::vec3 c(i.center[0], i.center[1], i.center[2]);
+      if (cast) {
+        casters = true;
+        clo = glm::min(clo, c - e);
+        chi = glm::max(chi, c + e);
+      }
       for (int k = 0; k < 8; ++k) {
         add(c + glm::vec3((k & 1) ? e.x : -e.x, (k & 2) ? e.y : -e.y, (k & 4) ? e.z : -e.z), 0.0f);
       }
     }
   };
-  add_bodies(boxes);
-  add_bodies(ghost_boxes);
-  for (const std::vector<BodyInstance>& v : spheres) add_bodies(v);
-  for (const std::vector<BodyInstance>& v : ghost_spheres) add_bodies(v);
+  add_bodies(boxes, true);
+  add_bodies(ghost_boxes, false);
+  for (const std::vector<BodyInstance>& v : spheres) add_bodies(v, true);
+  for (const std::vector<BodyInstance>& v : ghost_spheres) add_bodies(v, false);
   for (const LineInstance& l : lines) {
     add(glm::vec3(l.a[0], l.a[1], l.a[2]), l.width_px);
     add(glm::vec3(l.b[0], l.b[1], l.b[2]), l.width_px);
   }
-  if (shadow.enabled && !b.whole) {
-    const float margin = 8.0f * shadow.texel_world;
-    const glm::mat4 inv_view = glm::inverse(shadow.light_view);
+  if (shadow.enabled && casters && !b.whole) {
     for (const PlaneDraw& p : planes) {
       if (!p.visible) continue;
       const float denom = glm::dot(p.normal, view.light_dir);
@@ -234,23 +226,14 @@ void FramePlan::plan_dynamic_rect() {
         b.whole = true;
         break;
       }
-      std::vector<glm::vec3> poly;
-      for (const int k : {0, 1, 3, 2}) {  // the square's corners in order
-        const glm::vec3 o(inv_view * glm::vec4((k & 1) ? shadow.hi.x + margin : shadow.lo.x - margin,
-                                               (k & 2) ? shadow.hi.y + margin : shadow.lo.y - margin,
-                                               0.0f, 1.0f));
-        poly.push_back(o + ((p.offset - glm::dot(p.normal, o)) / denom) * view.light_dir);
-      }
-      if (!clip_near(poly)) continue;
-      for (const glm::vec3& v : poly) {
-        const glm::vec4 c = view.view_proj * glm::vec4(v, 1.0f);
-        if (!(c.w > 0.0f)) {
-          b.whole = true;
-          break;
+      const float margin = 8.0f * shadow.texel_world / std::abs(denom);
+      for (int k = 0; k < 8 && !b.whole; ++k) {
+        const glm::vec3 c((k & 1) ? chi.x : clo.x, (k & 2) ? chi.y : clo.y, (k & 4) ? chi.z : clo.z);
+        const glm::vec3 on_plane = c + ((p.offset - glm::dot(p.normal, c)) / denom) * view.light_dir;
+        for (int m = 0; m < 4; ++m) {
+          add(on_plane + ((m & 1) ? margin : -margin) * p.t1 + ((m & 2) ? margin : -margin) * p.t2,
+              0.0f);
         }
-        const glm::vec2 px((0.5f * c.x / c.w + 0.5f) * w, (0.5f * c.y / c.w + 0.5f) * h);
-        b.lo = glm::min(b.lo, px);
-        b.hi = glm::max(b.hi, px);
       }
     }
   }
@@ -406,9 +389,6 @@ void FramePlan::fit_shadow(const DrawList& list) {
   const glm::mat4 proj = glm::ortho(llo.x, lhi.x, llo.y, lhi.y, near_d, far_d);
   shadow.enabled = true;
   shadow.view_proj = proj * light_view;
-  shadow.light_view = light_view;
-  shadow.lo = glm::vec2(llo.x, llo.y);
-  shadow.hi = glm::vec2(lhi.x, lhi.y);
   shadow.texel_world = std::max(lhi.x - llo.x, lhi.y - llo.y) / static_cast<float>(k_shadow_size);
 }
 

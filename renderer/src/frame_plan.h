@@ -71,9 +71,6 @@ struct ShadowSetup {
   bool enabled = false;
   glm::mat4 view_proj{1.0f};
   float texel_world = 0.0f;  // m per shadow texel
-  glm::mat4 light_view{1.0f};  // world to the sun's eye space (view_proj = projection * this)
-  glm::vec2 lo{0.0f};          // m: the map's extent in the sun's eye space, x and y
-  glm::vec2 hi{0.0f};
 };
 
 /// A pixel rectangle in GL window coordinates (origin bottom left): x, y, width, height.
@@ -144,7 +141,6 @@ class FramePlan {
   void fit_shadow(const DrawList& list);
   bool plane_scissor(const PlaneDraw& d, std::array<int, 4>& rect) const;
   void plan_dynamic_rect();
-  bool clip_near(std::vector<glm::vec3>& poly) const;
 
   std::array<float, k_sphere_lods> sphere_limits_px_;  // see sphere_lod_limits_px
 };

@@ -47,10 +47,10 @@ RenderTarget::RenderTarget(GlContext& context) : context_(context) {
 void RenderTarget::begin(const glm::vec3& background, const PixelRect& rect) const {
   glBindFramebuffer(GL_FRAMEBUFFER, samples_ > 0 ? fbo_.id() : context_.framebuffer());
   glViewport(0, 0, context_.width(), context_.height());
-  glClearColor(background.r, background.g, background.b, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_SCISSOR_TEST);
   glScissor(rect[0], rect[1], rect[2], rect[3]);
+  glClearColor(background.r, background.g, background.b, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 }
 
 void RenderTarget::resolve(const PixelRect& rect) const {

@@ -82,7 +82,9 @@ class Renderer {
   std::string context_description();
 
   /// Draws one frame of `list` into the frame buffer and returns it as an RGB8 image, rows top to
-  /// bottom. Throws std::runtime_error on a GL error.
+  /// bottom. Throws std::runtime_error on a GL error. While the view (camera, sun, background,
+  /// planes, size) stays the same from frame to frame, only the rectangle holding the bodies,
+  /// lines and shadows is drawn again, over a kept frame of the planes: the same pixels.
   Image draw(const DrawList& list);
 
   /// Stage timing (for measurement only; off by default): when on, draw() waits for each stage

@@ -129,6 +129,128 @@ void FramePlan::build(const DrawList& list, int width, int height) {
     d.scissor = {0, 0, width, height};
     d.visible = d.alpha > 0.0f && plane_scissor(d, d.scissor);
   }
+  draw_rect = {0, 0, width, height};
+  plan_dynamic_rect();
+}
+
+void FramePlan::restrict_to(const PixelRect& rect) {
+  const auto intersect = [](const PixelRect& a, const PixelRect& b) {
+    const int x0 = std::max(a[0], b[0]);
+    const int y0 = std::max(a[1], b[1]);
+    const int x1 = std::min(a[0] + a[2], b[0] + b[2]);
+    const int y1 = std::min(a[1] + a[3], b[1] + b[3]);
+    return PixelRect{x0, y0, std::max(x1 - x0, 0), std::max(y1 - y0, 0)};
+  };
+  draw_rect = intersect(draw_rect, rect);
+  for (PlaneDraw& d : planes) {
+    if (!d.visible) continue;
+    d.scissor = intersect(d.scissor, draw_rect);
+    d.visible = d.scissor[2] > 0 && d.scissor[3] > 0;
+  }
+}
+
+namespace {
+
+/// Pixel bounds [lo, hi] of a set of points; `whole` once a point cannot be bounded (on or
+/// behind the eye plane), then the whole frame counts.
+struct ScreenBounds {
+  glm::vec2 lo{std::numeric_limits<float>::max()};
+  glm::vec2 hi{std::numeric_limits<float>::lowest()};
+  bool whole = false;
+};
+
+}  // namespace
+
+/// dynamic_rect: the screen bounds, widened by 2 pixels (multisample positions, rounding), of
+///  - each body's axis-aligned bounding box (its mesh lies inside it), ghosts included;
+///  - each line's ends, widened by its width (its quad and square caps reach width / sqrt 2);
+///  - on each plane drawn, where the shadow map can darken it: the bounding box of the shadow
+///    casters (the opaque bodies) carried along the light onto the plane, widened in the plane
+///    by 8 texels over |cos| of the light's incidence (the 3x3 filter's reach, 2.5 texels, plus
+///    lighting.glsl's normal offset, at most 3). Elsewhere every filter tap reads a texel no
+///    caster covers (cleared to depth 1, or the border: lit), so the plane is lit as with no
+///    shadow map at all.
+/// A point on or behind the near plane (a body or line reaching behind the eye), or a plane
+/// almost parallel to the light, makes it the whole frame.
+void FramePlan::plan_dynamic_rect() {
+  ScreenBounds b;
+  const float w = static_cast<float>(view.width);
+  const float h = static_cast<float>(view.height);
+  const float front = glm::dot(view.forward, view.eye) + view.near_m;
+  const auto add = [&](const glm::vec3& p, float margin_px) {
+    if (b.whole) return;
+    if (!(glm::dot(view.forward, p) > front)) {
+      b.whole = true;
+      return;
+    }
+    const glm::vec4 c = view.view_proj * glm::vec4(p, 1.0f);
+    const glm::vec2 px((0.5f * c.x / c.w + 0.5f) * w, (0.5f * c.y / c.w + 0.5f) * h);
+    b.lo = glm::min(b.lo, px - margin_px);
+    b.hi = glm::max(b.hi, px + margin_px);
+  };
+  // The bounding box of the shadow casters (the opaque bodies), m.
+  bool casters = false;
+  glm::vec3 clo(std::numeric_limits<float>::max());
+  glm::vec3 chi(std::numeric_limits<float>::lowest());
+  const auto add_bodies = [&](const std::vector<BodyInstance>& list, bool cast) {
+    for (const BodyInstance& i : list) {
+      const glm::quat q(i.orientation[3], i.orientation[0], i.orientation[1], i.orientation[2]);
+      const glm::mat3 r = glm::mat3_cast(q);
+      const glm::vec3 half(i.half_extents[0], i.half_extents[1], i.half_extents[2]);
+      // World half extents of the rotated box: |R| half.
+      const glm::vec3 e = glm::abs(r[0]) * half.x + glm::abs(r[1]) * half.y + glm::abs(r[2]) * half.z;
+      const glm::vec3 c(i.center[0], i.center[1], i.center[2]);
+      if (cast) {
+        casters = true;
+        clo = glm::min(clo, c - e);
+        chi = glm::max(chi, c + e);
+      }
+      for (int k = 0; k < 8; ++k) {
+        add(c + glm::vec3((k & 1) ? e.x : -e.x, (k & 2) ? e.y : -e.y, (k & 4) ? e.z : -e.z), 0.0f);
+      }
+    }
+  };
+  add_bodies(boxes, true);
+  add_bodies(ghost_boxes, false);
+  for (const std::vector<BodyInstance>& v : spheres) add_bodies(v, true);
+  for (const std::vector<BodyInstance>& v : ghost_spheres) add_bodies(v, false);
+  for (const LineInstance& l : lines) {
+    add(glm::vec3(l.a[0], l.a[1], l.a[2]), l.width_px);
+    add(glm::vec3(l.b[0], l.b[1], l.b[2]), l.width_px);
+  }
+  if (shadow.enabled && casters && !b.whole) {
+    for (const PlaneDraw& p : planes) {
+      if (!p.visible) continue;
+      const float denom = glm::dot(p.normal, view.light_dir);
+      if (std::abs(denom) < 0.05f) {
+        b.whole = true;
+        break;
+      }
+      const float margin = 8.0f * shadow.texel_world / std::abs(denom);
+      for (int k = 0; k < 8 && !b.whole; ++k) {
+        const glm::vec3 c((k & 1) ? chi.x : clo.x, (k & 2) ? chi.y : clo.y, (k & 4) ? chi.z : clo.z);
+        const glm::vec3 on_plane = c + ((p.offset - glm::dot(p.normal, c)) / denom) * view.light_dir;
+        for (int m = 0; m < 4; ++m) {
+          add(on_plane + ((m & 1) ? margin : -margin) * p.t1 + ((m & 2) ? margin : -margin) * p.t2,
+              0.0f);
+        }
+      }
+    }
+  }
+  if (b.whole) {
+    dynamic_rect = {0, 0, view.width, view.height};
+    return;
+  }
+  if (!(b.hi.x >= b.lo.x) || !(b.hi.y >= b.lo.y)) {
+    dynamic_rect = {0, 0, 0, 0};
+    return;
+  }
+  const float x0 = std::clamp(std::floor(b.lo.x) - 2.0f, 0.0f, w);
+  const float y0 = std::clamp(std::floor(b.lo.y) - 2.0f, 0.0f, h);
+  const float x1 = std::clamp(std::ceil(b.hi.x) + 2.0f, 0.0f, w);
+  const float y1 = std::clamp(std::ceil(b.hi.y) + 2.0f, 0.0f, h);
+  dynamic_rect = {static_cast<int>(x0), static_cast<int>(y0), static_cast<int>(std::max(x1 - x0, 0.0f)),
+                  static_cast<int>(std::max(y1 - y0, 0.0f))};
 }
 
 /// Copies the valid boxes and spheres into the instance lists, opaque or ghost by alpha. Spheres

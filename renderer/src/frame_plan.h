@@ -73,6 +73,9 @@ struct ShadowSetup {
   float texel_world = 0.0f;  // m per shadow texel
 };
 
+/// A pixel rectangle in GL window coordinates (origin bottom left): x, y, width, height.
+using PixelRect = std::array<int, 4>;
+
 /// The camera and lights of one frame, from DrawList::camera, light_direction and background,
 /// with fallbacks for degenerate values (see plan_view in frame_plan.cpp).
 struct FrameView {
@@ -116,6 +119,17 @@ class FramePlan {
   // as they still clip the others.
   std::vector<PlaneDraw> planes;
   std::size_t first_translucent = 0;  // index in planes of the first plane with alpha < 1
+  /// The pixels whose colour depends on the bodies, lines and shadows: the union of the screen
+  /// bounds of every body and line and of the sun's shadow-map footprint on every plane (see
+  /// plan_dynamic_rect in frame_plan.cpp); every other pixel shows the planes alone, lit as
+  /// without a shadow map. Width or height 0: no such pixel.
+  PixelRect dynamic_rect{0, 0, 0, 0};
+  /// The rectangle the main passes draw in: the whole frame unless restrict_to narrowed it.
+  PixelRect draw_rect{0, 0, 1, 1};
+
+  /// Narrows draw_rect to `rect` (inside the frame) and every plane's scissor with it (planes
+  /// left with nothing become invisible).
+  void restrict_to(const PixelRect& rect);
 
   /// Whether any ghost box or sphere is planned.
   bool has_ghosts() const;
@@ -126,6 +140,7 @@ class FramePlan {
   void gather_planes(const DrawList& list);
   void fit_shadow(const DrawList& list);
   bool plane_scissor(const PlaneDraw& d, std::array<int, 4>& rect) const;
+  void plan_dynamic_rect();
 
   std::array<float, k_sphere_lods> sphere_limits_px_;  // see sphere_lod_limits_px
 };

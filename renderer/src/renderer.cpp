@@ -12,6 +12,13 @@
 //      then planes with alpha < 1 back to front, blended, without depth writes, then the ghosts
 //      (bodies with alpha < 1) back to front, blended, depth tested but without depth writes;
 //   3. resolve (blit) into the context's framebuffer, glFinish, read back top row first.
+// The backdrop: once a view (camera, sun, background, planes, size) has stayed for two frames in
+// a row, the renderer draws the planes alone once (steps 0-3 without bodies or lines) and keeps
+// that frame. While the view stays, each frame then runs steps 1-3 only inside its dynamic
+// rectangle (FramePlan::dynamic_rect: the bodies, lines and shadows on screen), reads back only
+// that rectangle and pastes it into a copy of the backdrop: the same pixels, to the bit, as the
+// whole frame drawn (see Backdrop), for a fraction of the fragments, of the resolve and of the
+// read-back.
 
 #include "cps/render/renderer.h"
 
@@ -25,7 +32,10 @@
 #include "passes/render_target.h"
 #include "passes/shadow_pass.h"
 
+#include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <vector>
 #include <stdexcept>
 #include <string>
 
@@ -67,6 +77,58 @@ void check_gl(const char* where) {
                            std::to_string(e) + ") " + where);
 }
 
+// The draw list's planes, camera, sun and background, without bodies or lines.
+DrawList planes_only(const DrawList& list) {
+  DrawList d;
+  d.planes = list.planes;
+  d.camera = list.camera;
+  d.light_direction = list.light_direction;
+  d.background = list.background;
+  return d;
+}
+
+// The backdrop: the frame of the planes alone (no body, no line, so no shadow map), kept while
+// the view stays. Every pixel outside a frame's dynamic rectangle (FramePlan::dynamic_rect) is
+// the same as the backdrop's, to the bit: the same fragments of the same planes, shaded alike
+// (lit, as every shadow-map tap there reads the border), resolved alike.
+struct Backdrop {
+  std::vector<float> key;       // what the backdrop depends on, of the last frame drawn
+  bool ready = false;           // image is the backdrop of `key`
+  Image image;
+
+  // Records the view of `list` at width x height; true when it is the same as the last
+  // frame's (then a backdrop is worth drawing), false otherwise (the backdrop is dropped).
+  bool see(const DrawList& list, int width, int height) {
+    next.clear();
+    const auto put = [this](const glm::vec3& v) { next.insert(next.end(), {v.x, v.y, v.z}); };
+    next.push_back(static_cast<float>(width));
+    next.push_back(static_cast<float>(height));
+    const Camera& c = list.camera;
+    put(c.eye);
+    put(c.target);
+    put(c.up);
+    next.insert(next.end(), {c.fov_y_deg, c.near_m, c.far_m});
+    put(list.light_direction);
+    put(list.background);
+    for (const PlaneItem& p : list.planes) {
+      put(p.normal);
+      put(p.center_hint);
+      put(p.color_a);
+      put(p.color_b);
+      next.insert(next.end(), {p.offset, p.half_size, p.checker_m, p.alpha});
+    }
+    // Bitwise, so that a NaN compares equal to itself.
+    const bool same = next.size() == key.size() &&
+                      std::memcmp(next.data(), key.data(), next.size() * sizeof(float)) == 0;
+    if (!same) ready = false;
+    key.swap(next);
+    return same;
+  }
+
+ private:
+  std::vector<float> next;
+};
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -78,6 +140,10 @@ struct Renderer::Impl {
   LinePass line_pass;
   RenderTarget target;  // last GL member: its MSAA check reads glGetError
   FramePlan plan;       // CPU staging reused across frames
+  Backdrop backdrop;
+  FramePlan backdrop_plan;
+  bool timing = false;  // set_stage_timing
+  StageTimes times;
 
   Impl(int width, int height, Backend backend) : context(backend, width, height), target(context) {
     check_gl("while creating the renderer");
@@ -91,25 +157,75 @@ struct Renderer::Impl {
     }
   }
 
-  // The frame outline at the top of this file, step by step.
+  // The frame outline at the top of this file, step by step. With stage timing on, mark(x)
+  // waits for the GL work so far and adds the time since the previous mark to x.
   Image draw(const DrawList& list) {
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point last = Clock::now();
+    const auto mark = [&](double& into, bool gl) {
+      if (!timing) return;
+      if (gl) glFinish();
+      const Clock::time_point now = Clock::now();
+      into += std::chrono::duration<double, std::milli>(now - last).count();
+      last = now;
+    };
+    times = StageTimes{};
     context.make_current();
+    const bool same_view = backdrop.see(list, context.width(), context.height());
+    if (same_view && !backdrop.ready) {
+      // The backdrop (once the view has stayed for a frame): the planes alone, whole frame.
+      backdrop_plan.build(planes_only(list), context.width(), context.height());
+      backdrop.image = render(backdrop_plan, mark);
+      backdrop.ready = true;
+    }
     plan.build(list, context.width(), context.height());  // 0.
-    meshes.upload(plan.boxes, plan.spheres);
-    line_pass.upload(plan.lines);
+    mark(times.plan, false);
+    const PixelRect& dyn = plan.dynamic_rect;
+    const bool whole = dyn[0] == 0 && dyn[1] == 0 && dyn[2] == context.width() &&
+                       dyn[3] == context.height();
+    if (!same_view || !backdrop.ready || whole) return render(plan, mark);
+    plan.restrict_to(dyn);
+    Image image = backdrop.image;
+    if (dyn[2] > 0 && dyn[3] > 0) {
+      draw_passes(plan, mark);
+      target.read_rect(dyn, image);
+      mark(times.read_back, false);
+    }
+    return image;
+  }
+
+  // Steps 1 to 3 of the frame outline for `p` (uploaded here), inside p.draw_rect.
+  template <class Mark>
+  void draw_passes(const FramePlan& p, Mark& mark) {
+    meshes.upload(p.boxes, p.spheres);
+    line_pass.upload(p.lines);
+    mark(times.upload, true);
     reset_frame_state();
-    shadow_pass.draw(plan.shadow, meshes);  // 1.
-    target.begin(plan.view.background);     // 2.
+    shadow_pass.draw(p.shadow, meshes);  // 1.
+    mark(times.shadow, true);
+    target.begin(p.view.background, p.draw_rect);  // 2.
     shadow_pass.bind_map();
-    body_pass.draw_opaque(plan, meshes);
-    plane_pass.draw_opaque(plan);
-    line_pass.draw(plan);
-    plane_pass.draw_translucent(plan);
-    body_pass.draw_ghosts(plan, meshes);  // last: blended over everything else
+    body_pass.draw_opaque(p, meshes);
+    mark(times.bodies, true);
+    plane_pass.draw_opaque(p);
+    mark(times.planes, true);
+    line_pass.draw(p);
+    plane_pass.draw_translucent(p);
+    body_pass.draw_ghosts(p, meshes);  // last: blended over everything else
     glBindVertexArray(0);
-    target.resolve();  // 3.
+    mark(times.overlay, true);
+    target.resolve(p.draw_rect);  // 3.
+    mark(times.resolve, true);
     check_gl("while drawing a frame");
-    return target.read_back();
+  }
+
+  // The whole frame of `p`, read back.
+  template <class Mark>
+  Image render(const FramePlan& p, Mark& mark) {
+    draw_passes(p, mark);
+    Image image = target.read_back();
+    mark(times.read_back, false);
+    return image;
   }
 };
 
@@ -155,5 +271,8 @@ std::optional<Backend> parse_backend(std::string_view name) {
 // with PCF-filtered shadow mapping (Williams 1978; Reeves et al. 1987; LearnOpenGL "Shadow
 // Mapping"), hemisphere ambient and a weak camera-relative fill light.
 Image Renderer::draw(const DrawList& list) { return impl_->draw(list); }
+
+void Renderer::set_stage_timing(bool on) { impl_->timing = on; }
+StageTimes Renderer::last_stage_times() const { return impl_->times; }
 
 }  // namespace cps::render

@@ -508,3 +508,47 @@ TEST_CASE("spheres stay round at every level of detail", "[renderer]") {
     CHECK(covered == Approx(disc).epsilon(0.08));
   }
 }
+
+TEST_CASE("renderer draws a still view's frames as a fresh renderer draws each", "[renderer]") {
+  // Once the view has stayed for a frame, the renderer redraws only the rectangle where bodies,
+  // lines and shadows are, over a kept frame of the planes alone (renderer.cpp): every pixel
+  // must still be the same, to the bit, as a renderer without history draws it. The frames move
+  // a box, a ball and a line over a ground plane behind a translucent wall, then take the ball
+  // behind the eye (the whole frame is redrawn), then leave only the planes.
+  constexpr int w = 200;
+  constexpr int h = 150;
+  Renderer kept(w, h);
+  DrawList list = red_box_scene();
+  PlaneItem wall;
+  wall.normal = glm::normalize(glm::vec3(0.3f, 0.0f, -1.0f));
+  wall.offset = -3.0f;
+  wall.center_hint = glm::vec3(0.0f, 0.0f, 3.0f);
+  wall.half_size = 2.0f;
+  wall.alpha = 0.4f;
+  list.planes.push_back(wall);
+  SphereItem ball;
+  ball.radius = 0.4f;
+  ball.color = glm::vec3(0.1f, 0.3f, 0.9f);
+  list.spheres.push_back(ball);
+  LineItem rod;
+  rod.width_px = 3.0f;
+  list.lines.push_back(rod);
+  for (int k = 0; k < 7; ++k) {
+    const float t = 0.3f * static_cast<float>(k);
+    list.boxes[0].center = glm::vec3(-1.0f + t, 0.5f * t, -0.5f * t);
+    list.boxes[0].orientation = glm::angleAxis(t, glm::normalize(glm::vec3(1.0f, 2.0f, 0.5f)));
+    list.spheres[0].center = k == 5 ? glm::vec3(0.0f, 2.0f, 9.0f) : glm::vec3(1.5f - t, 1.0f, t);
+    list.lines[0].a = list.spheres[0].center;
+    list.lines[0].b = glm::vec3(1.5f, 3.0f, 0.0f);
+    if (k == 6) {
+      list.boxes.clear();
+      list.spheres.clear();
+      list.lines.clear();
+    }
+    const Image frame = kept.draw(list);
+    Renderer fresh(w, h);
+    const Image expected = fresh.draw(list);
+    INFO("frame " << k);
+    CHECK(frame.pixels == expected.pixels);
+  }
+}

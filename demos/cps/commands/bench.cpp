@@ -130,6 +130,7 @@ double seconds_since(Clock::time_point start) {
 }
 
 // The rendering table: per paper scene at 1280x720 over its first second at 30 fps.
+//  - Where the draw goes: the stages of Renderer::draw with stage timing on, median per stage.
 //  - Stages, one at a time on this thread: milliseconds per frame of physics, draw (including
 //    the readback) and PNG encode + atomic write, each the median over the frames.
 //  - "physics + draw": the real loop without the PNG files (advance, draw, drop the image), and
@@ -158,6 +159,7 @@ nlohmann::json render_table(bool quick, bool markdown) {
                 k_width, k_height, k_seconds, k_fps, repeats, repeats > 1 ? "s" : "");
   }
   nlohmann::json rows = nlohmann::json::array();
+  std::string breakdown;  // Markdown rows of the stage table
   render::Renderer renderer(k_width, k_height);
   const std::filesystem::path folder =
       std::filesystem::temp_directory_path() / ("cps_bench_frames_" + std::to_string(getpid()));
@@ -191,6 +193,23 @@ nlohmann::json render_table(bool quick, bool markdown) {
         encode.push_back(1e3 * seconds_since(start));
         bytes += static_cast<double>(std::filesystem::file_size(folder / "frame.png"));
       }
+    }
+    // Where a frame's draw goes: the same frames with stage timing on (glFinish after each
+    // stage), median per stage.
+    std::vector<std::vector<double>> stage(8);
+    {
+      scenes::Run run = scenes::make_run(scene);
+      const DrawStyle style = resolve_style(scene, run.world, View{}, k_aspect);
+      renderer.set_stage_timing(true);
+      for (int k = 0; k < frames; ++k) {
+        run.advance_to(static_cast<double>(k) / k_fps);
+        renderer.draw(draw_list(run.world, style));
+        const render::StageTimes t = renderer.last_stage_times();
+        const double v[8] = {t.plan,   t.upload,  t.shadow,  t.bodies,
+                             t.planes, t.overlay, t.resolve, t.read_back};
+        for (std::size_t i = 0; i < stage.size(); ++i) stage[i].push_back(v[i]);
+      }
+      renderer.set_stage_timing(false);
     }
     // The loop without PNG files, then the real pipeline, in turn.
     std::vector<double> alone, end_to_end;
@@ -230,13 +249,35 @@ nlohmann::json render_table(bool quick, bool markdown) {
                     {"png_ms", median(encode)},
                     {"png_kib", bytes / frames / 1024.0},
                     {"physics_and_draw_ms", a},
-                    {"end_to_end_ms", e}});
+                    {"end_to_end_ms", e},
+                    {"stages_ms",
+                     {{"plan", median(stage[0])},
+                      {"upload", median(stage[1])},
+                      {"shadow", median(stage[2])},
+                      {"bodies", median(stage[3])},
+                      {"planes", median(stage[4])},
+                      {"lines_translucent_ghosts", median(stage[5])},
+                      {"resolve", median(stage[6])},
+                      {"read_back", median(stage[7])}}}});
     if (markdown) {
       std::printf("| %s | %.1f | %.1f | %.1f | %.0f | %.1f | %.1f | %.2f |\n",
                   std::string(scene.name).c_str(), median(physics), median(draw), median(encode),
                   bytes / frames / 1024.0, a, e, e / a);
+      breakdown += "| " + std::string(scene.name);
+      for (const std::vector<double>& v : stage) {
+        char cell[32];
+        std::snprintf(cell, sizeof cell, " | %.1f", median(v));
+        breakdown += cell;
+      }
+      breakdown += " |\n";
       std::fflush(stdout);
     }
+  }
+  if (markdown) {
+    std::printf("\nWhere the draw goes (ms per frame, median over the frames, each stage ended by "
+                "glFinish: %s)\n\n| scene | plan | upload | shadow | bodies | planes | lines, "
+                "translucent, ghosts | resolve | read-back |\n|---|---|---|---|---|---|---|---|---|\n%s",
+                renderer.context_description().c_str(), breakdown.c_str());
   }
   std::filesystem::remove_all(folder);
   return rows;

@@ -38,6 +38,7 @@ void reset_frame_state() {
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glDisable(GL_BLEND);
+  glDisable(GL_SCISSOR_TEST);
 }
 
 void begin_blending() {

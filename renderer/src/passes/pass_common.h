@@ -55,7 +55,8 @@ struct FloatField {
 void float_attribs(const gl::Buffer& buffer, GLuint first, GLsizei stride,
                    std::initializer_list<FloatField> fields, bool instanced);
 
-/// The state every frame starts from: depth test GL_LESS with depth writes, no blending.
+/// The state every frame starts from: depth test GL_LESS with depth writes, no blending, no
+/// scissor test.
 void reset_frame_state();
 
 /// Translucent items: colour blended "over" by source alpha (the alpha channel adds up coverage),

@@ -32,11 +32,11 @@ void PlanePass::draw_translucent(const FramePlan& plan) const {
 
 void PlanePass::draw_range(const FramePlan& plan, std::size_t first, std::size_t last) const {
   glBindVertexArray(empty_vao_.id());
-  glEnable(GL_SCISSOR_TEST);
   for (std::size_t i = first; i < last; ++i) {
     if (plan.planes[i].visible) draw_plane(plan.planes[i], plan);
   }
-  glDisable(GL_SCISSOR_TEST);
+  const PixelRect& r = plan.draw_rect;
+  glScissor(r[0], r[1], r[2], r[3]);
 }
 
 void PlanePass::draw_plane(const PlaneDraw& d, const FramePlan& plan) const {

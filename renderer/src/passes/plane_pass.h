@@ -26,7 +26,9 @@ class PlanePass {
   void draw_translucent(const FramePlan& plan) const;
 
  private:
-  /// Draws planes [first, last) of plan.planes that are visible, each in its scissor rectangle.
+  /// Draws planes [first, last) of plan.planes that are visible, each in its scissor rectangle
+  /// (the scissor test on, as RenderTarget::begin leaves it), then sets the scissor back to
+  /// plan.draw_rect.
   void draw_range(const FramePlan& plan, std::size_t first, std::size_t last) const;
   /// Draws plane d, clipped by every other plane of `plan` (at most k_max_clip_planes).
   void draw_plane(const PlaneDraw& d, const FramePlan& plan) const;

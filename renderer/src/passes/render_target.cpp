@@ -44,21 +44,50 @@ RenderTarget::RenderTarget(GlContext& context) : context_(context) {
   }
 }
 
-void RenderTarget::begin(const glm::vec3& background) const {
+void RenderTarget::begin(const glm::vec3& background, const PixelRect& rect) const {
   glBindFramebuffer(GL_FRAMEBUFFER, samples_ > 0 ? fbo_.id() : context_.framebuffer());
   glViewport(0, 0, context_.width(), context_.height());
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(rect[0], rect[1], rect[2], rect[3]);
   glClearColor(background.r, background.g, background.b, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 }
 
-void RenderTarget::resolve() const {
-  if (samples_ == 0) return;
-  const int width = context_.width();
-  const int height = context_.height();
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_.id());
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, context_.framebuffer());
-  glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+void RenderTarget::resolve(const PixelRect& rect) const {
+  if (samples_ > 0) {
+    const int x1 = rect[0] + rect[2];
+    const int y1 = rect[1] + rect[3];
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_.id());
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, context_.framebuffer());
+    glBlitFramebuffer(rect[0], rect[1], x1, y1, rect[0], rect[1], x1, y1, GL_COLOR_BUFFER_BIT,
+                      GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+  glDisable(GL_SCISSOR_TEST);
+}
+
+void RenderTarget::read_rect(const PixelRect& rect, Image& image) {
+  const auto w = static_cast<std::size_t>(rect[2]);
+  const auto h = static_cast<std::size_t>(rect[3]);
+  if (w == 0 || h == 0) return;
+  rgba_.resize(w * h * 4u);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, context_.framebuffer());
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(rect[0], rect[1], rect[2], rect[3], GL_RGBA, GL_UNSIGNED_BYTE, rgba_.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  // GL rows run bottom to top; the image's top to bottom.
+  const auto width = static_cast<std::size_t>(image.width);
+  for (std::size_t j = 0; j < h; ++j) {
+    const std::size_t row = static_cast<std::size_t>(image.height) - 1u -
+                            (static_cast<std::size_t>(rect[1]) + j);
+    const std::uint8_t* src = rgba_.data() + j * w * 4u;
+    std::uint8_t* dst = image.pixels.data() + (row * width + static_cast<std::size_t>(rect[0])) * 3u;
+    for (std::size_t i = 0; i < w; ++i) {
+      dst[3 * i] = src[4 * i];
+      dst[3 * i + 1] = src[4 * i + 1];
+      dst[3 * i + 2] = src[4 * i + 2];
+    }
+  }
 }
 
 Image RenderTarget::read_back() const {

@@ -3,10 +3,14 @@
 // implementation allows it (else the context's own), its resolve into the context's framebuffer
 // and the read-back of the finished frame.
 
+#include "frame_plan.h"
 #include "gl_context.h"
 #include "gl_objects.h"
 
 #include <glm/glm.hpp>
+
+#include <cstdint>
+#include <vector>
 
 namespace cps::render {
 
@@ -23,16 +27,22 @@ class RenderTarget {
   RenderTarget(const RenderTarget&) = delete;
   RenderTarget& operator=(const RenderTarget&) = delete;
 
-  /// Binds the target for drawing over the whole frame and clears it to `background` (RGB in
-  /// [0, 1], alpha 1) and depth 1.
-  void begin(const glm::vec3& background) const;
+  /// Binds the target for drawing over the whole frame, turns the scissor test on with `rect`
+  /// (pixels, GL window coordinates) and clears that rectangle to `background` (RGB in [0, 1],
+  /// alpha 1) and depth 1. The passes draw only inside `rect` until resolve().
+  void begin(const glm::vec3& background, const PixelRect& rect) const;
 
-  /// Resolves (blits) the multisampled image into the context's framebuffer; nothing without
-  /// MSAA.
-  void resolve() const;
+  /// Resolves (blits) `rect` of the multisampled image into the context's framebuffer (nothing
+  /// to do without MSAA) and turns the scissor test off.
+  void resolve(const PixelRect& rect) const;
 
   /// glFinish, then the context's framebuffer as RGB8, rows top to bottom.
   Image read_back() const;
+
+  /// Reads `rect` (GL window coordinates, inside the frame) of the context's framebuffer into
+  /// the same pixels of `image` (RGB8, rows top to bottom, the context's size), leaving the
+  /// others as they are.
+  void read_rect(const PixelRect& rect, Image& image);
 
  private:
   GlContext& context_;
@@ -40,6 +50,7 @@ class RenderTarget {
   gl::Framebuffer fbo_;
   gl::Renderbuffer color_;
   gl::Renderbuffer depth_;
+  std::vector<std::uint8_t> rgba_;  // read_rect's staging, 4 bytes per pixel
 };
 
 }  // namespace cps::render

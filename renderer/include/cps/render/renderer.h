@@ -22,6 +22,24 @@ struct Image {
   std::vector<std::uint8_t> pixels;
 };
 
+/// Milliseconds (wall clock) one Renderer::draw spent in each stage, when stage timing is on
+/// (Renderer::set_stage_timing): glFinish ends each GL stage, so each figure is the work of that
+/// stage alone (llvmpipe draws on its own threads; without the glFinish calls their work would
+/// land in read_back).
+struct StageTimes {
+  double plan = 0.0;       // CPU: the frame plan (frame_plan.h)
+  double upload = 0.0;     // instance buffers
+  double shadow = 0.0;     // the shadow map (0 when it was kept from the previous frame)
+  double bodies = 0.0;     // clear and opaque bodies
+  double planes = 0.0;     // opaque planes
+  double overlay = 0.0;    // lines, translucent planes, ghosts
+  double resolve = 0.0;    // the multisample resolve
+  double read_back = 0.0;  // glReadPixels or OSMesa's copy, to top-down RGB8
+  double total() const {
+    return plan + upload + shadow + bodies + planes + overlay + resolve + read_back;
+  }
+};
+
 /// How the renderer gets its OpenGL context. Both render headless, without any window system.
 enum class Backend {
   /// OSMesa (libOSMesa, Mesa's llvmpipe on the CPU). Upstream Mesa removed OSMesa in 25.1;
@@ -64,8 +82,17 @@ class Renderer {
   std::string context_description();
 
   /// Draws one frame of `list` into the frame buffer and returns it as an RGB8 image, rows top to
-  /// bottom. Throws std::runtime_error on a GL error.
+  /// bottom. Throws std::runtime_error on a GL error. While the view (camera, sun, background,
+  /// planes, size) stays the same from frame to frame, only the rectangle holding the bodies,
+  /// lines and shadows is drawn again, over a kept frame of the planes: the same pixels.
   Image draw(const DrawList& list);
+
+  /// Stage timing (for measurement only; off by default): when on, draw() waits for each stage
+  /// to finish (glFinish) and records its time, which makes the frame slower (the stages no
+  /// longer overlap).
+  void set_stage_timing(bool on);
+  /// The stage times of the last draw() with stage timing on (all zero before).
+  StageTimes last_stage_times() const;
 
  private:
   struct Impl;

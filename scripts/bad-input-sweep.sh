@@ -166,13 +166,13 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     times)  # comma separated, finite, >= 0, increasing, at most 1e5 s, at most 64 of them
       printf '%s\n' "" , 0, ,0 0,,1 nan inf -inf -1 0,-1 1,0 0,0 0x10 1x 10s 1/0 1//60 -1/60 1e308 1e12 \
         100001 4294967297 0,1e-400x "0;1" "$(seq_csv 65)" ;;
-    compare)  # PARAM=V1,...,Vn (2 to 6 distinct values the table accepts) or a choice alone
+    compare)  # PARAM=V1,...,Vn (2 to 8 distinct values the table accepts) or a choice alone
       printf '%s\n' "" nosuch nosuch=1,2 gravity=0,0,-10 collision=true,false PUSH "push " " push" \
         beta beta= =0.1,0.2 beta=2,3 beta=0.1,2 beta=nan,0.1 beta=0.1,inf beta=0x10,0.1 \
-        beta=0.1 push=split beta=0.1,0.2,0.3,0.4,0.5,0.6,0.7 beta=0.1,0.1 beta=0.5,0.50 \
+        beta=0.1 push=split beta=0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9 beta=0.1,0.1 beta=0.5,0.50 \
         push=split,split push=sideways,split "beta=0.1,,0.2" beta=0.1,0.2, "beta=0.1, 0.2" \
         beta==0.1,0.2 iterations=1,0 iterations=1,1.5 dt=0,1/60 dt=1/0,1/60 \
-        "beta=0.1;0.2" iterations=1,2,3,4,5,6,7 ;;
+        "beta=0.1;0.2" iterations=1,2,3,4,5,6,7,8,9 ;;
     png_in)  # not a PNG file, or a file beside a folder (the base's other input is a PNG)
       printf '%s\n' "" nosuch.png file file.png dir.png adir bad.json ;;
     out_folder)  # cannot be a folder: an existing file, a path under a file, a device
@@ -628,9 +628,11 @@ control() {  # ARGS...: must exit 0
     echo "CONTROL FAILED (valid, must exit 0): $(show "$@") -> exit $RC: ${ERR:0:300}"
   fi
 }
-# The --merge source: a complete sweep (the intersecting stack's quick one, 32 runs, a few
-# seconds; RUN_ID is one of them), so that merging it is valid (a merge with runs missing exits 1).
-timeout "$TIMEOUT" "$CPS" report intersecting_stack --quick --out "$MERGE_SRC" > /dev/null 2>&1
+# The --merge source: a complete sweep (the intersecting stack's quick one; RUN_ID is one of
+# them), so that merging it is valid (a merge with runs missing exits 1).
+# A fixture, not a case: it gets its own bound (SWEEP_FIXTURE_TIMEOUT s; every push method of the
+# table runs, 5 timed repeats each, and other lines run beside it).
+timeout "${SWEEP_FIXTURE_TIMEOUT:-300}" "$CPS" report intersecting_stack --quick --out "$MERGE_SRC" > /dev/null 2>&1
 if ! compgen -G "$MERGE_SRC/*.csv" > /dev/null; then
   CONTROL_FAILS+=("cps report intersecting_stack --quick --out DIR wrote no CSV")
   echo "CONTROL FAILED: cps report intersecting_stack --quick --out DIR wrote no CSV"

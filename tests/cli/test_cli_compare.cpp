@@ -224,7 +224,7 @@ TEST_CASE("a bad --compare or --overlay exits 2 naming the problem and writes no
       {"render stack --compare nosuch=1,2", "'nosuch'"},
       {"render stack --compare beta=0.1,2", "--beta 2"},
       {"render stack --compare beta=0.1", "1 value"},
-      {"render stack --compare beta=0.1,0.2,0.3,0.4,0.5,0.6,0.7", "more than 6"},
+      {"render stack --compare beta=0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9", "more than 8"},
       {"render stack --compare beta=0.2,0.20", "same value"},
       {"render stack --compare beta=0.1,0.2 --beta 0.3", "--beta is given too"},
       {"render stack --compare push --push split", "--push is given too"},

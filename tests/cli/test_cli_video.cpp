@@ -143,14 +143,14 @@ TEST_CASE("cps render --video with --compare names the video after the compare f
   }
   const fs::path dir = fresh_dir("compare");
   const Result r =
-      cps("", "render stack --size 642x360 " + k_small + " --compare push --video mp4 --out out", dir);
+      cps("", "render stack --size 640x360 " + k_small + " --compare push --video mp4 --out out", dir);
   INFO("stderr: " << r.err);
   REQUIRE(r.exit_code == 0);
   const fs::path video = dir / "out" / "stack-compare-push.mp4";
   REQUIRE(fs::exists(video));
   CHECK_FALSE(fs::exists(dir / "out" / "stack.mp4"));
   const nlohmann::json s = probe(video);
-  CHECK(s["width"] == 642);  // --size: the five push methods in 2 x 3 cells of 214 x 180,
+  CHECK(s["width"] == 640);  // --size: the push methods (7 or 8) in 2 x 4 cells of 160 x 180,
   CHECK(s["height"] == 360);  // captions included
   CHECK(s["nb_read_frames"] == std::to_string(k_frames));
   fs::remove_all(dir);

@@ -113,8 +113,8 @@ TEST_CASE("a bad compare spec is a usage error naming the parameter, the value a
       {"beta=0.05,abc", {"abc", "not a number"}},
       {"iterations=5,2.5", {"2.5", "whole number"}},
       {"push=baumgarte,sideways", {"sideways", "baumgarte, split"}},
-      {"beta=0.1", {"1 value", "2 to 6"}},
-      {"beta=0.1,0.2,0.3,0.4,0.5,0.6,0.7", {"more than 6", "2 to 6"}},
+      {"beta=0.1", {"1 value", "2 to 8"}},
+      {"beta=0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9", {"more than 8", "2 to 8"}},
       {"beta=0.5,0.50", {"'0.50'", "same value", "'0.5'"}},
       {"push=split,split", {"same value"}},
       {"beta=0.1,,0.2", {"value 2 is empty"}},
@@ -144,7 +144,9 @@ TEST_CASE("compared variants are laid out so that panels stay large", "[compare]
   CHECK(is(grid_layout(4, 1.0), 2, 2));
   CHECK(is(grid_layout(5, 16.0 / 9.0), 2, 3));
   CHECK(is(grid_layout(6, 16.0 / 9.0), 2, 3));
-  CHECK_THROWS_AS(grid_layout(7, 1.0), std::invalid_argument);
+  CHECK(is(grid_layout(7, 16.0 / 9.0), 2, 4));
+  CHECK(is(grid_layout(8, 16.0 / 9.0), 2, 4));
+  CHECK_THROWS_AS(grid_layout(9, 1.0), std::invalid_argument);
   CHECK_THROWS_AS(grid_layout(0, 1.0), std::invalid_argument);
 }
 

@@ -511,7 +511,7 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
                   "increasing, decimals or fractions, e.g. 0,0.5,2 or 0,1/60,1/30; required "
                   "except for 'paper'");
   sub->add_option("--compare", o->compare,
-                  "PARAM=V1,V2,...: one row per value, 2 to 6 values of a world parameter (" +
+                  "PARAM=V1,V2,...: one row per value, 2 to 8 values of a world parameter (" +
                       comparable_list() + "), each checked as its own option is; a choice alone "
                       "(e.g. push) compares all its values (default: one row, the scene's "
                       "settings)")

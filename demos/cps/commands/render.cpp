@@ -603,7 +603,7 @@ Command add_render(CLI::App& app, int argc, char** argv) {
       ->capture_default_str()
       ->check(kNotEmpty);
   sub->add_option("--compare", o->compare,
-                  "PARAM=V1,V2,...: render 2 to 6 values of a world parameter (" + comparable_list() +
+                  "PARAM=V1,V2,...: render 2 to 8 values of a world parameter (" + comparable_list() +
                       "), each checked as its own option is, in a grid of labelled panels that "
                       "fills --size (2: 1x2 or 2x1 by aspect, 3: 1x3, 4: 2x2, 5-6: 2x3), into "
                       "OUT/SCENE-compare-PARAM-V1_V2_.../; a choice alone (e.g. push) compares "

@@ -199,6 +199,8 @@ Grid grid_layout(std::size_t variants, double aspect) {
     case 4: return {2, 2};
     case 5:
     case 6: return {2, 3};
+    case 7:
+    case 8: return {2, 4};
     default: break;
   }
   throw std::invalid_argument("grid_layout: " + std::to_string(variants) + " variants; 1 to " +
@@ -213,6 +215,8 @@ std::array<float, 3> overlay_colour(std::size_t k) {
       {0xd6 / 255.0f, 0x27 / 255.0f, 0x28 / 255.0f},  // red
       {0x94 / 255.0f, 0x67 / 255.0f, 0xbd / 255.0f},  // purple
       {0xbc / 255.0f, 0xbd / 255.0f, 0x22 / 255.0f},  // olive
+      {0xe3 / 255.0f, 0x77 / 255.0f, 0xc2 / 255.0f},  // pink
+      {0x17 / 255.0f, 0xa5 / 255.0f, 0x89 / 255.0f},  // teal
   }};
   return kColours.at(k);
 }

@@ -17,7 +17,7 @@ namespace cps::cli {
 
 /// Fewest and most variants a comparison may have (panels of a grid, ghosts of an overlay).
 inline constexpr std::size_t kMinVariants = 2;
-inline constexpr std::size_t kMaxVariants = 6;
+inline constexpr std::size_t kMaxVariants = 8;  // every push method side by side
 
 /// One variant of a comparison: the overrides it runs with, the label of its panel (one or two
 /// lines: "push factor constant beta (Eq. 5.2.3)\nbeta = 0.05"; empty for the single variant of
@@ -92,7 +92,7 @@ struct Grid {
 Grid grid_layout(std::size_t variants, double aspect);
 
 /// The colour of variant k's ghosts in an overlay, as shown (sRGB, each in [0, 1]): blue,
-/// orange, green, red, purple, olive (the Tableau 10 colours, hues 28 degrees or more apart).
+/// orange, green, red, purple, olive, pink, teal (hues 25 degrees or more apart).
 /// k < kMaxVariants, else std::out_of_range.
 std::array<float, 3> overlay_colour(std::size_t k);
 

@@ -41,7 +41,7 @@ struct MeasuredRun {
 
 /// The error run of `spec` (residuals measured) and its trajectory error: the RMS distance (m)
 /// of the movable bodies from a reference run (kReferenceIterations, kReferenceSubsteps) at the
-/// scene's Scene::report_trajectory_time_s(); reference_check_m (m) is the reference's distance
+/// scene's trajectory_time_of (references.h: within the references' horizon); reference_check_m (m) is the reference's distance
 /// from the same run at half its substeps, an estimate of its own error. The timing is set up to
 /// the horizon, or to the time the run diverged (diverged_at_s): a diverged run is timed until
 /// then, what the method cost until it failed. The result has no sweep (RunResult::sweep, quick),

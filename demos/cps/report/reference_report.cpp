@@ -251,7 +251,11 @@ std::string references_section(const fs::path& dir, const std::string& scene,
 
   const double t_scene = std::min(s->report_trajectory_time_s(), s->report_horizon_s());
   const double t_used = trajectory_time_of(*s);
+  double top = a->tolerance_m;
+  for (const double d : a->distance_m) top = std::max(top, std::isfinite(d) ? d : top);
   std::ostringstream gp;
+  gp << "set yrange [" << 0.5 * kDistanceFloor << ":" << 10.0 * top << "]\nset xrange [0:"
+     << 1.05 * std::max(t_used, a->checked_until_s) << "]\n";
   gp << "set title " << gp_text(scene + ": distance between the two references (PGS " +
                                 std::to_string(kReferenceIterations) + " sweeps and the exact "
                                 "solve, both " + std::to_string(kReferenceSubsteps) +

@@ -4,6 +4,8 @@
 #include "integrator.h"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace cps {
@@ -40,7 +42,7 @@ void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<d
     return;
   }
   solver->solve(rows, *bodies, f_ext, terms, s, out, start);
-  if (observer) [[unlikely]] notify_observer(s, terms, out, start);
+  if (observer || override_solve) [[unlikely]] notify_observer(s, terms, out, start);
   ++solves_this_step;
   ++counters.solves;
   if (def->measure_residual) {
@@ -55,7 +57,7 @@ void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<d
 }
 
 void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
-                                  const std::vector<double>& out,
+                                  std::vector<double>& out,
                                   const std::vector<double>* start) const {
   StepSystem system;
   system.step = counters.steps;
@@ -78,7 +80,15 @@ void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
   system.lambda = Eigen::Map<const Eigen::VectorXd>(out.data(), c);
   system.initial = start != nullptr ? Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(start->data(), c))
                                     : Eigen::VectorXd::Zero(c);
-  observer(system);
+  if (observer) observer(system);
+  if (!override_solve) return;
+  Eigen::VectorXd replaced = system.lambda;
+  override_solve(system, replaced);
+  if (replaced.size() != c) {
+    throw std::invalid_argument("solve override: a lambda of " + std::to_string(replaced.size()) +
+                                " entries for a system of " + std::to_string(c) + " rows");
+  }
+  std::copy(replaced.data(), replaced.data() + c, out.begin());
 }
 
 void StepContext::store_warm_start() {

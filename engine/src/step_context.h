@@ -59,6 +59,8 @@ struct StepContext {
   /// World::set_solve_observer's callback, or empty (the usual case: one branch a solve). Not
   /// copied with the context: a copy of a world starts unobserved.
   SolveObserver observer;
+  /// World::set_solve_override's callback, or empty (the usual case). Not copied either.
+  SolveOverride override_solve;
   int solves_this_step = 0;  ///< solves made in the current step (StepSystem::solve)
 
   /// Warm starting is on (WorldDef::warm_start > 0).
@@ -83,8 +85,10 @@ struct StepContext {
     solve(settings(def->dt), terms, out, f, start);
   }
   /// Writes out the system of the solve that just gave `out` (c, N) from `start` (c, N, or
-  /// nullptr for 0) with settings `s` and hands it to the observer (cps/step_system.h).
-  void notify_observer(const SolveSettings& s, TargetTerms terms, const std::vector<double>& out,
+  /// nullptr for 0) with settings `s` and hands it to the observer, then to the override, whose
+  /// lambda replaces `out` (cps/step_system.h). Throws std::invalid_argument when the override
+  /// leaves a lambda of another size.
+  void notify_observer(const SolveSettings& s, TargetTerms terms, std::vector<double>& out,
                        const std::vector<double>* start) const;
   /// With warm starting on, stores this step's lambda and lambda_second for the next step.
   void store_warm_start();

@@ -93,6 +93,8 @@ int World::add_distance(const DistanceConstraint& d) {
 
 void World::set_solve_observer(SolveObserver observer) { ctx_->observer = std::move(observer); }
 
+void World::set_solve_override(SolveOverride override) { ctx_->override_solve = std::move(override); }
+
 std::size_t World::persisting_contacts() const {
   return ctx_->warm_start && def_.warm_start > 0.0 ? ctx_->warm_start->matched_points() : 0;
 }

@@ -3,6 +3,7 @@
 // one on a full disk fails with ENOSPC), a gnuplot that fails, the temporaries of a killed run,
 // and the merge's refusals of duplicate runs, non-finite cells and too much data.
 #include "cli_support.h"
+#include "report/reference_report.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -16,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -118,6 +120,10 @@ pid_t ended_pid() {
   return pid;
 }
 
+// The pictures of each kind a report of the stack draws: three measures' diagrams and the
+// reference sections' (reference_report.h).
+constexpr std::size_t kStackPictures = 3 + std::size(cps::cli::kReferenceParts);
+
 }  // namespace
 
 TEST_CASE("report --merge on a full disk names the plot and leaves no plot, part or temporary",
@@ -127,7 +133,7 @@ TEST_CASE("report --merge on a full disk names the plot and leaves no plot, part
   // Unlimited, every picture is larger than the limit below.
   REQUIRE(run_cps("report --merge runs --out whole", dir).exit_code == 1);  // INCOMPLETE
   for (const char* ext : {".png", ".svg", ".pdf"}) {
-    REQUIRE(files_ending(dir / "whole", ext).size() == 3);
+    REQUIRE(files_ending(dir / "whole", ext).size() == kStackPictures);
     for (const std::string& name : files_ending(dir / "whole", ext)) {
       INFO(name);
       CHECK(fs::file_size(dir / "whole" / name) > 12288);
@@ -144,7 +150,7 @@ TEST_CASE("report --merge on a full disk names the plot and leaves no plot, part
   }
   // The rerun with room writes them all.
   CHECK(run_cps("report --merge runs --out out", dir).exit_code == 1);
-  CHECK(files_ending(dir / "out", ".pdf").size() == 3);
+  CHECK(files_ending(dir / "out", ".pdf").size() == kStackPictures);
   fs::remove_all(dir);
 }
 
@@ -282,7 +288,7 @@ TEST_CASE("a killed report --merge leaves no gnuplot writing, and the next merge
   CHECK(r.exit_code == 1);  // INCOMPLETE
   CHECK(files_ending(dir / "out", ".tmp").empty());
   CHECK(files_ending(dir / "out/plots", ".tmp").empty());
-  CHECK(files_ending(dir / "out", ".pdf").size() == 3);
+  CHECK(files_ending(dir / "out", ".pdf").size() == kStackPictures);
   fs::remove_all(dir);
 }
 

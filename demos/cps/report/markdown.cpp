@@ -445,6 +445,9 @@ void write_scene(std::ostream& md, const ReportContent& c, const std::string& sc
       md << "![" << scene << " " << m->column << "](" << stem << "_" << m->column << ".png)\n\n";
     }
   }
+  if (const auto extra = c.scene_sections.find(scene); extra != c.scene_sections.end()) {
+    md << extra->second;
+  }
   write_run_table(md, scene, runs);
   write_omissions(md, scene, runs);
 }

@@ -21,6 +21,8 @@ struct ReportContent {
   std::map<std::string, std::vector<const RunResult*>> runs;
   /// The diagrams drawn for each scene (draw_diagram), by scene, in kMeasures' order.
   std::map<std::string, std::vector<const Measure*>> diagrams;
+  /// Markdown placed after each scene's diagrams, by scene (write_reference_sections), or none.
+  std::map<std::string, std::string> scene_sections;
   /// The mass ratio table as written to mass_ratio.csv (mass_ratio_table).
   CsvTable pairs;
   /// The ids of the planned runs that are missing (--merge), of `planned` in all.

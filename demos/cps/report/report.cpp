@@ -2,7 +2,10 @@
 
 #include "report/diagrams.h"
 #include "report/markdown.h"
+#include "report/reference_report.h"
 #include "output/atomic_file.h"
+
+#include <algorithm>
 
 namespace cps::cli {
 
@@ -29,6 +32,10 @@ void write_report(const std::filesystem::path& dir, const std::vector<RunResult>
     for (const Measure& m : kMeasures) {
       if (draw_diagram(dir, scene, m, c.runs[scene], title_note)) c.diagrams[scene].push_back(&m);
     }
+    // Solver error, the two references and energy over time (reference_report.h).
+    const bool quick = std::any_of(c.runs[scene].begin(), c.runs[scene].end(),
+                                   [](const RunResult* r) { return r->quick.value_or(false); });
+    c.scene_sections[scene] = write_reference_sections(dir, scene, quick, title_note);
   }
   c.pairs = mass_ratio_table(pairs);
   write_csv(dir / "mass_ratio.csv", c.pairs);
@@ -43,6 +50,7 @@ std::vector<std::string> report_files(const std::vector<std::string>& scenes) {
       for (const char* ext : {".png", ".svg", ".pdf"}) files.push_back(file_stem(scene) + "_" + m.column + ext);
     }
   }
+  for (std::string& f : reference_files(scenes)) files.push_back(std::move(f));
   return files;
 }
 
@@ -53,6 +61,7 @@ std::vector<std::string> plot_files(const std::vector<std::string>& scenes) {
       for (const char* ext : {".dat", ".gp"}) files.push_back(file_stem(scene) + "_" + m.column + ext);
     }
   }
+  for (std::string& f : reference_plot_files(scenes)) files.push_back(std::move(f));
   return files;
 }
 

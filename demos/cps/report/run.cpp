@@ -1,6 +1,7 @@
 #include "report/run.h"
 
 #include "options/options.h"
+#include "report/references.h"
 #include "report/timing.h"
 
 #include <algorithm>
@@ -83,7 +84,7 @@ const Reference& reference_of(const RunSpec& spec) {
   const std::lock_guard<std::mutex> lock(mutex);
   const auto it = cache.find(ref.id());
   if (it != cache.end()) return it->second;
-  const double t = ref.scene_def().report_trajectory_time_s();
+  const double t = trajectory_time_of(ref.scene_def());
   Reference r;
   r.positions = positions_at(ref, t);
   RunSpec half = ref;
@@ -261,7 +262,7 @@ MeasuredRun measure_errors(const RunSpec& spec) {
   const scenes::Scene& scene = spec.scene_def();
   const double horizon = scene.report_horizon_s();
   const bool has_trajectory = !scene.report.has_reference_solution;
-  const double t_traj = std::min(scene.report_trajectory_time_s(), horizon);
+  const double t_traj = trajectory_time_of(scene);
   scenes::Overrides o = spec.overrides();
   RunResult r = result_of(spec);
   r.dt_s = csv(std::get<double>(*o.find("dt")));

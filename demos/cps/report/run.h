@@ -42,11 +42,11 @@ struct MeasuredRun {
 
 /// The error run of `spec` (residuals measured) and its trajectory error: the RMS distance (m)
 /// of the movable bodies from a reference run (kReferenceIterations, kReferenceSubsteps) at the
-/// scene's Scene::report_trajectory_time_s(); reference_check_m (m) is the reference's distance
-/// from the same run at half its substeps, an estimate of its own error, and
-/// under_reference_error says whether the trajectory error is under it. A diverged run says why
-/// in diverged_why (state_fault's words, or the penetration or rod error past the largest
-/// movable body's size). The timing is set up to
+/// scene's trajectory_time_of (references.h: within the references' horizon); reference_check_m
+/// (m) is the reference's distance from the same run at half its substeps, an estimate of its own
+/// error, and under_reference_error says whether the trajectory error is under it. A diverged
+/// run says why in diverged_why (state_fault's words, or the penetration or rod error past the
+/// largest movable body's size). The timing is set up to
 /// the horizon, or to the time the run diverged (diverged_at_s): a diverged run is timed until
 /// then, what the method cost until it failed. The result has no sweep (RunResult::sweep, quick),
 /// which the caller adds. Throws UsageError for an unknown scene or a bad parameter.

@@ -58,6 +58,13 @@ struct StepSystem {
 /// Called after each solve of a step with the system it solved; see World::set_solve_observer.
 using SolveObserver = std::function<void(const StepSystem&)>;
 
+/// Called after each solve of a step, after the observer, with the system it solved (its
+/// lambda the engine's) and `lambda` holding a copy of the engine's lambda (c, N): what the
+/// function leaves in `lambda` is what the step goes on with, in place of the engine's. For
+/// replacing the engine's sweeps by another solve of the same system (an exact one,
+/// demos/analysis/exact_lcp.h); see World::set_solve_override.
+using SolveOverride = std::function<void(const StepSystem&, Eigen::VectorXd& lambda)>;
+
 /// The engine's own sweeps (engine/src/solver.cpp, solve_lcp: the same code the explicit path of
 /// every step runs) on a captured system: `sweeps` sweeps of projected Gauss-Seidel (Sec. 7.2) or
 /// projected Jacobi (Sec. 7.1), lambda_j = clamp((b_j - sum_{i != j} A_ji lambda_i) / A_jj, lo_j,

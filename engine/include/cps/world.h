@@ -125,6 +125,14 @@ class World {
   /// world. A copy of the world is not observed. Unobserved, a step does nothing more than test
   /// that the function is empty. No errors.
   void set_solve_observer(SolveObserver observer);
+  /// Hands each solve of the following steps to `override` after the engine's own sweeps (and
+  /// after the observer): the lambda it leaves is the one the step uses (its forces, the warm
+  /// start; the residual of measure_residual with the explicit assembly, while the matrix-free
+  /// path's stays that of its own sweeps), so that a step can be taken with another solve of the same system,
+  /// e.g. an exact one; an empty function stops it. Runs inside World::step and must not touch
+  /// the world; a copy of the world has none. Unset, a solve tests that the function is empty.
+  /// A lambda of another size than the system's rows throws std::invalid_argument from step().
+  void set_solve_override(SolveOverride override);
 
   /// Replaces the parameters (validated first: throws std::invalid_argument and keeps the old
   /// ones on a bad value). The bodies and constraints stay as they are.

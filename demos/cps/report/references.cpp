@@ -1,0 +1,246 @@
+#include "report/references.h"
+
+#include "criteria.h"
+#include "exact_lcp.h"
+#include "energy_rise.h"
+#include "options/options.h"
+#include "report/csv.h"
+#include "report/run.h"
+#include "report/timing.h"
+
+#include <algorithm>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+
+namespace cps::cli {
+namespace {
+
+// The size (m) of the largest movable body: a box's longest edge, a ball's diameter; 0 if none.
+double largest_size(const World& world) {
+  double size = 0.0;
+  for (const Body& b : world.bodies()) {
+    if (b.is_static()) continue;
+    size = std::max(size, b.shape.kind == ShapeKind::sphere ? 2.0 * b.shape.radius
+                                                            : 2.0 * b.shape.half_extents.maxCoeff());
+  }
+  return size;
+}
+
+// RMS distance (m) between the movable bodies of two worlds of the same scene.
+double rms_between(const World& a, const World& b) {
+  double sq = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.bodies().size() && i < b.bodies().size(); ++i) {
+    if (a.bodies()[i].is_static()) continue;
+    sq += (a.bodies()[i].x - b.bodies()[i].x).squaredNorm();
+    ++n;
+  }
+  return n ? std::sqrt(sq / static_cast<double>(n)) : 0.0;
+}
+
+bool reached(const World& world, double t) { return world.time() + 0.5 * world.def().dt >= t; }
+
+bool is_paper_scene(const scenes::Scene& scene) {
+  for (const scenes::Scene& s : scenes::paper_scenes()) {
+    if (s.name == scene.name) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<SolverErrorPoint> sample_solver_error(const RunSpec& spec, int samples, int& no_solve) {
+  const scenes::Scene& scene = spec.scene_def();
+  scenes::Run run = make_run_or_usage_error(scene, spec.overrides());
+  World& world = run.world;
+  const double horizon = scene.report_horizon_s();
+  const auto total = static_cast<std::int64_t>(std::llround(horizon / world.def().dt));
+  const std::int64_t every = std::max<std::int64_t>(1, total / std::max(1, samples));
+  std::vector<StepSystem> systems;
+  world.set_solve_observer([&](const StepSystem& s) {
+    if (s.step % every == every - 1) systems.push_back(s);
+  });
+  no_solve = 0;
+  std::int64_t sampled = 0;
+  while (!reached(world, horizon)) {
+    const std::size_t before = systems.size();
+    const bool sample = world.counters().steps % every == every - 1;
+    world.step();
+    if (sample) {
+      ++sampled;
+      if (systems.size() == before) ++no_solve;
+    }
+    if (!sane_state(world)) break;
+  }
+  world.set_solve_observer({});
+  std::vector<SolverErrorPoint> points;
+  for (const StepSystem& s : systems) {
+    SolverErrorPoint head;
+    head.step = s.step;
+    head.t_s = static_cast<double>(s.step) * s.dt;
+    head.solve = s.solve;
+    head.rows = static_cast<int>(s.rows());
+    analysis::ExactSolution exact;
+    try {
+      exact = analysis::solve_exact(s);
+    } catch (const std::exception& e) {
+      head.method = "exact";
+      head.refused = e.what();
+      points.push_back(head);
+      continue;
+    }
+    const auto add = [&](const char* method, int sweeps, const Eigen::VectorXd& lambda) {
+      const analysis::Criteria c = analysis::evaluate(s, exact, lambda);
+      SolverErrorPoint p = head;
+      p.method = method;
+      p.sweeps = sweeps;
+      p.relative = c.lambda_error_relative;
+      p.velocity_mps = c.velocity_error_mps;
+      p.residual_N = c.natural_map_N;
+      points.push_back(p);
+    };
+    add("exact", 0, exact.lambda);
+    for (const SolverKind method : {SolverKind::pgs, SolverKind::jacobi}) {
+      for (const int k : kSolverErrorSweepCounts) {
+        add(method == SolverKind::pgs ? "pgs" : "jacobi", k, solve_sweeps(s, method, k));
+      }
+    }
+  }
+  return points;
+}
+
+double agreement_horizon(const std::vector<double>& t_s, const std::vector<double>& distance_m,
+                         double tolerance_m) {
+  if (t_s.size() != distance_m.size()) {
+    throw std::invalid_argument("agreement_horizon: " + std::to_string(t_s.size()) + " times and " +
+                                std::to_string(distance_m.size()) + " distances");
+  }
+  for (std::size_t i = 0; i < t_s.size(); ++i) {
+    if (!(distance_m[i] <= tolerance_m)) return i == 0 ? 0.0 : t_s[i - 1];
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+ReferenceAgreement compare_references(const RunSpec& spec, double until_s, long max_solves) {
+  RunSpec ref = spec;
+  ref.solver = SolverKind::pgs;
+  ref.iterations = kReferenceIterations;
+  ref.substeps = kReferenceSubsteps;
+  ref.warm_start = 0.0;
+  const scenes::Scene& scene = ref.scene_def();
+  scenes::Run pgs = make_run_or_usage_error(scene, ref.overrides());
+  RunSpec exact_spec = ref;
+  exact_spec.iterations = 1;  // the engine's sweeps are replaced by the exact solve
+  scenes::Run exact = make_run_or_usage_error(scene, exact_spec.overrides());
+  ReferenceAgreement a;
+  a.tolerance_m = kAgreementFraction * largest_size(pgs.world);
+  std::string refused;
+  exact.world.set_solve_override([&](const StepSystem& s, Eigen::VectorXd& lambda) {
+    ++a.exact_solves;
+    if (!refused.empty()) return;
+    try {
+      lambda = analysis::solve_exact(s).lambda;
+    } catch (const std::exception& e) {
+      refused = "the exact solve refused step " + std::to_string(s.step) + " (t = " +
+                number(static_cast<double>(s.step) * s.dt) + " s): " + e.what();
+    }
+  });
+  std::vector<double> t_all;
+  std::vector<double> d_all;
+  const int frame = kReferenceSubsteps;  // steps per 1/60 s
+  while (!reached(pgs.world, until_s)) {
+    if (a.exact_solves >= max_solves) {
+      a.stopped = "the budget of " + std::to_string(max_solves) + " exact solves";
+      break;
+    }
+    pgs.world.step();
+    const double start = thread_cpu_seconds();
+    exact.world.step();
+    a.exact_cpu_s += thread_cpu_seconds() - start;
+    if (!refused.empty()) {
+      a.stopped = refused;
+      break;
+    }
+    if (!sane_state(pgs.world) || !sane_state(exact.world)) {
+      a.stopped = "a reference blew up at " + number(pgs.world.time()) + " s";
+      break;
+    }
+    const double d = rms_between(pgs.world, exact.world);
+    t_all.push_back(pgs.world.time());
+    d_all.push_back(d);
+    if (pgs.world.counters().steps % frame == 0 || reached(pgs.world, until_s)) {
+      a.t_s.push_back(pgs.world.time());
+      a.distance_m.push_back(d);
+    }
+  }
+  exact.world.set_solve_override({});
+  a.checked_until_s = pgs.world.time();
+  a.horizon_s = agreement_horizon(t_all, d_all, a.tolerance_m);
+  return a;
+}
+
+const ReferenceAgreement* scene_agreement(const scenes::Scene& scene) {
+  if (scene.report.has_reference_solution || !is_paper_scene(scene)) return nullptr;
+  static std::mutex mutex;
+  static std::map<std::string, ReferenceAgreement> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const std::string name(scene.name);
+  auto it = cache.find(name);
+  if (it == cache.end()) {
+    const double t = std::min(scene.report_trajectory_time_s(), scene.report_horizon_s());
+    it = cache.emplace(name, compare_references(RunSpec{name}, t, kAgreementSolves)).first;
+  }
+  return &it->second;
+}
+
+double trajectory_time_of(const scenes::Scene& scene) {
+  const double t = std::min(scene.report_trajectory_time_s(), scene.report_horizon_s());
+  const ReferenceAgreement* a = scene_agreement(scene);
+  if (a == nullptr || !(a->horizon_s < t)) return t;
+  const double frame = 1.0 / 60.0;
+  return std::max(1.0, std::floor(a->horizon_s / frame + 1e-9)) * frame;
+}
+
+std::vector<EnergyTrace> energy_traces(const std::string& scene_name, int max_points) {
+  std::vector<EnergyTrace> traces;
+  for (const Choice& push : parameter("push").choices) {
+    RunSpec spec{scene_name};
+    spec.push = static_cast<PushMode>(push.value);
+    const scenes::Scene& scene = spec.scene_def();
+    scenes::Run run = make_run_or_usage_error(scene, spec.overrides());
+    World& world = run.world;
+    const double horizon = scene.report_horizon_s();
+    const auto total = static_cast<std::int64_t>(std::llround(horizon / world.def().dt));
+    const std::int64_t every = std::max<std::int64_t>(1, (total + max_points - 2) / (max_points - 1));
+    EnergyTrace e;
+    e.push = std::string(push.name);
+    const auto record = [&] {
+      const scenes::MechanicalEnergy m = scenes::mechanical_energy(world);
+      e.t_s.push_back(world.time());
+      e.kinetic_J.push_back(m.kinetic_J);
+      e.potential_J.push_back(m.potential_J);
+      e.total_J.push_back(m.total_J());
+      e.penetration_m.push_back(scenes::deepest_contact(world));
+      e.rod_error_m.push_back(scenes::max_rod_error(world));
+    };
+    record();
+    while (!reached(world, horizon)) {
+      try {
+        world.step();
+      } catch (const std::exception&) {  // a blown-up state the step refuses (too many contacts)
+        e.diverged_at_s = world.time();
+        break;
+      }
+      if (!sane_state(world)) {
+        e.diverged_at_s = world.time();
+        break;
+      }
+      if (world.counters().steps % every == 0 || reached(world, horizon)) record();
+    }
+    traces.push_back(std::move(e));
+  }
+  return traces;
+}
+
+}  // namespace cps::cli

@@ -324,6 +324,7 @@ CONTROLS=(
   "export pendulum_grid --seconds 0.1 --fps 1e-5 --out out/p.glb"
   "simulate stack --seconds 1 --max-work 9000"  # exactly the run's work
   "simulate stack --seconds 0.1 --push soft --soft-substeps 1000 --iterations 10000"
+  "simulate stack --seconds 0.1 --push avbd --avbd-beta 0 --avbd-alpha 1 --avbd-gamma 0 --avbd-post-iterations 100"
   "report intersecting_stack --list-runs --out out --max-work 1e18"
   "report intersecting_stack --list-runs --out out --repeats 3"  # the ends of --repeats' range
   "report intersecting_stack --list-runs --out out --repeats 100"

@@ -28,7 +28,9 @@
 // Error correction (Eq. 18): C_j = C_j(q) - alpha C_j(q = 0). With post-stabilisation
 // (avbd_post_iterations > 0) the sweeps use alpha = 1 (the error at the start is kept), then
 // that many more sweeps with alpha = 0 remove it, after the velocities are set: they move the
-// positions only (as the demo, which does one). Between steps (Eq. 19): k = clamp(gamma k,
+// positions only (as the demo, which does one); in them only the penalties ramp (k_j += beta |C_j|
+// with the full error: not in the demo, which has no dual update there; without it a rod started
+// stretched keeps 99 % of its error after 0.5 s, as k stays near k_start). Between steps (Eq. 19): k = clamp(gamma k,
 // k_start, k_max), lambda = alpha gamma lambda (lambda kept in full with post-stabilisation); a
 // new contact starts at lambda = 0, k = k_start.
 //
@@ -99,6 +101,7 @@ struct BodyState {
   Vec3 dx = Vec3::Zero();     // m
   Vec3 theta = Vec3::Zero();  // rad
   Vec6 y = Vec6::Zero();      // inertial target of (dx, theta)
+  Vec6 guess = Vec6::Zero();  // initial guess of (dx, theta)
   Mat3 inertia = Mat3::Zero();  // world inertia at the start (kg m^2)
   Mat3 R = Mat3::Identity();  // current rotation
   double mass = 0.0;          // kg
@@ -137,7 +140,8 @@ class Avbd final : public PushMethod {
     ctx.lambda_second.clear();
     begin_bodies(def, bodies);
     begin_contacts(def, ctx.manifolds, bodies);
-    begin_rods(def, rods);
+    begin_rods(def, rods);  // C0 at the start poses
+    apply_guess();
     build_adjacency(rods);
 
     const int post = def.avbd_post_iterations;
@@ -147,7 +151,7 @@ class Avbd final : public PushMethod {
       for (std::size_t i = 0; i < state_.size(); ++i) {
         if (state_[i].movable) primal(static_cast<int>(i), alpha, def, rods);
       }
-      if (it < def.iterations) dual(alpha, def, rods);
+      dual(alpha, def, rods, /*stabilising=*/it >= def.iterations);
       if (it + 1 == def.iterations) set_velocities(bodies, dt);
       if (it >= def.iterations) apply_poses(bodies);
     }
@@ -181,8 +185,17 @@ class Avbd final : public PushMethod {
       if (g2 > 0.0) weight = std::clamp((v - v_prev_[i]).dot(def.gravity) / dt / g2, 0.0, 1.0);
       if (!std::isfinite(weight)) weight = 0.0;
       v_prev_[i] = v;
-      s.dx = v * dt + def.gravity * (weight * dt * dt);
-      s.theta = w * dt;
+      s.guess << v * dt + def.gravity * (weight * dt * dt), w * dt;
+    }
+  }
+
+  // Moves the bodies to the initial guess of begin_bodies (after the rods' C0 is taken at the
+  // start poses).
+  void apply_guess() {
+    for (BodyState& s : state_) {
+      if (!s.movable) continue;
+      s.dx = s.guess.head<3>();
+      s.theta = s.guess.tail<3>();
       s.R = (exp_map(s.theta) * s.o0).toRotationMatrix();
     }
   }
@@ -365,7 +378,11 @@ class Avbd final : public PushMethod {
     s.R = (exp_map(s.theta) * s.o0).toRotationMatrix();
   }
 
-  void dual(double alpha, const WorldDef& def, const std::vector<DistanceConstraint>& rods) {
+  // The dual update; while stabilising only the penalties ramp (lambda of the alpha = 0 sweeps
+  // would carry the correction into the next step's forces), so a start error that the
+  // stabilisation corrects stiffens its row for the next step.
+  void dual(double alpha, const WorldDef& def, const std::vector<DistanceConstraint>& rods,
+            bool stabilising) {
     const auto ramp = [&](double& k, double C) {
       k = std::min(k + def.avbd_beta * std::abs(C), def.avbd_k_max);
     };
@@ -374,16 +391,18 @@ class Avbd final : public PushMethod {
         const std::size_t ru = static_cast<std::size_t>(r);
         const auto [lo, hi] = limits(c, r, def.friction);
         const double C = contact_value(c, r, alpha);
-        c.lambda[ru] = std::clamp(c.k[ru] * C + c.lambda[ru], lo, hi);
-        if (c.lambda[ru] > lo && c.lambda[ru] < hi) ramp(c.k[ru], C);
+        const double lambda = std::clamp(c.k[ru] * C + c.lambda[ru], lo, hi);
+        if (lambda > lo && lambda < hi) ramp(c.k[ru], C);
+        if (!stabilising) c.lambda[ru] = lambda;
       }
+      if (stabilising) continue;
       const double cone = def.friction * std::abs(c.lambda[0]);
       const double tangential = std::hypot(c.lambda[1], c.lambda[2]);
       c.stick = tangential < cone && std::hypot(c.C0[1], c.C0[2]) < kStickDistance;
     }
     for (std::size_t i = 0; i < rods.size(); ++i) {
       const double C = rod_value(rods[i], nullptr, nullptr, nullptr) - alpha * rod_[i].C0;
-      rod_[i].lambda += rod_[i].k * C;
+      if (!stabilising) rod_[i].lambda += rod_[i].k * C;
       ramp(rod_[i].k, C);
     }
   }

@@ -342,6 +342,7 @@ CONTROLS=(
   "simulate stack --seconds 0.1 --push soft --soft-substeps 1000 --iterations 10000"
   "simulate stack --seconds 0.1 --push tgs --tgs-substeps 1000 --max-depenetration-speed 1e6"
   "simulate stack --seconds 0.1 --push xpbd --xpbd-substeps 1000 --xpbd-compliance 1e6 --solver jacobi"
+  "simulate stack --seconds 0.1 --push avbd --avbd-beta 0 --avbd-alpha 1 --avbd-gamma 0 --avbd-post-iterations 100"
   "report intersecting_stack --list-runs --out out --max-work 1e18"
   "report intersecting_stack --list-runs --out out --repeats 3"  # the ends of --repeats' range
   "report intersecting_stack --list-runs --out out --repeats 100"

@@ -35,6 +35,8 @@ enum class PushMode {
               ///< rows with the push of the current error, then a relax solve without it
   xpbd,       ///< extended position based dynamics for rigid bodies (engine/src/push/xpbd.cpp):
               ///< substeps of positional corrections with compliance, then a velocity pass
+  avbd,       ///< Augmented Vertex Block Descent (engine/src/push/avbd.cpp): a primal solve, 6 x 6
+              ///< per body, with augmented Lagrangian penalties (Giles et al. 2025)
 };
 
 /// The iteration used for A lambda = b.
@@ -143,6 +145,23 @@ struct WorldDef {
   /// XPBD only: the rods' compliance alpha (m/N, >= 0), the inverse of their stiffness; 0 (the
   /// default) is a rigid rod, as the source's joints; contacts are always rigid.
   double xpbd_compliance = 0.0;
+  /// AVBD (push avbd) only: the penalty ramp beta (N/m per m of error, >= 0): after each sweep a
+  /// row inside its force limits stiffens by beta |C|. The authors' 2D demo: 1e5.
+  double avbd_beta = 1.0e5;
+  /// AVBD only: alpha (dimensionless, [0, 1]): the rows see C(x) - alpha C(x0), so 1 - alpha of
+  /// the error at the start of a step is corrected in it. Demo: 0.99. Unused with
+  /// avbd_post_iterations > 0 (then 1 in the sweeps, 0 in the post-stabilisation).
+  double avbd_alpha = 0.99;
+  /// AVBD only: gamma (dimensionless, [0, 1]): the warm start of lambda (times alpha gamma) and of
+  /// the penalty (times gamma) from the last step. Demo: 0.99.
+  double avbd_gamma = 0.99;
+  /// AVBD only: the smallest penalty (N/m, > 0), a new row's. Demo (PENALTY_MIN): 1.
+  double avbd_k_start = 1.0;
+  /// AVBD only: the largest penalty (N/m, > 0). Demo (PENALTY_MAX): 1e9.
+  double avbd_k_max = 1.0e9;
+  /// AVBD only: post-stabilisation sweeps per step (count, [0, 100]) with alpha = 0 after the
+  /// velocities are set: they remove the error from the positions only. Demo: 1 (on).
+  int avbd_post_iterations = 1;
   bool collision = true;  ///< false: the bodies never collide and the collide stage is skipped
   /// true: after every solve, measure the LCP residual into World::residual(); it costs one pass
   /// over the rows per solve, so it is off unless a report asks for it.

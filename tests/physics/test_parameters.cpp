@@ -85,7 +85,7 @@ TEST_CASE("the engine validates a WorldDef against the table, naming the paramet
   def.gravity = Vec3(0.0, kInfinity, 0.0);
   CHECK_THROWS_WITH(World(def), Catch::Contains("gravity"));
   def = {};
-  def.push = static_cast<PushMode>(7);
+  def.push = static_cast<PushMode>(99);  // no such push method
   CHECK_THROWS_WITH(World(def), Catch::Contains("push"));
   // A bad value leaves the world's parameters as they were.
   World world;

@@ -340,6 +340,27 @@ void add_size(MergeSize& size, const fs::path& file, std::size_t file_count) {
 
 }  // namespace
 
+namespace {
+
+// True for a table of the report's reference sections (reference_report.h): its name ends in
+// _solver_error.csv, _references.csv or _energy.csv and its header does not start with 'scene'
+// (a run table of a scene so named still does, and is read).
+bool is_reference_section_csv(const fs::path& file) {
+  const std::string name = file.filename().string();
+  const auto ends_with = [&](const std::string& tail) {
+    return name.size() > tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  if (!ends_with("_solver_error.csv") && !ends_with("_references.csv") && !ends_with("_energy.csv")) {
+    return false;
+  }
+  std::ifstream in(file);
+  std::string header;
+  std::getline(in, header);
+  return header.rfind("scene", 0) != 0;
+}
+
+}  // namespace
+
 std::vector<RunResult> read_results(const std::vector<fs::path>& dirs) {
   // Every CSV once, with the folder it was found below.
   std::vector<std::pair<fs::path, fs::path>> sources;  // file, given folder
@@ -351,9 +372,11 @@ std::vector<RunResult> read_results(const std::vector<fs::path>& dirs) {
     }
     std::vector<fs::path> files;
     for (const auto& entry : fs::recursive_directory_iterator(dir)) {
-      // mass_ratio.csv (the report's mass ratio table) holds no runs.
+      // mass_ratio.csv (the report's mass ratio table) and the reference sections' tables
+      // (SCENE_solver_error.csv, SCENE_references.csv, SCENE_energy.csv, whose header does not
+      // start with 'scene') hold no runs.
       if (entry.is_regular_file() && entry.path().extension() == ".csv" &&
-          entry.path().filename() != "mass_ratio.csv") {
+          entry.path().filename() != "mass_ratio.csv" && !is_reference_section_csv(entry.path())) {
         files.push_back(entry.path());
       }
     }

@@ -141,7 +141,10 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     param:*)  # a world parameter: param:TYPE:MIN:MAX:EXCL:UNIT from the parameter table
       local type lo hi excl unit
       IFS=: read -r _ type lo hi excl unit <<< "$kind"
-      printf '%s\n' "$NUM_COMMON" -1
+      # NUM_COMMON's 1e12 and 4294967297 are in range for a parameter whose max reaches them
+      # (the avbd penalties): left out there.
+      printf '%s\n' "$NUM_COMMON" -1 | awk -v hi="$hi" '
+        !(($0 == "1e12" || $0 == "4294967297") && (hi == "inf" || $0 + 0 <= hi + 0))'
       # Just outside each end: below min (min itself when it is excluded), above max.
       awk -v lo="$lo" -v hi="$hi" -v excl="$excl" 'BEGIN {
         if (excl == 1) { print lo; print "-0"; print "1e-400" }

@@ -27,6 +27,9 @@ constexpr double kActiveTolerance = 1e-9;
 constexpr double kNullTolerance = 1e-10;
 // Coupled friction: at most this many polish rounds (each with the bounds of the last lambda).
 constexpr int kMaxFixedPoint = 20;
+// Sweeps of the projected Gauss-Seidel start used when Lemke stops (pgs_start): enough for the
+// active set of the paper's scenes (PGS converges in velocity there; docs/exact_reference.md).
+constexpr int kFallbackSweeps = 2000;
 
 // The bounds of a box problem, per row (N).
 struct Box {
@@ -308,6 +311,32 @@ std::vector<int> polish(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, cons
   return best_free;
 }
 
+// The start of the polish when Lemke stops without a solution (its pivot limit: a degenerate
+// problem, e.g. a stack's redundant corner rows, can make it cycle): kFallbackSweeps sweeps of
+// projected Gauss-Seidel (paper Sec. 7.2) on the box problem from 0, with `coupling` the
+// friction bounds +-mu x_n of the current contact rows. Its active set, not its lambda, is what
+// the polish needs; the residual check after the polish decides whether the result is exact.
+Eigen::VectorXd pgs_start(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Box& box,
+                          const std::vector<bool>& movable, const Coupling* coupling) {
+  const Eigen::Index c = b.size();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(c);
+  for (int sweep = 0; sweep < kFallbackSweeps; ++sweep) {
+    for (Eigen::Index j = 0; j < c; ++j) {
+      if (!movable[static_cast<std::size_t>(j)]) continue;
+      double lo = box.lo[j];
+      double hi = box.hi[j];
+      const int n = coupling != nullptr ? coupling->normal_row[static_cast<std::size_t>(j)] : -1;
+      if (n >= 0) {
+        hi = coupling->mu[j] * std::max(x[n], 0.0);
+        lo = -hi;
+      }
+      const double w = A.row(j).dot(x) - b[j];
+      x[j] = std::clamp(x[j] - w / A(j, j), lo, hi);
+    }
+  }
+  return x;
+}
+
 // The bounds of s's rows with coupled friction limits from `lambda`'s contact rows.
 Box coupled_box(const StepSystem& s, const Eigen::VectorXd& lambda) {
   Box box{s.c_min, s.c_max};
@@ -334,23 +363,14 @@ void check_sizes(const StepSystem& s) {
   }
 }
 
-}  // namespace
-
-ExactSolution solve_exact(const StepSystem& s) {
-  check_sizes(s);
-  const Eigen::MatrixXd A(s.A);
-  const std::vector<bool> movable = movable_rows(A);
-  ExactSolution out;
+// One attempt at s's exact solution: the polish (fixed friction), or the polish rounds with the
+// bounds of the last lambda (coupled), from `lambda`; sets lambda, free_rows, polish_rounds, w
+// and residual_max.
+void polish_solution(const StepSystem& s, const Eigen::MatrixXd& A, const std::vector<bool>& movable,
+                     ExactSolution& out) {
   if (s.friction == FrictionModel::fixed) {
-    const Box box{s.c_min, s.c_max};
-    out.lambda = solve_box(A, s.b, box, movable, nullptr);
-    out.free_rows = polish(A, s.b, box, movable, out.lambda);
-    out.method = "siconos lexicolemke + polish";
+    out.free_rows = polish(A, s.b, Box{s.c_min, s.c_max}, movable, out.lambda);
   } else {
-    // The coupled bounds are linear in lambda: one LCP (solve_box with the coupling), then the
-    // polish with the bounds of the current lambda, repeated while the bounds move.
-    const Coupling coupling{s.normal_row, s.mu};
-    out.lambda = solve_box(A, s.b, Box{s.c_min, s.c_max}, movable, &coupling);
     for (int k = 1; k <= kMaxFixedPoint; ++k) {
       const Box box = coupled_box(s, out.lambda);
       Eigen::VectorXd next = out.lambda;
@@ -360,20 +380,58 @@ ExactSolution solve_exact(const StepSystem& s) {
       out.polish_rounds = k;
       if (change <= 1e-13 * force_scale(A, s.b, out.lambda)) break;
     }
-    out.method = "siconos lexicolemke (coupled bounds) + polish";
   }
   out.w = A * out.lambda - s.b;
   const Eigen::VectorXd r = natural_map_residual(s, out.lambda);
   out.residual_max = r.size() > 0 ? r.maxCoeff() : 0.0;
-  const double scale = force_scale(A, s.b, out.lambda);
-  if (out.residual_max > 1e-9 * scale) {
-    std::ostringstream why;
-    why << "exact solve: the polished solution has a natural-map residual of " << out.residual_max
-        << " N, above 1e-9 of the force scale " << scale << " N";
-    throw std::runtime_error(why.str());
+}
+
+}  // namespace
+
+ExactSolution solve_exact(const StepSystem& s) {
+  check_sizes(s);
+  const Eigen::MatrixXd A(s.A);
+  const std::vector<bool> movable = movable_rows(A);
+  const bool coupled = s.friction != FrictionModel::fixed;
+  const Coupling coupling{s.normal_row, s.mu};
+  const Box box{s.c_min, s.c_max};
+  // The bounds are linear in lambda with coupled friction too: one LCP (solve_box with the
+  // coupling), then the polish with the bounds of the current lambda, repeated while they move.
+  ExactSolution out;
+  std::string lemke_failure;
+  try {
+    out.lambda = solve_box(A, s.b, box, movable, coupled ? &coupling : nullptr);
+    out.method = coupled ? "siconos lexicolemke (coupled bounds) + polish" : "siconos lexicolemke + polish";
+    polish_solution(s, A, movable, out);
+  } catch (const std::runtime_error& e) {  // Lemke's pivot limit or a ray
+    lemke_failure = e.what();
+  }
+  const auto passes = [&](const ExactSolution& x) {
+    return x.lambda.size() == s.rows() && x.residual_max <= 1e-9 * force_scale(A, s.b, x.lambda);
+  };
+  if (!passes(out)) {  // Lemke stopped, or its polished result is not exact: start from PGS
+    ExactSolution retry;
+    retry.lambda = pgs_start(A, s.b, box, movable, coupled ? &coupling : nullptr);
+    retry.method = coupled ? "pgs start (coupled bounds) + polish" : "pgs start + polish";
+    polish_solution(s, A, movable, retry);
+    if (!passes(retry)) {
+      std::ostringstream why;
+      why << "exact solve: ";
+      if (!lemke_failure.empty()) {
+        why << lemke_failure << "; ";
+      } else {
+        why << "Lemke's polished solution has a natural-map residual of " << out.residual_max
+            << " N; ";
+      }
+      why << "from " << kFallbackSweeps << " PGS sweeps the polished solution has "
+          << retry.residual_max << " N, both above 1e-9 of the force scale "
+          << force_scale(A, s.b, retry.lambda) << " N";
+      throw std::runtime_error(why.str());
+    }
+    out = std::move(retry);
   }
   // The solution set's free directions: the null space of A_FF (fixed friction).
-  if (s.friction == FrictionModel::fixed) {
+  if (!coupled) {
     out.null_basis = restricted_inverse(A, out.free_rows).null_basis;
   } else {
     out.null_basis.resize(static_cast<Eigen::Index>(out.free_rows.size()), 0);

@@ -18,6 +18,11 @@
 // end at a solution of a non-symmetric LCP: solve_exact throws when the result does not pass the
 // residual check (the funnel at rest, docs/exact_reference.md).
 //
+// Where Lemke stops (its pivot limit: degenerate problems such as a stack's redundant corner
+// rows can make it cycle; or a ray), the polish starts instead from 2000 sweeps of projected
+// Gauss-Seidel; either way the result counts as exact only if its natural-map residual is under
+// 1e-9 of the force scale, else solve_exact throws.
+//
 // A = J M^-1 J^T is only positive semi-definite: a box resting on four contact points, or a pile
 // of balls with more contact rows than degrees of freedom, has many lambda that solve the
 // problem (they differ by a null vector of A), while w = A lambda - b and the contact forces on
@@ -40,8 +45,10 @@ struct ExactSolution {
   Eigen::VectorXd lambda;
   /// c, m/s^2: w = A lambda - b, the same for every exact solution (fixed friction).
   Eigen::VectorXd w;
-  /// How it was found, for reports: "siconos lexicolemke + polish", or "siconos lexicolemke
-  /// (coupled bounds) + polish".
+  /// How it was found, for reports: "siconos lexicolemke + polish", "siconos lexicolemke
+  /// (coupled bounds) + polish", or, where Lemke stopped at its pivot limit or a ray, "pgs start
+  /// (lexicolemke stopped...) + polish" (the polish from 2000 PGS sweeps; exact all the same
+  /// when it passes the residual check).
   std::string method;
   /// Coupled friction: rounds of the polish, each with the bounds of the last lambda (0 for
   /// fixed friction).
@@ -66,9 +73,9 @@ struct ExactSolution {
 
 /// Solves s exactly (see the file comment). Throws std::invalid_argument for a system whose
 /// sizes disagree (or a coupled friction row whose contact row is not bounded [0, inf)),
-/// std::runtime_error naming Siconos' status when its Lemke solver fails (it does not on a
-/// positive semi-definite A with a feasible box), or when the polished solution's natural-map
-/// residual is above 1e-9 of the problem's force scale (max |lambda_j|, |b_j| / A_jj; N).
+/// std::runtime_error when the polished solution's natural-map residual is above 1e-9 of the
+/// problem's force scale (max |lambda_j|, |b_j| / A_jj; N), whether the polish started from
+/// Lemke's solution or, where Lemke stopped, from PGS sweeps.
 ExactSolution solve_exact(const StepSystem& s);
 
 }  // namespace cps::analysis

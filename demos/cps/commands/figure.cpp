@@ -259,7 +259,7 @@ const std::vector<PaperFigure>& paper_figures() {
        "the stack test: five cubes dropped 0.6 m apart land and stand; the paper's stack falls "
        "after about 85 s, so the last column is t = 85 s"},
       // The paper's two: the original push factor and the single frame push factor (a bare
-      // "push" now compares all five push methods of the engine).
+      // "push" compares every push method of the engine).
       {"fig7_intersecting_stack", "paper Fig. 7", "intersecting_stack", "push=baumgarte,split",
        {0.0, 0.5, 1.0},
        // The --camera fit framing of the original push factor's run over the figure's 1 s

@@ -179,8 +179,8 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                 "only, Jacobi for the paper's push methods only, and warm-started PGS (warm "
                 "start 0.8 and 1) at iterations 1, 4, 16, 25 with Baumgarte push; each run "
                 "timed by --repeats as in the full sweep (the paper's five "
-                "scenes: " + std::to_string(quick_runs) + " runs, measured 126 s with 5 "
-                "repeats on 2 cores shared with other jobs); with 'push': the stack over 60 s "
+                "scenes: " + std::to_string(quick_runs) + " runs; its time: docs/benchmarks.md); "
+                "with 'push': the stack over 60 s "
                 "and the pendulum wave over 10 s");
   CLI::Option* list = sub->add_flag("--list-runs", o->list,
                 "print one self-contained command per run, to spread the sweep over machines");

@@ -1,8 +1,10 @@
 #include "report/push/cases.h"
 
 #include "options/options.h"
+#include "report/csv.h"
 #include "report/mass_ratio.h"
 #include "report/run.h"
+#include "report/timing.h"
 #include "scene_file.h"
 
 #include <algorithm>
@@ -210,7 +212,63 @@ MetricsResult run_metrics(const scenes::Scene& scene, const Method& m, double se
   return r;
 }
 
+// The hard cases in push.md's order, each with its duration (s) in the full and the quick plan:
+// the heavy ones over their default (10 s), the long runs over their 10,000 steps or, quick,
+// kQuickLongRunSteps steps of their dt.
+std::vector<HardCase> hard_cases(bool quick) {
+  std::vector<HardCase> list;
+  for (const char* name : {"heavy_on_light", "heavy_rope"}) {
+    const scenes::Scene* s = scene_named(name);
+    list.push_back({s, s->default_seconds, true});
+  }
+  for (const char* name : {"stack_20_long", "pyramid_20_rows_long"}) {
+    const scenes::Scene* s = scene_named(name);
+    const double dt = s->world_def().dt;
+    list.push_back({s, quick ? kQuickLongRunSteps * dt : s->default_seconds, false});
+  }
+  return list;
+}
+
 }  // namespace
+
+bool HardResult::held_throughout() const {
+  if (diverged_at || !metrics.value("holds", false)) return false;
+  return metric(metrics, "survival_s") >= seconds - 0.5 * dt;
+}
+
+HardResult run_hard_case(const scenes::Scene& scene, const Method& m, double seconds,
+                         std::optional<double> k_start) {
+  scenes::Overrides o = with_push(m);
+  if (k_start) o.set("avbd_k_start", ParameterValue(*k_start));
+  scenes::Run run = make_run_or_usage_error(scene, o);
+  HardResult r;
+  r.scene = std::string(scene.name);
+  if (k_start) r.variant = "avbd_k_start=" + number(*k_start);
+  r.seconds = seconds;
+  r.dt = run.world.def().dt;
+  r.iterations = run.world.def().iterations;
+  r.has_rods = !run.world.distances().empty();
+  while (run.world.time() + 0.5 * r.dt < seconds) {
+    const double start = thread_cpu_seconds();
+    run.world.step();
+    r.step_cpu_s += thread_cpu_seconds() - start;
+    ++r.steps;
+    run.metrics->observe(run.world);
+    if (!sane_state(run.world)) {
+      r.diverged_at = run.world.time();
+      break;
+    }
+  }
+  r.metrics = run.metrics->report();
+  return r;
+}
+
+std::optional<Method> push_method_named(const std::string& name) {
+  for (const Method& m : push_methods()) {
+    if (m.name == name) return m;
+  }
+  return std::nullopt;
+}
 
 std::vector<Method> push_methods() {
   std::vector<Method> list;
@@ -237,6 +295,7 @@ PushPlan plan_push_report(bool quick) {
   p.stack_seconds = quick ? kQuickStackSeconds : kStackSeconds;
   p.grid_seconds = quick ? std::min(p.grid->default_seconds, kQuickPendulumSeconds) : p.grid->default_seconds;
   p.wave_seconds = quick ? std::min(p.wave->default_seconds, kQuickPendulumSeconds) : p.wave->default_seconds;
+  p.hard = hard_cases(quick);
   return p;
 }
 
@@ -261,7 +320,27 @@ MethodResults run_method(const PushPlan& plan, const Method& m, const std::funct
   tick();
   r.wave = run_metrics(*plan.wave, m, plan.wave_seconds);
   tick();
+  for (const HardCase& h : plan.hard) {
+    r.hard.push_back(run_hard_case(*h.scene, m, h.seconds));
+    tick();
+  }
+  if (m.name == kTunedMethod) {
+    for (const HardCase& h : plan.hard) {
+      if (!h.tuned_avbd) continue;
+      r.hard.push_back(run_hard_case(*h.scene, m, h.seconds, kTunedAvbdKStart));
+      tick();
+    }
+  }
   return r;
+}
+
+int push_case_count(const PushPlan& plan, const Method& m) {
+  int n = 7 + static_cast<int>(plan.hard.size());
+  if (m.name == kTunedMethod) {
+    n += static_cast<int>(std::count_if(plan.hard.begin(), plan.hard.end(),
+                                        [](const HardCase& h) { return h.tuned_avbd; }));
+  }
+  return n;
 }
 
 double metric(const nlohmann::json& metrics, const char* key) {

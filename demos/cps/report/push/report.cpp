@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iterator>
 #include <sstream>
@@ -25,11 +26,15 @@ constexpr double kSpeedFloor = 1e-4;    // m/s
 
 // The columns of push.csv, in order; each carries its unit as a suffix (_s, _m, _mps, _J,
 // _rel: a ratio, us_per_step: microseconds); push, case and the mass ratios have none.
+// variant: "" at the scene's settings, else the parameter set besides push (a tuned row);
+// iterations: the solver's sweeps per solve (a count).
 const std::vector<std::string> kColumns = {
-    "push", "case", "seconds_s", "dt_s", "diverged_at_s", "overlap_under_1mm_from_s",
-    "max_overlap_m", "peak_speed_mps", "energy_injected_J", "final_height_error_m",
-    "final_heights_m", "rest_heights_m", "max_drift_m", "slide_off_time_s", "mass_ratios_held",
-    "largest_mass_ratio_held", "max_rod_error_m", "max_rod_error_rel", "max_phase_error_deg",
+    "push", "case", "variant", "seconds_s", "dt_s", "iterations", "diverged_at_s",
+    "overlap_under_1mm_from_s", "max_overlap_m", "peak_speed_mps", "energy_injected_J",
+    "final_height_error_m", "final_heights_m", "rest_heights_m", "max_drift_m",
+    "slide_off_time_s", "mass_ratios_held", "largest_mass_ratio_held", "max_rod_error_m",
+    "max_rod_error_rel", "max_phase_error_deg", "arrival_s", "survival_s",
+    "final_displacement_m", "leave_distance_m", "max_penetration_m", "max_rod_stretch_m",
     "us_per_step", "timed_from_s", "timed_for_s"};
 
 // Cell texts for times that did not happen and ratios that did not hold.
@@ -46,7 +51,7 @@ std::string numbers(const std::vector<double>& values) {
 struct PushRow {
   std::vector<std::string> cells = std::vector<std::string>(kColumns.size());
 
-  PushRow(const std::string& push, const char* kase, double seconds, double dt,
+  PushRow(const std::string& push, const std::string& kase, double seconds, double dt,
           const std::optional<double>& diverged_at) {
     set("push", push);
     set("case", kase);
@@ -78,6 +83,40 @@ PushRow metrics_row(const Method& m, const char* kase, const MetricsResult& r) {
   return PushRow(m.name, kase, r.seconds, r.dt, r.diverged_at);
 }
 
+// The label of a hard case's row in push.md: the method's, and for a tuned row what was set.
+std::string hard_label(const Method& m, const HardResult& h) {
+  if (h.variant.empty()) return m.label;
+  return m.name + " with " + h.variant + " (tuned variant, not the scene's settings)";
+}
+
+// The us per step (CPU time of this thread in World::step) of a hard case.
+double hard_us_per_step(const HardResult& h) {
+  return h.steps ? 1e6 * h.step_cpu_s / static_cast<double>(h.steps) : std::nan("");
+}
+
+// True for a case whose bodies' masses differ (the heavy cases): only there is a mass ratio held.
+bool unequal_masses(const HardResult& h) { return metric(h.metrics, "mass_ratio") > 1.0; }
+
+// The row of a hard case (HardCaseMetrics' keys).
+PushRow hard_row(const Method& m, const HardResult& h) {
+  PushRow r(m.name, h.scene, h.seconds, h.dt, h.diverged_at);
+  r.set("variant", h.variant);
+  r.set("iterations", std::to_string(h.iterations));
+  const nlohmann::json& j = h.metrics;
+  r.set("arrival_s", j.contains("arrival_s") && j["arrival_s"].is_number() ? number(metric(j, "arrival_s")) : kNever);
+  r.set("survival_s", h.held_throughout() ? kNever : number(metric(j, "survival_s")));
+  r.set("final_displacement_m", number(metric(j, "final_displacement_m")));
+  r.set("leave_distance_m", number(metric(j, "leave_distance_m")));
+  r.set("max_penetration_m", number(metric(j, "max_penetration_m")));
+  r.set("energy_injected_J", number(metric(j, "energy_injected_J")));
+  if (h.has_rods) r.set("max_rod_stretch_m", number(metric(j, "max_rod_stretch_m")));
+  if (unequal_masses(h)) r.set("largest_mass_ratio_held", h.held_throughout() ? number(metric(j, "mass_ratio")) : kNone);
+  r.set("us_per_step", number(hard_us_per_step(h)));
+  r.set("timed_from_s", "0");
+  r.set("timed_for_s", number(static_cast<double>(h.steps) * h.dt));
+  return r;
+}
+
 // The rows of one method, in the order of its cases.
 std::vector<PushRow> rows_of(const PushPlan& plan, const MethodResults& r) {
   PushRow is = column_row(r.method, "intersecting_stack", r.intersecting);
@@ -100,15 +139,19 @@ std::vector<PushRow> rows_of(const PushPlan& plan, const MethodResults& r) {
   PushRow wave = metrics_row(r.method, "pendulum_wave", r.wave);
   wave.set("max_rod_error_rel", number(metric(r.wave.metrics, "max_rod_error_rel")));
   wave.set("max_phase_error_deg", number(metric(r.wave.metrics, "max_phase_error_deg")));
-  return {is, column_row(r.method, "sphere_in_box", r.sphere), stack, pair, grid, wave};
+  pair.set("iterations", std::to_string(kPairIterations));
+  std::vector<PushRow> rows = {is, column_row(r.method, "sphere_in_box", r.sphere), stack, pair, grid, wave};
+  for (const HardResult& h : r.hard) rows.push_back(hard_row(r.method, h));
+  return rows;
 }
 
-// A cell of push.md: push.csv's cell of the method's case, "-" where it is empty (does not
+// A cell of push.md: push.csv's cell of the method's case (and variant, "" at the scene's
+// settings), "-" where it is empty (does not
 // apply, not measured), and "diverged at T s" for the measures of a case that diverged.
 std::string md_cell(const CsvTable& csv, const std::string& push, const std::string& kase,
-                    const std::string& column) {
+                    const std::string& column, const std::string& variant = "") {
   for (std::size_t i = 0; i < csv.rows.size(); ++i) {
-    if (csv.cell(i, "push") != push || csv.cell(i, "case") != kase) continue;
+    if (csv.cell(i, "push") != push || csv.cell(i, "case") != kase || csv.cell(i, "variant") != variant) continue;
     const std::string& diverged = csv.cell(i, "diverged_at_s");
     if (!diverged.empty()) return "diverged at " + diverged + " s";
     const std::string& cell = csv.cell(i, column);
@@ -184,8 +227,248 @@ std::string legend(const PushPlan& p) {
   return md.str();
 }
 
-// push.md: the legend and one row per method (elapsed: the whole run's wall time, s).
-std::string push_markdown(const PushPlan& p, const CsvTable& csv, double elapsed) {
+// ---- The hard cases' sections of push.md ----
+
+// A number in a sentence: 3 significant digits (printf "%.3g").
+std::string brief(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", v);
+  return text;
+}
+
+// "a", "a and b", "a, b and c".
+std::string name_list(const std::vector<std::string>& names) {
+  std::string s;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    s += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
+  }
+  return s;
+}
+
+// One row of a hard case's section: the method, its result, and its label in push.md.
+struct HardRow {
+  const Method* method = nullptr;
+  const HardResult* result = nullptr;
+  std::string label;
+};
+
+// The rows of the case `scene`: every method at the scene's settings in the table's order, then
+// the tuned rows.
+std::vector<HardRow> hard_rows(const std::vector<MethodResults>& results, const std::string& scene) {
+  std::vector<HardRow> rows;
+  for (const bool tuned : {false, true}) {
+    for (const MethodResults& r : results) {
+      for (const HardResult& h : r.hard) {
+        if (h.scene == scene && h.variant.empty() != tuned) rows.push_back({&r.method, &h, hard_label(r.method, h)});
+      }
+    }
+  }
+  return rows;
+}
+
+// The name of a row in a sentence: the method's, and the variant of a tuned row.
+std::string row_name(const HardRow& r) {
+  return r.result->variant.empty() ? r.method->name : r.method->name + " (" + r.result->variant + ")";
+}
+
+// The row with the largest (or, `smallest`, the smallest) `key` among the rows that did not
+// diverge; nullptr if none.
+const HardRow* extreme(const std::vector<HardRow>& rows, const char* key, bool smallest) {
+  const HardRow* best = nullptr;
+  for (const HardRow& r : rows) {
+    if (r.result->diverged_at) continue;
+    const double v = metric(r.result->metrics, key);
+    if (std::isnan(v)) continue;
+    const double b = best ? metric(best->result->metrics, key) : 0.0;
+    if (!best || (smallest ? v < b : v > b)) best = &r;
+  }
+  return best;
+}
+
+// What a hard case's table shows, in sentences computed from its rows: which rows held for the
+// whole run, when the others left their places (or diverged), what the tuned avbd row changes,
+// the deepest contact, the rod stretch (with rods), the energy injected and the cost.
+std::string hard_findings(const HardCase& c, const std::vector<HardRow>& rows) {
+  const HardResult& any = *rows.front().result;
+  const double seconds = c.seconds;
+  std::vector<std::string> held, diverged;
+  std::vector<const HardRow*> left, never_arrived;
+  for (const HardRow& r : rows) {
+    const HardResult& h = *r.result;
+    if (h.diverged_at) {
+      diverged.push_back(row_name(r) + " at " + brief(*h.diverged_at) + " s");
+    } else if (h.held_throughout()) {
+      held.push_back(row_name(r));
+    } else if (!h.metrics.contains("arrival_s") || !h.metrics["arrival_s"].is_number()) {
+      never_arrived.push_back(&r);
+    } else {
+      left.push_back(&r);
+    }
+  }
+  std::ostringstream s;
+  s << "**What it shows** (from the numbers above): ";
+  if (held.empty()) {
+    s << "no row keeps every body within " << brief(metric(any.metrics, "leave_distance_m"))
+      << " m of its place for the whole " << brief(seconds) << " s at " << any.iterations
+      << " iterations";
+  } else {
+    s << name_list(held) << (held.size() == 1 ? " keeps" : " keep") << " every body within "
+      << brief(metric(any.metrics, "leave_distance_m")) << " m of its place for the whole "
+      << brief(seconds) << " s at " << any.iterations << " iterations";
+  }
+  if (!left.empty()) {
+    std::stable_sort(left.begin(), left.end(), [](const HardRow* a, const HardRow* b) {
+      return metric(a->result->metrics, "survival_s") < metric(b->result->metrics, "survival_s");
+    });
+    const HardRow &first = *left.front(), &last = *left.back();
+    const double t_first = metric(first.result->metrics, "survival_s");
+    if (left.size() > 1 && t_first == metric(last.result->metrics, "survival_s")) {
+      s << "; " << (left.size() == rows.size() ? "every row loses" : std::to_string(left.size()) + " rows lose")
+        << " it, all at " << brief(t_first) << " s";
+    } else if (left.size() == 1) {
+      s << "; " << row_name(first) << " loses it at " << brief(metric(first.result->metrics, "survival_s")) << " s";
+    } else {
+      s << "; " << left.size() << " rows lose it, first " << row_name(first) << " at "
+        << brief(metric(first.result->metrics, "survival_s")) << " s, last " << row_name(last)
+        << " at " << brief(metric(last.result->metrics, "survival_s")) << " s";
+    }
+  }
+  if (!never_arrived.empty()) {
+    std::vector<std::string> names;
+    for (const HardRow* r : never_arrived) names.push_back(row_name(*r));
+    s << "; under " << name_list(names) << " the bodies never reach their places";
+  }
+  if (!diverged.empty()) s << "; diverged: " << name_list(diverged);
+  s << ".";
+  // The tuned row against the same method at the scene's settings.
+  for (const HardRow& t : rows) {
+    if (t.result->variant.empty()) continue;
+    for (const HardRow& d : rows) {
+      if (d.method != t.method || !d.result->variant.empty()) continue;
+      const auto fate = [](const HardResult& h) {
+        if (h.diverged_at) return "diverges at " + brief(*h.diverged_at) + " s";
+        if (h.held_throughout()) return std::string("holds");
+        return "fails at " + brief(metric(h.metrics, "survival_s")) + " s";
+      };
+      s << " " << t.method->name << " at the scene's settings " << fate(*d.result) << "; with "
+        << t.result->variant << " it " << fate(*t.result) << ".";
+    }
+  }
+  if (const HardRow* deep = extreme(rows, "max_penetration_m", false)) {
+    const HardRow* shallow = extreme(rows, "max_penetration_m", true);
+    s << " Deepest contact: " << brief(metric(deep->result->metrics, "max_penetration_m")) << " m ("
+      << row_name(*deep) << "), the least " << brief(metric(shallow->result->metrics, "max_penetration_m"))
+      << " m (" << row_name(*shallow) << ").";
+  }
+  if (any.has_rods) {
+    if (const HardRow* most = extreme(rows, "max_rod_stretch_m", false)) {
+      const HardRow* least = extreme(rows, "max_rod_stretch_m", true);
+      s << " Rods stretch up to " << brief(metric(most->result->metrics, "max_rod_stretch_m"))
+        << " m (" << row_name(*most) << "), the least " << brief(metric(least->result->metrics, "max_rod_stretch_m"))
+        << " m (" << row_name(*least) << ").";
+    }
+  }
+  if (const HardRow* most = extreme(rows, "energy_injected_J", false)) {
+    const double e = metric(most->result->metrics, "energy_injected_J");
+    if (e > 0.0) {
+      s << " The most energy injected: " << brief(e) << " J (" << row_name(*most) << ").";
+    } else {
+      s << " No row that stayed finite raised the energy above its reference (0 J injected).";
+    }
+  }
+  const HardRow *cheap = nullptr, *dear = nullptr;
+  for (const HardRow& r : rows) {
+    const double us = hard_us_per_step(*r.result);
+    if (std::isnan(us)) continue;
+    if (!cheap || us < hard_us_per_step(*cheap->result)) cheap = &r;
+    if (!dear || us > hard_us_per_step(*dear->result)) dear = &r;
+  }
+  if (cheap) {
+    s << " A step costs " << brief(hard_us_per_step(*cheap->result)) << " us (" << row_name(*cheap)
+      << ") to " << brief(hard_us_per_step(*dear->result)) << " us (" << row_name(*dear) << ").";
+  }
+  return s.str();
+}
+
+// The legend of the hard cases' sections.
+std::string hard_legend(const PushPlan& p) {
+  std::ostringstream md;
+  md << "## The hard cases (issue 28)\n\n"
+     << "Stress scenes where convergence, not stability, decides, each run at its own settings "
+        "(the paper's: dt = 1/60 s, PGS at the scene's iterations) with only push changed, and "
+        "measured by its own metrics (HardCaseMetrics: `cps simulate NAME --json`). Each body has "
+        "a resting place (where it stands as built, or the column it lands in) and leaves it when "
+        "its centre is farther than the case's leave distance from it. A row \"";
+  md << kTunedMethod << " with avbd_k_start=" << number(kTunedAvbdKStart)
+     << "\" is a tuned variant, not the scene's settings: avbd's penalties start at "
+     << number(kTunedAvbdKStart) << " N/m instead of its default; the row above it is avbd as "
+        "every other method runs.";
+  bool quick_long = false;
+  for (const HardCase& c : p.hard) quick_long |= c.seconds < c.scene->default_seconds;
+  if (quick_long) {
+    md << " **--quick**: the 10,000-step cases run " << kQuickLongRunSteps << " steps ("
+       << number(kQuickLongRunSteps * p.hard.back().scene->world_def().dt) << " s); the full report runs all 10,000.";
+  }
+  md << "\n\n"
+     << "- **survival (s)**: the time a body first leaves its place after every body had arrived "
+        "(survival_s); **never**: no body left its place at any step, held to the end of the run; "
+        "0 with arrival \"never\": the bodies never arrived.\n"
+     << "- **arrival (s)**: the first time every body is within the leave distance of its place "
+        "(0 for a scene built at rest).\n"
+     << "- **final displacement (m)**: the largest distance of a body from its place at the end.\n"
+     << "- **max penetration (m)**: the deepest contact of any step.\n"
+     << "- **energy injected (J)**: the largest rise of KE + PE above the larger of the start's "
+        "and the resting places' energy; a collapse lowers E and can hide energy made at the "
+        "same time, so 0 means no rise, not that nothing was made.\n"
+     << "- **max rod stretch (m)**: the largest |distance - length| of any rod at any step "
+        "(scenes with rods).\n"
+     << "- **mass ratio held** (the cases of unequal masses): the scene's heaviest movable mass "
+        "over its lightest when the row held for the whole run (survival \"never\"), at the "
+        "iterations stated; \"none\" when it did not.\n"
+     << "- **us/step**: microseconds of CPU time of the stepping thread (CLOCK_THREAD_CPUTIME_ID) "
+        "in World::step alone, per step over the whole run: a measurement on this machine at the "
+        "time of the run.\n";
+  return md.str();
+}
+
+// The section of one hard case: what ran, the table (from push.csv) and what it shows.
+std::string hard_section(const HardCase& c, const CsvTable& csv, const std::vector<MethodResults>& results) {
+  const std::string scene(c.scene->name);
+  const std::vector<HardRow> rows = hard_rows(results, scene);
+  if (rows.empty()) return "";
+  const HardResult& any = *rows.front().result;
+  const bool heavy = unequal_masses(any);
+  std::ostringstream md;
+  md << "### " << scene << "\n\n"
+     << c.scene->summary << ". Run " << number(c.seconds) << " s ("
+     << static_cast<long long>(std::llround(c.seconds / any.dt)) << " steps of " << number(any.dt)
+     << " s" << (c.seconds < c.scene->default_seconds ? "; --quick, its default is " + number(c.scene->default_seconds) + " s" : "")
+     << ") at " << any.iterations << " iterations; leave distance "
+     << number(metric(any.metrics, "leave_distance_m")) << " m.\n\n"
+     << "| method | survival (s) | arrival (s) | final displacement (m) | max penetration (m) | "
+        "energy injected (J) | " << (any.has_rods ? "max rod stretch (m) | " : "")
+     << (heavy ? "mass ratio held | " : "") << "us/step |\n|---|---|---|---|---|---|"
+     << (any.has_rods ? "---|" : "") << (heavy ? "---|" : "") << "---|\n";
+  for (const HardRow& r : rows) {
+    const auto cell = [&](const char* column) {
+      return md_cell(csv, r.method->name, scene, column, r.result->variant);
+    };
+    md << "| " << r.label;
+    for (const char* column : {"survival_s", "arrival_s", "final_displacement_m", "max_penetration_m", "energy_injected_J"}) {
+      md << " | " << cell(column);
+    }
+    if (any.has_rods) md << " | " << cell("max_rod_stretch_m");
+    if (heavy) md << " | " << cell("largest_mass_ratio_held");
+    md << " | " << cell("us_per_step") << " |\n";
+  }
+  md << "\n" << hard_findings(c, rows) << "\n\n";
+  return md.str();
+}
+
+// push.md: the legend and one row per method, then a section per hard case (elapsed: the whole
+// run's wall time, s).
+std::string push_markdown(const PushPlan& p, const CsvTable& csv, const std::vector<MethodResults>& results,
+                          double elapsed) {
   std::ostringstream md;
   md << "# Push methods side by side\n\n"
      << "Made by `cps report push" << (p.quick ? " --quick" : "") << "` (" << p.methods.size()
@@ -215,6 +498,10 @@ std::string push_markdown(const PushPlan& p, const CsvTable& csv, double elapsed
   }
   md << "\n![largest overlap against time](push_overlap.png)\n\n"
      << "![largest body speed against time](push_speed.png)\n";
+  if (!p.hard.empty()) {
+    md << "\n" << hard_legend(p) << "\n";
+    for (const HardCase& c : p.hard) md << hard_section(c, csv, results);
+  }
   return md.str();
 }
 
@@ -296,11 +583,18 @@ void write_diagram(const fs::path& out, const std::string& stem, const std::stri
                 body, {"reset\n", "unset output\n", ""});
 }
 
+// The cases run_methods runs, over every method.
+long long case_count(const PushPlan& plan) {
+  long long n = 0;
+  for (const Method& m : plan.methods) n += push_case_count(plan, m);
+  return n;
+}
+
 // Runs every method of the plan, with progress on stderr.
 std::vector<MethodResults> run_methods(const PushPlan& plan) {
   std::vector<MethodResults> results;
   Progress progress(std::string("report push") + (plan.quick ? " --quick" : ""),
-                    static_cast<long long>(plan.methods.size()) * kPushCases, "cases");
+                    case_count(plan), "cases");
   long long done = 0;
   const auto tick = [&] { progress.update(++done); };
   for (const Method& m : plan.methods) results.push_back(run_method(plan, m, tick));
@@ -352,7 +646,7 @@ int run_push_report(const fs::path& out, bool quick, bool force, const nlohmann:
   begin_output(main, info);
   begin_output(plots, info);
   write_csv(out / "push.csv", csv);
-  write_text_atomic(out / "push.md", push_markdown(plan, csv, elapsed));
+  write_text_atomic(out / "push.md", push_markdown(plan, csv, results, elapsed));
   write_diagram(out, "push_overlap", data.text,
                 diagram_script(out / "plots" / "push_overlap.dat", plan.methods, 1,
                                "largest overlap against time (values under " +

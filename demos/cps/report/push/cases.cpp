@@ -8,13 +8,11 @@
 #include "scene_file.h"
 
 #include <algorithm>
-#include <chrono>
 #include <stdexcept>
 
 namespace cps::cli {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 
 const scenes::Scene* scene_named(const char* name) {
   const scenes::Scene* s = scenes::find_scene(name);
@@ -26,11 +24,6 @@ scenes::Overrides with_push(const Method& m) {
   scenes::Overrides o;
   o.set("push", ParameterValue(m.value));
   return o;
-}
-
-// Seconds (s) between two clock readings.
-double seconds_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
 }
 
 // Largest contact depth (m, >= 0) over the world's manifolds: those of its last step, made by
@@ -168,7 +161,7 @@ ColumnResult run_column(const scenes::Scene& scene, const Method& m, double seco
   return r;
 }
 
-// Microseconds per step (wall clock around World::step only) of `scene` with push `m` over its
+// Microseconds per step (CPU time of this thread around World::step only) of `scene` with push `m` over its
 // bench window (Scene::bench: the intersecting stack's first 0.1 s, from t = 0): one untimed
 // repeat, then the median of kCostRepeats repeats, each from the scene as built.
 double window_us_per_step(const scenes::Scene& scene, const Method& m) {
@@ -178,15 +171,15 @@ double window_us_per_step(const scenes::Scene& scene, const Method& m) {
     const double dt = run.world.def().dt;
     while (run.world.time() + 0.5 * dt < scene.bench.start_s) run.world.step();
     const double end = scene.bench.start_s + scene.bench.seconds;
-    double wall = 0.0;
+    double cpu = 0.0;
     int steps = 0;
     while (run.world.time() + 0.5 * dt < end) {
-      const auto a = Clock::now();
+      const double a = thread_cpu_seconds();
       run.world.step();
-      wall += seconds_between(a, Clock::now());
+      cpu += thread_cpu_seconds() - a;
       ++steps;
     }
-    if (rep > 0 && steps > 0) us.push_back(1e6 * wall / steps);
+    if (rep > 0 && steps > 0) us.push_back(1e6 * cpu / steps);
   }
   std::sort(us.begin(), us.end());
   return us.empty() ? std::nan("") : us[us.size() / 2];
@@ -198,9 +191,9 @@ MetricsResult run_metrics(const scenes::Scene& scene, const Method& m, double se
   r.dt = run.world.def().dt;
   r.seconds = seconds;
   while (run.world.time() + 0.5 * r.dt < seconds) {
-    const auto a = Clock::now();
+    const double a = thread_cpu_seconds();
     run.world.step();
-    r.step_wall_s += seconds_between(a, Clock::now());
+    r.step_cpu_s += thread_cpu_seconds() - a;
     ++r.steps;
     run.metrics->observe(run.world);
     if (!sane_state(run.world)) {

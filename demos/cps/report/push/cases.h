@@ -106,12 +106,12 @@ struct ColumnResult {
 };
 
 /// A scene run for its metrics (scene.h's Metrics::report) over `seconds` (s): the metrics, the
-/// time the state stopped being sane (if it did), and the wall clock (s) spent in World::step
-/// alone and the steps taken.
+/// time the state stopped being sane (if it did), and the CPU time of the stepping thread (s)
+/// spent in World::step alone and the steps taken.
 struct MetricsResult {
   nlohmann::json metrics;
   std::optional<double> diverged_at;  ///< s
-  double step_wall_s = 0.0;
+  double step_cpu_s = 0.0;  ///< CPU time of this thread in World::step alone (s)
   long long steps = 0;
   double dt = 0.0;   ///< the scene's time step (s)
   double seconds = 0.0;  ///< how long it was to run (s)

@@ -127,7 +127,7 @@ std::vector<PushRow> rows_of(const PushPlan& plan, const MethodResults& r) {
   stack.set("max_drift_m", number(metric(r.stack.metrics, "max_drift_m")));
   const double slide = metric(r.stack.metrics, "slide_off_time_s");
   stack.set("slide_off_time_s", std::isnan(slide) ? kNever : number(slide));
-  stack.set("us_per_step", number(r.stack.steps ? 1e6 * r.stack.step_wall_s / static_cast<double>(r.stack.steps)
+  stack.set("us_per_step", number(r.stack.steps ? 1e6 * r.stack.step_cpu_s / static_cast<double>(r.stack.steps)
                                                 : std::nan("")));
   stack.set("timed_from_s", "0");
   stack.set("timed_for_s", number(static_cast<double>(r.stack.steps) * r.stack.dt));
@@ -219,7 +219,7 @@ std::string legend(const PushPlan& p) {
              ? " (--quick; its default is " + number(wave.default_seconds) + " s)"
              : std::string(" (its default)"))
      << ".\n"
-     << "- **IS us/step**, **stack us/step**: microseconds per step, wall clock around "
+     << "- **IS us/step**, **stack us/step**: microseconds per step, CPU time of the stepping thread around "
         "World::step only (metrics and bookkeeping outside): IS over its first "
      << number(is.bench.seconds) << " s (the median of " << kCostRepeats
      << " runs after one untimed), the stack over its whole run. A measurement on this machine "

@@ -494,6 +494,11 @@ std::string panel_plot(const Panel& p, const Diagram& d, const fs::path& data, i
   block(p.labels_ss, "using 1:2:5 with labels font ',8' tc rgb '#c0399c'");
   block(p.labels_div, "using 1:2:5 with labels font ',8' tc rgb '#d62728'");
   block(p.labels_never, "using 1:2:5 with labels font ',8' tc rgb '#7f7f7f'");
+  if (parts.empty()) {  // no run of this panel has the measure (e.g. no LCP residual for xpbd)
+    gp << "set label 3 'no run here has this measure' at graph 0.5, graph 0.5 center font ',9' "
+          "tc rgb 'gray30'\nplot NaN notitle\nunset label 3\n";
+    return gp.str();
+  }
   gp << "plot ";
   for (std::size_t k = 0; k < parts.size(); ++k) gp << (k ? ", \\\n     " : "") << parts[k];
   gp << "\n";

@@ -184,8 +184,10 @@ void record_errors(const ErrorRun& e, RunResult& r) {
   if (e.diverged_at) r.diverged_at_s = csv(*e.diverged_at);
   if (e.diverged_at) r.diverged_why = e.diverged_why;
   const ResidualStats& res = world.residual();
-  r.residual_max_N = csv(res.max);
-  r.residual_rms_N = csv(res.rms());
+  if (res.rows > 0) {  // no rows: no solve of A lambda = b was made (xpbd, avbd), so no residual
+    r.residual_max_N = csv(res.max);
+    r.residual_rms_N = csv(res.rms());
+  }
   const auto rms = [](const Spread& s) {
     return std::sqrt(s.sum_sq / static_cast<double>(s.n ? s.n : 1));
   };

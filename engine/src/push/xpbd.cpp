@@ -135,6 +135,7 @@ class Xpbd final : public PushMethod {
       for (std::size_t i = 0; i < bodies.size(); ++i) {
         state_[i].x = bodies[i].x;
         state_[i].o = bodies[i].o;
+        state_[i].R = bodies[i].rotation();
       }
       ctx.integrate(ctx.f_ext, ctx.f_ext, h);
       for (std::size_t i = 0; i < bodies.size(); ++i) {
@@ -169,6 +170,7 @@ class Xpbd final : public PushMethod {
   struct Saved {
     Vec3 x = Vec3::Zero();
     Quat o = Quat::Identity();
+    Mat3 R = Mat3::Identity();  // o's rotation matrix
     Vec3 v = Vec3::Zero();
     Vec3 w = Vec3::Zero();
   };
@@ -361,8 +363,8 @@ class Xpbd final : public PushMethod {
       // normal correction; Jacobi the state of the sweep.
       const Vec3 qa = world_point(a, p.local_a);
       const Vec3 qb = world_point(b, p.local_b);
-      const Vec3 pa_prev = state_[ia].x + state_[ia].o.toRotationMatrix() * p.local_a;
-      const Vec3 pb_prev = state_[ib].x + state_[ib].o.toRotationMatrix() * p.local_b;
+      const Vec3 pa_prev = state_[ia].x + state_[ia].R * p.local_a;
+      const Vec3 pb_prev = state_[ib].x + state_[ib].R * p.local_b;
       const Vec3 dp = (qa - pa_prev) - (qb - pb_prev);
       const Vec3 dp_t = dp - p.normal.dot(dp) * p.normal;
       const double slip = dp_t.norm();

@@ -134,7 +134,16 @@ void World::collide() {
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     if (bodies_[i].shape.kind != ShapeKind::sphere) rotations_[i] = bodies_[i].rotation();
   }
-  broad_phase_->find_pairs(bodies_, rotations_, def_.contact_margin, kMaxCandidatePairs, pairs_);
+  // The push method may widen the speculative distance per body (push_method.h): the broad phase
+  // then grows every bound by the largest, so that it lists a superset of the pairs.
+  const bool per_body = push_->contact_margins(def_, bodies_, margins_);
+  double broad_margin = def_.contact_margin;
+  if (per_body) {
+    double widest = 0.0;
+    for (const double m : margins_) widest = std::max(widest, m);
+    broad_margin += 2.0 * widest;
+  }
+  broad_phase_->find_pairs(bodies_, rotations_, broad_margin, kMaxCandidatePairs, pairs_);
   // Room for the manifolds a world of this size usually has (a body touches a few others); a
   // crowded step grows it as it finds them, never to a worst case of one per pair.
   detail::reserve_with_headroom(manifolds, std::min(pairs_.size(), 8 * bodies_.size()));
@@ -147,8 +156,9 @@ void World::collide() {
     m.body_b = b;
     const auto ia = static_cast<std::size_t>(a);
     const auto ib = static_cast<std::size_t>(b);
-    if (cps::collide(bodies_[ia], rotations_[ia], bodies_[ib], rotations_[ib], m,
-                     def_.contact_margin) > 0) {
+    const double margin =
+        per_body ? def_.contact_margin + margins_[ia] + margins_[ib] : def_.contact_margin;
+    if (cps::collide(bodies_[ia], rotations_[ia], bodies_[ib], rotations_[ib], m, margin) > 0) {
       counters.contacts += m.count;
       points += static_cast<std::size_t>(m.count);
       if (points > kMaxContactPoints) {

@@ -83,7 +83,8 @@ struct WorldDef {
   /// Speculative contact distance (m) >= 0: features closer than this already get a contact row
   /// that lets them close the gap within a step and no further, so resting contacts do not
   /// break and re-form each step. 0 gives the paper's contacts, made only on overlap. Typical:
-  /// 1e-3 m for bodies of 0.5 to 3 m.
+  /// 1e-3 m for bodies of 0.5 to 3 m. Push xpbd adds its own distance per body on top of it
+  /// (engine/src/push/xpbd.cpp).
   double contact_margin = 0.0;
   /// Penetration slop (m) >= 0: the push of a contact row (Eq. 5.3.1, and the second solve's
   /// target of Sec. 8.1) corrects only the depth beyond it, beta max(d - slop, 0) / dt, so a

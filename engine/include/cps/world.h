@@ -158,6 +158,7 @@ class World {
   std::unique_ptr<BroadPhase> broad_phase_;
   std::vector<Mat3> rotations_;
   std::vector<std::pair<int, int>> pairs_;
+  std::vector<double> margins_;  // per body (m), when the push method asks for them
   std::vector<BodyVelocity> velocities_;
   std::vector<unsigned char> velocity_known_;
 };

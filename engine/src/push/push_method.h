@@ -29,6 +29,18 @@ class PushMethod {
     (void)params;
   }
 
+  /// The collide stage's speculative distance per body (Sec. 4; m, >= 0, finite): a pair (a, b)
+  /// is tested with margin def.contact_margin + margins[a] + margins[b]. Returns false (the
+  /// paper's methods) to test every pair with def.contact_margin alone; when it returns true,
+  /// `margins` holds one value per body. No errors.
+  virtual bool contact_margins(const WorldDef& def, const std::vector<Body>& bodies,
+                               std::vector<double>& margins) const {
+    (void)def;
+    (void)bodies;
+    (void)margins;
+    return false;
+  }
+
   /// The solve and integrate stages: solves with ctx's rows and prepared solver, leaves the
   /// step's lambda (and lambda_second, or clears it) in ctx, stores the warm start, and moves the
   /// bodies over ctx.def->dt. No errors.

@@ -1,22 +1,22 @@
 // Extended position based dynamics for rigid bodies: `--push xpbd`. Sources: M. Mueller, M.
 // Macklin, N. Chentanez, S. Jeschke, T.-Y. Kim, "Detailed Rigid Body Simulation with Extended
 // Position Based Dynamics" (SCA 2020; Algorithm 2 the step, Sec. 3.3 the positional correction,
-// Sec. 3.5 the contacts with static friction, Sec. 3.6 the velocity pass with dynamic friction
-// and restitution); M. Macklin, K. Storey, M. Lu, P. Terdiman, N. Chentanez, S. Jeschke, M.
-// Mueller, "Small Steps in Physics Simulation" (SCA 2019): many substeps of one iteration each;
-// M. Macklin, M. Mueller, N. Chentanez, T.-Y. Kim, "Unified Particle Physics for Real-Time
-// Applications" (SIGGRAPH 2014), pre-stabilisation (Sec. 4.4: the errors present at the start of
-// a step corrected on positions alone, so they add no velocity) and the Jacobi averaging (Sec.
-// 4.2).
+// Sec. 3.5 the contacts with static friction and the collection of pairs, Sec. 3.6 the velocity
+// pass with dynamic friction and restitution); M. Macklin, K. Storey, M. Lu, P. Terdiman, N.
+// Chentanez, S. Jeschke, M. Mueller, "Small Steps in Physics Simulation" (SCA 2019): many
+// substeps of one iteration each; M. Macklin, M. Mueller, N. Chentanez, T.-Y. Kim, "Unified
+// Particle Physics for Real-Time Applications" (SIGGRAPH 2014), pre-stabilisation (Sec. 4.4: the
+// errors present at the start of a step corrected on positions alone, so they add no velocity)
+// and the Jacobi averaging (Sec. 4.2).
 //
 // XPBD does not solve A lambda = b: it moves positions. One step of length dt is N =
 // xpbd_substeps substeps of h = dt / N; each, with x, o the bodies' positions and orientations
 // and v, w their velocities (m^-1 p, I^-1 l):
 //   1. x_prev = x, o_prev = o; the momenta take f_ext h and the bodies move over h with them
 //      (semi-implicit Euler, Eqs. 3.2.1-3.2.4: the paper's integration of Algorithm 2);
-//   2. one sweep over the contacts, then the rods (Sec. 3.3). A constraint C between points at
-//      offsets r_a, r_b from the centres of mass, along the unit axis k (the gradient of C at
-//      body b), with the generalised inverse masses
+//   2. one Gauss-Seidel sweep over the contacts in the collide stage's order, then the rods (Sec.
+//      3.3). A constraint C between points at offsets r_a, r_b from the centres of mass, along
+//      the unit axis k (the gradient of C at body b), with the generalised inverse masses
 //        w_i = m_i^-1 + (r_i x k)^T I_i^-1 (r_i x k)   (1/kg; 0 for a static body or the world)
 //      and the compliance alpha (m/N) as alpha~ = alpha / h^2, gets
 //        Delta lambda = (-C - alpha~ lambda) / (w_a + w_b + alpha~)   (kg m; lambda = 0 at the
@@ -26,8 +26,8 @@
 //        contact: its two witness points fixed in the bodies' frames (Contact::point is midway:
 //          p_a = point + n d/2, p_b = point - n d/2, as ngs.cpp), n its normal of the start of
 //          the step (a to b, kept in the world frame), C = n . (p_b - p_a) + allowed, acted on
-//          when C < 0 (rigid: alpha = 0, as the paper's contacts), with `allowed` the overlap the
-//          point had after the pre-stabilisation below (0 once pushed out);
+//          when C < 0 (rigid: alpha = 0, as the paper's contacts), `allowed` the slop (or the
+//          overlap the pre-stabilisation below left);
 //        static friction: the tangential part Delta p_t of the points' relative motion over the
 //          substep, (p_a - p_a,prev) - (p_b - p_b,prev) less its normal part, is undone (C =
 //          |Delta p_t|) if the impulse it takes is below mu lambda_n (mu: WorldDef::friction for
@@ -40,24 +40,30 @@
 //      one: dynamic friction applies the impulse -u_t / |u_t| min(mu lambda_n / h, |u_t| / w_t)
 //      (N s; the paper's velocity change min(h mu |f_n|, |u_t|), f_n = lambda_n / h^2, written
 //      as an impulse so that its units agree), and the normal velocity is set to
-//      max(-eps v~_n, 0), v~_n its value at the start of the substep (eps = WorldDef::restitution
-//      when -v~_n exceeds the restitution threshold, else 0; the paper uses 2 |g| h there), each as
-//      a velocity impulse (N s) Delta v / (w_a + w_b) along its direction.
+//      max(-eps v~_n, 0), v~_n its pre-solve value (after step 1; eps = WorldDef::restitution
+//      when -v~_n exceeds the restitution threshold, else 0; the paper uses 2 |g| h there), each
+//      as a velocity impulse (N s) Delta v / (w_a + w_b) along its direction.
+//
+// Contacts. As the paper's Sec. 3.5, the contacts are collected once per step and followed
+// through the substeps: their points stay fixed in the bodies' frames and each substep measures
+// C from the current poses. The paper finds them among pairs whose bounds it grows by k dt |v|
+// (k = 2); here the collide stage tests each pair with the speculative distance (m)
+//   margin_a + margin_b,  margin = k dt (|v| + |w| rho + |g| dt)   (0 for a static body)
+// (contact_margins; rho the body's farthest surface point from its centre, |g| dt the speed
+// gravity adds in a step; plus WorldDef::contact_margin), so that a contact that closes within
+// the step is there, as a speculative point (depth < 0), in the substep where it touches.
+// Without it a point is found only once it overlaps: a box resting at depth 0 keeps only the
+// corners that happen to overlap, rocks onto the others within the step, and every landing is
+// found a step late, up to v dt deep (docs/findings.md, "TGS and XPBD").
 //
 // Pre-stabilisation. The paper's contacts push an overlap out in full within a substep, so an
-// overlap found by the collision becomes a velocity of depth / h (0.4 m at h = 1/1200 s: 480
-// m/s). Instead, each contact's overlap at the start of the step is moved out on positions alone
-// (Unified Particle Physics' pre-stabilisation: no velocity follows, since x_prev is taken after
-// it), to the target depth max(depth - max_depenetration_speed dt, slop) (PhysX's depenetration
-// cap), by one Gauss-Seidel sweep at the start of every substep (so N sweeps a step; one sweep
-// over the corners of a face would leave the body turned); what is left after it is the
-// `allowed` overlap of the contact in that substep. New overlap made by the motion within the
-// step is corrected in full, as the paper does.
-//
-// Contacts come from the step's collision, once per step (as the paper's Sec. 3.5, which
-// collects them once per step and follows their points through the substeps); a contact that
-// starts within the step is found at the next step; with contact_margin > 0 the collision gives
-// the near ones as speculative contacts (depth < 0), which act once they touch.
+// overlap present at the start of the step would become a velocity of depth / h (0.4 m at h =
+// 1/1200 s: 480 m/s). Instead, once at the start of the step and on positions alone, every point
+// deeper than max(slop, depth - max_depenetration_speed dt) (PhysX's depenetration cap) is moved
+// out to that depth by N Gauss-Seidel sweeps, each followed by a sweep that holds the rods at
+// their lengths of the start of the step; such a point keeps, through the substeps, the overlap
+// it is then left with. The solver's own residual of the last step is pushed out at the same
+// time, and new overlap made within the step is corrected in full, as the paper does.
 //
 // Solvers: PGS is the paper's Gauss-Seidel sweep, each correction applied at once. Jacobi
 // computes every correction of a sweep (and of the velocity pass) from the same state and
@@ -79,6 +85,11 @@
 namespace cps {
 namespace {
 
+// Mueller et al.'s safety multiplier k of the collection bounds (Sec. 3.5: they grow a body's
+// bounds by k dt |v| "accounting for potential accelerations during the time step"; they use
+// k = 2). Dimensionless.
+constexpr double kMarginFactor = 2.0;
+
 // Turns o by the small rotation vector theta (rad): o += 1/2 [0, theta] o, normalised.
 void turn(Quat& o, const Vec3& theta) {
   const Quat spin(0.0, 0.5 * theta.x(), 0.5 * theta.y(), 0.5 * theta.z());
@@ -88,6 +99,26 @@ void turn(Quat& o, const Vec3& theta) {
 
 class Xpbd final : public PushMethod {
  public:
+  // The collection margin of each body (m): k dt (|v| + |w| rho + |g| dt), rho the distance from
+  // its centre to its farthest surface point; 0 for a static body.
+  bool contact_margins(const WorldDef& def, const std::vector<Body>& bodies,
+                       std::vector<double>& margins) const override {
+    margins.resize(bodies.size());
+    const double gravity_speed = def.gravity.norm() * def.dt;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      const Body& b = bodies[i];
+      if (b.is_static()) {
+        margins[i] = 0.0;
+        continue;
+      }
+      const double rho =
+          b.shape.kind == ShapeKind::box ? b.shape.half_extents.norm() : b.shape.radius;
+      const double reach = b.velocity().norm() + b.angular_velocity().norm() * rho + gravity_speed;
+      margins[i] = std::isfinite(reach) ? kMarginFactor * def.dt * reach : 0.0;
+    }
+    return true;
+  }
+
   void step(StepContext& ctx) override {
     const WorldDef& def = *ctx.def;
     std::vector<Body>& bodies = *ctx.bodies;
@@ -96,16 +127,21 @@ class Xpbd final : public PushMethod {
     jacobi_ = def.solver == SolverKind::jacobi;
     ctx.lambda_second.clear();
     detail::assign_with_headroom(ctx.lambda, ctx.rows.size(), 0.0);
-    capture(ctx.manifolds, bodies);
+    capture(ctx.manifolds, bodies, def);
     detail::resize_with_headroom(state_, bodies.size());
     detail::resize_with_headroom(delta_, bodies.size());
-    set_prestabilisation_targets(bodies, def);
+    prestabilise(bodies, *ctx.distances, def, substeps);
     for (int k = 0; k < substeps; ++k) {
-      prestabilise(bodies);
       for (std::size_t i = 0; i < bodies.size(); ++i) {
-        state_[i] = {bodies[i].x, bodies[i].o, bodies[i].velocity(), bodies[i].angular_velocity()};
+        state_[i].x = bodies[i].x;
+        state_[i].o = bodies[i].o;
+        state_[i].R = bodies[i].rotation();
       }
       ctx.integrate(ctx.f_ext, ctx.f_ext, h);
+      for (std::size_t i = 0; i < bodies.size(); ++i) {
+        state_[i].v = bodies[i].velocity();
+        state_[i].w = bodies[i].angular_velocity();
+      }
       solve_positions(bodies, *ctx.distances, def, h);
       update_velocities(bodies, h);
       solve_velocities(bodies, def, h);
@@ -121,17 +157,20 @@ class Xpbd final : public PushMethod {
     Vec3 local_a = Vec3::Zero();  // witness point on a, in a's frame (m)
     Vec3 local_b = Vec3::Zero();  // witness point on b, in b's frame (m)
     Vec3 normal = Vec3::UnitY();  // world direction from a to b
-    double target = 0.0;          // m: the depth the pre-stabilisation moves it out to
-    double allowed = 0.0;         // m: the overlap left after this substep's pre-stabilisation
-    // This substep's results: the normal and static friction positional impulses (kg m; the
-    // friction one along `tangent`), the velocity pass's impulses (N s).
+    double target = 0.0;   // m: the overlap the pre-stabilisation moves it out to
+    double allowed = 0.0;  // m: the overlap the substeps leave it (slop, or more: above)
+    // This substep's results: the normal positional impulse (kg m), the static friction one on b
+    // (kg m), the velocity pass's impulse on b (N s).
     double lambda_n = 0.0;
-    Vec3 friction = Vec3::Zero();  // static friction positional impulse on b (kg m)
-    Vec3 velocity_impulse = Vec3::Zero();  // the velocity pass's impulse on b (N s)
+    Vec3 friction = Vec3::Zero();
+    Vec3 velocity_impulse = Vec3::Zero();
   };
+  // A body at the start of the substep (x, o) and after the integration (v, w: the pre-solve
+  // velocities of the velocity pass).
   struct Saved {
     Vec3 x = Vec3::Zero();
     Quat o = Quat::Identity();
+    Mat3 R = Mat3::Identity();  // o's rotation matrix
     Vec3 v = Vec3::Zero();
     Vec3 w = Vec3::Zero();
   };
@@ -143,23 +182,36 @@ class Xpbd final : public PushMethod {
     int count = 0;
   };
 
-  // Records each contact point's witness points in its bodies' frames and its normal.
-  void capture(const std::vector<Manifold>& manifolds, const std::vector<Body>& bodies) {
+  // Records each contact point's witness points in its bodies' frames, its normal and its
+  // pre-stabilisation target (speculative points, depth < 0, get the slop and act once they
+  // touch).
+  void capture(const std::vector<Manifold>& manifolds, const std::vector<Body>& bodies,
+               const WorldDef& def) {
     points_.clear();
     detail::reserve_with_headroom(points_, contact_point_count(manifolds));
-    for_each_contact_point(manifolds, bodies, [this](const Manifold& m, const Contact& c,
-                                                     const Body& a, const Body& b,
-                                                     const Mat3& Ra_t, const Mat3& Rb_t) {
+    const double cap = def.max_depenetration_speed * def.dt;
+    for_each_contact_point(manifolds, bodies, [&](const Manifold& m, const Contact& c,
+                                                  const Body& a, const Body& b,
+                                                  const Mat3& Ra_t, const Mat3& Rb_t) {
       Point& p = points_.emplace_back();
       p.body_a = m.body_a;
       p.body_b = m.body_b;
       p.normal = c.normal;
       p.local_a = Ra_t * (c.point + 0.5 * c.depth * c.normal - a.x);
       p.local_b = Rb_t * (c.point - 0.5 * c.depth * c.normal - b.x);
+      p.target = std::max(c.depth - cap, def.penetration_slop);
+      p.allowed = def.penetration_slop;
     });
   }
 
   static Vec3 world_point(const Body& body, const Vec3& local) { return body.x + body.rotation() * local; }
+
+  // The overlap of point p now (m; < 0: apart).
+  static double overlap(const std::vector<Body>& bodies, const Point& p) {
+    const Body& a = bodies[static_cast<std::size_t>(p.body_a)];
+    const Body& b = bodies[static_cast<std::size_t>(p.body_b)];
+    return -p.normal.dot(world_point(b, p.local_b) - world_point(a, p.local_a));
+  }
 
   // Generalised inverse mass of `body` for a correction along unit k at offset r (1/kg).
   static double inverse_mass(const Body* body, const Vec3& r, const Vec3& k) {
@@ -168,8 +220,8 @@ class Xpbd final : public PushMethod {
     return body->inv_mass + rk.dot(body->inv_inertia_world() * rk);
   }
 
-  // Applies the positional impulse P (kg m) at offset r to `body` (sign: +1 for b, -1 for a), at
-  // once (Gauss-Seidel) or into its Jacobi delta.
+  // Applies the positional impulse P (kg m) at offset r to `body`, at once (Gauss-Seidel) or
+  // into its Jacobi delta.
   void move(Body* body, std::size_t index, const Vec3& r, const Vec3& P) {
     if (body == nullptr || body->is_static()) return;
     const Vec3 dx = body->inv_mass * P;
@@ -197,15 +249,11 @@ class Xpbd final : public PushMethod {
     }
   }
 
-  void clear_deltas() {
-    for (Delta& d : delta_) d = Delta{};
-  }
-
   // Jacobi: applies each body's averaged delta (positions, or momenta when `momenta`).
   void flush(std::vector<Body>& bodies, bool momenta) {
     if (!jacobi_) return;
     for (std::size_t i = 0; i < bodies.size(); ++i) {
-      const Delta& d = delta_[i];
+      Delta& d = delta_[i];
       if (d.count == 0) continue;
       const double share = 1.0 / static_cast<double>(d.count);
       if (momenta) {
@@ -215,8 +263,8 @@ class Xpbd final : public PushMethod {
         bodies[i].x += share * d.linear;
         turn(bodies[i].o, share * d.angular);
       }
+      d = Delta{};
     }
-    clear_deltas();
   }
 
   // One correction of C (m) along unit k between points pa on a and pb on b (either body may be
@@ -233,35 +281,64 @@ class Xpbd final : public PushMethod {
     return dlambda;
   }
 
-  // Pre-stabilisation: each contact's target depth, the overlap it had at the start of the step
-  // less max_depenetration_speed dt (never below the slop).
-  void set_prestabilisation_targets(const std::vector<Body>& bodies, const WorldDef& def) {
-    const double cap = def.max_depenetration_speed * def.dt;
-    for (Point& p : points_) {
-      const Body& a = bodies[static_cast<std::size_t>(p.body_a)];
-      const Body& b = bodies[static_cast<std::size_t>(p.body_b)];
-      const double overlap = -p.normal.dot(world_point(b, p.local_b) - world_point(a, p.local_a));
-      p.target = std::max(overlap - cap, def.penetration_slop);
-    }
-  }
-
-  // One pre-stabilisation sweep (positions alone, before x_prev is taken): each contact deeper
-  // than its target moved out to it; then each contact's allowed overlap in the substep.
-  void prestabilise(std::vector<Body>& bodies) {
-    for (const Point& p : points_) {
-      const auto ia = static_cast<std::size_t>(p.body_a);
-      const auto ib = static_cast<std::size_t>(p.body_b);
-      const Vec3 pa = world_point(bodies[ia], p.local_a);
-      const Vec3 pb = world_point(bodies[ib], p.local_b);
-      const double C = p.normal.dot(pb - pa) + p.target;
-      if (C < 0.0) correct(&bodies[ia], ia, &bodies[ib], ib, pa, pb, p.normal, C, 0.0);
+  // One sweep over the rods toward the lengths `lengths` (m, one per rod), or their own length
+  // when null, compliance alpha~; each rod's Delta lambda into `out` when given.
+  void sweep_rods(std::vector<Body>& bodies, const std::vector<DistanceConstraint>& distances,
+                  const std::vector<double>* lengths, double alpha_tilde,
+                  std::vector<double>* out) {
+    for (std::size_t r = 0; r < distances.size(); ++r) {
+      const DistanceConstraint& d = distances[r];
+      Vec3 pa;
+      Vec3 pb;
+      distance_endpoints(d, bodies, pa, pb);
+      const Vec3 ab = pb - pa;
+      const double length = ab.norm();
+      double dlambda = 0.0;
+      if (length > 1e-12) {  // else no axis
+        Body* a = &bodies[static_cast<std::size_t>(d.body_a)];
+        Body* b = d.body_b == kWorldBody ? nullptr : &bodies[static_cast<std::size_t>(d.body_b)];
+        const double goal = lengths != nullptr ? (*lengths)[r] : d.length;
+        dlambda = correct(a, static_cast<std::size_t>(d.body_a), b,
+                          b != nullptr ? static_cast<std::size_t>(d.body_b) : 0, pa, pb,
+                          ab / length, length - goal, alpha_tilde);
+      }
+      if (out != nullptr) (*out)[r] = dlambda;
     }
     flush(bodies, false);
-    for (Point& p : points_) {
-      const Body& a = bodies[static_cast<std::size_t>(p.body_a)];
-      const Body& b = bodies[static_cast<std::size_t>(p.body_b)];
-      p.allowed = std::max(-p.normal.dot(world_point(b, p.local_b) - world_point(a, p.local_a)), 0.0);
+  }
+
+  // Pre-stabilisation, once at the start of the step and on positions alone: `sweeps` Gauss-
+  // Seidel sweeps move every point deeper than its target out to it, each followed by a sweep
+  // that holds the rods at the lengths they had at the start of the step (so that what the
+  // contacts move does not become rod error, which the substeps would turn into velocity). Then
+  // every point may keep, through the substeps, the overlap it is left with (a point that the
+  // others pushed deeper too: the substeps would turn that into velocity).
+  void prestabilise(std::vector<Body>& bodies, const std::vector<DistanceConstraint>& distances,
+                    const WorldDef& def, int sweeps) {
+    if (std::none_of(points_.begin(), points_.end(),
+                     [&](const Point& p) { return overlap(bodies, p) > p.target; })) {
+      return;  // nothing to move (the usual case)
     }
+    detail::resize_with_headroom(rod_lengths_, distances.size());
+    for (std::size_t r = 0; r < distances.size(); ++r) {
+      Vec3 pa;
+      Vec3 pb;
+      distance_endpoints(distances[r], bodies, pa, pb);
+      rod_lengths_[r] = (pb - pa).norm();
+    }
+    for (int s = 0; s < sweeps; ++s) {
+      for (const Point& p : points_) {
+        const auto ia = static_cast<std::size_t>(p.body_a);
+        const auto ib = static_cast<std::size_t>(p.body_b);
+        const Vec3 pa = world_point(bodies[ia], p.local_a);
+        const Vec3 pb = world_point(bodies[ib], p.local_b);
+        const double C = p.normal.dot(pb - pa) + p.target;
+        if (C < 0.0) correct(&bodies[ia], ia, &bodies[ib], ib, pa, pb, p.normal, C, 0.0);
+      }
+      flush(bodies, false);
+      sweep_rods(bodies, distances, &rod_lengths_, 0.0, nullptr);
+    }
+    for (Point& p : points_) p.allowed = std::max(overlap(bodies, p), def.penetration_slop);
   }
 
   // Step 2: one sweep over the contacts (with static friction), then the rods.
@@ -286,39 +363,22 @@ class Xpbd final : public PushMethod {
       // normal correction; Jacobi the state of the sweep.
       const Vec3 qa = world_point(a, p.local_a);
       const Vec3 qb = world_point(b, p.local_b);
-      const Vec3 pa_prev = state_[ia].x + state_[ia].o.toRotationMatrix() * p.local_a;
-      const Vec3 pb_prev = state_[ib].x + state_[ib].o.toRotationMatrix() * p.local_b;
+      const Vec3 pa_prev = state_[ia].x + state_[ia].R * p.local_a;
+      const Vec3 pb_prev = state_[ib].x + state_[ib].R * p.local_b;
       const Vec3 dp = (qa - pa_prev) - (qb - pb_prev);
       const Vec3 dp_t = dp - p.normal.dot(dp) * p.normal;
       const double slip = dp_t.norm();
       if (!(slip > 0.0)) continue;
       const Vec3 t = dp_t / slip;  // a's motion relative to b
-      const double w = inverse_mass(a.is_static() ? nullptr : &a, qa - a.x, t) +
-                       inverse_mass(b.is_static() ? nullptr : &b, qb - b.x, t);
+      const double w = inverse_mass(&a, qa - a.x, t) + inverse_mass(&b, qb - b.x, t);
       if (!(w > 0.0) || !(slip / w < def.friction * p.lambda_n)) continue;
       // -C along t moves b by +slip/w t and a by -slip/w t: the relative motion cancelled.
       correct(&a, ia, &b, ib, qa, qb, t, -slip, 0.0);
       p.friction = (slip / w) * t;
     }
     flush(bodies, false);
-    const double alpha_tilde = def.xpbd_compliance / (h * h);
     detail::resize_with_headroom(rod_lambda_, distances.size());
-    for (std::size_t r = 0; r < distances.size(); ++r) {
-      const DistanceConstraint& d = distances[r];
-      Vec3 pa;
-      Vec3 pb;
-      distance_endpoints(d, bodies, pa, pb);
-      const Vec3 ab = pb - pa;
-      const double length = ab.norm();
-      rod_lambda_[r] = 0.0;
-      if (!(length > 1e-12)) continue;  // no axis
-      Body* a = &bodies[static_cast<std::size_t>(d.body_a)];
-      Body* b = d.body_b == kWorldBody ? nullptr : &bodies[static_cast<std::size_t>(d.body_b)];
-      rod_lambda_[r] = correct(a, static_cast<std::size_t>(d.body_a), b,
-                               b != nullptr ? static_cast<std::size_t>(d.body_b) : 0, pa, pb,
-                               ab / length, length - d.length, alpha_tilde);
-    }
-    flush(bodies, false);
+    sweep_rods(bodies, distances, nullptr, def.xpbd_compliance / (h * h), &rod_lambda_);
   }
 
   // Step 3: velocities from the change of position and orientation over the substep.
@@ -392,9 +452,10 @@ class Xpbd final : public PushMethod {
   }
 
   std::vector<Point> points_;
-  std::vector<Saved> state_;    // n: each body at the start of the substep
-  std::vector<Delta> delta_;    // n: Jacobi's pending changes
+  std::vector<Saved> state_;        // n: each body at the start of the substep
+  std::vector<Delta> delta_;        // n: Jacobi's pending changes
   std::vector<double> rod_lambda_;  // one per rod: this substep's Delta lambda (kg m)
+  std::vector<double> rod_lengths_; // one per rod: its length at the start of the step (m)
   bool jacobi_ = false;
 };
 

@@ -185,22 +185,29 @@ double window_us_per_step(const scenes::Scene& scene, const Method& m) {
   return us.empty() ? std::nan("") : us[us.size() / 2];
 }
 
+// Steps `run` to `seconds` (s), its metrics observing every step, and stops early where the
+// state stops being sane (sane_state); adds the CPU time of this thread in World::step (s) to
+// step_cpu_s and the steps to `steps`. Returns when it stopped being sane (s), if it did.
+std::optional<double> step_observed(scenes::Run& run, double seconds, double& step_cpu_s,
+                                    long long& steps) {
+  const double dt = run.world.def().dt;
+  while (run.world.time() + 0.5 * dt < seconds) {
+    const double start = thread_cpu_seconds();
+    run.world.step();
+    step_cpu_s += thread_cpu_seconds() - start;
+    ++steps;
+    run.metrics->observe(run.world);
+    if (!sane_state(run.world)) return run.world.time();
+  }
+  return std::nullopt;
+}
+
 MetricsResult run_metrics(const scenes::Scene& scene, const Method& m, double seconds) {
   scenes::Run run = make_run_or_usage_error(scene, with_push(m));
   MetricsResult r;
   r.dt = run.world.def().dt;
   r.seconds = seconds;
-  while (run.world.time() + 0.5 * r.dt < seconds) {
-    const double a = thread_cpu_seconds();
-    run.world.step();
-    r.step_cpu_s += thread_cpu_seconds() - a;
-    ++r.steps;
-    run.metrics->observe(run.world);
-    if (!sane_state(run.world)) {
-      r.diverged_at = run.world.time();
-      break;
-    }
-  }
+  r.diverged_at = step_observed(run, seconds, r.step_cpu_s, r.steps);
   r.metrics = run.metrics->report();
   return r;
 }
@@ -241,17 +248,7 @@ HardResult run_hard_case(const scenes::Scene& scene, const Method& m, double sec
   r.dt = run.world.def().dt;
   r.iterations = run.world.def().iterations;
   r.has_rods = !run.world.distances().empty();
-  while (run.world.time() + 0.5 * r.dt < seconds) {
-    const double start = thread_cpu_seconds();
-    run.world.step();
-    r.step_cpu_s += thread_cpu_seconds() - start;
-    ++r.steps;
-    run.metrics->observe(run.world);
-    if (!sane_state(run.world)) {
-      r.diverged_at = run.world.time();
-      break;
-    }
-  }
+  r.diverged_at = step_observed(run, seconds, r.step_cpu_s, r.steps);
   r.metrics = run.metrics->report();
   return r;
 }

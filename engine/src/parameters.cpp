@@ -680,6 +680,14 @@ const Parameter& parameter(std::string_view name) {
   throw std::invalid_argument("no world parameter is called '" + std::string(name) + "'");
 }
 
+PushReads push_reads(PushMode push) {
+  switch (push) {
+    case PushMode::xpbd: return {.solver = true, .friction_model = false, .warm_start = false};
+    case PushMode::avbd: return {.solver = false, .friction_model = false, .warm_start = false};
+    default: return {};
+  }
+}
+
 std::string_view name_of(PushMode v) { return parameter("push").choice_name(static_cast<int>(v)); }
 std::string_view name_of(SolverKind v) { return parameter("solver").choice_name(static_cast<int>(v)); }
 std::string_view name_of(FrictionModel v) {

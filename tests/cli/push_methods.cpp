@@ -10,6 +10,15 @@ std::vector<std::string> push_method_names() {
   return names;
 }
 
+std::vector<Reads> push_method_reads() {
+  std::vector<Reads> reads;
+  for (const cps::Choice& c : cps::parameter("push").choices) {
+    const cps::PushReads r = cps::push_reads(static_cast<cps::PushMode>(c.value));
+    reads.push_back({r.solver, r.friction_model, r.warm_start});
+  }
+  return reads;
+}
+
 int push_methods() { return static_cast<int>(cps::parameter("push").choices.size()); }
 
 int paper_push_methods() {

@@ -15,6 +15,14 @@ std::vector<std::string> push_method_names();
 /// How many push methods the table has.
 int push_methods();
 
+/// The settings of the solve each push method reads (cps::push_reads), in the table's order.
+struct Reads {
+  bool solver = true;
+  bool friction_model = true;
+  bool warm_start = true;
+};
+std::vector<Reads> push_method_reads();
+
 /// How many of them are the paper's: their source names a section of the paper ("Sec. 5.3",
 /// "Sec. 8.1"), as the report's is_paper_push decides.
 int paper_push_methods();

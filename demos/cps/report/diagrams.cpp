@@ -141,7 +141,9 @@ std::vector<PlotPoint> by_count(std::vector<std::pair<int, PlotPoint>> line) {
 Panel make_panel(const Measure& m, const std::vector<const RunResult*>& runs, Diagram& d, Extent& e) {
   Panel p;
   const RunResult& first = *runs.front();
-  p.title = first.solver + ", " + first.push + " push, " + first.friction_model + " friction";
+  const PushReads reads = first.reads();
+  p.title = (reads.solver ? first.solver + ", " : std::string()) + first.push + " push" +
+            (reads.friction_model ? ", " + first.friction_model + " friction" : std::string());
   std::vector<const RunResult*> sorted = runs;
   std::sort(sorted.begin(), sorted.end(), [](const RunResult* a, const RunResult* b) {
     return std::make_pair(a->substeps, a->iterations) < std::make_pair(b->substeps, b->iterations);

@@ -177,9 +177,12 @@ std::string own_dt_note(const std::string& scene, const RunResult& r) {
   return t == dt_text(r) ? std::string() : " (its own: " + t + ")";
 }
 
-// The settings of a run in one line: "jacobi, split, fixed, 25 it, 4 substeps, warm start 0.8".
+// The settings of a run in one line: "jacobi, split, fixed, 25 it, 4 substeps, warm start 0.8"
+// (the solver and the friction model only where its push reads them: "avbd, 25 it, 1 substep").
 std::string settings_text(const RunResult& r) {
-  return r.solver + ", " + r.push + ", " + r.friction_model + ", " + std::to_string(r.iterations) +
+  const PushReads reads = r.reads();
+  return (reads.solver ? r.solver + ", " : std::string()) + r.push + ", " +
+         (reads.friction_model ? r.friction_model + ", " : std::string()) + std::to_string(r.iterations) +
          " it, " + std::to_string(r.substeps) + (r.substeps == 1 ? " substep" : " substeps") +
          (r.warm_start != 0.0 ? ", warm start " + shortest_decimal(r.warm_start) : std::string());
 }

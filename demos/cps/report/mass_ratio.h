@@ -63,7 +63,8 @@ struct PairRow {
 };
 
 /// The mass ratio table: a row per ratio of kMassRatios, push method (every choice of the world
-/// parameter push, in the table's order) and solver (pgs, jacobi), in that order.
+/// parameter push, in the table's order) and solver (pgs, jacobi; pgs alone for a push that does
+/// not read the solver, push_reads), in that order.
 std::vector<PairRow> mass_ratio_study();
 
 /// The table as mass_ratio.csv: columns solver, push, iterations, mass_ratio, seconds (s), held

@@ -161,14 +161,18 @@ std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, 
     for (const FrictionModel f : frictions) {
       for (const Choice& c : parameter("push").choices) {
         const auto p = static_cast<PushMode>(c.value);
+        // A setting the push does not read would repeat its runs (see the declaration).
+        const PushReads reads = push_reads(p);
+        if (f != FrictionModel::fixed && !reads.friction_model) continue;
         for (const SolverKind s : {SolverKind::pgs, SolverKind::jacobi}) {
+          if (s != SolverKind::pgs && !reads.solver) continue;
           // The quick sweep runs Jacobi for the paper's push methods only (see the declaration).
           if (quick && s != SolverKind::pgs && !is_paper_push(c)) continue;
           for (const int it : iterations) runs.push_back({name, s, p, f, it, 1});
           for (const int ss : substeps) runs.push_back({name, s, p, f, kPaperIterations, ss});
         }
         // Warm starting, PGS only (see the declaration); the quick sweep at the paper's push.
-        if (quick && p != PushMode::baumgarte) continue;
+        if (!reads.warm_start || (quick && p != PushMode::baumgarte)) continue;
         for (const double w : kReportWarmStarts) {
           if (quick) {
             for (const int it : kQuickWarmIterations) runs.push_back({name, SolverKind::pgs, p, f, it, 1, w});

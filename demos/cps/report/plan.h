@@ -78,7 +78,9 @@ bool is_paper_push(const Choice& push);
 /// at 1 substep for each warm factor, every push method and the friction models as above (20
 /// runs per push and friction model). Quick: iterations 1, 4, 16, 25 at 1 substep for
 /// each warm factor, push baumgarte and fixed friction only (8 runs per scene; with the two
-/// paper methods, 24 + 8 = 32 runs per scene).
+/// paper methods, 24 + 8 = 32 runs per scene). A push method runs only the settings it reads
+/// (push_reads): avbd at PGS, fixed friction and no warm start alone; xpbd at fixed friction and
+/// no warm start alone; the others would repeat the same run under another name.
 std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, bool quick);
 
 /// The name a scene's files start with: scenes::output_name, never a scene file's path as typed

@@ -180,6 +180,11 @@ std::string RunResult::id() const {
 
 std::string RunResult::variant() const { return solver + " " + push + " " + friction_model; }
 
+PushReads RunResult::reads() const {
+  const Choice* c = parameter("push").find_choice(push);
+  return c != nullptr ? push_reads(static_cast<PushMode>(c->value)) : PushReads{};
+}
+
 bool RunResult::is_paper_setting() const {
   return solver == "pgs" && push == "baumgarte" && friction_model == "fixed" &&
          iterations == kPaperIterations && substeps == 1 && warm_start == 0.0;

@@ -81,6 +81,9 @@ struct RunResult {
   std::string id() const;
   /// "solver push friction_model", e.g. "pgs baumgarte fixed".
   std::string variant() const;
+  /// The settings its push reads (push_reads of `push`; all of them for a push this build does
+  /// not know, a merged CSV's): a label leaves the others out, as they change nothing.
+  PushReads reads() const;
   /// True at the paper's settings: PGS, Baumgarte push, fixed friction, kPaperIterations
   /// iterations, 1 substep, cold start.
   bool is_paper_setting() const;

@@ -39,6 +39,18 @@ enum class PushMode {
               ///< per body, with augmented Lagrangian penalties (Giles et al. 2025)
 };
 
+/// Which settings of the solve of A lambda = b a push method reads. Those it does not read
+/// change nothing in its runs, so a sweep or a comparison over them would repeat one run.
+/// Source: the top comment of each method's file in engine/src/push/.
+struct PushReads {
+  bool solver = true;          ///< --solver (pgs or jacobi); avbd solves per body, not A lambda = b
+  bool friction_model = true;  ///< --friction-model; xpbd and avbd bound friction by mu lambda_n
+  bool warm_start = true;      ///< --warm-start; xpbd starts each substep at 0, avbd uses gamma
+};
+
+/// The settings `push` reads (above). Throws nothing.
+PushReads push_reads(PushMode push);
+
 /// The iteration used for A lambda = b.
 enum class SolverKind {
   pgs,     ///< projected Gauss-Seidel: new values used at once (Sec. 7.2)

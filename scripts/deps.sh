@@ -24,6 +24,7 @@ cps_packages=(
   # numerics' Lemke solver.
   libsiconos-numerics-dev
   # FCLIB files of `cps export --fclib` (optional: without it the option says it was left out).
+  # fclib.h at build time; cps opens libfclib.so.0 (libfclib0, a dependency) only for --fclib.
   libfclib-dev
 )
 

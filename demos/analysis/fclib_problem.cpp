@@ -1,12 +1,17 @@
 // A captured solve as a local FCLIB problem (see fclib_problem.h).
 #include "fclib_problem.h"
 
-// fclib.h declares C functions without extern "C".
+// fclib.h declares C functions without extern "C". Only its types and declarations are used:
+// the functions are resolved in the library opened by load_fclib.
 extern "C" {
 #include <fclib.h>
 }
 
+#include <dlfcn.h>
+
 #include <climits>
+#include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -57,7 +62,47 @@ fclib_matrix view(Eigen::SparseMatrix<double>& m) {
   return f;
 }
 
+// FCLIB's functions cps calls, resolved in its library (load_fclib).
+struct FclibFunctions {
+  std::string library;
+  decltype(&fclib_write_local) write_local = nullptr;
+};
+
+FclibFunctions open_fclib() {
+  const char* env = std::getenv("CPS_FCLIB_LIBRARY");
+  const bool from_env = env != nullptr && *env != '\0';
+  FclibFunctions f;
+  f.library = from_env ? env : CPS_FCLIB_SONAME;
+  const std::string named = f.library + (from_env ? " (from CPS_FCLIB_LIBRARY)" : "");
+  const std::string install = "; cps export --fclib needs it: install Debian's libfclib0 "
+                              "(libfclib-dev to build cps with FCLIB)";
+  // Kept open to the end of the process (HDF5 holds global state).
+  void* handle = dlopen(f.library.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (handle == nullptr) {
+    const char* why = dlerror();
+    throw std::runtime_error("cannot open FCLIB's library " + named + ": " +
+                             (why != nullptr ? why : "dlopen failed") + install);
+  }
+  dlerror();
+  void* symbol = dlsym(handle, "fclib_write_local");
+  if (symbol == nullptr) {
+    throw std::runtime_error("FCLIB's library " + named + " has no fclib_write_local (not FCLIB 3?)" +
+                             install);
+  }
+  static_assert(sizeof f.write_local == sizeof symbol, "dlsym's pointer holds a function pointer");
+  std::memcpy(&f.write_local, &symbol, sizeof symbol);
+  return f;
+}
+
+const FclibFunctions& fclib_functions() {
+  // Initialised once, thread-safe; an exception leaves it for the next call to try again.
+  static const FclibFunctions functions = open_fclib();
+  return functions;
+}
+
 }  // namespace
+
+std::string load_fclib() { return fclib_functions().library; }
 
 FclibLocal fclib_local_problem(const StepSystem& s) {
   const Eigen::Index c = s.rows();
@@ -142,6 +187,7 @@ void write_fclib_local(const FclibLocal& p, const FclibText& text, const std::fi
   if (p.W.nonZeros() > INT_MAX || p.V.nonZeros() > INT_MAX || m > INT_MAX) {
     throw std::invalid_argument("write_fclib_local: more entries than FCLIB's int indices hold");
   }
+  const FclibFunctions& fclib = fclib_functions();
   std::error_code ec;
   if (std::filesystem::exists(std::filesystem::symlink_status(path, ec))) {
     throw std::invalid_argument("write_fclib_local: " + path.string() + " exists (fclib would add to it)");
@@ -168,7 +214,7 @@ void write_fclib_local(const FclibLocal& p, const FclibText& text, const std::fi
     problem.R = &R;
     problem.s = copy.s.data();
   }
-  if (fclib_write_local(&problem, path.c_str()) != 1) {
+  if (fclib.write_local(&problem, path.c_str()) != 1) {
     throw std::runtime_error("cannot write " + path.string() + ": fclib_write_local failed");
   }
 }

@@ -1,7 +1,9 @@
 #pragma once
 // A captured solve (cps/step_system.h) as a local frictional contact problem of FCLIB (Acary,
 // Brémond, Koziniec, Mons, Dubois, Renouf, "FCLIB: a collection of discrete 3D frictional
-// contact problems", JOTA 2014), written through Debian's libfclib (HDF5).
+// contact problems", JOTA 2014), written through Debian's libfclib (HDF5). cps is not linked
+// against libfclib: load_fclib opens it (dlopen) when a file is to be written, so that other
+// runs do not load it and its libraries (docs/benchmarks.md).
 //
 // FCLIB's local problem: find r and u (m entries each) and l (p entries) with
 //   u = W r + V l + q,   V^T r + R l + s = 0,   Coulomb's cone per contact (n, t1, t2 rows).
@@ -67,10 +69,19 @@ struct FclibText {
 /// The mapping of the file comment in a few lines, with units, for FclibText::math_info.
 std::string fclib_mapping_text();
 
+/// Opens FCLIB's shared library, once per process: the name in the environment variable
+/// CPS_FCLIB_LIBRARY if set and not empty, else the SONAME found when cps was configured
+/// (CMake's CPS_FCLIB_SONAME, e.g. libfclib.so.0, Debian's libfclib0), searched as dlopen(3)
+/// searches; then resolves the functions cps calls (fclib_write_local). Returns the name opened.
+/// Throws std::runtime_error naming the library and the Debian packages (libfclib0,
+/// libfclib-dev) when it cannot be opened or lacks a function; a later call tries again.
+std::string load_fclib();
+
 /// Writes p and its text as a new FCLIB file at `path` (fclib_write_local: the group
 /// /fclib_local; W, V, R in compressed columns). `path` must not exist (fclib would add to an
-/// HDF5 file already there). Throws std::invalid_argument when p's sizes disagree or exceed
-/// FCLIB's int indices, std::runtime_error naming the path when fclib reports a failure. FCLIB
+/// HDF5 file already there). Opens FCLIB first (load_fclib). Throws std::invalid_argument when
+/// p's sizes disagree or exceed FCLIB's int indices, std::runtime_error when FCLIB cannot be
+/// opened (load_fclib) or naming the path when fclib reports a failure. FCLIB
 /// ends the process (exit 1) on a failed HDF5 call within a write.
 void write_fclib_local(const FclibLocal& p, const FclibText& text, const std::filesystem::path& path);
 

@@ -380,3 +380,22 @@ TEST_CASE("export --fclib refuses bad input with exit 2 and writes nothing", "[f
   CHECK(local.p != nullptr);
   fs::remove_all(dir);
 }
+
+TEST_CASE("export --fclib without FCLIB's library fails naming it, and writes nothing", "[fclib]") {
+  // cps opens libfclib only for --fclib (dlopen); CPS_FCLIB_LIBRARY names one that is not there.
+  const fs::path dir = cli_test::fresh_dir("cps-test-fclib-nolib");
+  const std::string missing = "libcps-test-no-such-fclib.so.0";
+  const cli_test::Result r = run_cps("export stack --seconds 0.1 --at 1 --fclib out/s.hdf5", dir,
+                                     "CPS_FCLIB_LIBRARY=" + missing);
+  INFO(r.err);
+  CHECK(r.exit_code == 1);
+  CHECK(r.err.find(missing) != std::string::npos);
+  CHECK(r.err.find("libfclib0") != std::string::npos);
+  CHECK(r.err.find("nothing written") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "out"));
+  // Everything else works without it.
+  const cli_test::Result list = run_cps("list", dir, "CPS_FCLIB_LIBRARY=" + missing);
+  CHECK(list.exit_code == 0);
+  CHECK(list.out.find("stack") != std::string::npos);
+  fs::remove_all(dir);
+}

@@ -99,6 +99,13 @@ int run_fclib_export(const FclibExportOptions& o, int argc, char** argv) {
   throw UsageError("--fclib " + o.path + ": FCLIB was left out of this build (libfclib-dev was "
                    "not found when cps was configured; scripts/deps.sh installs it)");
 #else
+  // FCLIB's library is opened (dlopen) before the run and before any output: without it the
+  // export fails (exit 1) having written nothing.
+  try {
+    analysis::load_fclib();
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("--fclib " + o.path + ": " + e.what() + "; nothing written");
+  }
   const nlohmann::json parameters = parameters_json(run.world.def());
   const nlohmann::json info = run_info("export", argc, argv,
                                        {{"scene", scene->name},

@@ -31,7 +31,9 @@ struct FclibExportOptions {
 /// lists them in the folder's run.json (argc, argv). Returns 0. Throws UsageError (exit 2) for
 /// a bad option (a name not ending in .hdf5, a step outside the run, more than kMaxFclibSteps
 /// steps, a foreign file without --force, FCLIB left out of this build), std::runtime_error
-/// naming the step when a chosen step had no solve or no contact (nothing is then written).
+/// naming the step when a chosen step had no solve or no contact, or naming FCLIB's library
+/// when it cannot be opened (analysis::load_fclib; checked before the run). Nothing is then
+/// written.
 int run_fclib_export(const FclibExportOptions& o, int argc, char** argv);
 
 }  // namespace cps::cli

@@ -228,6 +228,8 @@ TEST_CASE("a bad --compare or --overlay exits 2 naming the problem and writes no
       {"render stack --compare beta=0.2,0.20", "same value"},
       {"render stack --compare beta=0.1,0.2 --beta 0.3", "--beta is given too"},
       {"render stack --compare push --push split", "--push is given too"},
+      {"render stack --compare solver --push avbd", "push avbd does not read --solver"},
+      {"figure stack --times 0 --compare friction-model --push xpbd", "does not read --friction-model"},
       {"render stack --overlay", "--overlay"},
       {"render stack --compare beta=0.1,0.2,0.3,0.4 --size 30x30", "16x16"},
       {"figure stack --times 0 --compare iterations=1,0", "--iterations 0"},

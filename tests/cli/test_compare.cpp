@@ -133,6 +133,17 @@ TEST_CASE("a bad compare spec is a usage error naming the parameter, the value a
   scenes::Overrides push;
   push.set("push", PushMode::split);
   CHECK(contains(usage_error("push", push), "--push is given too"));
+  // A setting the given push does not read (cps::push_reads): every variant the same run.
+  scenes::Overrides avbd;
+  avbd.set("push", PushMode::avbd);
+  CHECK(contains(usage_error("solver", avbd), "push avbd does not read --solver"));
+  CHECK(contains(usage_error("friction-model", avbd), "does not read --friction-model"));
+  CHECK(contains(usage_error("warm-start=0,0.8", avbd), "does not read --warm-start"));
+  scenes::Overrides xpbd;
+  xpbd.set("push", PushMode::xpbd);
+  CHECK(contains(usage_error("warm-start=0,0.8", xpbd), "push xpbd does not read --warm-start"));
+  CHECK_NOTHROW(parse_comparison("solver", xpbd));  // xpbd's Jacobi averages its corrections
+  CHECK_NOTHROW(parse_comparison("solver", push));  // split solves A lambda = b
 }
 
 TEST_CASE("compared variants are laid out so that panels stay large", "[compare]") {

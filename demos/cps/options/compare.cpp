@@ -70,6 +70,19 @@ Comparison parse_comparison(const std::string& spec, const scenes::Overrides& ba
     throw UsageError(what + "--" + name + " is given too; drop --" + name +
                      ": the comparison sets it for each variant");
   }
+  // A setting the given push does not read (push_reads) would draw the same run in every variant.
+  if (const ParameterValue* push = base.find("push"); push != nullptr && std::holds_alternative<int>(*push)) {
+    const auto mode = static_cast<PushMode>(std::get<int>(*push));
+    const PushReads reads = push_reads(mode);
+    const bool unread = (p->name == "solver" && !reads.solver) ||
+                        (p->name == "friction_model" && !reads.friction_model) ||
+                        (p->name == "warm_start" && !reads.warm_start);
+    if (unread) {
+      throw UsageError(what + "push " + std::string(name_of(mode)) + " does not read --" + name +
+                       ", so every variant would be the same run; compare another parameter, or " +
+                       "drop --push to compare it under the scene's push");
+    }
+  }
   std::vector<std::string> texts;
   if (eq == std::string::npos) {
     if (p->type != ParameterType::choice) {

@@ -52,7 +52,8 @@ std::string comparable_list();
 /// parameter, a value the table refuses (its message names the parameter, the value and the
 /// allowed range), an empty value, fewer than kMinVariants or more than kMaxVariants values,
 /// two values that are equal once parsed ("0.5" and "0.50"), "PARAM" alone for a parameter that
-/// is not a choice, or a parameter `base` also sets (its own option was given too).
+/// is not a choice, a parameter `base` also sets (its own option was given too), or solver,
+/// friction model or warm start where `base` sets a push that does not read it (push_reads).
 Comparison parse_comparison(const std::string& spec, const scenes::Overrides& base);
 
 /// The variants of a comparison, one per value in order, each `base` with the value set and

@@ -46,9 +46,10 @@ struct ExactSolution {
   /// c, m/s^2: w = A lambda - b, the same for every exact solution (fixed friction).
   Eigen::VectorXd w;
   /// How it was found, for reports: "siconos lexicolemke + polish", "siconos lexicolemke
-  /// (coupled bounds) + polish", or, where Lemke stopped at its pivot limit or a ray, "pgs start
-  /// (lexicolemke stopped...) + polish" (the polish from 2000 PGS sweeps; exact all the same
-  /// when it passes the residual check).
+  /// (coupled bounds) + polish", or, where Lemke stopped at its pivot limit or a ray or its
+  /// polished result missed the residual check, "pgs start + polish" ("pgs start (coupled
+  /// bounds) + polish"): the polish from 2000 PGS sweeps, exact all the same since it passed
+  /// the residual check.
   std::string method;
   /// Coupled friction: rounds of the polish, each with the bounds of the last lambda (0 for
   /// fixed friction).

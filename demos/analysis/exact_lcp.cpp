@@ -1,6 +1,8 @@
 // The exact solve of a captured step (see exact_lcp.h).
 #include "exact_lcp.h"
 
+#include "shared_library.h"
+
 #include <Eigen/Dense>
 
 #include <siconos/numerics/LCP_Solvers.h>
@@ -55,14 +57,49 @@ double force_scale(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eig
   return scale > 0.0 ? scale : 1.0;
 }
 
+// Siconos numerics' functions cps calls, resolved in its library when the first exact solve
+// needs them (load_siconos), not at start-up: the library brings BLAS and LAPACK, and Debian's
+// OpenBLAS starts a thread per core when it is loaded that spins about 0.1 s of CPU time
+// (docs/benchmarks.md), in every cps process, most of which never solve exactly.
+struct SiconosFunctions {
+  std::string library;
+  decltype(&NM_create_from_data) create_from_data = nullptr;
+  decltype(&NM_clear) clear = nullptr;
+  decltype(&solver_options_create) options_create = nullptr;
+  decltype(&solver_options_delete) options_delete = nullptr;
+  decltype(&lcp_lexicolemke) lexicolemke = nullptr;
+};
+
+SiconosFunctions open_siconos() {
+  const std::string what = "Siconos numerics' library";
+  const std::string hint = "; the exact solve needs it: install Debian's libsiconos-numerics7 "
+                           "(libsiconos-numerics-dev to build cps)";
+  const detail::SharedLibrary lib =
+      detail::open_shared_library("CPS_SICONOS_LIBRARY", CPS_SICONOS_SONAME, what, hint);
+  SiconosFunctions f;
+  f.library = lib.file;
+  detail::resolve_symbol(lib, "NM_create_from_data", what, hint, f.create_from_data);
+  detail::resolve_symbol(lib, "NM_clear", what, hint, f.clear);
+  detail::resolve_symbol(lib, "solver_options_create", what, hint, f.options_create);
+  detail::resolve_symbol(lib, "solver_options_delete", what, hint, f.options_delete);
+  detail::resolve_symbol(lib, "lcp_lexicolemke", what, hint, f.lexicolemke);
+  return f;
+}
+
+const SiconosFunctions& siconos() {
+  // Initialised once, thread-safe; an exception leaves it for the next call to try again.
+  static const SiconosFunctions functions = open_siconos();
+  return functions;
+}
+
 // Owns the Siconos objects of one LCP solve.
 struct SiconosLcp {
   LinearComplementarityProblem problem{};
   SolverOptions* options = nullptr;
   ~SiconosLcp() {
-    if (options != nullptr) solver_options_delete(options);
+    if (options != nullptr) siconos().options_delete(options);
     if (problem.M != nullptr) {
-      NM_clear(problem.M);  // frees the dense data (malloc'ed below)
+      siconos().clear(problem.M);  // frees the dense data (malloc'ed below)
       std::free(problem.M);
     }
   }
@@ -166,6 +203,7 @@ Eigen::VectorXd solve_box(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, co
   }
   const Eigen::VectorXd w0 = A * x0 - b;
   const Eigen::MatrixXd AP = A * P;
+  const SiconosFunctions& f = siconos();  // may throw: before data is allocated
   // Column-major dense M for Siconos (malloc'ed: NM_clear frees it).
   auto* data = static_cast<double*>(std::calloc(static_cast<std::size_t>(m * m), sizeof(double)));
   if (data == nullptr) throw std::bad_alloc();
@@ -186,14 +224,14 @@ Eigen::VectorXd solve_box(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, co
   }
   SiconosLcp lcp;
   lcp.problem.size = static_cast<int>(m);
-  lcp.problem.M = NM_create_from_data(NM_DENSE, static_cast<int>(m), static_cast<int>(m), data);
+  lcp.problem.M = f.create_from_data(NM_DENSE, static_cast<int>(m), static_cast<int>(m), data);
   lcp.problem.q = q.data();
-  lcp.options = solver_options_create(SICONOS_LCP_LEMKE);
+  lcp.options = f.options_create(SICONOS_LCP_LEMKE);
   lcp.options->iparam[SICONOS_IPARAM_MAX_ITER] = static_cast<int>(std::max<Eigen::Index>(10000, 50 * m));
   Eigen::VectorXd z = Eigen::VectorXd::Zero(m);
   Eigen::VectorXd wz = Eigen::VectorXd::Zero(m);
   int info = -1;
-  lcp_lexicolemke(&lcp.problem, z.data(), wz.data(), &info, lcp.options);
+  f.lexicolemke(&lcp.problem, z.data(), wz.data(), &info, lcp.options);
   if (info != 0) {
     throw std::runtime_error("exact solve: Siconos lcp_lexicolemke returned info " +
                              std::to_string(info) + " on an LCP of size " + std::to_string(m) +
@@ -390,6 +428,7 @@ void polish_solution(const StepSystem& s, const Eigen::MatrixXd& A, const std::v
 
 ExactSolution solve_exact(const StepSystem& s) {
   check_sizes(s);
+  siconos();  // opened here: a missing library is an error, not a Lemke failure to fall back from
   const Eigen::MatrixXd A(s.A);
   const std::vector<bool> movable = movable_rows(A);
   const bool coupled = s.friction != FrictionModel::fixed;

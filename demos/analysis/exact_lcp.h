@@ -76,7 +76,10 @@ struct ExactSolution {
 /// sizes disagree (or a coupled friction row whose contact row is not bounded [0, inf)),
 /// std::runtime_error when the polished solution's natural-map residual is above 1e-9 of the
 /// problem's force scale (max |lambda_j|, |b_j| / A_jj; N), whether the polish started from
-/// Lemke's solution or, where Lemke stopped, from PGS sweeps.
+/// Lemke's solution or, where Lemke stopped, from PGS sweeps, and std::runtime_error naming the
+/// library when Siconos numerics cannot be opened. Siconos is opened (dlopen) by the first solve
+/// that needs Lemke, not at start-up: CPS_SICONOS_LIBRARY if set and not empty, else the SONAME
+/// found when cps was configured (CMake's CPS_SICONOS_SONAME, e.g. libsiconos_numerics.so.7).
 ExactSolution solve_exact(const StepSystem& s);
 
 }  // namespace cps::analysis

@@ -1,17 +1,15 @@
 // A captured solve as a local FCLIB problem (see fclib_problem.h).
 #include "fclib_problem.h"
 
+#include "shared_library.h"
+
 // fclib.h declares C functions without extern "C". Only its types and declarations are used:
 // the functions are resolved in the library opened by load_fclib.
 extern "C" {
 #include <fclib.h>
 }
 
-#include <dlfcn.h>
-
 #include <climits>
-#include <cstdlib>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -69,28 +67,15 @@ struct FclibFunctions {
 };
 
 FclibFunctions open_fclib() {
-  const char* env = std::getenv("CPS_FCLIB_LIBRARY");
-  const bool from_env = env != nullptr && *env != '\0';
-  FclibFunctions f;
-  f.library = from_env ? env : CPS_FCLIB_SONAME;
-  const std::string named = f.library + (from_env ? " (from CPS_FCLIB_LIBRARY)" : "");
-  const std::string install = "; cps export --fclib needs it: install Debian's libfclib0 "
-                              "(libfclib-dev to build cps with FCLIB)";
+  const std::string what = "FCLIB's library";
+  const std::string hint = "; cps export --fclib needs it: install Debian's libfclib0 "
+                           "(libfclib-dev to build cps with FCLIB)";
   // Kept open to the end of the process (HDF5 holds global state).
-  void* handle = dlopen(f.library.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (handle == nullptr) {
-    const char* why = dlerror();
-    throw std::runtime_error("cannot open FCLIB's library " + named + ": " +
-                             (why != nullptr ? why : "dlopen failed") + install);
-  }
-  dlerror();
-  void* symbol = dlsym(handle, "fclib_write_local");
-  if (symbol == nullptr) {
-    throw std::runtime_error("FCLIB's library " + named + " has no fclib_write_local (not FCLIB 3?)" +
-                             install);
-  }
-  static_assert(sizeof f.write_local == sizeof symbol, "dlsym's pointer holds a function pointer");
-  std::memcpy(&f.write_local, &symbol, sizeof symbol);
+  const detail::SharedLibrary lib =
+      detail::open_shared_library("CPS_FCLIB_LIBRARY", CPS_FCLIB_SONAME, what, hint);
+  FclibFunctions f;
+  f.library = lib.file;
+  detail::resolve_symbol(lib, "fclib_write_local", what, hint, f.write_local);
   return f;
 }
 

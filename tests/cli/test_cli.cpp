@@ -809,3 +809,26 @@ TEST_CASE("cps report's mass ratio table says whether each stack held", "[cli][r
   CHECK(value(thousand, "heavy_height_m") == Approx(h).margin(0.05));
   fs::remove_all(dir);
 }
+
+TEST_CASE("the exact solve opens Siconos when it first runs: without the library --solver-error "
+          "fails naming it, and every other run works", "[cli][exact]") {
+  // cps is not linked against Siconos numerics (dlopen on the first exact solve);
+  // CPS_SICONOS_LIBRARY names one that is not there.
+  const fs::path dir = cli_test::fresh_dir("cps-test-siconos-nolib");
+  const std::string missing = "CPS_SICONOS_LIBRARY=libcps-test-no-such-siconos.so.7";
+  const std::string with_errors = "simulate stack --seconds 0.6 --at 30 --solver-error out/e.csv";
+  const Result r = run_cps(with_errors, dir, missing);
+  INFO(r.err);
+  CHECK(r.exit_code == 1);
+  CHECK(r.err.find("libcps-test-no-such-siconos.so.7") != std::string::npos);
+  CHECK(r.err.find("libsiconos-numerics7") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "out" / "e.csv"));
+  const Result plain = run_cps("simulate stack --seconds 0.6", dir, missing);
+  CHECK(plain.exit_code == 0);
+  // With the library found (the SONAME from configure time), the same run solves step 30 exactly.
+  const Result found = run_cps(with_errors, dir);
+  INFO(found.err);
+  CHECK(found.exit_code == 0);
+  CHECK(slurp(dir / "out" / "e.csv").find("\n30,") != std::string::npos);
+  fs::remove_all(dir);
+}

@@ -12,6 +12,33 @@ namespace {
 btVector3 to_bt(const Vec3& v) { return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z())); }
 Vec3 from_bt(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
 
+// btSequentialImpulseConstraintSolver unchanged, but counting the rows of each solve and the
+// iterations it ran (read after the solve from m_analyticsData, which Bullet sets when it
+// leaves its iteration loop).
+class CountingSolver final : public btSequentialImpulseConstraintSolver {
+ public:
+  Engine::Work work;
+
+ protected:
+  btScalar solveGroupCacheFriendlyIterations(btCollisionObject** bodies, int num_bodies,
+                                             btPersistentManifold** manifolds, int num_manifolds,
+                                             btTypedConstraint** constraints, int num_constraints,
+                                             const btContactSolverInfo& info,
+                                             btIDebugDraw* debug) override {
+    const int rows = m_tmpSolverContactConstraintPool.size() +
+                     m_tmpSolverContactFrictionConstraintPool.size() +
+                     m_tmpSolverContactRollingFrictionConstraintPool.size() +
+                     m_tmpSolverNonContactConstraintPool.size();
+    const int calls = m_analyticsData.m_numSolverCalls;
+    const btScalar residual = btSequentialImpulseConstraintSolver::solveGroupCacheFriendlyIterations(
+        bodies, num_bodies, manifolds, num_manifolds, constraints, num_constraints, info, debug);
+    const int iterations = m_analyticsData.m_numSolverCalls > calls ? m_analyticsData.m_numIterationsUsed : 0;
+    work.rows += rows;
+    work.row_updates += static_cast<double>(rows) * iterations;
+    return residual;
+  }
+};
+
 class BulletEngine final : public Engine {
  public:
   explicit BulletEngine(const World& cps) : dt_(cps.def().dt) {
@@ -87,6 +114,8 @@ class BulletEngine final : public Engine {
     return n;
   }
 
+  Work work() const override { return solver_.work; }
+
   std::vector<BodyState> states() const override {
     std::vector<BodyState> out;
     for (const auto& b : bodies_) {
@@ -109,7 +138,7 @@ class BulletEngine final : public Engine {
   btDefaultCollisionConfiguration config_;
   btCollisionDispatcher dispatcher_{&config_};
   btDbvtBroadphase broadphase_;
-  btSequentialImpulseConstraintSolver solver_;
+  CountingSolver solver_;
   btDiscreteDynamicsWorld world_{&dispatcher_, &broadphase_, &solver_, &config_};
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;

@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -45,9 +46,12 @@ double thread_cpu_seconds() {
 }
 
 /// us/step of `step` (dt in s): 1 s untimed (the same loop as World::time() < 1), then 5 timed
-/// blocks of `steps` by thread CPU time; the median block.
-double us_per_step(const std::function<void()>& step, double dt, int steps) {
+/// blocks of `steps` by thread CPU time; the median block. `mark`, when given, is called once
+/// between the untimed second and the first timed block.
+double us_per_step(const std::function<void()>& step, double dt, int steps,
+                   const std::function<void()>& mark = {}) {
   for (long k = 0; static_cast<double>(k) * dt < 1.0; ++k) step();
+  if (mark) mark();
   std::vector<double> blocks;
   for (int b = 0; b < 5; ++b) {
     const double start = thread_cpu_seconds();
@@ -234,7 +238,24 @@ struct Column {
   std::vector<double> us;
   Check check;
   int contacts = 0;  ///< contact points of the last step
+  Engine::Work work; ///< per step over the first repeat's timed steps: rows, row updates (count)
 };
+
+/// A's work over the timed steps (from `before`, taken at the mark, to `after`), per step.
+Engine::Work work_per_step(const Engine::Work& before, const Engine::Work& after, int steps) {
+  return {(after.rows - before.rows) / steps, (after.row_updates - before.row_updates) / steps};
+}
+
+/// cps's work a step between two StepCounters of one run: rows built a step, each swept
+/// `iterations` times by each of the step's solves (solves a step over the window: exact when
+/// every step of the window has rows, as in every scene here once its first second is over).
+Engine::Work cps_work_per_step(const StepCounters& before, const StepCounters& after, int iterations) {
+  const auto steps = static_cast<double>(after.steps - before.steps);
+  if (steps <= 0.0) return {};
+  const double rows = static_cast<double>(after.rows - before.rows) / steps;
+  const double solves = static_cast<double>(after.solves - before.solves) / steps;
+  return {rows, rows * solves * iterations};
+}
 
 int run(int argc, char** argv) {
   CLI::App app{"cps_engine_benchmark: us/step of the cps scenes and of the same scenes in Bullet and ODE "
@@ -286,21 +307,27 @@ int run(int argc, char** argv) {
               "|---|---|---|---|---|---|---|---|\n");
   std::string checks;
   std::string ratios;
+  std::string work;
   for (const std::string& name : names) {
     const scenes::Scene& scene = *scenes::find_scene(name);
     const scenes::Run built = scenes::make_run(scene);
     const World& initial = built.world;
     const double dt = initial.def().dt;
-    std::vector<Column> cols{{"Bullet", {}, {}}, {"ODE", {}, {}}, {"cps matrix-free", {}, {}},
-                             {"cps explicit", {}, {}}};
+    std::vector<Column> cols(4);
+    for (std::size_t e = 0; e < cols.size(); ++e) {
+      cols[e].label = std::array<const char*, 4>{"Bullet", "ODE", "cps matrix-free", "cps explicit"}[e];
+    }
     std::fprintf(stderr, "cps_engine_benchmark: %s\n", name.c_str());
     for (int r = 0; r < repeats; ++r) {
       for (int e = 0; e < 2; ++e) {
         std::unique_ptr<Engine> engine = e == 0 ? make_bullet(initial) : make_ode(initial);
-        cols[static_cast<std::size_t>(e)].us.push_back(us_per_step([&] { engine->step(); }, dt, steps));
+        Engine::Work before;
+        cols[static_cast<std::size_t>(e)].us.push_back(
+            us_per_step([&] { engine->step(); }, dt, steps, [&] { before = engine->work(); }));
         if (r == 0) {
           cols[static_cast<std::size_t>(e)].check = sanity(name, initial, engine->states());
           cols[static_cast<std::size_t>(e)].contacts = engine->contacts();
+          cols[static_cast<std::size_t>(e)].work = work_per_step(before, engine->work(), 5 * steps);
         }
       }
       // cps: exactly as bench.cpp's us_per_step (make_run, assembly set on the def, world.step()).
@@ -309,8 +336,12 @@ int run(int argc, char** argv) {
         WorldDef def = run.world.def();
         def.assembly = e == 0 ? Assembly::matrix_free : Assembly::explicit_matrices;
         run.world.set_def(def);
-        cols[static_cast<std::size_t>(2 + e)].us.push_back(us_per_step([&] { run.world.step(); }, dt, steps));
+        StepCounters before;
+        cols[static_cast<std::size_t>(2 + e)].us.push_back(
+            us_per_step([&] { run.world.step(); }, dt, steps, [&] { before = run.world.counters(); }));
         if (r == 0) {
+          cols[static_cast<std::size_t>(2 + e)].work =
+              cps_work_per_step(before, run.world.counters(), run.world.def().iterations);
           cols[static_cast<std::size_t>(2 + e)].check = sanity(name, initial, cps_states(run.world));
           int n = 0;
           for (const Manifold& m : run.world.manifolds()) n += m.count;
@@ -337,6 +368,17 @@ int run(int argc, char** argv) {
       ratios += cell;
     }
     ratios += "\n";
+    // Work a step (first repeat) and the step's time over its row updates (median us/step).
+    char w[512];
+    const auto per_update = [](const Column& c) {
+      return c.work.row_updates > 0.0 ? 1e3 * median(c.us) / c.work.row_updates : 0.0;
+    };
+    std::snprintf(w, sizeof w, "| %s | %.1f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
+                  name.c_str(), cols[0].work.rows, cols[0].work.rows > 0 ? cols[0].work.row_updates / cols[0].work.rows : 0.0,
+                  cols[1].work.rows, cols[2].work.rows, cols[0].work.row_updates / std::max(1.0, cols[2].work.row_updates),
+                  cols[1].work.row_updates / std::max(1.0, cols[2].work.row_updates),
+                  per_update(cols[0]), per_update(cols[1]), per_update(cols[2]));
+    work += w;
     const double end_time = std::ceil(1.0 / dt - 1e-9) * dt + 3.0 * steps * dt;
     for (const Column& c : cols) {
       char line[512];
@@ -348,6 +390,14 @@ int run(int argc, char** argv) {
   std::printf("\n## Time over cps matrix-free's in the same repeat, median over the repeats\n\n"
               "| scene | Bullet | ODE | cps explicit |\n|---|---|---|---|\n%s",
               ratios.c_str());
+  std::printf("\n## Solver work a step, and the step's time per row update\n\n"
+              "Rows handed to each solver a step and row updates a step (rows times the sweeps run), mean over the "
+              "first repeat's timed steps; Bullet stops sweeping when its residual reaches 0 (its split-impulse "
+              "passes are not counted). ns per row update: the median us/step above (the whole step, collision "
+              "included) over the row updates a step.\n\n"
+              "| scene | Bullet rows | Bullet sweeps | ODE rows | cps rows | Bullet updates / cps | ODE updates / cps "
+              "| Bullet ns per update | ODE ns per update | cps ns per update |\n|---|---|---|---|---|---|---|---|---|---|\n%s",
+              work.c_str());
   std::printf("\n## Sanity at the end of the first repeat's last timed block\n\n"
               "| scene | engine | state | contact points (last step) | check |\n|---|---|---|---|---|\n%s",
               checks.c_str());

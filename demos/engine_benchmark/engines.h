@@ -31,6 +31,17 @@ class Engine {
   /// Contact points the last step used (Bullet: points in the dispatcher's persistent
   /// manifolds; ODE: contact joints made).
   virtual int contacts() const = 0;
+  /// Solver work summed over every step so far: rows handed to the solver (count) and row
+  /// updates (count: each row times the sweeps its solve ran). Bullet: its contact, friction and
+  /// joint rows, times the iterations it ran (it stops early when its residual reaches 0;
+  /// btSolverAnalyticsData); its split-impulse passes are not counted. ODE: 3 rows a contact
+  /// joint with friction (1 without), 1 a DBall joint, times the iterations (quickstep runs them
+  /// all).
+  struct Work {
+    double rows = 0.0;
+    double row_updates = 0.0;
+  };
+  virtual Work work() const = 0;
 };
 
 /// Bullet 3.24: btDiscreteDynamicsWorld with btSequentialImpulseConstraintSolver, DBVT

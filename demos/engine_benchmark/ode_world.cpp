@@ -77,6 +77,7 @@ class OdeEngine final : public Engine {
       dJointSetDBallAnchor1(j, p_a.x(), p_a.y(), p_a.z());
       dJointSetDBallAnchor2(j, d.local_b.x(), d.local_b.y(), d.local_b.z());
       dJointSetDBallDistance(j, d.length);
+      ++dballs_;
     }
   }
 
@@ -91,9 +92,15 @@ class OdeEngine final : public Engine {
     if (collide_) dSpaceCollide(space_, this, &OdeEngine::near_callback);
     dWorldQuickStep(world_, dt_);
     dJointGroupEmpty(contacts_);
+    // Rows of this step's quickstep: contact joints (dContactApprox1, one friction coefficient
+    // for both directions: 3 rows, or 1 without friction) and the DBall joints (1 row each).
+    const double rows = contacts_made_ * (friction_ > 0.0 ? 3.0 : 1.0) + static_cast<double>(dballs_);
+    work_.rows += rows;
+    work_.row_updates += rows * dWorldGetQuickStepNumIterations(world_);
   }
 
   int contacts() const override { return contacts_made_; }
+  Work work() const override { return work_; }
 
   std::vector<BodyState> states() const override {
     std::vector<BodyState> out;
@@ -143,6 +150,8 @@ class OdeEngine final : public Engine {
   double restitution_;
   bool collide_;
   int contacts_made_ = 0;
+  int dballs_ = 0;
+  Work work_;
   dWorldID world_ = nullptr;
   dSpaceID space_ = nullptr;
   dJointGroupID contacts_ = nullptr;

@@ -57,10 +57,10 @@ double force_scale(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eig
   return scale > 0.0 ? scale : 1.0;
 }
 
-// Siconos numerics' functions cps calls, resolved in its library when the first exact solve
-// needs them (load_siconos), not at start-up: the library brings BLAS and LAPACK, and Debian's
-// OpenBLAS starts a thread per core when it is loaded that spins about 0.1 s of CPU time
-// (docs/benchmarks.md), in every cps process, most of which never solve exactly.
+// Siconos numerics' functions cps calls, resolved in its library by the first exact solve
+// (siconos()), not at start-up: the library brings BLAS and LAPACK, and Debian's OpenBLAS starts
+// threads when it is loaded that spin about 0.1 s of CPU time (docs/benchmarks.md), in every cps
+// process, most of which never solve exactly.
 struct SiconosFunctions {
   std::string library;
   decltype(&NM_create_from_data) create_from_data = nullptr;

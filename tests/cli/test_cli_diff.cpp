@@ -121,6 +121,7 @@ TEST_CASE("the paper scenes render as their baselines on every backend here, and
                     << render.err);
         break;
       }
+      INFO(render.err);
       REQUIRE(render.exit_code == 0);
       const Result r = run_cps("diff '" + (baselines / scene).string() + "' '" + (out / scene).string() +
                                    "' --out '" + (dir / "diff").string() + "'",

@@ -171,7 +171,9 @@ TEST_CASE("a file cps wrote and the user edited is foreign, and a command never 
   CHECK(slurp(dir / "o/s.json") != text);
 
   // The same for a figure: an edited figure is kept.
-  REQUIRE(run_cps("figure stack --times 0 --size 64x48 --out f/fig.png", dir).exit_code == 0);
+  r = run_cps("figure stack --times 0 --size 64x48 --out f/fig.png", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
   write_text(dir / "f/fig.png", "my own picture");
   r = run_cps("figure stack --times 0 --size 64x48 --out f/fig.png", dir);
   CHECK(r.exit_code == 2);

@@ -14,7 +14,6 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -241,7 +240,7 @@ struct Column {
   Engine::Work work; ///< per step over the first repeat's timed steps: rows, row updates (count)
 };
 
-/// A's work over the timed steps (from `before`, taken at the mark, to `after`), per step.
+/// An engine's work over the timed steps (from `before`, taken at the mark, to `after`), per step.
 Engine::Work work_per_step(const Engine::Work& before, const Engine::Work& after, int steps) {
   return {(after.rows - before.rows) / steps, (after.row_updates - before.row_updates) / steps};
 }
@@ -313,10 +312,8 @@ int run(int argc, char** argv) {
     const scenes::Run built = scenes::make_run(scene);
     const World& initial = built.world;
     const double dt = initial.def().dt;
-    std::vector<Column> cols(4);
-    for (std::size_t e = 0; e < cols.size(); ++e) {
-      cols[e].label = std::array<const char*, 4>{"Bullet", "ODE", "cps matrix-free", "cps explicit"}[e];
-    }
+    std::vector<Column> cols;
+    for (const char* label : {"Bullet", "ODE", "cps matrix-free", "cps explicit"}) cols.push_back({label, {}, {}, 0, {}});
     std::fprintf(stderr, "cps_engine_benchmark: %s\n", name.c_str());
     for (int r = 0; r < repeats; ++r) {
       for (int e = 0; e < 2; ++e) {

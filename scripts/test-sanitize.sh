@@ -11,12 +11,12 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCPS_SANITIZE=ON -DCPS_BUILD_TESTS=ON
 cmake --build build-asan --parallel "$(nproc)"
 # intercept_tls_get_addr=0: GCC 12's sanitizer runtime takes a dynamic TLS block that happens to
-# start 16 bytes past a page for a glibc 2.19 header, and records the two words before it (ASan's
-# chunk header) as that block's range; LeakSanitizer's tracer reads that range at exit and crashes
-# ("Tracer caught signal 11", google/sanitizers#1322). Every process that renders allocates one
-# dynamic TLS block (in the GL stack), at an address that moves with the heap's history (paths,
+# start 16 bytes past a page boundary for a glibc 2.19 header, and records the two words before it
+# (ASan's chunk header) as that block's range; LeakSanitizer's tracer reads that range at exit and
+# crashes ("Tracer caught signal 11", google/sanitizers#1322). Every process that renders
+# allocates one dynamic TLS block, at an address that moves with the heap's history (paths,
 # pids): this fits the rare exit-134 aborts of rendering cps children in CI. Dynamic TLS is then
-# not scanned for roots; static TLS, stacks and globals still are.
+# not scanned for roots; static TLS, stacks and globals still are. See docs/testing.md.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:intercept_tls_get_addr=0
 # Leaks inside a Debian library that cps cannot free, each explained: scripts/lsan-suppressions.txt.
 export LSAN_OPTIONS=suppressions=$PWD/scripts/lsan-suppressions.txt

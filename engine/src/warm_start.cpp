@@ -71,7 +71,8 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
                                      const std::vector<ConstraintRow>& rows, std::size_t rods,
                                      double factor, FrictionModel friction,
                                      std::vector<double>& first,
-                                     std::vector<double>& second) const {
+                                     std::vector<double>& second, WarmStartRule rule) const {
+  const bool last = rule == WarmStartRule::last;
   const std::size_t c = rows.size();
   const std::size_t points = point_count(manifolds);
   const bool friction_rows = rows_have_friction(points, c, rods);
@@ -92,20 +93,20 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
         const double* cached = solve == 0 ? p.first : p.second;
         const double older = p.older[solve];
         // Contact row k: the smaller of its last two lambdas (see the class comment).
-        const double sustained = std::max(0.0, std::min(cached[0], older));
+        const double sustained = last ? cached[0] : std::max(0.0, std::min(cached[0], older));
         out[k] = factor * sustained;
         if (!friction_rows || !has_friction_) continue;
         // The cached friction force, scaled as the contact's, along this step's directions (t1
         // is the cached t1 in the new plane, so this is close to a copy), within the row's limits.
-        const double scale = cached[0] > 0.0 ? sustained / cached[0] : 0.0;
+        const double scale = last ? 1.0 : cached[0] > 0.0 ? sustained / cached[0] : 0.0;
         const Vec3 force = scale * (cached[1] * p.t1 + cached[2] * p.t2);
         const Vec3& t1 = tangents_[k];
         const Vec3 t2 = m.contacts[static_cast<std::size_t>(i)].normal.cross(t1);
         for (int r = 0; r < 2; ++r) {
           const std::size_t row = points + 2 * k + static_cast<std::size_t>(r);
-          double lo = rows[row].c_min;
-          double hi = rows[row].c_max;
-          if (coupled) {
+          double lo = last ? -kInfinity : rows[row].c_min;
+          double hi = last ? kInfinity : rows[row].c_max;
+          if (coupled && !last) {
             hi = rows[row].mu * out[k];
             lo = -hi;
           }
@@ -120,7 +121,9 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
     for (std::size_t r = 0; r < rods && r < cached_rods.size(); ++r) {
       const double a = cached_rods[r];
       const double b = older_rods[r];
-      out[c - rods + r] = (a > 0.0) == (b > 0.0) ? factor * (std::abs(a) < std::abs(b) ? a : b) : 0.0;
+      out[c - rods + r] = last                     ? factor * a
+                          : (a > 0.0) == (b > 0.0) ? factor * (std::abs(a) < std::abs(b) ? a : b)
+                                                   : 0.0;
     }
   }
 }

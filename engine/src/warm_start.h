@@ -16,6 +16,15 @@
 
 namespace cps {
 
+/// How a cached lambda becomes a row's initial guess.
+enum class WarmStartRule {
+  /// The smaller of the last two lambdas, friction within its row's limits (the class comment).
+  sustained,
+  /// The last step's lambdas as they are, friction unclamped: Box3D's and Box2D v3's warm start
+  /// (b3PrepareContacts: the stored impulses times the warm-start scale), which the soft step runs.
+  last,
+};
+
 /// The contacts and rods of the last step with their lambdas, and this step's matches to them.
 ///
 /// The guess is the factor times the smaller of a row's lambdas of the last two steps (for a rod,
@@ -57,10 +66,13 @@ class WarmStartCache {
   /// within +-mu times its contact row's guess (coupled model). `first` is for the solve with the
   /// push (Sec. 7), `second` for the solve without it (Sec. 8.1), each from the cached lambda of
   /// the same solve; `second` is left empty when the cache holds no second solve.
+  /// With WarmStartRule::last each guess is instead `factor` times the row's last lambda (a
+  /// friction row's re-expressed along this step's t1, t2, not clamped).
   void initial_guesses(const std::vector<Manifold>& manifolds,
                        const std::vector<ConstraintRow>& rows, std::size_t rods, double factor,
                        FrictionModel friction, std::vector<double>& first,
-                       std::vector<double>& second) const;
+                       std::vector<double>& second,
+                       WarmStartRule rule = WarmStartRule::sustained) const;
 
   /// Replaces the cache by this step's points (features, t1, t2) and lambdas: `first` (c, N)
   /// from the solve with the push, `second` (c, N, or empty) from the solve without it (Sec.

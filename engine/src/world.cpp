@@ -112,7 +112,7 @@ void World::step() {
   external_forces();  // Sec. 6.1: f_ext
   collide();          // Sec. 4: manifolds
   build_rows();       // Sec. 5: rows of J, targets, limits
-  ctx.prepare();      // Sec. 6: A or the packed rows
+  if (push_->solves_system()) ctx.prepare();  // Sec. 6: A or the packed rows
   push_->step(ctx);   // Secs. 7, 8.1 and 3.2, as the push method does them (push/)
   ++ctx.counters.steps;
 }
@@ -230,7 +230,8 @@ void World::build_rows() {
   ctx.counters.rows += static_cast<std::int64_t>(rows.size());
   if (warm) {
     ctx.warm_start->initial_guesses(ctx.manifolds, rows, distances_.size(), def_.warm_start,
-                                    def_.friction_model, ctx.initial, ctx.initial_second);
+                                    def_.friction_model, ctx.initial, ctx.initial_second,
+                                    push_->warm_start_rule(def_));
   }
 }
 

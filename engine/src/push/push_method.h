@@ -41,6 +41,19 @@ class PushMethod {
     return false;
   }
 
+  /// How the warm-start cache turns last step's lambdas into this step's initial guesses
+  /// (warm_start.h) under the world's parameters `def`; the paper's methods take the sustained
+  /// rule. No errors.
+  virtual WarmStartRule warm_start_rule(const WorldDef& def) const {
+    (void)def;
+    return WarmStartRule::sustained;
+  }
+
+  /// Whether the method solves A lambda = b through the step context's solver (Sec. 6-7), so that
+  /// World::step assembles A (or packs the rows) before step(); methods that sweep their own rows
+  /// return false and the assembly is skipped. No errors.
+  virtual bool solves_system() const { return true; }
+
   /// The solve and integrate stages: solves with ctx's rows and prepared solver, leaves the
   /// step's lambda (and lambda_second, or clears it) in ctx, stores the warm start, and moves the
   /// bodies over ctx.def->dt. No errors.

@@ -55,7 +55,7 @@ constexpr std::array kPushChoices = {
            /*in_paper=*/true, &make_single_frame_push},
     Choice{"split-impulse", static_cast<int>(PushMode::split_impulse), "Bullet", "split impulse",
            /*in_paper=*/false, &make_split_impulse},
-    Choice{"soft", static_cast<int>(PushMode::soft), "Box2D v3", "soft step",
+    Choice{"soft", static_cast<int>(PushMode::soft), "Box3D", "soft step",
            /*in_paper=*/false, &make_soft_step},
     Choice{"ngs", static_cast<int>(PushMode::ngs), "Box2D v2.4", "non-linear Gauss-Seidel",
            /*in_paper=*/false, &make_ngs},
@@ -73,6 +73,12 @@ constexpr std::array kSolverChoices = {
 constexpr std::array kFrictionModelChoices = {
     Choice{"fixed", static_cast<int>(FrictionModel::fixed), "Sec. 5.4", "friction limit mu m |g.n|"},
     Choice{"coupled", static_cast<int>(FrictionModel::coupled), "", "friction limit mu lambda_n"},
+};
+constexpr std::array kSoftRelaxChoices = {
+    Choice{"continue", static_cast<int>(SoftRelax::continue_solve), "Box3D",
+           "relax from the soft solve's impulses"},
+    Choice{"restart", static_cast<int>(SoftRelax::restart), "Sec. 8.1",
+           "relax from the substep's start and the last relax's impulses"},
 };
 constexpr std::array kRotationChoices = {
     Choice{"linear", static_cast<int>(RotationUpdate::linear), "Eq. 3.2.4", "linear orientation update"},
@@ -168,7 +174,7 @@ const std::array kParameters = {
               .choices = kPushChoices,
               .help = "baumgarte: the push factor kept in the velocity (Sec. 5); split: the single "
                       "frame push factor, two solves (Sec. 8.1); split-impulse: Bullet's split "
-                      "impulse, the push on pseudo-velocities; soft: Box2D v3's soft step, "
+                      "impulse, the push on pseudo-velocities; soft: Box3D's soft step, "
                       "substeps with soft rows and relax; ngs: non-linear Gauss-Seidel position "
                       "projection (Box2D v2.4); tgs: temporal Gauss-Seidel (PhysX 5), substeps with the "
                       "push then a relax; xpbd: extended position based dynamics (Mueller et al. "
@@ -271,9 +277,20 @@ const std::array kParameters = {
               .min = 1.0,
               .max = 1000.0,
               .help = "push soft: substeps per step, each a soft solve, a position update and a "
-                      "relax solve; Box2D v3's 4",
+                      "relax solve; Box3D's 4",
               .get = &get_member<&WorldDef::soft_substeps>,
               .set = &set_member<&WorldDef::soft_substeps>},
+    Parameter{.name = "soft_relax",
+              .flag = "soft-relax",
+              .json_key = "soft_relax",
+              .type = ParameterType::choice,
+              .choices = kSoftRelaxChoices,
+              .help = "push soft: where each substep's relax starts; continue: from the soft "
+                      "solve's impulses and velocities (Box3D's); restart: from the velocities "
+                      "before the soft solve and the last relax's impulses, as the single frame "
+                      "push factor's second solve (Sec. 8.1)",
+              .get = &get_member<&WorldDef::soft_relax>,
+              .set = &set_member<&WorldDef::soft_relax>},
     Parameter{.name = "contact_hertz",
               .flag = "contact-hertz",
               .json_key = "contact_hertz_hz",
@@ -281,8 +298,8 @@ const std::array kParameters = {
               .type = ParameterType::real,
               .min = 0.0,
               .max = 1.0e6,
-              .help = "push soft: contact stiffness, capped at a quarter of the substep rate "
-                      "(twice it against a static body); 0 = rigid, no push; Box2D v3's 30",
+              .help = "push soft: contact stiffness, capped at an eighth of the substep rate "
+                      "(twice it against a static body); 0 = rigid, no push; Box3D's 30",
               .get = &get_member<&WorldDef::contact_hertz>,
               .set = &set_member<&WorldDef::contact_hertz>},
     Parameter{.name = "contact_damping_ratio",
@@ -292,7 +309,7 @@ const std::array kParameters = {
               .type = ParameterType::real,
               .min = 0.0,
               .max = 1.0e6,
-              .help = "push soft: contact damping ratio; Box2D v3's 10",
+              .help = "push soft: contact damping ratio (half of it against a static body); Box3D's 10",
               .get = &get_member<&WorldDef::contact_damping_ratio>,
               .set = &set_member<&WorldDef::contact_damping_ratio>},
     Parameter{.name = "rod_hertz",
@@ -302,7 +319,8 @@ const std::array kParameters = {
               .type = ParameterType::real,
               .min = 0.0,
               .max = 1.0e6,
-              .help = "push soft: rod stiffness; 0 = rigid, no push; Box2D v3's joint default 60",
+              .help = "push soft: rod stiffness, capped at a quarter of the substep rate; 0 = rigid, no "
+                      "push; Box3D's joint default 60",
               .get = &get_member<&WorldDef::rod_hertz>,
               .set = &set_member<&WorldDef::rod_hertz>},
     Parameter{.name = "rod_damping_ratio",
@@ -312,7 +330,7 @@ const std::array kParameters = {
               .type = ParameterType::real,
               .min = 0.0,
               .max = 1.0e6,
-              .help = "push soft: rod damping ratio; Box2D v3's joint default 2",
+              .help = "push soft: rod damping ratio; Box3D's joint default 2",
               .get = &get_member<&WorldDef::rod_damping_ratio>,
               .set = &set_member<&WorldDef::rod_damping_ratio>},
     Parameter{.name = "contact_push_max_speed",
@@ -323,7 +341,7 @@ const std::array kParameters = {
               .min = 0.0,
               .max = 1.0e6,
               .min_exclusive = true,
-              .help = "push soft: the fastest an overlap is pushed out; Box2D v3's 3",
+              .help = "push soft: the fastest an overlap is pushed out; Box3D's 3",
               .get = &get_member<&WorldDef::contact_push_max_speed>,
               .set = &set_member<&WorldDef::contact_push_max_speed>},
     Parameter{.name = "position_iterations",
@@ -682,6 +700,7 @@ const Parameter& parameter(std::string_view name) {
 
 PushReads push_reads(PushMode push) {
   switch (push) {
+    case PushMode::soft: return {.solver = false, .friction_model = true, .warm_start = true};
     case PushMode::xpbd: return {.solver = true, .friction_model = false, .warm_start = false};
     case PushMode::avbd: return {.solver = false, .friction_model = false, .warm_start = false};
     default: return {};
@@ -695,6 +714,9 @@ std::string_view name_of(FrictionModel v) {
 }
 std::string_view name_of(RotationUpdate v) {
   return parameter("rotation").choice_name(static_cast<int>(v));
+}
+std::string_view name_of(SoftRelax v) {
+  return parameter("soft_relax").choice_name(static_cast<int>(v));
 }
 std::string_view name_of(Assembly v) { return parameter("assembly").choice_name(static_cast<int>(v)); }
 

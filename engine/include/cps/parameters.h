@@ -43,7 +43,7 @@ enum class PushMode {
 /// change nothing in its runs, so a sweep or a comparison over them would repeat one run.
 /// Source: the top comment of each method's file in engine/src/push/.
 struct PushReads {
-  bool solver = true;          ///< --solver (pgs or jacobi); avbd solves per body, not A lambda = b
+  bool solver = true;          ///< --solver (pgs or jacobi); soft and avbd sweep their own rows, not A lambda = b
   bool friction_model = true;  ///< --friction-model; xpbd and avbd bound friction by mu lambda_n
   bool warm_start = true;      ///< --warm-start; xpbd starts each substep at 0, avbd uses gamma
 };
@@ -68,6 +68,12 @@ enum class FrictionModel {
 enum class RotationUpdate {
   linear,  ///< o += 1/2 [0, w] o dt, then normalise (Eq. 3.2.4)
   exact,   ///< o = [cos(|w| dt / 2), sin(|w| dt / 2) w / |w|] o (Eq. 12.4.1)
+};
+
+/// Where the soft step's relax (push soft, engine/src/push/soft_step.cpp) starts each substep.
+enum class SoftRelax {
+  continue_solve,  ///< from the soft solve's accumulated impulses, as Box3D and Box2D v3 relax
+  restart,         ///< from the velocities before the soft solve and the last relax's impulses
 };
 
 /// How A lambda = b is represented while it is solved.
@@ -119,19 +125,22 @@ struct WorldDef {
   /// m_splitImpulsePenetrationThreshold is 0.04 m.
   double split_impulse_threshold = 0.0;
   /// Soft step (push soft) only: substeps per step (count, >= 1); each solves with the soft
-  /// push, moves the positions, then relaxes. Box2D v3's default: 4.
+  /// push, moves the positions, then relaxes. Box3D's default: 4.
   int soft_substeps = 4;
+  /// Soft step only: where each substep's relax starts (SoftRelax). Box3D's: continue_solve.
+  SoftRelax soft_relax = SoftRelax::continue_solve;
   /// Soft step only: the contact rows' stiffness (Hz, >= 0; 0 = rigid rows without push), capped
-  /// at a quarter of the substep rate; contacts with a static body get twice it. Box2D v3's
+  /// at an eighth of the substep rate; contacts with a static body get twice it. Box3D's
   /// default: 30.
   double contact_hertz = 30.0;
-  /// Soft step only: the contact rows' damping ratio (dimensionless, >= 0). Box2D v3's default:
-  /// 10 (strongly overdamped: an overlap is pushed out without bouncing).
+  /// Soft step only: the contact rows' damping ratio (dimensionless, >= 0; half of it against a
+  /// static body). Box3D's default: 10 (strongly overdamped: an overlap is pushed out without
+  /// bouncing).
   double contact_damping_ratio = 10.0;
-  /// Soft step only: the rods' stiffness (Hz, >= 0; 0 = rigid rods without push). Box2D v3's
-  /// default for joints: 60.
+  /// Soft step only: the rods' stiffness (Hz, >= 0; 0 = rigid rods without push), capped at a
+  /// quarter of the substep rate. Box3D's default for joints: 60.
   double rod_hertz = 60.0;
-  /// Soft step only: the rods' damping ratio (dimensionless, >= 0). Box2D v3's default for
+  /// Soft step only: the rods' damping ratio (dimensionless, >= 0). Box3D's default for
   /// joints: 2.
   double rod_damping_ratio = 2.0;
   /// Soft step only: the fastest an overlap is pushed out (m/s, > 0). Box2D v3's default
@@ -277,6 +286,7 @@ std::string_view name_of(PushMode v);
 std::string_view name_of(SolverKind v);
 std::string_view name_of(FrictionModel v);
 std::string_view name_of(RotationUpdate v);
+std::string_view name_of(SoftRelax v);
 std::string_view name_of(Assembly v);
 
 }  // namespace cps

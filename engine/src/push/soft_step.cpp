@@ -1,227 +1,673 @@
-// The soft step: `--push soft`. Sources: Box2D v3 (erincatto/box2d, src/solver.c b2SolverStage
-// order: integrate velocities, warm start, solve, integrate positions, relax, restitution;
-// src/contact_solver.c b2PrepareContactsTask, b2SolveContact, b2ApplyRestitution; src/solver_set.c
-// and src/core.h b2MakeSoft; src/distance_joint.c for the rods); E. Catto, "Solver2D" (2024,
-// box2d.org/posts/2024/02/solver2d), the soft step solver.
+// The soft step: `--push soft`. Sources: Box3D (erincatto/box3d 0.1.0, src/solver.c: the stage
+// order of b3SolverStep; src/contact_solver.c: b3PrepareContacts, b3WarmStartContacts,
+// b3SolveContacts with useBias true and false, b3ApplyRestitution, b3StoreImpulses;
+// src/distance_joint.c: the rigid rod; src/solver.h: b3MakeSoft; src/physics_world.c: the
+// softness of a step) and Box2D v3 (erincatto/box2d, src/solver.c, src/contact_solver.c), whose
+// 2D solver Box3D's follows; E. Catto, "Solver2D" (2024), the soft step.
 //
-// Soft rows. A row with stiffness f (Hz) and damping ratio zeta over a substep h (s) is a
-// damped spring of angular frequency omega = 2 pi f solved implicitly (Catto, "Soft
-// constraints", GDC 2011). With a1 = 2 zeta + h omega and a2 = h omega a1, b2MakeSoft gives
-//   bias rate = omega / a1 (1/s),  mass scale = a2 / (1 + a2),  impulse scale = 1 / (1 + a2),
-// and the sequential impulse update lambda += -m_eff (mass scale) (J v + bias) - (impulse scale)
-// lambda. In the paper's terms (lambda a force, A = J M^-1 J^T, b of Eq. 6.2.9 with the target
-// v = bias rate x depth): its fixed point is (A + gamma diag(A)) lambda = b with
-// gamma = 1 / a2, and PGS on that matrix is the same update (SolveSettings::softness).
+// Soft rows. A row with stiffness f (Hz) and damping ratio zeta over a substep h (s) is a damped
+// spring of angular frequency omega = 2 pi f solved implicitly (Catto, "Soft constraints", GDC
+// 2011). With a1 = 2 zeta + h omega and a2 = h omega a1 (b3MakeSoft):
+//   bias rate = omega / a1 (1/s), mass scale = a2 / (1 + a2), impulse scale = 1 / (1 + a2),
+// and a row's sequential impulse update (impulses P in N s over one substep, the row's effective
+// mass m = 1 / (J M^-1 J^T) = 1 / A_jj of Eq. 6.2.9) is
+//   dP = -m (mass scale) (J v + bias rate C) - (impulse scale) P,   P += dP, clamped,
+// with C the row's current position error (m, negative for an overlap). In the paper's terms the
+// row force is lambda = P / h (N) and the push is the target -bias rate C (m/s) of Eq. 5.3.1
+// with a spring's rate in place of beta / dt.
 //
-// One step of length dt is soft_substeps substeps of h = dt / substeps. The rows, A and each
-// body's I^-1 are those of the start of the step (as Box2D's: it does not collide again within
-// a step). Each substep, from the momenta v0 it starts with:
-//   1. soft solve: every contact row with current separation s <= 0 (an overlap) targets
-//      min(bias rate x max(-s - slop, 0), contact_push_max_speed) and is soft (contact_hertz,
-//      capped at a quarter of the substep rate as Box2D does, twice it against a static body);
-//      a separated one (s > 0) targets -s / h and is rigid (it may close its gap within the
-//      substep, no further, like a speculative contact). Each rod targets -bias rate x C (C its current length error, m) and
-//      is soft (rod_hertz, rod_damping_ratio: Box2D's joint softness). Friction rows target 0,
-//      rigid. lambda_s starts from the previous substep's relaxed lambda: Box2D's accumulated
-//      impulse, which it re-applies each substep ("warm start"); the first substep starts from
-//      the warm starting cache (WorldDef::warm_start times the last step's relaxed lambda,
-//      Sec. 6.2.3; Box2D always warm starts, with factor 1) or from 0.
-//   2. positions move with f_s = f_ext + J^T lambda_s over h (Eqs. 3.2.3-3.2.4); the momenta
-//      stay v0.
-//   3. relax solve: the same rows, rigid, without the push (a contact targets -s / h if its
-//      points separated in the substep, else 0; rods 0), from the momenta v0; its
-//      f_r = f_ext + J^T lambda_r sets the momenta (Eqs. 3.2.1-3.2.2). Box2D applies the relax
-//      as a change of velocity from v_soft with its accumulated impulse, that is, it starts
-//      from lambda_s (solving from v0 for the total lambda_r gives the same velocity). Here it
-//      starts from the previous substep's lambda_r instead (the warm start guess in the first
-//      substep), as the paper's second solve of Sec. 8.1 starts from its own lambda and not from
-//      the first's (split.cpp): lambda_s carries the push, and the sweeps that do not converge
-//      leave part of it in the momenta. Measured from lambda_s at 25 sweeps: the intersecting
-//      stack's cubes reach 1.24 m/s, and energy enters beyond the push work by up to 1.13 J in a
-//      step of chain_20 and 0.29 J at dt = 0.1 s (tests/physics/test_stress.cpp, "[push_methods]");
-//      from the last lambda_r: 0.003 m/s, and the bound holds. Box2D's one relax sweep per
-//      substep could not do more than continue from lambda_s.
-// After the last substep the restitution of a contact that approached faster than the
-// threshold at the start of the step (ConstraintRow::restitution, Eq. 8.2.1) is applied: the
-// last relax solve targets it (Box2D runs a separate restitution pass over those points after
-// the relax; here it is folded into the last relax, which then also keeps the other rows).
-// The current separation of a contact is that of its point fixed in both bodies' frames along
-// the normal of the start of the step, s = -d + n . (p_b - p_a) (Box2D's: fixed normal,
-// anchors rotated with their bodies); a rod's error is from its current end points.
+// One step of length dt is soft_substeps substeps of h = dt / soft_substeps, in Box3D's stages:
+//   prepare (once a step): each contact point's anchors r_a, r_b relative to the centres of
+//     mass (m, world frame, fixed for the step), its normal and tangents and the effective mass
+//     of each of its rows, its separation at the start of the step and its approach speed (for
+//     restitution); each rod's anchors and axial mass; each body's I^-1 (as in b3PrepareContacts:
+//     the bodies' inverse inertias of the start of the step serve every substep). The impulses
+//     start from the warm-start cache (WorldDef::warm_start times the last step's, Sec. 6.2.3,
+//     WarmStartRule::last; Box3D always warm starts with factor 1; the restart variant below
+//     takes the sustained rule of the other methods) or from 0.
+//   each substep:
+//     1. integrate velocities: v += h m^-1 f, w += h I^-1 tau (f_ext, Sec. 6.1);
+//     2. warm start: every row's accumulated impulse applied to the velocities;
+//     3. solve (bias on), `iterations` sweeps: rods, then per manifold its contact points. A
+//        point with current separation s > 0 is speculative: rigid, bias s / h (the points may
+//        close the gap within the substep, no further). Else the row is soft with the push
+//        max(mass scale x bias rate x min(s + slop, 0), -contact_push_max_speed) (Box3D's
+//        contactSpeed cap; slop 0 is Box3D's). Contacts with a static body are stiffer: twice
+//        the stiffness and half the damping ratio. No friction here (b3SolveContacts: "No
+//        friction when applying bias").
+//     4. integrate positions: x += h v; o += 1/2 [0, w] o h, normalised (Eq. 3.2.4; or the
+//        axis-angle step of Eq. 12.4.1); each body's displacement dp and rotation dq over the
+//        step so far are kept, and a point's current separation is
+//        s = s0 + n . (dp_b - dp_a + dq_b r_b - dq_a r_a) - n . (r_b - r_a) at fixed n.
+//     5. relax (bias off), `iterations` sweeps, continuing from the accumulated impulses (with
+//        soft_relax restart instead from the velocities before step 2 and the impulses the last
+//        relax left, re-applied: the variant below): rods
+//        rigid, contact points rigid (speculative ones keep s / h), then each manifold's
+//        friction at its centre (b3PrepareContacts' weighted average of the anchors): a twist
+//        row about the normal and two tangent rows with their coupled 2 x 2 effective mass,
+//        clamped to a disc of radius mu times the manifold's normal impulse (the coupled
+//        model, as Box3D) or the sum of its points' fixed limits mu m |g.n| / points (Sec. 5.4),
+//        the twist to the same times the points' lever arms.
+//   after the last substep:
+//     6. restitution: each contact row with a restitution target v_r (Eq. 8.2.1,
+//        ConstraintRow::restitution) that took an impulse in the step gets
+//        dP = -m (J v - v_r), the accumulated impulse clamped at 0 (b3ApplyRestitution);
+//     7. store impulses: lambda = P / h per row (N) for the warm-start cache and ctx.lambda (a
+//        manifold's friction as forces at its points' friction rows, store()); the bodies'
+//        momenta p = m v, l = I w with the I of the start of the step.
+// Stiffness: the contact's is capped at an eighth of the substep rate (b3World_Step), a rod's at
+// a quarter (b3PrepareJoint). A rod (distance constraint) is Box3D's rigid distance joint: its
+// axis and anchors follow the bodies within the step (the current anchors, dq r), its effective
+// mass is the start of the step's; its error C = |p_b - p_a| - length.
 //
-// In the paper's terms each substep is the single frame push factor (Sec. 8.1) at dt = h with
-// soft rows: positions move with the solve that has the push, the momenta with the one that has
-// not; the differences are the soft rows, the push rate (bias rate with a speed limit instead of
-// beta / h), the substeps, and the second solve started from the first's lambda.
+// The variant soft_relax = restart is the single frame push factor's second solve (Sec. 8.1) at
+// dt = h: the soft solve's impulses move the positions and are then taken back, and the relax
+// sets the momenta from where the substep began; it warm starts by the sustained rule (the
+// smaller of the last two lambdas, warm_start.h), whose reason it shares. Box3D's relax continues from the soft solve's
+// velocities and impulses; where one relax sweep does not take out all of the push, the rest stays
+// in the momenta, and a step can gain more energy than its push's work: measured at 25 sweeps on
+// chain_20 (1.36 J in a step), the stack at dt = 0.1 s (0.20 J) and the heavy ball on the grid
+// (0.15 J), where restart keeps the bound (tests/physics/test_stress.cpp, "[push_methods]").
 //
-// Both solvers (the soft rows in PGS and Jacobi alike), both friction models (friction rows are
-// rigid), both assemblies (the explicit path adds gamma diag(A) to A; the matrix-free path
-// sweeps soft rows row by row), restitution as above. Cost: 2 x substeps solves of `iterations`
-// sweeps each per step (Box2D v3 runs 4 substeps of one sweep each: `--iterations 1`).
-// After a step, the rows' push and bias hold the targets of the last relax solve.
+// Differences from Box3D: double precision, one thread, manifolds in the collide stage's order
+// (no graph colouring); the manifolds as the collide stage makes them (up to 8 points; Box3D
+// reduces to 4); the twist starts each step from 0; no rolling resistance, no gyroscopic term
+// (Box3D integrates one; for the spheres and cubes of the scenes it is zero), no speed caps on
+// the bodies (Box3D clamps at 400 m/s and a quarter turn a step).
+// The solvers of A lambda = b (--solver, --assembly) play no part: the rows are swept as the
+// source sweeps them, Gauss-Seidel over body velocities.
 
 #include "push_method.h"
 
 #include "../buffers.h"
-#include "../integrator.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 namespace cps {
 namespace {
 
-// Box2D's soft parameters of one kind of row over a substep.
+// Box3D's soft coefficients of one kind of row over a substep (b3MakeSoft).
 struct Softness {
-  double bias_rate = 0.0;  // 1/s: the push is bias_rate x depth (m/s)
-  double gamma = 0.0;      // dimensionless: the row solves (A_jj (1 + gamma)) (SolveSettings)
+  double bias_rate = 0.0;      // 1/s
+  double mass_scale = 1.0;     // dimensionless
+  double impulse_scale = 0.0;  // dimensionless
 };
 
-// b2MakeSoft: stiffness `hertz` (Hz, >= 0), damping ratio zeta (>= 0), substep h (s, > 0).
-// hertz = 0 gives a rigid row without push ({0, 0}).
+// Stiffness `hertz` (Hz, >= 0), damping ratio zeta (>= 0), substep h (s, > 0). hertz = 0 gives a
+// rigid row without push.
 Softness make_softness(double hertz, double zeta, double h) {
   if (!(hertz > 0.0)) return {};
   const double omega = 2.0 * std::numbers::pi * hertz;
   const double a1 = 2.0 * zeta + h * omega;
   const double a2 = h * omega * a1;
-  return {omega / a1, 1.0 / a2};
+  const double a3 = 1.0 / (1.0 + a2);
+  return {omega / a1, a2 * a3, a3};
+}
+
+// A body's state in the solver (the last entry stands for the static world of a rod's fixed end).
+struct SolverBody {
+  Vec3 v = Vec3::Zero();   // m/s
+  Vec3 w = Vec3::Zero();   // rad/s
+  Vec3 dp = Vec3::Zero();  // m: displacement since the start of the step
+  Quat dq = Quat::Identity();  // rotation since the start of the step
+  Mat3 dR = Mat3::Identity();  // dq as a matrix, once a substep
+  Mat3 inv_I = Mat3::Zero();   // 1/(kg m^2), world frame, start of the step
+  double inv_mass = 0.0;       // 1/kg
+};
+
+// One row along a unit axis between anchors r_a, r_b (a contact's normal or tangent): what a
+// sweep reads, prepared once a step.
+struct AxisRow {
+  Vec3 axis = Vec3::Zero();
+  Vec3 rn_a = Vec3::Zero();    // r_a x axis
+  Vec3 rn_b = Vec3::Zero();    // r_b x axis
+  Vec3 Irn_a = Vec3::Zero();   // I_a^-1 (r_a x axis)
+  Vec3 Irn_b = Vec3::Zero();   // I_b^-1 (r_b x axis)
+  double mass = 0.0;           // kg: 1 / (J M^-1 J^T)
+  double impulse = 0.0;        // N s: accumulated over the current substep
+};
+
+struct ContactPoint {
+  int a = 0;
+  int b = 0;
+  int row = 0;                   // the contact row's index in ctx.rows
+  Vec3 r_a = Vec3::Zero();       // m: anchor relative to a's centre of mass
+  Vec3 r_b = Vec3::Zero();
+  double base_separation = 0.0;  // m: s0 - n . (r_b - r_a)
+  double restitution = 0.0;      // m/s: the row's restitution target (0: none)
+  double total_impulse = 0.0;    // N s: sum of the normal impulses over the step
+  double lever_arm = 0.0;        // m: distance from the manifold's friction centre (on a)
+  bool touches_static = false;
+  AxisRow normal;
+};
+
+// A manifold's friction, solved once at its centre as Box3D solves it (b3PrepareContacts: the
+// anchors' average weighted by closeness; two tangent rows with a coupled 2 x 2 effective mass,
+// clamped to a disc; a twist row about the normal clamped by the points' lever arms).
+struct ManifoldFriction {
+  int a = 0;
+  int b = 0;
+  std::size_t begin = 0;  // its points in contacts_
+  std::size_t end = 0;
+  int first_friction_row = -1;  // the friction rows of its first point in ctx.rows, or -1
+  Vec3 normal = Vec3::UnitY();
+  Vec3 t1 = Vec3::UnitX();
+  Vec3 t2 = Vec3::UnitZ();
+  Vec3 center_a = Vec3::Zero();  // m: the centre relative to a's centre of mass
+  Vec3 center_b = Vec3::Zero();
+  Eigen::Matrix2d tangent_mass = Eigen::Matrix2d::Zero();  // kg: the inverse of K (2 x 2)
+  Eigen::Vector2d impulse = Eigen::Vector2d::Zero();       // N s along t1, t2
+  double twist_mass = 0.0;     // kg m^2
+  double twist_impulse = 0.0;  // N m s
+  double mu = 0.0;
+  double fixed_limit = -1.0;   // N s a substep: the fixed model's limit per point; < 0: coupled
+};
+
+
+struct Rod {
+  int a = 0;
+  int b = 0;
+  int row = 0;
+  Vec3 r_a = Vec3::Zero();  // m: anchor relative to a's centre, world frame, start of the step
+  Vec3 r_b = Vec3::Zero();
+  Vec3 delta_center = Vec3::Zero();  // m: centre of b minus centre of a at the start
+  double length = 0.0;
+  double mass = 0.0;     // kg: axial effective mass at the start of the step
+  double impulse = 0.0;  // N s
+  Vec3 axis0 = Vec3::UnitY();  // the start of the step's axis, for a rod of length 0
+};
+
+// The velocity of a body's point at offset r (m/s).
+inline Vec3 point_velocity(const SolverBody& s, const Vec3& r) { return s.v + s.w.cross(r); }
+
+// j . v of an axis row (m/s): the rate at which the points separate along the axis.
+inline double row_speed(const AxisRow& row, const SolverBody& a, const SolverBody& b) {
+  return row.axis.dot(b.v - a.v) + row.rn_b.dot(b.w) - row.rn_a.dot(a.w);
+}
+
+// Applies impulse P (N s) along an axis row: -P to a, +P to b.
+inline void apply(const AxisRow& row, double P, SolverBody& a, SolverBody& b) {
+  a.v -= (a.inv_mass * P) * row.axis;
+  a.w -= P * row.Irn_a;
+  b.v += (b.inv_mass * P) * row.axis;
+  b.w += P * row.Irn_b;
+}
+
+AxisRow make_axis_row(const Vec3& axis, const Vec3& r_a, const Vec3& r_b, const SolverBody& a,
+                      const SolverBody& b, double impulse) {
+  AxisRow row;
+  row.axis = axis;
+  row.rn_a = r_a.cross(axis);
+  row.rn_b = r_b.cross(axis);
+  row.Irn_a = a.inv_I * row.rn_a;
+  row.Irn_b = b.inv_I * row.rn_b;
+  const double k = a.inv_mass + b.inv_mass + row.rn_a.dot(row.Irn_a) + row.rn_b.dot(row.Irn_b);
+  row.mass = k > 0.0 ? 1.0 / k : 0.0;
+  row.impulse = impulse;
+  return row;
+}
+
+// The orientation update of Eq. 3.2.4 (then normalised) or Eq. 12.4.1 by angular velocity w over h.
+Quat rotate(const Quat& q, const Vec3& w, double h, RotationUpdate rotation) {
+  Quat out;
+  if (rotation == RotationUpdate::linear) {
+    const Quat spin(0.0, 0.5 * h * w.x(), 0.5 * h * w.y(), 0.5 * h * w.z());
+    out.coeffs() = q.coeffs() + (spin * q).coeffs();
+  } else {
+    const double speed = w.norm();
+    if (!(speed > 0.0)) return q;
+    const double half = 0.5 * speed * h;
+    const Vec3 axis = w / speed;
+    out = Quat(std::cos(half), std::sin(half) * axis.x(), std::sin(half) * axis.y(),
+               std::sin(half) * axis.z()) * q;
+  }
+  out.normalize();
+  return out;
 }
 
 class SoftStep final : public PushMethod {
  public:
-  // Per substep a soft solve that moves the positions, then a relax solve that sets the momenta;
-  // lambda carried from each solve to the next.
+  bool solves_system() const override { return false; }
+  // Box3D's warm start (the last step's impulses), or for the restart variant the sustained
+  // rule of the other methods (warm_start.h).
+  WarmStartRule warm_start_rule(const WorldDef& def) const override {
+    return def.soft_relax == SoftRelax::restart ? WarmStartRule::sustained : WarmStartRule::last;
+  }
+
   void step(StepContext& ctx) override {
     const WorldDef& def = *ctx.def;
-    if (ctx.rows.empty()) {  // nothing to solve: substeps of free flight under f_ext
-      const double h = def.dt / static_cast<double>(def.soft_substeps);
-      for (int k = 0; k < def.soft_substeps; ++k) ctx.integrate(ctx.f_ext, ctx.f_ext, h);
-      ctx.lambda.clear();
-      ctx.lambda_second.clear();
-      return;
-    }
-    begin(ctx.rows, ctx.manifolds, *ctx.bodies, def);
-    zero_force_.setZero(ctx.f_ext.size());  // no allocation once it has the size
-    const std::vector<double>* start = ctx.warm_guess();
+    std::vector<Body>& bodies = *ctx.bodies;
+    const double h = def.dt / static_cast<double>(def.soft_substeps);
+    prepare(ctx, h);
+    const bool restart = def.soft_relax == SoftRelax::restart;
     for (int k = 0; k < def.soft_substeps; ++k) {
-      // 1. soft solve (lambda_second) from the last relaxed lambda
-      set_targets(ctx.rows, *ctx.distances, *ctx.bodies, /*soft=*/true, /*last=*/false);
-      SolveSettings soft_settings = ctx.settings(h_);
-      soft_settings.softness = &softness_;
-      ctx.solve(soft_settings, TargetTerms::push_and_bias, ctx.lambda_second, ctx.f_cv, start);
-      // 2. positions with f_s; momenta kept
-      ctx.integrate(ctx.f_cv, zero_force_, h_);
-      // 3. relax solve (lambda), rigid, without the push, from the last relaxed lambda (not
-      //    lambda_s, which carries the push: see the comment at the top); it sets the momenta
-      set_targets(ctx.rows, *ctx.distances, *ctx.bodies, /*soft=*/false,
-                  /*last=*/k + 1 == def.soft_substeps);
-      detail::reserve_with_headroom(relax_start_, ctx.lambda.size());
-      relax_start_.assign(ctx.lambda.begin(), ctx.lambda.end());
-      ctx.solve(ctx.settings(h_), TargetTerms::bias_only, ctx.lambda, ctx.f_c0,
-                k > 0 ? &relax_start_ : ctx.warm_guess());
-      add_momenta(*ctx.bodies, ctx.f_c0, h_);
-      start = &ctx.lambda;
+      integrate_velocities(ctx.f_ext, h);
+      if (restart) save();
+      warm_start();
+      for (int i = 0; i < def.iterations; ++i) solve(/*use_bias=*/true, h);
+      integrate_positions(bodies, h, def.rotation);
+      if (restart) {
+        restore();
+        warm_start();
+      }
+      for (int i = 0; i < def.iterations; ++i) solve(/*use_bias=*/false, h);
     }
+    apply_restitution();
+    store(ctx, h);
+  }
+
+ private:
+  // Stage "prepare": solver bodies, contact points and rods from ctx's bodies, manifolds and rows
+  // (contact rows in the manifolds' point order, then two friction rows per point when the world
+  // has friction, then one row per rod: World::build_rows), with the warm-start impulses.
+  void prepare(StepContext& ctx, double h) {
+    const WorldDef& def = *ctx.def;
+    const std::vector<Body>& bodies = *ctx.bodies;
+    const std::vector<ConstraintRow>& rows = ctx.rows;
+    const std::vector<double>* warm = ctx.warm_guess();
+    const auto guess = [&](std::size_t r) { return warm != nullptr ? (*warm)[r] * h : 0.0; };
+
+    const std::size_t n = bodies.size();
+    detail::resize_with_headroom(solver_bodies_, n + 1);
+    detail::resize_with_headroom(inertia_, n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Body& body = bodies[i];
+      SolverBody& s = solver_bodies_[i];
+      s = SolverBody{};
+      if (body.is_static()) continue;
+      s.inv_mass = body.inv_mass;
+      s.inv_I = body.inv_inertia_world();
+      s.v = body.velocity();
+      s.w = s.inv_I * body.l;
+      inertia_[i] = s.inv_I.inverse();
+    }
+    solver_bodies_[n] = SolverBody{};  // the static world (kWorldBody)
+    const auto index = [n](int body) { return body == kWorldBody ? n : static_cast<std::size_t>(body); };
+
+    // Box3D's softness of a step (b3World_Step, b3PrepareJoint).
+    const double contact_hertz = std::min(def.contact_hertz, 0.125 / h);
+    contact_soft_ = make_softness(contact_hertz, def.contact_damping_ratio, h);
+    static_soft_ = make_softness(2.0 * contact_hertz, 0.5 * def.contact_damping_ratio, h);
+    rod_soft_ = make_softness(std::min(def.rod_hertz, 0.25 / h), def.rod_damping_ratio, h);
+    slop_ = def.penetration_slop;
+    max_push_ = def.contact_push_max_speed;
+
+    const std::size_t points = contact_point_count(ctx.manifolds);
+    const bool friction = def.friction > 0.0;
+    const bool coupled = def.friction_model == FrictionModel::coupled;
+    // Box3D's friction centre weight: 1 for touching points, falling to 0 past twice the
+    // speculative distance (m).
+    const double inv_tau = 1.0 / std::max(def.contact_margin, 1e-9);
+    contacts_.clear();
+    detail::reserve_with_headroom(contacts_, points);
+    manifolds_.clear();
+    detail::reserve_with_headroom(manifolds_, ctx.manifolds.size());
+    std::size_t g = 0;       // the point's index over the step: its contact row
+    for (const Manifold& m : ctx.manifolds) {
+      const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];
+      const Body& body_b = bodies[static_cast<std::size_t>(m.body_b)];
+      const SolverBody& a = solver_bodies_[static_cast<std::size_t>(m.body_a)];
+      const SolverBody& b = solver_bodies_[static_cast<std::size_t>(m.body_b)];
+      ManifoldFriction& f = manifolds_.emplace_back();
+      f.a = m.body_a;
+      f.b = m.body_b;
+      f.begin = contacts_.size();
+      f.normal = m.contacts[0].normal;
+      Vec3 center_a = Vec3::Zero();
+      Vec3 center_b = Vec3::Zero();
+      double total_weight = 0.0;
+      for (int i = 0; i < m.count; ++i, ++g) {
+        const Contact& c = m.contacts[static_cast<std::size_t>(i)];
+        ContactPoint& p = contacts_.emplace_back();
+        p.a = m.body_a;
+        p.b = m.body_b;
+        p.row = static_cast<int>(g);
+        p.r_a = c.point - body_a.x;
+        p.r_b = c.point - body_b.x;
+        p.base_separation = -c.depth - c.normal.dot(p.r_b - p.r_a);
+        p.restitution = rows[g].restitution;
+        p.touches_static = body_a.is_static() || body_b.is_static();
+        p.normal = make_axis_row(c.normal, p.r_a, p.r_b, a, b, guess(g));
+        const double weight = std::clamp(2.0 + c.depth * inv_tau, 1e-10, 1.0);
+        center_a += weight * p.r_a;
+        center_b += weight * p.r_b;
+        total_weight += weight;
+      }
+      f.end = contacts_.size();
+      if (!friction) continue;
+      f.center_a = center_a / total_weight;
+      f.center_b = center_b / total_weight;
+      for (std::size_t i = f.begin; i < f.end; ++i) {
+        contacts_[i].lever_arm = (contacts_[i].r_a - f.center_a).norm();
+      }
+      const std::size_t first = points + 2 * f.begin;
+      f.first_friction_row = static_cast<int>(first);
+      f.mu = rows[first].mu;
+      f.fixed_limit = coupled ? -1.0 : rows[first].c_max * h;
+      tangent_basis(f.normal, f.t1, f.t2);
+      const Vec3 rt_a1 = f.center_a.cross(f.t1);
+      const Vec3 rt_a2 = f.center_a.cross(f.t2);
+      const Vec3 rt_b1 = f.center_b.cross(f.t1);
+      const Vec3 rt_b2 = f.center_b.cross(f.t2);
+      Eigen::Matrix2d K;
+      K(0, 0) = a.inv_mass + b.inv_mass + rt_a1.dot(a.inv_I * rt_a1) + rt_b1.dot(b.inv_I * rt_b1);
+      K(1, 1) = a.inv_mass + b.inv_mass + rt_a2.dot(a.inv_I * rt_a2) + rt_b2.dot(b.inv_I * rt_b2);
+      K(0, 1) = K(1, 0) = rt_a1.dot(a.inv_I * rt_a2) + rt_b1.dot(b.inv_I * rt_b2);
+      f.tangent_mass = K.determinant() != 0.0 ? Eigen::Matrix2d(K.inverse()) : Eigen::Matrix2d::Zero();
+      const double k_twist = f.normal.dot((a.inv_I + b.inv_I) * f.normal);
+      f.twist_mass = k_twist > 0.0 ? 1.0 / k_twist : 0.0;
+      // The warm start: the friction rows' initial lambdas (N, store() below) summed back into
+      // the force at the centre, as an impulse over h. The twist starts from 0 each step (Box3D
+      // warm starts it too; here, taken back from the rows, it spun large_pyramid's bottom boxes
+      // about their normals at up to 11 rad/s within 1 s: docs/findings.md).
+      if (warm != nullptr) {
+        Vec3 P = Vec3::Zero();
+        for (std::size_t i = f.begin; i < f.end; ++i) {
+          const std::size_t r = first + 2 * (i - f.begin);
+          const Vec3 F = h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
+          P += F;
+        }
+        f.impulse = Eigen::Vector2d(P.dot(f.t1), P.dot(f.t2));
+      }
+    }
+
+    const std::vector<DistanceConstraint>& distances = *ctx.distances;
+    const std::size_t first_rod = points * (friction ? 3 : 1);
+    rods_.clear();
+    detail::reserve_with_headroom(rods_, distances.size());
+    for (std::size_t r = 0; r < distances.size(); ++r) {
+      const DistanceConstraint& d = distances[r];
+      Vec3 p_a;
+      Vec3 p_b;
+      distance_endpoints(d, bodies, p_a, p_b);
+      Rod& rod = rods_.emplace_back();
+      rod.a = static_cast<int>(index(d.body_a));
+      rod.b = static_cast<int>(index(d.body_b));
+      rod.row = static_cast<int>(first_rod + r);
+      const Vec3 x_a = bodies[static_cast<std::size_t>(d.body_a)].x;
+      const Vec3 x_b = d.body_b == kWorldBody ? Vec3::Zero() : bodies[static_cast<std::size_t>(d.body_b)].x;
+      rod.r_a = p_a - x_a;
+      rod.r_b = p_b - x_b;
+      rod.delta_center = x_b - x_a;
+      rod.length = d.length;
+      rod.axis0 = rows[first_rod + r].j.segment<3>(6);  // the row's axis (+y for coincident ends)
+      const AxisRow axial = make_axis_row(rod.axis0, rod.r_a, rod.r_b, solver_bodies_[index(d.body_a)],
+                                          solver_bodies_[index(d.body_b)], 0.0);
+      rod.mass = axial.mass;
+      rod.impulse = guess(first_rod + r);
+    }
+  }
+
+  // SoftRelax::restart: keeps the velocities before the warm start and the impulses the relax
+  // left (the soft solve changes the normal and rod impulses only), and puts them back.
+  void save() {
+    saved_velocities_.resize(solver_bodies_.size());
+    for (std::size_t i = 0; i < solver_bodies_.size(); ++i) {
+      saved_velocities_[i] = {solver_bodies_[i].v, solver_bodies_[i].w};
+    }
+    saved_impulses_.clear();
+    for (const ContactPoint& p : contacts_) saved_impulses_.push_back(p.normal.impulse);
+    for (const Rod& rod : rods_) saved_impulses_.push_back(rod.impulse);
+  }
+  void restore() {
+    for (std::size_t i = 0; i < solver_bodies_.size(); ++i) {
+      solver_bodies_[i].v = saved_velocities_[i].first;
+      solver_bodies_[i].w = saved_velocities_[i].second;
+    }
+    std::size_t k = 0;
+    for (ContactPoint& p : contacts_) p.normal.impulse = saved_impulses_[k++];
+    for (Rod& rod : rods_) rod.impulse = saved_impulses_[k++];
+  }
+
+  // Stage "integrate velocities": f_ext (6n: force and torque per body, N and N m) over h.
+  void integrate_velocities(const Eigen::VectorXd& f_ext, double h) {
+    const std::size_t n = solver_bodies_.size() - 1;
+    for (std::size_t i = 0; i < n; ++i) {
+      SolverBody& s = solver_bodies_[i];
+      if (s.inv_mass == 0.0) continue;
+      const auto k = 6 * static_cast<Eigen::Index>(i);
+      s.v += (h * s.inv_mass) * f_ext.segment<3>(k);
+      s.w += h * (s.inv_I * f_ext.segment<3>(k + 3));
+    }
+  }
+
+  // A rod's current anchors (m) and the vector from its a end to its b end (m).
+  void rod_geometry(const Rod& rod, Vec3& r_a, Vec3& r_b, Vec3& separation) const {
+    const SolverBody& a = solver_bodies_[static_cast<std::size_t>(rod.a)];
+    const SolverBody& b = solver_bodies_[static_cast<std::size_t>(rod.b)];
+    r_a = a.dR * rod.r_a;
+    r_b = b.dR * rod.r_b;
+    separation = rod.delta_center + (b.dp - a.dp) + (r_b - r_a);
+  }
+
+  static Vec3 axis_of(const Vec3& separation, const Vec3& fallback) {
+    const double length = separation.norm();
+    return length > 0.0 ? Vec3(separation / length) : fallback;
+  }
+
+  // Applies impulse P (N s) along `axis` at the current anchors of a rod.
+  void apply_rod(const Rod& rod, const Vec3& r_a, const Vec3& r_b, const Vec3& axis, double P) {
+    SolverBody& a = solver_bodies_[static_cast<std::size_t>(rod.a)];
+    SolverBody& b = solver_bodies_[static_cast<std::size_t>(rod.b)];
+    const Vec3 impulse = P * axis;
+    a.v -= a.inv_mass * impulse;
+    a.w -= a.inv_I * r_a.cross(impulse);
+    b.v += b.inv_mass * impulse;
+    b.w += b.inv_I * r_b.cross(impulse);
+  }
+
+  // Stage "warm start": every accumulated impulse applied to the velocities.
+  void warm_start() {
+    for (const Rod& rod : rods_) {
+      Vec3 r_a;
+      Vec3 r_b;
+      Vec3 separation;
+      rod_geometry(rod, r_a, r_b, separation);
+      apply_rod(rod, r_a, r_b, axis_of(separation, rod.axis0), rod.impulse);
+    }
+    for (const ManifoldFriction& f : manifolds_) {
+      SolverBody& a = solver_bodies_[static_cast<std::size_t>(f.a)];
+      SolverBody& b = solver_bodies_[static_cast<std::size_t>(f.b)];
+      for (std::size_t i = f.begin; i < f.end; ++i) apply(contacts_[i].normal, contacts_[i].normal.impulse, a, b);
+      if (f.first_friction_row < 0) continue;
+      apply_friction(f, f.impulse.x() * f.t1 + f.impulse.y() * f.t2, a, b);
+      apply_twist(f, f.twist_impulse, a, b);
+    }
+  }
+
+  // Applies a friction impulse P (N s, world frame) at the manifold's centre: -P to a, +P to b.
+  static void apply_friction(const ManifoldFriction& f, const Vec3& P, SolverBody& a, SolverBody& b) {
+    a.v -= a.inv_mass * P;
+    a.w -= a.inv_I * f.center_a.cross(P);
+    b.v += b.inv_mass * P;
+    b.w += b.inv_I * f.center_b.cross(P);
+  }
+
+  // Applies a twist impulse L (N m s) about the normal: -L to a, +L to b.
+  static void apply_twist(const ManifoldFriction& f, double L, SolverBody& a, SolverBody& b) {
+    const Vec3 torque = L * f.normal;
+    a.w -= a.inv_I * torque;
+    b.w += b.inv_I * torque;
+  }
+
+  // One sweep of the stages "solve" (use_bias) or "relax": rods, then each manifold's points
+  // (normal rows, then, in the relax, their friction rows).
+  void solve(bool use_bias, double h) {
+    const double inv_h = 1.0 / h;
+    for (Rod& rod : rods_) {
+      Vec3 r_a;
+      Vec3 r_b;
+      Vec3 separation;
+      rod_geometry(rod, r_a, r_b, separation);
+      const Vec3 axis = axis_of(separation, rod.axis0);
+      const SolverBody& a = solver_bodies_[static_cast<std::size_t>(rod.a)];
+      const SolverBody& b = solver_bodies_[static_cast<std::size_t>(rod.b)];
+      const double speed = axis.dot(point_velocity(b, r_b) - point_velocity(a, r_a));
+      double bias = 0.0;
+      double mass_scale = 1.0;
+      double impulse_scale = 0.0;
+      if (use_bias) {
+        bias = rod_soft_.bias_rate * (separation.norm() - rod.length);
+        mass_scale = rod_soft_.mass_scale;
+        impulse_scale = rod_soft_.impulse_scale;
+      }
+      const double dP = -mass_scale * rod.mass * (speed + bias) - impulse_scale * rod.impulse;
+      rod.impulse += dP;
+      apply_rod(rod, r_a, r_b, axis, dP);
+    }
+    for (ManifoldFriction& f : manifolds_) {
+      SolverBody& a = solver_bodies_[static_cast<std::size_t>(f.a)];
+      SolverBody& b = solver_bodies_[static_cast<std::size_t>(f.b)];
+      double total = 0.0;        // N s: the manifold's normal impulse
+      double twist_limit = 0.0;  // N m s: sum of lever arm x normal impulse
+      for (std::size_t i = f.begin; i < f.end; ++i) {
+        ContactPoint& p = contacts_[i];
+        solve_normal(p, a, b, use_bias, inv_h);
+        total += p.normal.impulse;
+        twist_limit += p.lever_arm * p.normal.impulse;
+      }
+      if (!use_bias && f.first_friction_row >= 0) solve_friction(f, total, twist_limit, a, b);
+    }
+  }
+
+  void solve_normal(ContactPoint& p, SolverBody& a, SolverBody& b, bool use_bias, double inv_h) const {
+    const AxisRow& row = p.normal;
+    const Vec3 ds = (b.dp - a.dp) + (b.dR * p.r_b - a.dR * p.r_a);
+    const double s = row.axis.dot(ds) + p.base_separation;
+    double bias = 0.0;
+    double mass_scale = 1.0;
+    double impulse_scale = 0.0;
+    if (s > 0.0) {
+      bias = s * inv_h;  // speculative
+    } else if (use_bias) {
+      const Softness& k = p.touches_static ? static_soft_ : contact_soft_;
+      bias = std::max(k.mass_scale * k.bias_rate * std::min(s + slop_, 0.0), -max_push_);
+      mass_scale = k.mass_scale;
+      impulse_scale = k.impulse_scale;
+    }
+    const double speed = row_speed(row, a, b);
+    const double old = row.impulse;
+    const double next = std::max(old - row.mass * (mass_scale * speed + bias) - impulse_scale * old, 0.0);
+    p.normal.impulse = next;
+    p.total_impulse += next;
+    apply(row, next - old, a, b);
+  }
+
+  // The relax's friction of a manifold (b3SolveContacts, useBias false): the twist row, then the
+  // two tangent rows at the centre, clamped to mu times the manifold's normal impulse `total`
+  // (N s; coupled) or to the fixed limits, twist_limit (N m s) the lever arms' share.
+  static void solve_friction(ManifoldFriction& f, double total, double twist_limit, SolverBody& a,
+                             SolverBody& b) {
+    const double points = static_cast<double>(f.end - f.begin);
+    double limit = f.mu * total;
+    double twist_max = f.mu * twist_limit;
+    if (f.fixed_limit >= 0.0) {  // the fixed model: mu m |g.n| / points per point (Sec. 5.4)
+      limit = f.fixed_limit * points;
+      twist_max = total > 0.0 ? limit * twist_limit / total : 0.0;
+    }
+    {
+      const double speed = f.normal.dot(b.w - a.w);
+      const double old = f.twist_impulse;
+      f.twist_impulse = std::clamp(old - f.twist_mass * speed, -twist_max, twist_max);
+      apply_twist(f, f.twist_impulse - old, a, b);
+    }
+    const Vec3 vr = (b.v + b.w.cross(f.center_b)) - (a.v + a.w.cross(f.center_a));
+    const Eigen::Vector2d vt(vr.dot(f.t1), vr.dot(f.t2));
+    Eigen::Vector2d next = f.impulse - f.tangent_mass * vt;
+    const double length2 = next.squaredNorm();
+    if (length2 > limit * limit) next *= limit / std::sqrt(length2);
+    const Eigen::Vector2d d = next - f.impulse;
+    f.impulse = next;
+    apply_friction(f, d.x() * f.t1 + d.y() * f.t2, a, b);
+  }
+
+  // Stage "integrate positions": bodies and the solver's displacements over h.
+  void integrate_positions(std::vector<Body>& bodies, double h, RotationUpdate rotation) {
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      SolverBody& s = solver_bodies_[i];
+      if (s.inv_mass == 0.0) continue;
+      Body& body = bodies[i];
+      const Vec3 dx = h * s.v;
+      body.x += dx;
+      s.dp += dx;
+      body.o = rotate(body.o, s.w, h, rotation);
+      s.dq = rotate(s.dq, s.w, h, rotation);
+      s.dR = s.dq.toRotationMatrix();
+    }
+  }
+
+  // Stage "restitution" (Eq. 8.2.1 as b3ApplyRestitution applies it).
+  void apply_restitution() {
+    for (ContactPoint& p : contacts_) {
+      if (p.restitution <= 0.0 || p.total_impulse == 0.0) continue;
+      SolverBody& a = solver_bodies_[static_cast<std::size_t>(p.a)];
+      SolverBody& b = solver_bodies_[static_cast<std::size_t>(p.b)];
+      const double old = p.normal.impulse;
+      const double next = std::max(old - p.normal.mass * (row_speed(p.normal, a, b) - p.restitution), 0.0);
+      p.normal.impulse = next;
+      p.total_impulse += next - old;
+      apply(p.normal, next - old, a, b);
+    }
+  }
+
+  // Stage "store impulses": lambda = P / h per row into ctx, the warm-start cache, and the
+  // bodies' momenta.
+  void store(StepContext& ctx, double h) {
+    std::vector<Body>& bodies = *ctx.bodies;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      Body& body = bodies[i];
+      if (body.is_static()) continue;
+      const SolverBody& s = solver_bodies_[i];
+      body.p = body.mass * s.v;
+      body.l = inertia_[i] * s.w;
+    }
+    detail::assign_with_headroom(ctx.lambda, ctx.rows.size(), 0.0);
+    const double inv_h = 1.0 / h;
+    for (const ContactPoint& p : contacts_) ctx.lambda[static_cast<std::size_t>(p.row)] = p.normal.impulse * inv_h;
+    // A manifold's friction as forces at its points' friction rows: the force at the centre
+    // shared equally, plus the twist as tangential forces F_i = tau (n x d_i) / sum |d_j|^2 (d_i
+    // the point's offset from the centre across the normal), which sum to no force and to the
+    // torque tau about the normal; each row's lambda the component along its tangent. (A twist
+    // on a single point has no such forces and is dropped.)
+    for (const ManifoldFriction& f : manifolds_) {
+      if (f.first_friction_row < 0) continue;
+      const Vec3 share = (f.impulse.x() * f.t1 + f.impulse.y() * f.t2) *
+                         (inv_h / static_cast<double>(f.end - f.begin));
+      double spread = 0.0;  // m^2
+      for (std::size_t i = f.begin; i < f.end; ++i) {
+        const Vec3 d = contacts_[i].r_a - f.center_a;
+        spread += (d - f.normal.dot(d) * f.normal).squaredNorm();
+      }
+      const double tau = spread > 0.0 ? f.twist_impulse * inv_h / spread : 0.0;  // N / m
+      for (std::size_t i = f.begin; i < f.end; ++i) {
+        const Vec3 d = contacts_[i].r_a - f.center_a;
+        const Vec3 F = share + tau * f.normal.cross(d);
+        const std::size_t r = static_cast<std::size_t>(f.first_friction_row) + 2 * (i - f.begin);
+        ctx.lambda[r] = F.dot(ctx.rows[r].j.segment<3>(6));
+        ctx.lambda[r + 1] = F.dot(ctx.rows[r + 1].j.segment<3>(6));
+      }
+    }
+    for (const Rod& rod : rods_) ctx.lambda[static_cast<std::size_t>(rod.row)] = rod.impulse * inv_h;
     ctx.lambda_second.clear();
     ctx.store_warm_start();
   }
 
- private:
-  struct ContactPoint {
-    Vec3 local_a = Vec3::Zero();  // the point in a's frame (m)
-    Vec3 local_b = Vec3::Zero();  // the point in b's frame (m)
-    Vec3 normal = Vec3::UnitY();
-    double depth = 0.0;           // m, at the start of the step
-    bool touches_static = false;
-  };
-
-  // Records, for the step's rows (c; contact rows in the order of the manifolds' points, as
-  // World::build_rows makes them, then friction rows, then one row per distance constraint),
-  // each contact's point in the frames of its two bodies, its normal and depth, which rows touch
-  // a static body, and the softness of each kind for def (substep h = def.dt / soft_substeps).
-  // bodies: as at the start of the step.
-  void begin(const std::vector<ConstraintRow>& rows, const std::vector<Manifold>& manifolds,
-             const std::vector<Body>& bodies, const WorldDef& def) {
-    h_ = def.dt / static_cast<double>(def.soft_substeps);
-    slop_ = def.penetration_slop;
-    max_push_ = def.contact_push_max_speed;
-    // Box2D: the contact stiffness at most a quarter of the substep rate; twice it for a contact
-    // with a static body.
-    const double contact_hertz = std::min(def.contact_hertz, 0.25 / h_);
-    contact_soft_ = make_softness(contact_hertz, def.contact_damping_ratio, h_);
-    static_soft_ = make_softness(2.0 * contact_hertz, def.contact_damping_ratio, h_);
-    rod_soft_ = make_softness(def.rod_hertz, def.rod_damping_ratio, h_);
-    contacts_.clear();
-    detail::reserve_with_headroom(contacts_, contact_point_count(manifolds));
-    for_each_contact_point(manifolds, bodies, [this](const Manifold&, const Contact& c,
-                                                     const Body& a, const Body& b,
-                                                     const Mat3& Ra_t, const Mat3& Rb_t) {
-      ContactPoint& p = contacts_.emplace_back();
-      p.local_a = Ra_t * (c.point - a.x);
-      p.local_b = Rb_t * (c.point - b.x);
-      p.normal = c.normal;
-      p.depth = c.depth;
-      p.touches_static = a.is_static() || b.is_static();
-    });
-    detail::resize_with_headroom(softness_, rows.size());
-  }
-
-  // Sets every row's push and bias (m/s) for one solve from the bodies as they are now (the
-  // comment at the top): the soft solve (soft = true; softness_ then holds each row's gamma) or
-  // the relax solve (soft = false; with the restitution targets when last).
-  void set_targets(std::vector<ConstraintRow>& rows,
-                   const std::vector<DistanceConstraint>& distances,
-                   const std::vector<Body>& bodies, bool soft, bool last) {
-    std::size_t contact = 0;
-    std::size_t rod = 0;
-    for (std::size_t r = 0; r < rows.size(); ++r) {
-      ConstraintRow& row = rows[r];
-      double gamma = 0.0;
-      row.push = 0.0;
-      row.bias = 0.0;
-      if (row.kind == RowKind::contact) {
-        const ContactPoint& p = contacts_[contact++];
-        const Body& a = bodies[static_cast<std::size_t>(row.body_a)];
-        const Body& b = bodies[static_cast<std::size_t>(row.body_b)];
-        // s = -d + n . (p_b - p_a): both points were at the contact point at the start of the step.
-        const double s =
-            -p.depth + p.normal.dot((b.x + b.rotation() * p.local_b) - (a.x + a.rotation() * p.local_a));
-        if (s > 0.0) {
-          // Rigid: the points may approach by the gap s within the substep, no further (j . v >=
-          // -s / h; Box2D's bias s / h in its sign convention, as a speculative contact here).
-          row.bias = -s / h_;
-        } else if (soft) {
-          const Softness& k = p.touches_static ? static_soft_ : contact_soft_;
-          row.push = std::min(k.bias_rate * std::max(-s - slop_, 0.0), max_push_);
-          gamma = k.gamma;
-        }
-        if (!soft && last && row.restitution > 0.0) row.bias = row.restitution;
-      } else if (row.kind == RowKind::distance) {
-        if (soft) {
-          Vec3 pa;
-          Vec3 pb;
-          distance_endpoints(distances[rod], bodies, pa, pb);
-          row.push = -rod_soft_.bias_rate * ((pb - pa).norm() - distances[rod].length);
-          gamma = rod_soft_.gamma;
-        }
-        ++rod;
-      }
-      softness_[r] = gamma;
-    }
-  }
-
-  std::vector<ContactPoint> contacts_;  // one per contact row, in row order
-  std::vector<double> softness_;        // gamma per row (c) of the last soft set_targets
-  std::vector<double> relax_start_;     // the last relaxed lambda (c, N)
-  Eigen::VectorXd zero_force_;          // 6n zeros: the positions-only integration
+  std::vector<SolverBody> solver_bodies_;  // n + 1: the bodies, then the static world
+  std::vector<Mat3> inertia_;              // n: I (kg m^2, world frame) at the start of the step
+  std::vector<ContactPoint> contacts_;     // one per contact row, in row order
+  std::vector<ManifoldFriction> manifolds_;     // one per manifold, in order
+  std::vector<Rod> rods_;                  // one per distance constraint
+  std::vector<std::pair<Vec3, Vec3>> saved_velocities_;  // n + 1: v, w (SoftRelax::restart)
+  std::vector<double> saved_impulses_;                   // normal, then rod impulses (N s)
   Softness contact_soft_;
   Softness static_soft_;
   Softness rod_soft_;
-  double h_ = 0.0;  // the substep (s)
-  double slop_ = 0.0;
-  double max_push_ = 0.0;
+  double slop_ = 0.0;      // m
+  double max_push_ = 0.0;  // m/s
 };
 
 }  // namespace

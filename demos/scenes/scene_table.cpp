@@ -1,3 +1,4 @@
+#include "box3d_pyramids.h"
 #include "scene.h"
 #include "scene_file.h"
 #include "stress/stress.h"
@@ -175,6 +176,9 @@ const Scene* find_scene(std::string_view name) {
   const auto it =
       std::find_if(all.begin(), all.end(), [name](const Scene& s) { return s.name == name; });
   if (it != all.end()) return &*it;
+  for (const Scene& s : benchmark_scenes()) {
+    if (s.name == name) return &s;
+  }
   if (const Scene* example = find_example_scene(name)) return example;
   if (name.size() > 5 && name.substr(name.size() - 5) == ".json") return load_scene_file(name);
   constexpr std::string_view kRandom = "random_";

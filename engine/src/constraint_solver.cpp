@@ -29,19 +29,9 @@ class ExplicitSolver final : public ConstraintSolver {
       v1_.segment<3>(k + 3) = inv_inertia_[i] * bodies[i].l;
     }
     system_.b = assemble_rhs(rows, system_.J, system_.M_inv, v1_, f_ext, settings.dt, terms);
-    soft_ = settings.softness != nullptr;
-    if (soft_) {
-      // (A + diag(gamma_j A_jj)) lambda = b: PGS on it is Box2D v3's soft row update.
-      soft_A_ = system_.A;
-      for (Eigen::Index j = 0; j < soft_A_.rows(); ++j) {
-        const double gamma = (*settings.softness)[static_cast<std::size_t>(j)];
-        if (gamma > 0.0 && system_.A.coeff(j, j) > 0.0) soft_A_.coeffRef(j, j) *= 1.0 + gamma;
-      }
-    }
     const Eigen::VectorXd x =
-        solve_lcp(soft_ ? soft_A_ : system_.A, system_.b, system_.limits, settings.friction,
-                  settings.kind, settings.iterations,
-                  initial != nullptr ? initial->data() : nullptr);
+        solve_lcp(system_.A, system_.b, system_.limits, settings.friction, settings.kind,
+                  settings.iterations, initial != nullptr ? initial->data() : nullptr);
     lambda.assign(x.data(), x.data() + x.size());
   }
 
@@ -49,14 +39,14 @@ class ExplicitSolver final : public ConstraintSolver {
                 const std::vector<double>& lambda, double& max,
                 double& sum_squares) const override {
     const Eigen::VectorXd r =
-        lcp_residual(soft_ ? soft_A_ : system_.A, system_.b, system_.limits, friction,
+        lcp_residual(system_.A, system_.b, system_.limits, friction,
                      Eigen::Map<const Eigen::VectorXd>(lambda.data(), static_cast<Eigen::Index>(lambda.size())));
     max = r.size() > 0 ? r.maxCoeff() : 0.0;
     sum_squares = r.squaredNorm();
   }
 
   void system(SparseRowMatrix& A, Eigen::VectorXd& b, RowLimits& limits) const override {
-    A = soft_ ? soft_A_ : system_.A;
+    A = system_.A;
     b = system_.b;
     limits = system_.limits;
   }
@@ -65,8 +55,6 @@ class ExplicitSolver final : public ConstraintSolver {
   std::vector<Mat3> inv_inertia_;  // n: world inverse inertia per body at prepare()
   Eigen::VectorXd v1_;  // 6n: [v_i, w_i] per body at the solve (m/s, rad/s)
   System system_;
-  bool soft_ = false;       // the last solve had soft rows: soft_A_ is its matrix
-  SparseRowMatrix soft_A_;  // A + diag(gamma_j A_jj)
 };
 
 // The matrix-free form (matrix_free.h): w = M^-1 J^T lambda per body, O(12) a row update, no
@@ -82,7 +70,7 @@ class MatrixFreeSolver final : public ConstraintSolver {
              std::vector<double>& lambda, const std::vector<double>* initial) override {
     rhs(system_, rows, bodies, f_ext, settings.dt, terms);
     cps::solve(system_, rows, settings.friction, settings.kind, settings.iterations, lambda,
-               initial, settings.softness);
+               initial);
   }
 
   void residual(const std::vector<ConstraintRow>& rows, FrictionModel friction,

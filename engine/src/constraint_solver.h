@@ -18,18 +18,14 @@
 
 namespace cps {
 
-/// What one solve needs besides the rows and bodies: dt (s, > 0; a substep's length for the soft
-/// step), the number of sweeps (>= 1), PGS or Jacobi, the friction model of the force limits,
-/// and the rows' softness.
+/// What one solve needs besides the rows and bodies: dt (s, > 0; a substep's length for the
+/// methods that substep), the number of sweeps (>= 1), PGS or Jacobi, and the friction model of
+/// the force limits.
 struct SolveSettings {
   double dt = 1.0 / 60.0;
   int iterations = 25;
   SolverKind kind = SolverKind::pgs;
   FrictionModel friction = FrictionModel::fixed;
-  /// nullptr: rigid rows (the paper's A lambda = b). Else c values gamma_j >= 0 (dimensionless):
-  /// the solve is of (A + diag(gamma_j A_jj)) lambda = b, soft rows as Box2D v3 makes them
-  /// (push/soft_step.cpp: gamma = 1 / (h omega (2 zeta + h omega))); gamma_j = 0 leaves row j rigid.
-  const std::vector<double>* softness = nullptr;
 };
 
 /// A way to solve the step's bounded system A lambda = b.
@@ -60,7 +56,7 @@ class ConstraintSolver {
                         double& sum_squares) const = 0;
 
   /// The system the last solve() solved, written out explicitly (for a StepSystem): A (c x c,
-  /// 1/kg; with soft rows A + diag(gamma_j A_jj)), b (c, m/s^2) and the rows' limits. Built on
+  /// 1/kg), b (c, m/s^2) and the rows' limits. Built on
   /// request only (the matrix-free path multiplies its packed rows out, J times M^-1 J^T), never
   /// in a step that nobody observes. No errors.
   virtual void system(SparseRowMatrix& A, Eigen::VectorXd& b, RowLimits& limits) const = 0;

@@ -23,8 +23,8 @@ void integrate(std::vector<Body>& bodies, const Eigen::VectorXd& f_position,
                RotationUpdate rotation = RotationUpdate::linear);
 
 /// Advances every movable body's momenta by f dt (p += force dt, l += torque dt; f: 6n, N and
-/// N m; dt in s) without moving it: the relax solve of the soft step (push/soft_step.cpp) sets the
-/// velocity after its substep's positions have moved.
+/// N m; dt in s) without moving it: the relax of temporal Gauss-Seidel (push/tgs.cpp) sets the
+/// velocity after its substeps' positions have moved.
 void add_momenta(std::vector<Body>& bodies, const Eigen::VectorXd& f, double dt);
 
 }  // namespace cps

@@ -158,46 +158,6 @@ void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lam
   }
 }
 
-// Soft rows (SolveSettings::softness): PGS or Jacobi row by row on (A + diag(gamma_j A_jj)),
-// lambda_j <- clamp(lambda_j + ((b_j - (A lambda)_j) / A_jj - gamma_j lambda_j) / (1 + gamma_j)),
-// which is Box2D v3's soft update with mass scale 1 / (1 + gamma) and impulse scale
-// gamma / (1 + gamma) (push/soft_step.cpp). With gamma_j = 0 it is Eq. 7.1.1.
-template <bool kCoupled>
-void soft_sweeps(MatrixFreeSystem& s, const std::vector<double>& softness, bool jacobi,
-                 int iterations, std::vector<double>& lambda) {
-  const std::size_t c = s.rows.size();
-  const PackedRow* rows = s.rows.data();
-  const double* b = s.b.data();
-  double* l = lambda.data();
-  const int fixed_slot = static_cast<int>(s.w.size()) - 1;
-  for (int k = 0; k < iterations; ++k) {
-    for (std::size_t j = 0; j < c; ++j) {
-      const PackedRow& row = rows[j];
-      if (row.inv_diagonal == 0.0) continue;  // the row touches no movable body: lambda_j stays 0
-      double lo;
-      double hi;
-      bounds<kCoupled>(row, lambda, lo, hi);
-      const double gamma = softness[j];
-      const double value = std::clamp(
-          l[j] + ((b[j] - row_times_w(row, s.w, fixed_slot)) * row.inv_diagonal - gamma * l[j]) /
-                     (1.0 + gamma),
-          lo, hi);
-      if (jacobi) {
-        s.next[j] = value;
-      } else {
-        add_to_w(row, value - l[j], s.w, fixed_slot);
-        l[j] = value;
-      }
-    }
-    if (!jacobi) continue;
-    for (std::size_t j = 0; j < c; ++j) {
-      if (rows[j].inv_diagonal == 0.0) continue;
-      add_to_w(rows[j], s.next[j] - l[j], s.w, fixed_slot);
-      l[j] = s.next[j];
-    }
-  }
-}
-
 }  // namespace
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
@@ -330,7 +290,7 @@ void build_runs(MatrixFreeSystem& s) {
 
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
            SolverKind kind, int iterations, std::vector<double>& lambda,
-           const std::vector<double>* initial, const std::vector<double>* softness) {
+           const std::vector<double>* initial) {
   detail::assign_with_headroom(lambda, rows.size(), 0.0);  // initial guess 0 (Sec. 7.2) ...
   for (Vec6& w : s.w) w.setZero();
   if (initial != nullptr) {  // ... or the one given, with w = M^-1 J^T lambda to match
@@ -363,14 +323,6 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
     flush();
   }
   const bool coupled = friction == FrictionModel::coupled;
-  s.softness = softness;
-  if (softness != nullptr) {
-    const bool jacobi = kind == SolverKind::jacobi;
-    if (jacobi) detail::assign_with_headroom(s.next, rows.size(), 0.0);
-    coupled ? soft_sweeps<true>(s, *softness, jacobi, iterations, lambda)
-            : soft_sweeps<false>(s, *softness, jacobi, iterations, lambda);
-    return;
-  }
   if (kind == SolverKind::jacobi) {
     detail::assign_with_headroom(s.next, rows.size(), 0.0);
     coupled ? jacobi_sweeps<true>(s, iterations, lambda) : jacobi_sweeps<false>(s, iterations, lambda);
@@ -395,14 +347,8 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     } else {
       bounds<false>(s.rows[j], lambda, lo, hi);
     }
-    double Ax = row_times_w(s.rows[j], s.w, static_cast<int>(s.w.size()) - 1);
-    double d = diagonal;
-    if (s.softness != nullptr) {  // the soft system's row: A_jj (1 + gamma_j)
-      const double gamma = (*s.softness)[j];
-      Ax += gamma * diagonal * lambda[j];
-      d *= 1.0 + gamma;
-    }
-    const double r = detail::natural_map_residual(lambda[j], Ax - s.b[j], d, lo, hi);
+    const double Ax = row_times_w(s.rows[j], s.w, static_cast<int>(s.w.size()) - 1);
+    const double r = detail::natural_map_residual(lambda[j], Ax - s.b[j], diagonal, lo, hi);
     max = std::max(max, r);
     sum_squares += r * r;
   }
@@ -441,12 +387,6 @@ void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::Vecto
   J.setFromTriplets(j_entries.begin(), j_entries.end());
   MJt.setFromTriplets(m_entries.begin(), m_entries.end());
   A = J * SparseRowMatrix(MJt.transpose());
-  if (s.softness != nullptr) {
-    for (Eigen::Index j = 0; j < c; ++j) {
-      const double gamma = (*s.softness)[static_cast<std::size_t>(j)];
-      if (gamma > 0.0 && s.diagonal[static_cast<std::size_t>(j)] > 0.0) A.coeffRef(j, j) *= 1.0 + gamma;
-    }
-  }
   b = Eigen::Map<const Eigen::VectorXd>(s.b.data(), c);
 }
 

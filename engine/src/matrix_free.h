@@ -60,9 +60,6 @@ struct MatrixFreeSystem {
   std::vector<double> next;      ///< Jacobi: the sweep's new values (N)
   std::vector<Vec6> w;           ///< per body, and one zero slot: M^-1 J^T lambda
   std::vector<Mat3> inv_inertia; ///< per body: world inverse inertia this step (1/(kg m^2))
-  /// The softness of the last solve (c values, dimensionless; SolveSettings::softness), or
-  /// nullptr for rigid rows; the residual reads it. Not owned.
-  const std::vector<double>* softness = nullptr;
 };
 
 /// Packs the rows (c) for bodies (n): j, minv_jt, diagonal, 1 / A_jj and the bounds, and the
@@ -84,13 +81,10 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
 /// It starts from `initial` (c values, N; warm starting, Sec. 6.2.3) when given, with
 /// w = M^-1 J^T initial, else from lambda = 0 and w = 0; a row that touches no movable body
 /// starts at 0 whatever the guess (as solve_lcp). s must be prepared for these rows and s.b
-/// filled. softness: nullptr (rigid rows), or c values gamma_j >= 0: the system is then
-/// (A + diag(gamma_j A_jj)) lambda = b (SolveSettings::softness), swept row by row; the vector
-/// must outlive the next residual() call.
+/// filled.
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
            SolverKind kind, int iterations, std::vector<double>& lambda,
-           const std::vector<double>* initial = nullptr,
-           const std::vector<double>* softness = nullptr);
+           const std::vector<double>* initial = nullptr);
 
 /// The natural-map residual of lcp_residual for the lambda that solve() left (using its w),
 /// per row: the largest value and the sum of squares (N, N^2).
@@ -99,7 +93,7 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
               double& sum_squares);
 
 /// The system s holds, written out: A = J M^-1 J^T (c x c, 1/kg) from the packed rows' j and
-/// M^-1 j^T, with the softness of the last solve on its diagonal (A_jj (1 + gamma_j)), b (c, m/s^2)
+/// M^-1 j^T, b (c, m/s^2)
 /// and the limits (c each). For capturing a step (cps/step_system.h); not used by the sweeps.
 /// s must be prepared and its b filled. No errors.
 void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::VectorXd& b,

@@ -67,7 +67,6 @@ void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
   system.solver = s.kind;
   system.iterations = s.iterations;
   system.friction = s.friction;
-  system.soft = s.softness != nullptr;
   RowLimits limits;
   solver->system(system.A, system.b, limits);
   system.c_min = std::move(limits.c_min);

@@ -43,14 +43,14 @@ analysis::FclibText problem_text(const std::string& scene, const StepSystem& s,
   std::snprintf(head, sizeof head,
                 "cps export %s: scene %s, step %lld (0 is the first; t = %.9g s at its start), "
                 "solve %d of the step (targets: %s), dt = %.17g s, solver %s with %d sweeps, "
-                "friction %s, soft rows %s; %d contacts (%lld rows), %zu rods. Units: W, V, R in "
+                "friction %s; %d contacts (%lld rows), %zu rods. Units: W, V, R in "
                 "1/kg, q and s in m/s, r and l impulses in N s, u in m/s. Parameters: ",
                 engine_version(), scene.c_str(), static_cast<long long>(s.step),
                 static_cast<double>(s.step) * s.dt, s.solve, terms_name(s.terms), s.dt,
                 s.solver == SolverKind::pgs ? "pgs" : "jacobi", s.iterations,
                 s.friction == FrictionModel::fixed ? "fixed (a box of +-mu m g.n per tangent row)"
                                                    : "coupled (a box of +-mu lambda_n per tangent row)",
-                s.soft ? "yes (A holds A + diag(gamma A_jj))" : "no", p.contacts(),
+                p.contacts(),
                 static_cast<long long>(p.W.rows()), p.rod_rows.size());
   return {"cps " + scene + " step " + std::to_string(s.step), head + parameters.dump(),
           analysis::fclib_mapping_text()};

@@ -35,8 +35,6 @@ struct StepSystem {
   SolverKind solver = SolverKind::pgs;  ///< the engine's method for this solve (Sec. 7)
   int iterations = 0;     ///< the engine's sweeps for this solve (count)
   FrictionModel friction = FrictionModel::fixed;  ///< how friction rows are bounded (Sec. 5.4)
-  /// True when the solve had soft rows (the soft step): A then holds A + diag(gamma_j A_jj).
-  bool soft = false;
   /// c x c, 1/kg (1/(kg m^2) terms times m^2): A = J M^-1 J^T (Eq. 6.2.9), symmetric positive
   /// semi-definite, as the solve used it (the explicit path's matrix, or the matrix-free path's
   /// packed rows multiplied out).
@@ -70,7 +68,6 @@ using SolveOverride = std::function<void(const StepSystem&, Eigen::VectorXd& lam
 /// projected Jacobi (Sec. 7.1), lambda_j = clamp((b_j - sum_{i != j} A_ji lambda_i) / A_jj, lo_j,
 /// hi_j) (Eq. 7.1.1), with the bounds of s.friction (fixed c_min, c_max, or +-mu lambda_n). From
 /// `start` (c values, N) when given, else from lambda = 0 (Sec. 7.2). Returns lambda (c, N).
-/// Soft systems (s.soft) are swept as the explicit path sweeps them, row by row on A.
 /// Throws std::invalid_argument on mismatched sizes, a start of the wrong size, or sweeps < 0.
 Eigen::VectorXd solve_sweeps(const StepSystem& s, SolverKind method, int sweeps,
                              const Eigen::VectorXd* start = nullptr);

@@ -77,7 +77,7 @@ class SplitImpulse final : public PushMethod {
 
  private:
   // Solves the pseudo-velocities of the rows that carry a push (contact rows with push > 0, and
-  // every rod row) with `settings` (its softness ignored) from rest, and sets
+  // every rod row) with `settings` from rest, and sets
   // f_position = f_momentum + J_p^T lambda_p (6n). rows: the step's (c); bodies (n) as before the
   // integration; f_momentum: f_c0 of the velocity solve (6n).
   void solve_pseudo_velocities(const std::vector<ConstraintRow>& rows,
@@ -103,9 +103,7 @@ class SplitImpulse final : public PushMethod {
     }
     zero_force_.setZero(f_momentum.size());  // no allocation once it has the size
     solver_->prepare(rows_, bodies);
-    SolveSettings pseudo = settings;
-    pseudo.softness = nullptr;
-    solver_->solve(rows_, bodies, zero_force_, TargetTerms::push_from_rest, pseudo, lambda_,
+    solver_->solve(rows_, bodies, zero_force_, TargetTerms::push_from_rest, settings, lambda_,
                    nullptr);
     add_constraint_forces(rows_, lambda_, f_momentum, f_position);  // + J_p^T lambda_p
   }

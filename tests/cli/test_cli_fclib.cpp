@@ -399,3 +399,21 @@ TEST_CASE("export --fclib without FCLIB's library fails naming it, and writes no
   CHECK(list.out.find("stack") != std::string::npos);
   fs::remove_all(dir);
 }
+
+TEST_CASE("export --fclib of a push that solves no A lambda = b says so, and writes nothing",
+          "[fclib]") {
+  // The soft step, xpbd and avbd sweep their own rows: the intersecting stack has contacts from
+  // its first step, and still no solve to write.
+  const fs::path dir = cli_test::fresh_dir("cps-test-fclib-own-sweeps");
+  for (const char* push : {"soft", "xpbd", "avbd"}) {
+    const cli_test::Result r = run_cps(std::string("export intersecting_stack --seconds 0.1 --at 2 --push ") +
+                                           push + " --fclib out/s.hdf5",
+                                       dir);
+    INFO(push << "\n" << r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(r.err.find(std::string("push ") + push + " sweeps its own rows") != std::string::npos);
+    CHECK(r.err.find("nothing written") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "out"));
+  }
+  fs::remove_all(dir);
+}

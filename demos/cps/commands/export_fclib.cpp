@@ -141,6 +141,12 @@ int run_fclib_export(const FclibExportOptions& o, int argc, char** argv) {
   for (const std::int64_t step : steps) {
     const auto it = captured.find(step);
     if (it == captured.end()) {
+      const StepCounters& counted = run.world.counters();
+      if (counted.solves == 0 && counted.rows > 0) {
+        throw std::runtime_error("--fclib: push " + std::string(name_of(run.world.def().push)) +
+                                 " sweeps its own rows and solves no A lambda = b, so its steps "
+                                 "have no FCLIB problem; nothing written");
+      }
       throw std::runtime_error("--fclib: step " + std::to_string(step) + " of " + scene_name +
                                " had no solve (no contact and no rod then); nothing written");
     }

@@ -10,6 +10,11 @@
 
 namespace cps {
 
+/// The orientation o (unit quaternion) turned by angular velocity w (rad/s, world frame) over dt
+/// (s): o + 1/2 [0, w] o dt (Eq. 3.2.4) or the axis-angle step of Eq. 12.4.1, then normalised.
+/// No errors.
+Quat rotated(const Quat& o, const Vec3& w, double dt, RotationUpdate rotation);
+
 /// Advances every movable body by dt (s, > 0).
 /// f_position and f_momentum (6n each): force and torque per body (N, N m), external plus
 /// constraint forces. Momenta advanced with f_position move the bodies (Eqs. 3.2.3, 3.2.4):

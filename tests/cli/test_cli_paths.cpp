@@ -1,4 +1,4 @@
-// Where outputs go, as a user and a CI script meet it (issue 24's findings 1, 2 and 8): other
+// Where outputs go, as a user and a CI script meet it: other
 // commands' files in a frames folder are kept, outputs are named by the scene (never by the path
 // of a scene file as typed) and lie under --out, two scenes of one name are refused, and a file
 // cps wrote is replaced only while it is what cps wrote, never when it is the command's input.

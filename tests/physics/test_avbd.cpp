@@ -1,4 +1,4 @@
-// AVBD (--push avbd, engine/src/push/avbd.cpp) on the hard cases of issue 28: the mass ratios
+// AVBD (--push avbd, engine/src/push/avbd.cpp) on the hard cases: the mass ratios
 // that PGS with every other push method loses within 0.1 s (docs/findings.md, "The hard cases").
 // The resting box, the intersecting stack and the stretched rod are checked for every push
 // method, avbd included, in test_push_methods.cpp.

@@ -1,4 +1,4 @@
-// The hard cases (issue 28; demos/scenes/stress/hard_cases.cpp): each builds as it says, its
+// The hard cases (demos/scenes/stress/hard_cases.cpp): each builds as it says, its
 // mass ratio computed from its bodies is the one it states, its metrics are finite at the
 // paper's settings, and what the solver must achieve is asserted only where it is physics (the
 // rope's static tensions once it has come to rest). Whether a method holds a case is measured,

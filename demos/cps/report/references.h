@@ -1,5 +1,5 @@
 #pragma once
-// Solver error and time-step error apart (`cps report`, issue 26): the solver error of sampled
+// Solver error and time-step error apart (`cps report`): the solver error of sampled
 // steps against their exact solution (demos/analysis/exact_lcp.h), the time until which two
 // independent references of the trajectory agree (PGS at many sweeps, and the exact solve, at
 // the same small dt), and the energy over time of each push method. The computations; the

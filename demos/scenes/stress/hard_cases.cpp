@@ -1,4 +1,4 @@
-// The hard cases of issue 28, where a solver's convergence rather than its stability decides:
+// The hard cases, where a solver's convergence rather than its stability decides:
 // - heavy_on_light: six cubes of one density whose edges double going up, the heaviest on top
 //   (mass ratio 2^15 = 32768 between the top and bottom cubes; AVBD's StackRatio, Giles et al.
 //   2025, goes to 1024 in 2D).

@@ -100,7 +100,7 @@ class EnergyMetrics : public Metrics {
   double max_penetration_ = 0.0;
 };
 
-/// The hard cases' measurements (issue 28: survival, penetration, energy injected, rod stretch,
+/// The hard cases' measurements (survival, penetration, energy injected, rod stretch,
 /// whether the scene holds), fed with the world as built and after every step. Every movable
 /// body has a resting place: where its centre lies when the scene stands as it is meant to (m;
 /// the position as built for a scene built at rest, the stacked column for one whose bodies fall
@@ -230,7 +230,7 @@ void populate_edge_balance(World& world);
 void populate_touching_boxes(World& world);
 std::unique_ptr<Metrics> make_degenerate_metrics(const World& world);
 
-// hard_cases.cpp: the hard cases of issue 28 (heavy on light, a heavy rope, long runs)
+// hard_cases.cpp: the hard cases (heavy on light, a heavy rope, long runs)
 /// heavy_on_light: the static ground plane y = 0 and kHeavyOnLightCubes cubes of one density,
 /// edges kHeavyOnLightSmallestEdgeM x 2^k (k = 0 at the bottom), stacked touching, at rest.
 WorldDef heavy_on_light_world_def();

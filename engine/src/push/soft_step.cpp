@@ -80,6 +80,7 @@
 #include "push_method.h"
 
 #include "../buffers.h"
+#include "../integrator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -209,24 +210,6 @@ AxisRow make_axis_row(const Vec3& axis, const Vec3& r_a, const Vec3& r_b, const 
   row.mass = k > 0.0 ? 1.0 / k : 0.0;
   row.impulse = impulse;
   return row;
-}
-
-// The orientation update of Eq. 3.2.4 (then normalised) or Eq. 12.4.1 by angular velocity w over h.
-Quat rotate(const Quat& q, const Vec3& w, double h, RotationUpdate rotation) {
-  Quat out;
-  if (rotation == RotationUpdate::linear) {
-    const Quat spin(0.0, 0.5 * h * w.x(), 0.5 * h * w.y(), 0.5 * h * w.z());
-    out.coeffs() = q.coeffs() + (spin * q).coeffs();
-  } else {
-    const double speed = w.norm();
-    if (!(speed > 0.0)) return q;
-    const double half = 0.5 * speed * h;
-    const Vec3 axis = w / speed;
-    out = Quat(std::cos(half), std::sin(half) * axis.x(), std::sin(half) * axis.y(),
-               std::sin(half) * axis.z()) * q;
-  }
-  out.normalize();
-  return out;
 }
 
 class SoftStep final : public PushMethod {
@@ -594,8 +577,8 @@ class SoftStep final : public PushMethod {
       const Vec3 dx = h * s.v;
       body.x += dx;
       s.dp += dx;
-      body.o = rotate(body.o, s.w, h, rotation);
-      s.dq = rotate(s.dq, s.w, h, rotation);
+      body.o = rotated(body.o, s.w, h, rotation);
+      s.dq = rotated(s.dq, s.w, h, rotation);
       s.dR = s.dq.toRotationMatrix();
     }
   }

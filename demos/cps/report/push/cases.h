@@ -51,7 +51,7 @@ struct Method {
 /// Every push method of this build, in the table's order (cps::parameter("push").choices).
 std::vector<Method> push_methods();
 
-/// A hard case of issue 28 (stress scenes with HardCaseMetrics) in the report: its scene, how
+/// A hard case (stress scenes with HardCaseMetrics) in the report: its scene, how
 /// long it runs (s) and whether avbd also runs it with its penalties from kTunedAvbdKStart.
 struct HardCase {
   const scenes::Scene* scene = nullptr;

@@ -393,7 +393,7 @@ std::string hard_findings(const HardCase& c, const std::vector<HardRow>& rows) {
 // The legend of the hard cases' sections.
 std::string hard_legend(const PushPlan& p) {
   std::ostringstream md;
-  md << "## The hard cases (issue 28)\n\n"
+  md << "## The hard cases\n\n"
      << "Stress scenes where convergence, not stability, decides, each run at its own settings "
         "(the paper's: dt = 1/60 s, PGS at the scene's iterations) with only push changed, and "
         "measured by its own metrics (HardCaseMetrics: `cps simulate NAME --json`). Each body has "

@@ -3,7 +3,7 @@
 // table's order: cps::parameter("push").choices) on the same cases, each at the scene's own
 // settings with only push changed: the intersecting stack and sphere_in_box (overlaps resolved,
 // energy injected, final heights), the stack's drift, the mass ratios that hold, the pendulums'
-// rod and phase errors, the cost per step, and the hard cases of issue 28 (survival, penetration,
+// rod and phase errors, the cost per step, and the hard cases (survival, penetration,
 // energy injected, rod stretch, mass ratio held, with a tuned avbd row on the heavy ones;
 // push/cases.h). Writes push.csv, push.md and two diagrams.
 

@@ -17,7 +17,9 @@ StepContext::StepContext(const StepContext& other)
       lambda_second(other.lambda_second),
       warm_start(other.warm_start ? std::make_unique<WarmStartCache>(*other.warm_start) : nullptr),
       counters(other.counters),
-      residual(other.residual) {}
+      residual(other.residual),
+      time_stages(other.time_stages),
+      stage_times(other.stage_times) {}
 
 StepContext::~StepContext() = default;
 
@@ -31,6 +33,7 @@ void StepContext::prepare() {
     solver = make_constraint_solver(def->assembly);
     solver_assembly = def->assembly;
   }
+  StageTimer timer(*this, &StageTimes::prepare);
   solver->prepare(rows, *bodies);
 }
 
@@ -41,6 +44,10 @@ void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<d
     f = f_ext;
     return;
   }
+  // A later solve without the push is a relax (Sec. 8.1's second solve); every other one a solve.
+  StageTimer timer(*this, terms == TargetTerms::bias_only && solves_this_step > 0
+                              ? &StageTimes::relax
+                              : &StageTimes::solve);
   solver->solve(rows, *bodies, f_ext, terms, s, out, start);
   if (observer || override_solve) [[unlikely]] notify_observer(s, terms, out, start);
   ++solves_this_step;
@@ -91,11 +98,13 @@ void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
 }
 
 void StepContext::store_warm_start() {
+  StageTimer timer(*this, &StageTimes::store);
   if (warm()) warm_start->store(manifolds, rows, distances->size(), lambda, lambda_second);
 }
 
 void StepContext::integrate(const Eigen::VectorXd& f_position, const Eigen::VectorXd& f_momentum,
                             double h) {
+  StageTimer timer(*this, &StageTimes::integrate);
   cps::integrate(*bodies, f_position, f_momentum, h, def->rotation);
 }
 

@@ -18,17 +18,34 @@
 
 #include <Eigen/Core>
 
+#include <chrono>
 #include <memory>
 #include <vector>
 
 namespace cps {
 
+struct StepContext;
+
+/// Adds the wall-clock time from its construction to its destruction to one stage of
+/// ctx.stage_times (s), when ctx.time_stages is on; otherwise reads no clock. No errors.
+class StageTimer {
+ public:
+  StageTimer(StepContext& ctx, double StageTimes::*stage);
+  ~StageTimer();
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+
+ private:
+  double* sum_ = nullptr;
+  std::chrono::steady_clock::time_point start_;
+};
+
 /// What one step's stages share. n bodies, c rows. Forces are 6n vectors: force and torque per
 /// body (N, N m). Buffers keep their storage from step to step (no allocation once grown).
 struct StepContext {
   StepContext() = default;
-  /// Copies the last step's results (manifolds, rows, both lambdas), the warm-start cache and
-  /// the counters; the buffers and the solver start empty (nothing in them outlives a step).
+  /// Copies the last step's results (manifolds, rows, both lambdas), the warm-start cache, the
+  /// counters and the stage timing; the buffers and the solver start empty (nothing in them outlives a step).
   StepContext(const StepContext& other);
   StepContext& operator=(const StepContext&) = delete;
   StepContext(StepContext&&) noexcept = default;
@@ -62,6 +79,8 @@ struct StepContext {
   /// World::set_solve_override's callback, or empty (the usual case). Not copied either.
   SolveOverride override_solve;
   int solves_this_step = 0;  ///< solves made in the current step (StepSystem::solve)
+  bool time_stages = false;  ///< World::set_stage_timing
+  StageTimes stage_times;    ///< s, summed while time_stages is on
 
   /// Warm starting is on (WorldDef::warm_start > 0).
   bool warm() const { return def->warm_start > 0.0; }
@@ -95,5 +114,21 @@ struct StepContext {
   /// Sec. 3.2 over h (s): positions with f_position, stored momenta with f_momentum (6n each).
   void integrate(const Eigen::VectorXd& f_position, const Eigen::VectorXd& f_momentum, double h);
 };
+
+}  // namespace cps
+
+namespace cps {
+
+inline StageTimer::StageTimer(StepContext& ctx, double StageTimes::*stage) {
+  if (!ctx.time_stages) return;
+  sum_ = &(ctx.stage_times.*stage);
+  start_ = std::chrono::steady_clock::now();
+}
+
+inline StageTimer::~StageTimer() {
+  if (sum_ != nullptr) {
+    *sum_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+}
 
 }  // namespace cps

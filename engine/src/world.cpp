@@ -54,6 +54,12 @@ World::~World() = default;
 
 const StepCounters& World::counters() const { return ctx_->counters; }
 const ResidualStats& World::residual() const { return ctx_->residual; }
+const StageTimes& World::stage_times() const { return ctx_->stage_times; }
+
+void World::set_stage_timing(bool on) {
+  if (on && !ctx_->time_stages) ctx_->stage_times = StageTimes{};
+  ctx_->time_stages = on;
+}
 const std::vector<Manifold>& World::manifolds() const { return ctx_->manifolds; }
 const std::vector<ConstraintRow>& World::rows() const { return ctx_->rows; }
 const std::vector<double>& World::lambda() const { return ctx_->lambda; }
@@ -109,11 +115,24 @@ void World::step() {
     push_mode_ = def_.push;
   }
   ctx.solves_this_step = 0;
-  external_forces();  // Sec. 6.1: f_ext
-  collide();          // Sec. 4: manifolds
-  build_rows();       // Sec. 5: rows of J, targets, limits
+  {
+    StageTimer timer(ctx, &StageTimes::collide);
+    external_forces();  // Sec. 6.1: f_ext
+    collide();          // Sec. 4: manifolds
+  }
+  {
+    StageTimer timer(ctx, &StageTimes::rows);
+    build_rows();  // Sec. 5: rows of J, targets, limits
+  }
   if (push_->solves_system()) ctx.prepare();  // Sec. 6: A or the packed rows
-  push_->step(ctx);   // Secs. 7, 8.1 and 3.2, as the push method does them (push/)
+  // The push method's time in the stages it times itself; the rest of it is `other`.
+  StageTimes& times = ctx.stage_times;
+  const double staged_before = times.total() - times.other;
+  {
+    StageTimer timer(ctx, &StageTimes::other);
+    push_->step(ctx);  // Secs. 7, 8.1 and 3.2, as the push method does them (push/)
+  }
+  times.other -= times.total() - times.other - staged_before;
   ++ctx.counters.steps;
 }
 

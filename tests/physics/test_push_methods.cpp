@@ -2,6 +2,7 @@
 // engine/src/push/): each recovers the intersecting stack without throwing
 // its cubes, holds a resting box still, and pulls a stretched rod back to its length.
 #include "scene.h"
+#include "state_hash.h"
 
 #include "cps/parameters.h"
 #include "cps/world.h"
@@ -9,6 +10,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -170,5 +172,50 @@ TEST_CASE("a stretched rod returns toward its length under every push method", "
     INFO("error left after 0.5 s: " << left << " m; largest: " << largest << " m");
     CHECK(left < 0.1 * initial);
     CHECK(largest <= initial * (1.0 + 1e-9));
+  }
+}
+
+TEST_CASE("stage timing accounts for a step's time once, by stage, and changes no result",
+          "[push_methods][stages]") {
+  // The stages are disjoint intervals inside the steps, so their sum is bounded by the wall time
+  // of the steps around them; each is >= 0 (other up to the round-off of the subtraction that
+  // makes it); a method's own stages are seen (all but the paper's methods' relax: one solve);
+  // and timing reads a clock, never the physics: the state is bit for bit that of a run without.
+  const scenes::Scene* scene = scenes::find_scene("pyramid_100");
+  REQUIRE(scene != nullptr);
+  for (const char* push : {"baumgarte", "split", "soft", "tgs", "xpbd"}) {
+    CAPTURE(push);
+    scenes::Run timed = scenes::make_run(*scene);
+    WorldDef def = timed.world.def();
+    def.push = static_cast<PushMode>(parameter("push").find_choice(push)->value);
+    timed.world.set_def(def);
+    scenes::Run plain = scenes::make_run(*scene);
+    plain.world.set_def(def);
+    CHECK(timed.world.stage_times().total() == 0.0);  // never turned on
+    timed.world.set_stage_timing(true);
+    const auto start = std::chrono::steady_clock::now();
+    for (int k = 0; k < 20; ++k) timed.world.step();
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (int k = 0; k < 20; ++k) plain.world.step();
+    const StageTimes t = timed.world.stage_times();
+    CHECK(t.total() <= wall);
+    for (const double s : {t.collide, t.rows, t.prepare, t.solve, t.relax, t.integrate, t.store}) {
+      CHECK(s >= 0.0);
+    }
+    CHECK(t.other >= -1e-9);
+    CHECK(t.collide > 0.0);
+    CHECK(t.rows > 0.0);
+    CHECK(t.integrate > 0.0);
+    const std::string p = push;
+    if (p != "xpbd") CHECK(t.solve > 0.0);
+    if (p == "split" || p == "soft" || p == "tgs") CHECK(t.relax > 0.0);
+    if (p == "baumgarte") CHECK(t.relax == 0.0);
+    CHECK(scenes::state_hash(timed.world) == scenes::state_hash(plain.world));
+    // Turned off, the sums stay; turned on again, they start from 0.
+    timed.world.set_stage_timing(false);
+    timed.world.step();
+    CHECK(timed.world.stage_times().collide == t.collide);
+    timed.world.set_stage_timing(true);
+    CHECK(timed.world.stage_times().total() == 0.0);
   }
 }

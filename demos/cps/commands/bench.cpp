@@ -1,5 +1,6 @@
-// `cps bench`: microseconds per physics step (explicit and matrix-free side by side), the cost
-// of warm starting, the cost growth with body count, and milliseconds per rendered frame.
+// `cps bench`: microseconds per physics step (explicit and matrix-free side by side) and where a
+// step goes by stage, the cost of warm starting, the cost growth with body count, and
+// milliseconds per rendered frame.
 #include "command.h"
 #include "options/options.h"
 #include "output/output.h"
@@ -22,10 +23,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -47,12 +50,21 @@ struct StepCost {
   double us = 0.0;        ///< median repeat's microseconds per step
   double rows = 0.0;      ///< rows per step in the window (contact, friction, distance)
   double contacts = 0.0;  ///< contact points per step in the window
+  StageTimes stages;      ///< s per step by stage, from one more repeat with stage timing on
 };
+
+// The stages of StageTimes with their names in the tables and the JSON keys.
+constexpr std::pair<const char*, double StageTimes::*> kStages[] = {
+    {"collide", &StageTimes::collide}, {"rows", &StageTimes::rows},
+    {"prepare", &StageTimes::prepare}, {"solve", &StageTimes::solve},
+    {"relax", &StageTimes::relax},     {"integrate", &StageTimes::integrate},
+    {"store", &StageTimes::store},     {"other", &StageTimes::other}};
 
 // The world is advanced, untimed, to `start_s`; a copy of it is then stepped `steps` times once
 // untimed (the copy's buffers grow to their working size) and `repeats` times timed, each from
 // a fresh copy of the same state, so every repeat times the same window. The median repeat's
-// thread CPU time per step counts. start_s >= 0 (s); steps >= 1; repeats >= 1. warm_start, if
+// thread CPU time per step counts. One more repeat, not in the median, runs with the engine's
+// stage timing on (World::set_stage_timing) for the stages' shares of a step. start_s >= 0 (s); steps >= 1; repeats >= 1. warm_start, if
 // set, replaces the scene's warm starting factor (dimensionless, [0, 1]) from the start.
 StepCost step_cost(const scenes::Scene& scene, Assembly assembly, double start_s, int steps,
                    int repeats, std::optional<double> warm_start = std::nullopt) {
@@ -78,6 +90,11 @@ StepCost step_cost(const scenes::Scene& scene, Assembly assembly, double start_s
     times.push_back(us);
   }
   cost.us = median(times);
+  World world = run.world;
+  world.set_stage_timing(true);
+  for (int k = 0; k < steps; ++k) world.step();
+  cost.stages = world.stage_times();
+  for (const auto& [name, stage] : kStages) cost.stages.*stage /= steps;
   return cost;
 }
 
@@ -284,6 +301,39 @@ nlohmann::json render_table(bool quick, bool markdown) {
 }
 #endif
 
+// The stage times of a step (s per step) as JSON, in us per step.
+nlohmann::json stages_json(const StageTimes& t) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [name, stage] : kStages) j[name] = 1e6 * (t.*stage);
+  return j;
+}
+
+// The Markdown heading of a stage table, for runs of `assembly` (its words).
+std::string stage_table_heading(const std::string& assembly) {
+  std::string h = "Where a step goes (" + assembly +
+                  ": us per step by stage, wall clock, one more repeat of the window with the "
+                  "engine's stage timing on; the shares are of that repeat's total)\n\n| scene";
+  for (const auto& [name, stage] : kStages) h += std::string(" | ") + name;
+  h += " | total |\n|---";
+  for (std::size_t k = 0; k <= std::size(kStages); ++k) h += "|---";
+  return h + "|\n";
+}
+
+// One row of a stage table: us per step and share of the total per stage.
+std::string stage_row(const std::string& scene, const StageTimes& t) {
+  const double total = t.total();
+  std::string row = "| " + scene;
+  for (const auto& [name, stage] : kStages) {
+    char cell[48];
+    std::snprintf(cell, sizeof cell, " | %.1f (%.0f %%)", 1e6 * (t.*stage),
+                  total > 0.0 ? 100.0 * (t.*stage) / total : 0.0);
+    row += cell;
+  }
+  char cell[32];
+  std::snprintf(cell, sizeof cell, " | %.1f |\n", 1e6 * total);
+  return row + cell;
+}
+
 // The options of `cps bench`.
 struct BenchOptions {
   bool quick = false;
@@ -323,6 +373,7 @@ nlohmann::json physics_table(const std::vector<std::string>& names, bool quick, 
                 timed_steps);
   }
   nlohmann::json rows = nlohmann::json::array();
+  std::string stage_rows;  // the stage table's Markdown rows
   for (const std::string& name : names) {
     const scenes::Scene& scene = *scenes::find_scene(name);
     const int steps = window_steps(scene, quick);
@@ -344,7 +395,9 @@ nlohmann::json physics_table(const std::vector<std::string>& names, bool quick, 
                     {"contacts_per_step", m.contacts},
                     {"rows_per_step", m.rows},
                     {"explicit_us_per_step", e.us},
-                    {"matrix_free_us_per_step", m.us}});
+                    {"matrix_free_us_per_step", m.us},
+                    {"matrix_free_stages_us_per_step", stages_json(m.stages)}});
+    stage_rows += stage_row(name, m.stages);
     if (markdown) {
       std::printf("| %s | %zu | %.2f-%.2f | %d | %.1f | %.1f | %.1f | %.1f | %.2fx |\n",
                   name.c_str(), bodies, start, end, repeats, m.contacts, m.rows, e.us, m.us,
@@ -353,6 +406,8 @@ nlohmann::json physics_table(const std::vector<std::string>& names, bool quick, 
     }
   }
   if (markdown) {
+    std::printf("\n%s", stage_table_heading("matrix-free").c_str());
+    std::printf("%s", stage_rows.c_str());
     std::printf("\nWindows:\n\n");
     for (const std::string& name : names) {
       const std::string_view reason = scenes::find_scene(name)->bench.reason;
@@ -503,8 +558,8 @@ int run_bench(const BenchOptions& o) {
 Command add_bench(CLI::App& app) {
   auto o = std::make_shared<BenchOptions>();
   CLI::App* sub = app.add_subcommand(
-      "bench", "microseconds per step (explicit and matrix-free), the cost of warm starting, cost "
-             "growth, ms per frame");
+      "bench", "microseconds per step (explicit and matrix-free) and by stage, the cost of warm "
+             "starting, cost growth, ms per frame");
   sub->add_flag("--quick", o->quick, "smaller scenes and fewer steps (results in us/step, ms/frame)");
   sub->add_flag("--rendering", o->rendering,
                 "only the rendering table (ms per frame at 1280x720: draw, PNG, end to end)");

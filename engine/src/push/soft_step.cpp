@@ -225,22 +225,39 @@ class SoftStep final : public PushMethod {
     const WorldDef& def = *ctx.def;
     std::vector<Body>& bodies = *ctx.bodies;
     const double h = def.dt / static_cast<double>(def.soft_substeps);
-    prepare(ctx, h);
+    {
+      StageTimer timer(ctx, &StageTimes::prepare);
+      prepare(ctx, h);
+    }
     const bool restart = def.soft_relax == SoftRelax::restart;
     for (int k = 0; k < def.soft_substeps; ++k) {
-      integrate_velocities(ctx.f_ext, h);
-      if (restart) save();
-      warm_start();
-      for (int i = 0; i < def.iterations; ++i) solve(/*use_bias=*/true, h);
-      integrate_positions(bodies, h, def.rotation);
+      {
+        StageTimer timer(ctx, &StageTimes::integrate);
+        integrate_velocities(ctx.f_ext, h);
+      }
+      {
+        StageTimer timer(ctx, &StageTimes::solve);
+        if (restart) save();
+        warm_start();
+        for (int i = 0; i < def.iterations; ++i) solve(/*use_bias=*/true, h);
+      }
+      {
+        StageTimer timer(ctx, &StageTimes::integrate);
+        integrate_positions(bodies, h, def.rotation);
+      }
+      StageTimer timer(ctx, &StageTimes::relax);
       if (restart) {
         restore();
         warm_start();
       }
       for (int i = 0; i < def.iterations; ++i) solve(/*use_bias=*/false, h);
     }
-    apply_restitution();
-    store(ctx, h);
+    {
+      StageTimer timer(ctx, &StageTimes::store);
+      apply_restitution();
+      store(ctx, h);
+    }
+    ctx.store_warm_start();
   }
 
  private:
@@ -597,7 +614,7 @@ class SoftStep final : public PushMethod {
     }
   }
 
-  // Stage "store impulses": lambda = P / h per row into ctx, the warm-start cache, and the
+  // Stage "store impulses": lambda = P / h per row into ctx (for the warm-start cache) and the
   // bodies' momenta.
   void store(StepContext& ctx, double h) {
     std::vector<Body>& bodies = *ctx.bodies;
@@ -636,7 +653,6 @@ class SoftStep final : public PushMethod {
     }
     for (const Rod& rod : rods_) ctx.lambda[static_cast<std::size_t>(rod.row)] = rod.impulse * inv_h;
     ctx.lambda_second.clear();
-    ctx.store_warm_start();
   }
 
   std::vector<SolverBody> solver_bodies_;  // n + 1: the bodies, then the static world

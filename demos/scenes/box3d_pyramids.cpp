@@ -57,6 +57,8 @@ WorldDef box3d_world_def() {
   def.friction_model = FrictionModel::coupled;
   def.restitution = 0.0;
   def.contact_margin = 0.02;
+  def.manifold_points = ManifoldPoints::four;
+  def.contact_recycle_distance = 0.05;
   def.contact_hertz = 30.0;
   def.contact_damping_ratio = 10.0;
   def.contact_push_max_speed = 3.0;

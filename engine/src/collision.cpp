@@ -1,6 +1,10 @@
 // Collision dispatch and the box-plane test (paper Sec. 4).
 #include "cps/collision.h"
 
+#include "cps/constraint.h"
+
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace cps {
@@ -148,6 +152,73 @@ int collide(const Body& a, const Body& b, Manifold& out, double margin) {
 int collide(const Body& a, const Mat3& R_a, const Body& b, const Mat3& R_b, Manifold& out,
             double margin) {
   return collide_bodies(a, &R_a, b, &R_b, out, margin);
+}
+
+void reduce_manifold(Manifold& m, double tolerance) {
+  if (m.count <= 4) return;
+  constexpr double kSlack = 0.05;  // a later candidate must score 5 % better (Box3D's 0.95 bias)
+  const auto better = [](double score, double best) { return score > best + kSlack * std::abs(best); };
+  const Vec3 n = m.contacts[0].normal;
+  Vec3 t1;
+  Vec3 t2;
+  tangent_basis(n, t1, t2);
+  const Vec3 across = 0.6 * t1 + 0.8 * t2;  // a fixed direction across the normal
+  const double tol2 = tolerance * tolerance;
+  std::array<Contact, kMaxManifoldPoints> left = m.contacts;
+  int count = m.count;
+  int kept = 0;
+  // Moves candidate i of `left` into m.contacts[kept].
+  const auto keep = [&](int i) {
+    m.contacts[static_cast<std::size_t>(kept++)] = left[static_cast<std::size_t>(i)];
+    left[static_cast<std::size_t>(i)] = left[static_cast<std::size_t>(--count)];
+  };
+  // Picks the best of `left` by score(c), or -1 when none scores above `floor`.
+  const auto pick = [&](auto&& score, double floor) {
+    int best = -1;
+    double best_score = floor;
+    for (int i = 0; i < count; ++i) {
+      const double s = score(left[static_cast<std::size_t>(i)]);
+      if (best < 0 ? s > floor : better(s, best_score)) {
+        best = i;
+        best_score = s;
+      }
+    }
+    return best;
+  };
+  const Vec3 origin = m.contacts[0].point;
+  keep(pick([&](const Contact& c) { return c.depth + across.dot(c.point - origin); }, -kInfinity));
+  const Vec3 a = m.contacts[0].point;
+  const auto plane = [&n](const Vec3& d) { return Vec3(d - d.dot(n) * n); };
+  int i = pick([&](const Contact& c) {
+    const double depth = std::max(c.depth, 0.0);
+    return plane(c.point - a).squaredNorm() + 4.0 * depth * depth;
+  }, tol2);
+  if (i < 0) {
+    m.count = kept;
+    return;
+  }
+  keep(i);
+  const Vec3 ab = m.contacts[1].point - a;
+  i = pick([&](const Contact& c) { return std::abs(n.dot(ab.cross(c.point - a))); }, tol2);
+  if (i < 0) {
+    m.count = kept;
+    return;
+  }
+  keep(i);
+  const Vec3 b = m.contacts[1].point;
+  const Vec3 c3 = m.contacts[2].point;
+  const double sign = n.dot(ab.cross(c3 - a)) < 0.0 ? -1.0 : 1.0;
+  // The area a point adds outside triangle a, b, c: the largest of its signed areas beyond the
+  // triangle's three edges.
+  i = pick([&](const Contact& c) {
+    const Vec3& p = c.point;
+    const double u1 = sign * n.dot((p - a).cross(ab));
+    const double u2 = sign * n.dot((p - b).cross(c3 - b));
+    const double u3 = sign * n.dot((p - c3).cross(a - c3));
+    return std::max(u1, std::max(u2, u3));
+  }, tol2);
+  if (i >= 0) keep(i);
+  m.count = kept;
 }
 
 }  // namespace cps

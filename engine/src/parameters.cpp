@@ -74,6 +74,11 @@ constexpr std::array kFrictionModelChoices = {
     Choice{"fixed", static_cast<int>(FrictionModel::fixed), "Sec. 5.4", "friction limit mu m |g.n|"},
     Choice{"coupled", static_cast<int>(FrictionModel::coupled), "", "friction limit mu lambda_n"},
 };
+constexpr std::array kManifoldPointsChoices = {
+    Choice{"all", static_cast<int>(ManifoldPoints::all), "Sec. 4", "every clipped point (up to 8)"},
+    Choice{"4", static_cast<int>(ManifoldPoints::four), "Box3D",
+           "reduced to 4 points that keep the contact area"},
+};
 constexpr std::array kSoftRelaxChoices = {
     Choice{"continue", static_cast<int>(SoftRelax::continue_solve), "Box3D",
            "relax from the soft solve's impulses"},
@@ -232,6 +237,29 @@ const std::array kParameters = {
                       "0.001 for bodies of 0.5 to 3 m",
               .get = &get_member<&WorldDef::contact_margin>,
               .set = &set_member<&WorldDef::contact_margin>},
+    Parameter{.name = "manifold_points",
+              .flag = "manifold-points",
+              .json_key = "manifold_points",
+              .type = ParameterType::choice,
+              .choices = kManifoldPointsChoices,
+              .help = "which clipped points of a manifold become contact rows: all (up to 8, as "
+                      "in Sec. 4) or 4 that keep the contact area (Box3D's reduction, tolerance "
+                      "contact_margin)",
+              .get = &get_member<&WorldDef::manifold_points>,
+              .set = &set_member<&WorldDef::manifold_points>},
+    Parameter{.name = "contact_recycle_distance",
+              .flag = "contact-recycle-distance",
+              .json_key = "contact_recycle_distance_m",
+              .unit = "m",
+              .type = ParameterType::real,
+              .min = 0.0,
+              .max = 1.0e6,
+              .help = "contact recycling: a manifold is kept, its depths updated, while its "
+                      "bodies move relative to each other by less than this since it was made "
+                      "(and turn less than 10 degrees); 0 = clip every step, as the paper; "
+                      "Box3D's 0.05",
+              .get = &get_member<&WorldDef::contact_recycle_distance>,
+              .set = &set_member<&WorldDef::contact_recycle_distance>},
     Parameter{.name = "penetration_slop",
               .flag = "penetration-slop",
               .json_key = "penetration_slop_m",
@@ -291,6 +319,18 @@ const std::array kParameters = {
                       "push factor's second solve (Sec. 8.1)",
               .get = &get_member<&WorldDef::soft_relax>,
               .set = &set_member<&WorldDef::soft_relax>},
+    Parameter{.name = "threads",
+              .flag = "threads",
+              .json_key = "threads",
+              .unit = "",
+              .type = ParameterType::integer,
+              .min = 1.0,
+              .max = 64.0,
+              .help = "threads a step runs on: push soft shares each graph colour's rows among "
+                      "them, the other methods run on one; the same result for every count; "
+                      "typical: the machine's cores for large scenes",
+              .get = &get_member<&WorldDef::threads>,
+              .set = &set_member<&WorldDef::threads>},
     Parameter{.name = "contact_hertz",
               .flag = "contact-hertz",
               .json_key = "contact_hertz_hz",
@@ -714,6 +754,9 @@ std::string_view name_of(FrictionModel v) {
 }
 std::string_view name_of(RotationUpdate v) {
   return parameter("rotation").choice_name(static_cast<int>(v));
+}
+std::string_view name_of(ManifoldPoints v) {
+  return parameter("manifold_points").choice_name(static_cast<int>(v));
 }
 std::string_view name_of(SoftRelax v) {
   return parameter("soft_relax").choice_name(static_cast<int>(v));

@@ -16,6 +16,7 @@ StepContext::StepContext(const StepContext& other)
       lambda(other.lambda),
       lambda_second(other.lambda_second),
       warm_start(other.warm_start ? std::make_unique<WarmStartCache>(*other.warm_start) : nullptr),
+      recycler(other.recycler ? std::make_unique<ContactRecycler>(*other.recycler) : nullptr),
       counters(other.counters),
       residual(other.residual),
       time_stages(other.time_stages),

@@ -6,6 +6,7 @@
 // solve and integrate stages.
 
 #include "constraint_solver.h"
+#include "contact_recycling.h"
 #include "system.h"
 #include "warm_start.h"
 
@@ -27,10 +28,11 @@ namespace cps {
 struct StepContext;
 
 /// Adds the wall-clock time from its construction to its destruction to one stage of
-/// ctx.stage_times (s), when ctx.time_stages is on; otherwise reads no clock. No errors.
+/// ctx.stage_times (s), when ctx.time_stages and `active` are on (a method on several threads
+/// times on one of them); otherwise reads no clock. No errors.
 class StageTimer {
  public:
-  StageTimer(StepContext& ctx, double StageTimes::*stage);
+  StageTimer(StepContext& ctx, double StageTimes::*stage, bool active = true);
   ~StageTimer();
   StageTimer(const StageTimer&) = delete;
   StageTimer& operator=(const StageTimer&) = delete;
@@ -45,7 +47,7 @@ class StageTimer {
 struct StepContext {
   StepContext() = default;
   /// Copies the last step's results (manifolds, rows, both lambdas), the warm-start cache, the
-  /// counters and the stage timing; the buffers and the solver start empty (nothing in them outlives a step).
+  /// recycled contacts, the counters and the stage timing; the buffers and the solver start empty (nothing in them outlives a step).
   StepContext(const StepContext& other);
   StepContext& operator=(const StepContext&) = delete;
   StepContext(StepContext&&) noexcept = default;
@@ -71,6 +73,8 @@ struct StepContext {
   std::unique_ptr<WarmStartCache> warm_start;
   std::vector<double> initial;
   std::vector<double> initial_second;
+  /// Contact recycling (WorldDef::contact_recycle_distance > 0): the manifolds that may be kept.
+  std::unique_ptr<ContactRecycler> recycler;
   StepCounters counters;
   ResidualStats residual;
   /// World::set_solve_observer's callback, or empty (the usual case: one branch a solve). Not
@@ -119,8 +123,8 @@ struct StepContext {
 
 namespace cps {
 
-inline StageTimer::StageTimer(StepContext& ctx, double StageTimes::*stage) {
-  if (!ctx.time_stages) return;
+inline StageTimer::StageTimer(StepContext& ctx, double StageTimes::*stage, bool active) {
+  if (!ctx.time_stages || !active) return;
   sum_ = &(ctx.stage_times.*stage);
   start_ = std::chrono::steady_clock::now();
 }

@@ -88,6 +88,9 @@ class WarmStartCache {
   std::size_t cached_points() const { return points_.size(); }
   /// Points of the last match() that found their cached point (count), for tests.
   std::size_t matched_points() const { return matched_; }
+  /// Whether this step's contact point k (in row order, after match()) persisted from the last
+  /// step. No errors (false for k out of range).
+  bool matched(std::size_t k) const { return k < match_.size() && match_[k] >= 0; }
 
  private:
   struct CachedManifold {

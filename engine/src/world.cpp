@@ -166,6 +166,14 @@ void World::collide() {
   // Room for the manifolds a world of this size usually has (a body touches a few others); a
   // crowded step grows it as it finds them, never to a worst case of one per pair.
   detail::reserve_with_headroom(manifolds, std::min(pairs_.size(), 8 * bodies_.size()));
+  // Contact recycling: a pair that barely moved keeps last step's manifold (contact_recycling.h).
+  const double recycle = def_.contact_recycle_distance;
+  if (recycle > 0.0) {
+    if (!ctx_->recycler) ctx_->recycler = std::make_unique<ContactRecycler>();
+    ctx_->recycler->begin_step();
+  } else {
+    ctx_->recycler.reset();
+  }
   std::size_t points = 0;
   for (const auto& [a, b] : pairs_) {
     ++counters.pairs_tested;
@@ -177,7 +185,11 @@ void World::collide() {
     const auto ib = static_cast<std::size_t>(b);
     const double margin =
         per_body ? def_.contact_margin + margins_[ia] + margins_[ib] : def_.contact_margin;
-    if (cps::collide(bodies_[ia], rotations_[ia], bodies_[ib], rotations_[ib], m, margin) > 0) {
+    const bool recycled = recycle > 0.0 && ctx_->recycler->recycle(a, b, bodies_, recycle, m);
+    if (recycled || cps::collide(bodies_[ia], rotations_[ia], bodies_[ib], rotations_[ib], m, margin) > 0) {
+      if (!recycled && def_.manifold_points == ManifoldPoints::four) reduce_manifold(m, def_.contact_margin);
+      if (recycle > 0.0) ctx_->recycler->keep(m, bodies_, recycled);
+      counters.recycled += recycled ? 1 : 0;
       counters.contacts += m.count;
       points += static_cast<std::size_t>(m.count);
       if (points > kMaxContactPoints) {
@@ -190,6 +202,7 @@ void World::collide() {
       manifolds.pop_back();
     }
   }
+  if (recycle > 0.0) ctx_->recycler->end_step();
 }
 // Stage 2, Sec. 5: contact rows, friction rows, then distance rows.
 void World::build_rows() {

@@ -1,10 +1,15 @@
 // Collision detection (paper Sec. 4): box-plane and box-box manifolds against geometry worked
 // out by hand.
+#include "contact_recycling.h"
+#include "scene.h"
+#include "state_hash.h"
+
 #include "cps/collision.h"
 #include "cps/world.h"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -339,4 +344,192 @@ TEST_CASE("the broad phase finds the manifolds of the all-pairs test, in index o
       CHECK(found[k].contacts[c].depth == expected[k].contacts[c].depth);
     }
   }
+}
+
+namespace {
+
+// The area (m^2) of the convex polygon through `points` (in the plane y = const), taken in
+// angular order about their mean.
+double polygon_area_xz(std::vector<Vec3> points) {
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : points) mean += p / static_cast<double>(points.size());
+  std::sort(points.begin(), points.end(), [&mean](const Vec3& a, const Vec3& b) {
+    return std::atan2(a.z() - mean.z(), a.x() - mean.x()) < std::atan2(b.z() - mean.z(), b.x() - mean.x());
+  });
+  double twice = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
+    const Vec3& q = points[(i + 1) % points.size()];
+    twice += p.x() * q.z() - q.x() * p.z();
+  }
+  return 0.5 * std::abs(twice);
+}
+
+}  // namespace
+
+TEST_CASE("reducing a manifold to 4 points keeps clipped points that hold the contact area",
+          "[collision][manifold]") {
+  // The turned box's octagon of 8 points (above) is reduced to 4 of its corners. A box resting on
+  // the kept points alone must still be supported: its centre's projection (the octagon's centre,
+  // the origin) lies inside them, and they span at least half the octagon's area (a square on
+  // alternate corners spans 0.71 of a regular octagon; the best 4 of the 8 no more than that).
+  // Then the box is tilted: its deepest point must be among those kept, since it carries the
+  // most load.
+  const Mat3 R = rotation(M_PI / 4.0, Vec3::UnitY());
+  const OrientedBox lower = box_at(Vec3::Zero(), Vec3::Ones());
+  for (const double tilt : {0.0, 0.01}) {
+    CAPTURE(tilt);
+    const OrientedBox upper = box_at(Vec3(0, 1.95, 0), Vec3::Ones(), rotation(tilt, Vec3::UnitX()) * R);
+    Manifold m;
+    REQUIRE(collide_box_box(lower, upper, m) == 8);
+    const Manifold full = m;
+    reduce_manifold(m, 0.02);
+    REQUIRE(m.count == 4);
+    std::vector<Vec3> all;
+    std::vector<Vec3> kept;
+    double deepest = -kInfinity;
+    for (int i = 0; i < full.count; ++i) {
+      all.push_back(full.contacts[static_cast<std::size_t>(i)].point);
+      deepest = std::max(deepest, full.contacts[static_cast<std::size_t>(i)].depth);
+    }
+    double deepest_kept = -kInfinity;
+    for (int i = 0; i < m.count; ++i) {
+      const Contact& c = m.contacts[static_cast<std::size_t>(i)];
+      kept.push_back(c.point);
+      deepest_kept = std::max(deepest_kept, c.depth);
+      bool found = false;  // one of the clipped points, unchanged
+      for (int j = 0; j < full.count; ++j) {
+        const Contact& o = full.contacts[static_cast<std::size_t>(j)];
+        found = found || (o.feature == c.feature && o.point == c.point && o.depth == c.depth &&
+                          o.normal == c.normal);
+      }
+      CHECK(found);
+    }
+    CHECK(deepest_kept == deepest);
+    const double area = polygon_area_xz(kept);
+    CHECK(area >= 0.5 * polygon_area_xz(all));
+    // The origin inside the kept quadrilateral: the four triangles it makes with the edges
+    // add up to the quadrilateral's area.
+    double around = 0.0;
+    std::vector<Vec3> sorted = kept;
+    std::sort(sorted.begin(), sorted.end(),
+              [](const Vec3& a, const Vec3& b) { return std::atan2(a.z(), a.x()) < std::atan2(b.z(), b.x()); });
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+      const Vec3& p = sorted[i];
+      const Vec3& q = sorted[(i + 1) % sorted.size()];
+      around += 0.5 * std::abs(p.x() * q.z() - q.x() * p.z());
+    }
+    CHECK(around == Approx(area).epsilon(1e-9));
+  }
+  // At most 4 points: left as they are.
+  Manifold four;
+  REQUIRE(collide_box_box(lower, box_at(Vec3(0, 1.95, 0), Vec3::Ones()), four) == 4);
+  const Manifold before = four;
+  reduce_manifold(four, 0.02);
+  CHECK(four.count == 4);
+  for (int i = 0; i < 4; ++i) CHECK(four.contacts[static_cast<std::size_t>(i)].point == before.contacts[static_cast<std::size_t>(i)].point);
+}
+
+TEST_CASE("contact recycling keeps a manifold while the bodies barely move, with the depths a "
+          "new clip gives", "[collision][recycling]") {
+  // A box of 1 m resting 1 cm deep on the ground. Moved rigidly by less than the recycling
+  // distance, its manifold is kept: the same feature ids, each point midway between where the
+  // ground and the box have carried it (half the box's motion), its depth changed by the box's
+  // motion along the normal, exactly what clipping again gives for a
+  // move along the normal and a slide within the face. Moved further than the distance, or
+  // turned by more than 10 degrees, it is not kept (the bound of contact_recycling.h: the
+  // relative motion plus 2 sin(turn / 2) times the bounding radius, 0.866 m).
+  std::vector<Body> bodies;
+  bodies.push_back(make_body({Shape::plane(Vec3::UnitY(), 0.0), true}));
+  BodyDef box_def;
+  box_def.shape = Shape::box(Vec3::Constant(0.5));
+  box_def.position = Vec3(0.0, 0.49, 0.0);
+  bodies.push_back(make_body(box_def));
+  Manifold first;
+  REQUIRE(collide(bodies[0], bodies[1], first, 0.02) == 4);
+  first.body_a = 0;  // as the collide stage names them
+  first.body_b = 1;
+  ContactRecycler recycler;
+  recycler.begin_step();
+  recycler.keep(first, bodies, false);
+  recycler.end_step();
+
+  const auto moved = [&](const Vec3& dx, double turn_deg) {
+    std::vector<Body> b = bodies;
+    b[1].x += dx;
+    b[1].o = Quat(Eigen::AngleAxisd(turn_deg * M_PI / 180.0, Vec3::UnitY())) * b[1].o;
+    return b;
+  };
+  {
+    const std::vector<Body> b = moved(Vec3(0.01, -0.003, 0.02), 0.0);
+    recycler.begin_step();
+    Manifold kept;
+    REQUIRE(recycler.recycle(0, 1, b, 0.05, kept));
+    Manifold fresh;
+    REQUIRE(collide(b[0], b[1], fresh, 0.02) == 4);
+    REQUIRE(kept.count == 4);
+    for (int i = 0; i < 4; ++i) {
+      const Contact& k = kept.contacts[static_cast<std::size_t>(i)];
+      const Contact& o = first.contacts[static_cast<std::size_t>(i)];
+      CHECK(k.feature == o.feature);
+      CHECK(k.normal == o.normal);
+      CHECK((k.point - (o.point + 0.5 * Vec3(0.01, -0.003, 0.02))).norm() < 1e-12);
+      CHECK(k.depth == Approx(o.depth + 0.003).margin(1e-12));
+      bool same = false;  // the new clip's point of the same feature: the same depth
+      for (int j = 0; j < 4; ++j) {
+        const Contact& f = fresh.contacts[static_cast<std::size_t>(j)];
+        if (f.feature == k.feature) same = std::abs(f.depth - k.depth) < 1e-12;
+      }
+      CHECK(same);
+    }
+    recycler.keep(kept, b, true);
+    recycler.end_step();
+  }
+  // The motion adds up from the pose of the clip, not from the last recycling: 0.03 m more
+  // passes the 0.05 m distance.
+  {
+    recycler.begin_step();
+    Manifold kept;
+    CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3(0.04, 0.0, 0.03), 0.0), 0.05, kept));
+    recycler.end_step();
+  }
+  // Turns: 3 degrees moves the box's corners by 2 sin(1.5 deg) 0.866 = 0.045 m, kept at 0.05;
+  // 12 degrees is past the turn limit at any distance.
+  recycler.begin_step();
+  recycler.keep(first, bodies, false);
+  recycler.end_step();
+  recycler.begin_step();
+  Manifold kept;
+  CHECK(recycler.recycle(0, 1, moved(Vec3::Zero(), 3.0), 0.05, kept));
+  recycler.begin_step();
+  CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3::Zero(), 3.0), 0.04, kept));
+  recycler.begin_step();
+  CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3::Zero(), 12.0), 100.0, kept));
+  // Another pair than the cached one is never recycled.
+  recycler.begin_step();
+  CHECK_FALSE(recycler.recycle(0, 2, bodies, 0.05, kept));
+}
+
+TEST_CASE("a world with contact recycling and reduced manifolds steps its copy as itself",
+          "[collision][recycling]") {
+  // The recycled manifolds are part of the state a step depends on: a copy made mid-run must
+  // keep them and end bit for bit where the original ends. The pile recycles most of its
+  // manifolds (a check that the test exercises recycling at all).
+  const scenes::Scene* scene = scenes::find_scene("pyramid_100");
+  REQUIRE(scene != nullptr);
+  scenes::Run run = scenes::make_run(*scene);
+  WorldDef def = run.world.def();
+  def.contact_margin = 0.02;
+  def.contact_recycle_distance = 0.05;
+  def.manifold_points = ManifoldPoints::four;
+  def.warm_start = 0.8;
+  run.world.set_def(def);
+  for (int k = 0; k < 120; ++k) run.world.step();
+  CHECK(run.world.counters().recycled > run.world.counters().steps * 10);
+  World copy = run.world;
+  for (int k = 0; k < 60; ++k) {
+    run.world.step();
+    copy.step();
+  }
+  CHECK(scenes::state_hash(copy) == scenes::state_hash(run.world));
 }

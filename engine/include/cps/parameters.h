@@ -71,6 +71,12 @@ enum class RotationUpdate {
 };
 
 /// Where the soft step's relax (push soft, engine/src/push/soft_step.cpp) starts each substep.
+/// Which of a manifold's clipped points become contact rows (WorldDef::manifold_points).
+enum class ManifoldPoints {
+  all,   ///< every point of the clipping (up to 8), as the paper's Sec. 4
+  four,  ///< reduced to 4 (collision.h, reduce_manifold), as Box3D, Jolt and Bullet do
+};
+
 enum class SoftRelax {
   continue_solve,  ///< from the soft solve's accumulated impulses, as Box3D and Box2D v3 relax
   restart,         ///< from the velocities before the soft solve and the last relax's impulses
@@ -104,6 +110,16 @@ struct WorldDef {
   /// 1e-3 m for bodies of 0.5 to 3 m. Push xpbd adds its own distance per body on top of it
   /// (engine/src/push/xpbd.cpp).
   double contact_margin = 0.0;
+  /// Which clipped points a manifold keeps (ManifoldPoints): all of them (the default, the
+  /// paper's Sec. 4) or 4, chosen to keep the contact area (Box3D's reduction; the tolerance is
+  /// contact_margin). Fewer rows a step; a face contact's support is kept.
+  ManifoldPoints manifold_points = ManifoldPoints::all;
+  /// Contact recycling distance (m, >= 0): while two bodies' points have moved relative to each
+  /// other by less than this since their manifold was made (and neither has turned by more than
+  /// 10 degrees), the collide stage keeps that manifold, its points fixed to the bodies, and
+  /// updates only their depths (engine/src/contact_recycling.h). 0 (the default) clips every
+  /// step, as the paper. Box3D's: 0.05 m (ten times its linear slop).
+  double contact_recycle_distance = 0.0;
   /// Penetration slop (m) >= 0: the push of a contact row (Eq. 5.3.1, and the second solve's
   /// target of Sec. 8.1) corrects only the depth beyond it, beta max(d - slop, 0) / dt, so a
   /// resting contact settles about `slop` deep instead of being pushed out of contact and
@@ -129,6 +145,11 @@ struct WorldDef {
   int soft_substeps = 4;
   /// Soft step only: where each substep's relax starts (SoftRelax). Box3D's: continue_solve.
   SoftRelax soft_relax = SoftRelax::continue_solve;
+  /// Threads a step runs on (count, in [1, 64]; the calling thread is one of them). The soft
+  /// step shares each graph colour's rows among them (engine/src/constraint_graph.h); the
+  /// other methods run on one thread. The result is the same for every count, bit for bit.
+  /// Typical: the machine's cores for large scenes; 1 (the default) for small ones.
+  int threads = 1;
   /// Soft step only: the contact rows' stiffness (Hz, >= 0; 0 = rigid rows without push), capped
   /// at an eighth of the substep rate; contacts with a static body get twice it. Box3D's
   /// default: 30.
@@ -286,6 +307,7 @@ std::string_view name_of(PushMode v);
 std::string_view name_of(SolverKind v);
 std::string_view name_of(FrictionModel v);
 std::string_view name_of(RotationUpdate v);
+std::string_view name_of(ManifoldPoints v);
 std::string_view name_of(SoftRelax v);
 std::string_view name_of(Assembly v);
 

@@ -52,6 +52,7 @@ struct StepCounters {
   std::int64_t steps = 0;
   std::int64_t pairs_tested = 0;  ///< body pairs handed to the narrow phase
   std::int64_t contacts = 0;      ///< contact points found
+  std::int64_t recycled = 0;      ///< manifolds kept from the step before (contact recycling)
   std::int64_t rows = 0;          ///< constraint rows built
   std::int64_t solves = 0;        ///< solves of A lambda = b
 };

@@ -28,7 +28,8 @@
 //   each substep:
 //     1. integrate velocities: v += h m^-1 f, w += h I^-1 tau (f_ext, Sec. 6.1);
 //     2. warm start: every row's accumulated impulse applied to the velocities;
-//     3. solve (bias on), `iterations` sweeps: rods, then per manifold its contact points. A
+//     3. solve (bias on), `iterations` sweeps: per graph colour its rods, then its manifolds'
+//        contact points (below). A
 //        point with current separation s > 0 is speculative: rigid, bias s / h (the points may
 //        close the gap within the substep, no further). Else the row is soft with the push
 //        max(mass scale x bias rate x min(s + slop, 0), -contact_push_max_speed) (Box3D's
@@ -69,21 +70,33 @@
 // chain_20 (1.36 J in a step), the stack at dt = 0.1 s (0.20 J) and the heavy ball on the grid
 // (0.15 J), where restart keeps the bound (tests/physics/test_stress.cpp, "[push_methods]").
 //
-// Differences from Box3D: double precision, one thread, manifolds in the collide stage's order
-// (no graph colouring); the manifolds as the collide stage makes them (up to 8 points; Box3D
-// reduces to 4); the twist starts each step from 0; no rolling resistance, no gyroscopic term
-// (Box3D integrates one; for the spheres and cubes of the scenes it is zero), no speed caps on
-// the bodies (Box3D clamps at 400 m/s and a quarter turn a step).
+// Sweep order: the rods and manifolds are graph-coloured once a step (constraint_graph.h, Box3D's
+// constraint graph: 23 colours and an overflow; the rods first, then the manifolds, each in
+// order); the warm start, solve and relax sweep the overflow in order, then colour by colour. The rows
+// of a colour share no moving body, so WorldDef::threads threads share each colour's rows
+// (workers.h; a barrier after each colour) and every count gives the same result.
+//
+// Differences from Box3D: double precision, no SIMD lanes; the manifolds as the collide stage
+// makes them (WorldDef::manifold_points and contact_recycle_distance choose Box3D's 4 points and
+// its recycling; Box3D's recycled anchors stay as they were, a cps point is midway between the
+// bodies' material points); the twist warm starts only when all of a manifold's points
+// persisted; no rolling resistance, no gyroscopic term (Box3D integrates one; for the spheres and
+// cubes of the scenes it is zero), no speed caps on the bodies (Box3D clamps at 400 m/s and a
+// quarter turn a step).
 // The solvers of A lambda = b (--solver, --assembly) play no part: the rows are swept as the
 // source sweeps them, Gauss-Seidel over body velocities.
 
 #include "push_method.h"
 
 #include "../buffers.h"
+#include "../constraint_graph.h"
 #include "../integrator.h"
+#include "../workers.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <utility>
 #include <vector>
@@ -223,35 +236,14 @@ class SoftStep final : public PushMethod {
 
   void step(StepContext& ctx) override {
     const WorldDef& def = *ctx.def;
-    std::vector<Body>& bodies = *ctx.bodies;
     const double h = def.dt / static_cast<double>(def.soft_substeps);
+    if (!workers_ || workers_->count() != def.threads) workers_ = std::make_unique<Workers>(def.threads);
     {
       StageTimer timer(ctx, &StageTimes::prepare);
       prepare(ctx, h);
     }
-    const bool restart = def.soft_relax == SoftRelax::restart;
-    for (int k = 0; k < def.soft_substeps; ++k) {
-      {
-        StageTimer timer(ctx, &StageTimes::integrate);
-        integrate_velocities(ctx.f_ext, h);
-      }
-      {
-        StageTimer timer(ctx, &StageTimes::solve);
-        if (restart) save();
-        warm_start();
-        for (int i = 0; i < def.iterations; ++i) solve(/*use_bias=*/true, h);
-      }
-      {
-        StageTimer timer(ctx, &StageTimes::integrate);
-        integrate_positions(bodies, h, def.rotation);
-      }
-      StageTimer timer(ctx, &StageTimes::relax);
-      if (restart) {
-        restore();
-        warm_start();
-      }
-      for (int i = 0; i < def.iterations; ++i) solve(/*use_bias=*/false, h);
-    }
+    auto substeps = [this, &ctx, h](int t) { run_substeps(ctx, h, t); };
+    workers_->run(substeps);
     {
       StageTimer timer(ctx, &StageTimes::store);
       apply_restitution();
@@ -272,7 +264,9 @@ class SoftStep final : public PushMethod {
     const auto guess = [&](std::size_t r) { return warm != nullptr ? (*warm)[r] * h : 0.0; };
 
     const std::size_t n = bodies.size();
-    detail::resize_with_headroom(solver_bodies_, n + 1);
+    bodies_ = n;
+    const auto threads = static_cast<std::size_t>(workers_->count());
+    detail::resize_with_headroom(solver_bodies_, n + threads);
     detail::resize_with_headroom(inertia_, n);
     for (std::size_t i = 0; i < n; ++i) {
       const Body& body = bodies[i];
@@ -285,8 +279,13 @@ class SoftStep final : public PushMethod {
       s.w = s.inv_I * body.l;
       inertia_[i] = s.inv_I.inverse();
     }
-    solver_bodies_[n] = SolverBody{};  // the static world (kWorldBody)
+    for (std::size_t t = 0; t < threads; ++t) solver_bodies_[n + t] = SolverBody{};  // stand-ins
+    // A static body and the world (kWorldBody) are -1 in the sweeps (body()); read here, a
+    // static body's entry and the stand-in n are both zero.
     const auto index = [n](int body) { return body == kWorldBody ? n : static_cast<std::size_t>(body); };
+    const auto moving = [&bodies](int body) {
+      return body == kWorldBody || bodies[static_cast<std::size_t>(body)].is_static() ? -1 : body;
+    };
 
     // Box3D's softness of a step (b3World_Step, b3PrepareJoint).
     const double contact_hertz = std::min(def.contact_hertz, 0.125 / h);
@@ -302,19 +301,30 @@ class SoftStep final : public PushMethod {
     // Box3D's friction centre weight: 1 for touching points, falling to 0 past twice the
     // speculative distance (m).
     const double inv_tau = 1.0 / std::max(def.contact_margin, 1e-9);
+    const std::vector<DistanceConstraint>& distances = *ctx.distances;
+    colour(ctx.manifolds, distances, moving);
+    // Each manifold's first contact row (its points' rows follow in order).
+    first_row_.resize(ctx.manifolds.size());
+    for (std::size_t k = 0, g = 0; k < ctx.manifolds.size(); ++k) {
+      first_row_[k] = g;
+      g += static_cast<std::size_t>(ctx.manifolds[k].count);
+    }
+    // The manifolds and their points stored colour by colour (manifold_order_), so that a
+    // colour's sweep reads them in order.
     contacts_.clear();
     detail::reserve_with_headroom(contacts_, points);
     manifolds_.clear();
     detail::reserve_with_headroom(manifolds_, ctx.manifolds.size());
-    std::size_t g = 0;       // the point's index over the step: its contact row
-    for (const Manifold& m : ctx.manifolds) {
+    for (const std::size_t k : manifold_order_) {
+      const Manifold& m = ctx.manifolds[k];
+      std::size_t g = first_row_[k];  // the point's index over the step: its contact row
       const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];
       const Body& body_b = bodies[static_cast<std::size_t>(m.body_b)];
       const SolverBody& a = solver_bodies_[static_cast<std::size_t>(m.body_a)];
       const SolverBody& b = solver_bodies_[static_cast<std::size_t>(m.body_b)];
       ManifoldFriction& f = manifolds_.emplace_back();
-      f.a = m.body_a;
-      f.b = m.body_b;
+      f.a = moving(m.body_a);
+      f.b = moving(m.body_b);
       f.begin = contacts_.size();
       f.normal = m.contacts[0].normal;
       Vec3 center_a = Vec3::Zero();
@@ -323,8 +333,8 @@ class SoftStep final : public PushMethod {
       for (int i = 0; i < m.count; ++i, ++g) {
         const Contact& c = m.contacts[static_cast<std::size_t>(i)];
         ContactPoint& p = contacts_.emplace_back();
-        p.a = m.body_a;
-        p.b = m.body_b;
+        p.a = f.a;
+        p.b = f.b;
         p.row = static_cast<int>(g);
         p.r_a = c.point - body_a.x;
         p.r_b = c.point - body_b.x;
@@ -339,12 +349,12 @@ class SoftStep final : public PushMethod {
       }
       f.end = contacts_.size();
       if (!friction) continue;
+      const std::size_t first = points + 2 * first_row_[k];
       f.center_a = center_a / total_weight;
       f.center_b = center_b / total_weight;
       for (std::size_t i = f.begin; i < f.end; ++i) {
         contacts_[i].lever_arm = (contacts_[i].r_a - f.center_a).norm();
       }
-      const std::size_t first = points + 2 * f.begin;
       f.first_friction_row = static_cast<int>(first);
       f.mu = rows[first].mu;
       f.fixed_limit = coupled ? -1.0 : rows[first].c_max * h;
@@ -361,32 +371,37 @@ class SoftStep final : public PushMethod {
       const double k_twist = f.normal.dot((a.inv_I + b.inv_I) * f.normal);
       f.twist_mass = k_twist > 0.0 ? 1.0 / k_twist : 0.0;
       // The warm start: the friction rows' initial lambdas (N, store() below) summed back into
-      // the force at the centre, as an impulse over h. The twist starts from 0 each step (Box3D
-      // warm starts it too; here, taken back from the rows, it spun large_pyramid's bottom boxes
-      // about their normals at up to 11 rad/s within 1 s: docs/findings.md).
+      // the force at the centre and its twist about the normal, as impulses over h. The twist
+      // only when every point of the manifold persisted: of a part of the points, their forces'
+      // moment about the new centre is not the twist they carried, and warm starting that
+      // spun large_pyramid's bottom boxes about their normals at up to 11 rad/s within 1 s.
       if (warm != nullptr) {
         Vec3 P = Vec3::Zero();
+        double L = 0.0;
+        bool all_persisted = ctx.warm_start != nullptr;
         for (std::size_t i = f.begin; i < f.end; ++i) {
           const std::size_t r = first + 2 * (i - f.begin);
           const Vec3 F = h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
           P += F;
+          L += f.normal.dot((contacts_[i].r_a - f.center_a).cross(F));
+          all_persisted = all_persisted && ctx.warm_start->matched(static_cast<std::size_t>(contacts_[i].row));
         }
         f.impulse = Eigen::Vector2d(P.dot(f.t1), P.dot(f.t2));
+        f.twist_impulse = all_persisted ? L : 0.0;
       }
     }
 
-    const std::vector<DistanceConstraint>& distances = *ctx.distances;
     const std::size_t first_rod = points * (friction ? 3 : 1);
     rods_.clear();
     detail::reserve_with_headroom(rods_, distances.size());
-    for (std::size_t r = 0; r < distances.size(); ++r) {
+    for (const std::size_t r : rod_order_) {
       const DistanceConstraint& d = distances[r];
       Vec3 p_a;
       Vec3 p_b;
       distance_endpoints(d, bodies, p_a, p_b);
       Rod& rod = rods_.emplace_back();
-      rod.a = static_cast<int>(index(d.body_a));
-      rod.b = static_cast<int>(index(d.body_b));
+      rod.a = moving(d.body_a);
+      rod.b = moving(d.body_b);
       rod.row = static_cast<int>(first_rod + r);
       const Vec3 x_a = bodies[static_cast<std::size_t>(d.body_a)].x;
       const Vec3 x_b = d.body_b == kWorldBody ? Vec3::Zero() : bodies[static_cast<std::size_t>(d.body_b)].x;
@@ -399,6 +414,104 @@ class SoftStep final : public PushMethod {
                                           solver_bodies_[index(d.body_b)], 0.0);
       rod.mass = axial.mass;
       rod.impulse = guess(first_rod + r);
+    }
+  }
+
+  // Colours the rods, then the manifolds, in order (constraint_graph.h; `moving` maps a body
+  // index to itself or to -1 for a static body and the world), and lists each colour's in
+  // order.
+  template <class Moving>
+  void colour(const std::vector<Manifold>& manifolds, const std::vector<DistanceConstraint>& distances,
+              Moving&& moving) {
+    graph_.reset(bodies_);
+    rod_colour_.clear();
+    for (const DistanceConstraint& d : distances) rod_colour_.push_back(graph_.add(moving(d.body_a), moving(d.body_b)));
+    manifold_colour_.clear();
+    for (const Manifold& m : manifolds) manifold_colour_.push_back(graph_.add(moving(m.body_a), moving(m.body_b)));
+    order_by_colour(rod_colour_, rod_start_, rod_order_);
+    order_by_colour(manifold_colour_, manifold_start_, manifold_order_);
+  }
+
+  // A counting sort of item indices by colour: order lists them colour by colour, each colour's
+  // in index order, and colour c's are order[start[c], start[c + 1]).
+  static void order_by_colour(const std::vector<int>& colours,
+                              std::array<std::size_t, ConstraintGraph::kColours + 1>& start,
+                              std::vector<std::size_t>& order) {
+    start.fill(0);
+    for (const int c : colours) ++start[static_cast<std::size_t>(c) + 1];
+    for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+    order.resize(colours.size());
+    std::array<std::size_t, ConstraintGraph::kColours + 1> next = start;
+    for (std::size_t i = 0; i < colours.size(); ++i) order[next[static_cast<std::size_t>(colours[i])]++] = i;
+  }
+
+
+  // The substeps, as thread t of workers_ runs them (every thread runs this with its own t and
+  // they meet at workers_->sync()): each sweeps its share of every colour's rods and manifolds
+  // and of the bodies; thread 0 alone sweeps the overflow, runs the restart variant's save and
+  // restore, and times the stages.
+  void run_substeps(StepContext& ctx, double h, int t) {
+    const WorldDef& def = *ctx.def;
+    const bool restart = def.soft_relax == SoftRelax::restart;
+    const bool main = t == 0;
+    for (int k = 0; k < def.soft_substeps; ++k) {
+      {
+        StageTimer timer(ctx, &StageTimes::integrate, main);
+        integrate_velocities(ctx.f_ext, h, t);
+        workers_->sync();
+      }
+      {
+        StageTimer timer(ctx, &StageTimes::solve, main);
+        if (restart) {
+          if (main) save();
+          workers_->sync();
+        }
+        warm_start(t);
+        for (int i = 0; i < def.iterations; ++i) solve(/*use_bias=*/true, h, t);
+      }
+      {
+        StageTimer timer(ctx, &StageTimes::integrate, main);
+        integrate_positions(*ctx.bodies, h, def.rotation, t);
+        workers_->sync();
+      }
+      StageTimer timer(ctx, &StageTimes::relax, main);
+      if (restart) {
+        if (main) restore();
+        workers_->sync();
+        warm_start(t);
+      }
+      for (int i = 0; i < def.iterations; ++i) solve(/*use_bias=*/false, h, t);
+    }
+  }
+
+  // Thread t's share [begin, end) of `count` items split evenly over the threads.
+  std::pair<std::size_t, std::size_t> share(std::size_t count, int t) const {
+    const auto threads = static_cast<std::size_t>(workers_->count());
+    const auto k = static_cast<std::size_t>(t);
+    return {count * k / threads, count * (k + 1) / threads};
+  }
+
+  // Calls rod_fn(rod, t) and manifold_fn(manifold, t) for the overflow's rods and manifolds
+  // (thread 0, in order), then for thread t's share of each colour's, colour by colour, with a
+  // barrier after each (Box3D's order: b3SolverStep).
+  template <class RodFn, class ManifoldFn>
+  void sweep_colours(int t, RodFn&& rod_fn, ManifoldFn&& manifold_fn) {
+    for (int k = 0; k < ConstraintGraph::kColours; ++k) {
+      const bool overflow = k == 0;
+      const auto c = static_cast<std::size_t>(overflow ? ConstraintGraph::kOverflow : k - 1);
+      const std::size_t rods = rod_start_[c + 1] - rod_start_[c];
+      const std::size_t manifolds = manifold_start_[c + 1] - manifold_start_[c];
+      if (rods + manifolds == 0) continue;  // every thread sees the same counts
+      if (!overflow || t == 0) {
+        const auto [rb, re] = overflow ? std::pair<std::size_t, std::size_t>{0, rods} : share(rods, t);
+        for (std::size_t i = rb; i < re; ++i) rod_fn(rods_[rod_start_[c] + i], t);
+        const auto [mb, me] =
+            overflow ? std::pair<std::size_t, std::size_t>{0, manifolds} : share(manifolds, t);
+        for (std::size_t i = mb; i < me; ++i) {
+          manifold_fn(manifolds_[manifold_start_[c] + i], t);
+        }
+      }
+      workers_->sync();
     }
   }
 
@@ -423,10 +536,11 @@ class SoftStep final : public PushMethod {
     for (Rod& rod : rods_) rod.impulse = saved_impulses_[k++];
   }
 
-  // Stage "integrate velocities": f_ext (6n: force and torque per body, N and N m) over h.
-  void integrate_velocities(const Eigen::VectorXd& f_ext, double h) {
-    const std::size_t n = solver_bodies_.size() - 1;
-    for (std::size_t i = 0; i < n; ++i) {
+  // Stage "integrate velocities": f_ext (6n: force and torque per body, N and N m) over h, for
+  // thread t's share of the bodies.
+  void integrate_velocities(const Eigen::VectorXd& f_ext, double h, int t) {
+    const auto [begin, end] = share(bodies_, t);
+    for (std::size_t i = begin; i < end; ++i) {
       SolverBody& s = solver_bodies_[i];
       if (s.inv_mass == 0.0) continue;
       const auto k = 6 * static_cast<Eigen::Index>(i);
@@ -435,10 +549,15 @@ class SoftStep final : public PushMethod {
     }
   }
 
+  // The solver body of index i (>= 0), or for -1 (a static body, the world) thread t's stand-in:
+  // static bodies are never written, and each thread writes the zero updates of its own.
+  SolverBody& body(int i, int t) {
+    return solver_bodies_[i >= 0 ? static_cast<std::size_t>(i) : bodies_ + static_cast<std::size_t>(t)];
+  }
+
   // A rod's current anchors (m) and the vector from its a end to its b end (m).
-  void rod_geometry(const Rod& rod, Vec3& r_a, Vec3& r_b, Vec3& separation) const {
-    const SolverBody& a = solver_bodies_[static_cast<std::size_t>(rod.a)];
-    const SolverBody& b = solver_bodies_[static_cast<std::size_t>(rod.b)];
+  static void rod_geometry(const Rod& rod, const SolverBody& a, const SolverBody& b, Vec3& r_a,
+                           Vec3& r_b, Vec3& separation) {
     r_a = a.dR * rod.r_a;
     r_b = b.dR * rod.r_b;
     separation = rod.delta_center + (b.dp - a.dp) + (r_b - r_a);
@@ -450,9 +569,8 @@ class SoftStep final : public PushMethod {
   }
 
   // Applies impulse P (N s) along `axis` at the current anchors of a rod.
-  void apply_rod(const Rod& rod, const Vec3& r_a, const Vec3& r_b, const Vec3& axis, double P) {
-    SolverBody& a = solver_bodies_[static_cast<std::size_t>(rod.a)];
-    SolverBody& b = solver_bodies_[static_cast<std::size_t>(rod.b)];
+  static void apply_rod(const Vec3& r_a, const Vec3& r_b, const Vec3& axis, double P, SolverBody& a,
+                        SolverBody& b) {
     const Vec3 impulse = P * axis;
     a.v -= a.inv_mass * impulse;
     a.w -= a.inv_I * r_a.cross(impulse);
@@ -460,23 +578,27 @@ class SoftStep final : public PushMethod {
     b.w += b.inv_I * r_b.cross(impulse);
   }
 
-  // Stage "warm start": every accumulated impulse applied to the velocities.
-  void warm_start() {
-    for (const Rod& rod : rods_) {
-      Vec3 r_a;
-      Vec3 r_b;
-      Vec3 separation;
-      rod_geometry(rod, r_a, r_b, separation);
-      apply_rod(rod, r_a, r_b, axis_of(separation, rod.axis0), rod.impulse);
-    }
-    for (const ManifoldFriction& f : manifolds_) {
-      SolverBody& a = solver_bodies_[static_cast<std::size_t>(f.a)];
-      SolverBody& b = solver_bodies_[static_cast<std::size_t>(f.b)];
-      for (std::size_t i = f.begin; i < f.end; ++i) apply(contacts_[i].normal, contacts_[i].normal.impulse, a, b);
-      if (f.first_friction_row < 0) continue;
-      apply_friction(f, f.impulse.x() * f.t1 + f.impulse.y() * f.t2, a, b);
-      apply_twist(f, f.twist_impulse, a, b);
-    }
+  // Stage "warm start": every accumulated impulse applied to the velocities (thread t's share).
+  void warm_start(int t) {
+    sweep_colours(
+        t,
+        [this](const Rod& rod, int tt) {
+          SolverBody& a = body(rod.a, tt);
+          SolverBody& b = body(rod.b, tt);
+          Vec3 r_a;
+          Vec3 r_b;
+          Vec3 separation;
+          rod_geometry(rod, a, b, r_a, r_b, separation);
+          apply_rod(r_a, r_b, axis_of(separation, rod.axis0), rod.impulse, a, b);
+        },
+        [this](const ManifoldFriction& f, int tt) {
+          SolverBody& a = body(f.a, tt);
+          SolverBody& b = body(f.b, tt);
+          for (std::size_t i = f.begin; i < f.end; ++i) apply(contacts_[i].normal, contacts_[i].normal.impulse, a, b);
+          if (f.first_friction_row < 0) return;
+          apply_friction(f, f.impulse.x() * f.t1 + f.impulse.y() * f.t2, a, b);
+          apply_twist(f, f.twist_impulse, a, b);
+        });
   }
 
   // Applies a friction impulse P (N s, world frame) at the manifold's centre: -P to a, +P to b.
@@ -494,44 +616,45 @@ class SoftStep final : public PushMethod {
     b.w += b.inv_I * torque;
   }
 
-  // One sweep of the stages "solve" (use_bias) or "relax": rods, then each manifold's points
-  // (normal rows, then, in the relax, their friction rows).
-  void solve(bool use_bias, double h) {
+  // One sweep of the stages "solve" (use_bias) or "relax", thread t's share: per colour its rods,
+  // then its manifolds' points (normal rows, then, in the relax, their friction).
+  void solve(bool use_bias, double h, int t) {
     const double inv_h = 1.0 / h;
-    for (Rod& rod : rods_) {
-      Vec3 r_a;
-      Vec3 r_b;
-      Vec3 separation;
-      rod_geometry(rod, r_a, r_b, separation);
-      const Vec3 axis = axis_of(separation, rod.axis0);
-      const SolverBody& a = solver_bodies_[static_cast<std::size_t>(rod.a)];
-      const SolverBody& b = solver_bodies_[static_cast<std::size_t>(rod.b)];
-      const double speed = axis.dot(point_velocity(b, r_b) - point_velocity(a, r_a));
-      double bias = 0.0;
-      double mass_scale = 1.0;
-      double impulse_scale = 0.0;
-      if (use_bias) {
-        bias = rod_soft_.bias_rate * (separation.norm() - rod.length);
-        mass_scale = rod_soft_.mass_scale;
-        impulse_scale = rod_soft_.impulse_scale;
-      }
-      const double dP = -mass_scale * rod.mass * (speed + bias) - impulse_scale * rod.impulse;
-      rod.impulse += dP;
-      apply_rod(rod, r_a, r_b, axis, dP);
+    sweep_colours(
+        t, [this, use_bias](Rod& rod, int tt) { solve_rod(rod, use_bias, body(rod.a, tt), body(rod.b, tt)); },
+        [this, use_bias, inv_h](ManifoldFriction& f, int tt) {
+          SolverBody& a = body(f.a, tt);
+          SolverBody& b = body(f.b, tt);
+          double total = 0.0;        // N s: the manifold's normal impulse
+          double twist_limit = 0.0;  // N m s: sum of lever arm x normal impulse
+          for (std::size_t i = f.begin; i < f.end; ++i) {
+            ContactPoint& p = contacts_[i];
+            solve_normal(p, a, b, use_bias, inv_h);
+            total += p.normal.impulse;
+            twist_limit += p.lever_arm * p.normal.impulse;
+          }
+          if (!use_bias && f.first_friction_row >= 0) solve_friction(f, total, twist_limit, a, b);
+        });
+  }
+
+  void solve_rod(Rod& rod, bool use_bias, SolverBody& a, SolverBody& b) const {
+    Vec3 r_a;
+    Vec3 r_b;
+    Vec3 separation;
+    rod_geometry(rod, a, b, r_a, r_b, separation);
+    const Vec3 axis = axis_of(separation, rod.axis0);
+    const double speed = axis.dot(point_velocity(b, r_b) - point_velocity(a, r_a));
+    double bias = 0.0;
+    double mass_scale = 1.0;
+    double impulse_scale = 0.0;
+    if (use_bias) {
+      bias = rod_soft_.bias_rate * (separation.norm() - rod.length);
+      mass_scale = rod_soft_.mass_scale;
+      impulse_scale = rod_soft_.impulse_scale;
     }
-    for (ManifoldFriction& f : manifolds_) {
-      SolverBody& a = solver_bodies_[static_cast<std::size_t>(f.a)];
-      SolverBody& b = solver_bodies_[static_cast<std::size_t>(f.b)];
-      double total = 0.0;        // N s: the manifold's normal impulse
-      double twist_limit = 0.0;  // N m s: sum of lever arm x normal impulse
-      for (std::size_t i = f.begin; i < f.end; ++i) {
-        ContactPoint& p = contacts_[i];
-        solve_normal(p, a, b, use_bias, inv_h);
-        total += p.normal.impulse;
-        twist_limit += p.lever_arm * p.normal.impulse;
-      }
-      if (!use_bias && f.first_friction_row >= 0) solve_friction(f, total, twist_limit, a, b);
-    }
+    const double dP = -mass_scale * rod.mass * (speed + bias) - impulse_scale * rod.impulse;
+    rod.impulse += dP;
+    apply_rod(r_a, r_b, axis, dP, a, b);
   }
 
   void solve_normal(ContactPoint& p, SolverBody& a, SolverBody& b, bool use_bias, double inv_h) const {
@@ -585,9 +708,11 @@ class SoftStep final : public PushMethod {
     apply_friction(f, d.x() * f.t1 + d.y() * f.t2, a, b);
   }
 
-  // Stage "integrate positions": bodies and the solver's displacements over h.
-  void integrate_positions(std::vector<Body>& bodies, double h, RotationUpdate rotation) {
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
+  // Stage "integrate positions": bodies and the solver's displacements over h, for thread t's
+  // share of the bodies.
+  void integrate_positions(std::vector<Body>& bodies, double h, RotationUpdate rotation, int t) {
+    const auto [begin, end] = share(bodies_, t);
+    for (std::size_t i = begin; i < end; ++i) {
       SolverBody& s = solver_bodies_[i];
       if (s.inv_mass == 0.0) continue;
       Body& body = bodies[i];
@@ -604,8 +729,8 @@ class SoftStep final : public PushMethod {
   void apply_restitution() {
     for (ContactPoint& p : contacts_) {
       if (p.restitution <= 0.0 || p.total_impulse == 0.0) continue;
-      SolverBody& a = solver_bodies_[static_cast<std::size_t>(p.a)];
-      SolverBody& b = solver_bodies_[static_cast<std::size_t>(p.b)];
+      SolverBody& a = body(p.a, 0);
+      SolverBody& b = body(p.b, 0);
       const double old = p.normal.impulse;
       const double next = std::max(old - p.normal.mass * (row_speed(p.normal, a, b) - p.restitution), 0.0);
       p.normal.impulse = next;
@@ -655,12 +780,25 @@ class SoftStep final : public PushMethod {
     ctx.lambda_second.clear();
   }
 
-  std::vector<SolverBody> solver_bodies_;  // n + 1: the bodies, then the static world
+  std::unique_ptr<Workers> workers_;       // def.threads threads (workers.h)
+  std::size_t bodies_ = 0;                 // n: the step's bodies
+  std::vector<SolverBody> solver_bodies_;  // n + threads: the bodies, then each thread's static stand-in
+  // The colours (constraint_graph.h): the step's rods and manifolds by colour (their indices in
+  // ctx's distances and manifolds), the overflow last; colour c's are [start[c], start[c + 1])
+  // of the order and of rods_ and manifolds_, which are stored in that order.
+  ConstraintGraph graph_;
+  std::vector<int> rod_colour_;
+  std::vector<int> manifold_colour_;
+  std::vector<std::size_t> rod_order_;
+  std::vector<std::size_t> manifold_order_;
+  std::array<std::size_t, ConstraintGraph::kColours + 1> rod_start_{};
+  std::array<std::size_t, ConstraintGraph::kColours + 1> manifold_start_{};
+  std::vector<std::size_t> first_row_;  // per manifold of ctx: its first contact row
   std::vector<Mat3> inertia_;              // n: I (kg m^2, world frame) at the start of the step
-  std::vector<ContactPoint> contacts_;     // one per contact row, in row order
-  std::vector<ManifoldFriction> manifolds_;     // one per manifold, in order
-  std::vector<Rod> rods_;                  // one per distance constraint
-  std::vector<std::pair<Vec3, Vec3>> saved_velocities_;  // n + 1: v, w (SoftRelax::restart)
+  std::vector<ContactPoint> contacts_;     // one per contact row, by manifold in colour order
+  std::vector<ManifoldFriction> manifolds_;     // one per manifold, in colour order
+  std::vector<Rod> rods_;                  // one per distance constraint, in colour order
+  std::vector<std::pair<Vec3, Vec3>> saved_velocities_;  // n + threads: v, w (SoftRelax::restart)
   std::vector<double> saved_impulses_;                   // normal, then rod impulses (N s)
   Softness contact_soft_;
   Softness static_soft_;

@@ -1,0 +1,71 @@
+#pragma once
+// Contact recycling (WorldDef::contact_recycle_distance), after Box3D (erincatto/box3d
+// src/physics_world.c, b3CollideTask: "contact recycling optimization", and Box2D v3.2): while
+// two bodies have barely moved relative to each other since their manifold was last made by the
+// narrow phase, the collide stage keeps that manifold (its points fixed to the bodies, its
+// normal and feature ids) and only updates each point's depth, as the soft step's substeps do,
+// instead of clipping again. The clipped points of resting boxes whose faces are exactly aligned
+// otherwise change their feature ids from step to step (a vertex on a side plane is kept or clipped
+// by round-off), and each change starts the point's warm start from 0.
+
+#include "cps/body.h"
+#include "cps/collision.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace cps {
+
+/// The manifolds of the last step that may be recycled, in pair order, each with the bodies'
+/// poses when the narrow phase made it.
+class ContactRecycler {
+ public:
+  /// Starts a step: its pairs are then looked up in the order the collide stage tests them
+  /// (ascending pairs). No errors.
+  void begin_step();
+
+  /// For the pair (a, b) of the collide stage (a < b, ascending over a step): when the last step
+  /// had a manifold for it and the bodies have moved relative to its cached poses by less than
+  /// `distance` (m, > 0) at every point within their bounding radius, and neither has turned by
+  /// more than about 10 degrees, writes the recycled manifold into `out` (each point midway
+  /// between where the two bodies have carried it, its depth changed by their relative motion
+  /// along the cached normal) and returns true; else returns false and `out` is untouched. No errors.
+  bool recycle(int a, int b, const std::vector<Body>& bodies, double distance, Manifold& out);
+
+  /// Caches the manifold `m` the narrow phase has just made for its pair at the bodies' current
+  /// poses (m.count > 0), or carries over the one just recycled; call once per manifold of the
+  /// step, in the collide stage's order. No errors.
+  void keep(const Manifold& m, const std::vector<Body>& bodies, bool recycled);
+
+  /// Ends the step: this step's cache replaces the last one. No errors.
+  void end_step();
+
+ private:
+  struct CachedPoint {
+    Vec3 r_a = Vec3::Zero();  // m: the point relative to a's centre, world frame, at caching
+    Vec3 r_b = Vec3::Zero();  // m: relative to b's centre
+    double depth = 0.0;       // m: at caching
+    std::uint32_t feature = 0;
+  };
+  struct Cached {
+    int a = -1;
+    int b = -1;
+    Vec3 normal = Vec3::UnitY();
+    Vec3 x_a = Vec3::Zero();  // m: the centres at caching
+    Vec3 x_b = Vec3::Zero();
+    Quat o_a = Quat::Identity();  // the orientations at caching
+    Quat o_b = Quat::Identity();
+    int count = 0;
+    std::array<CachedPoint, kMaxManifoldPoints> points{};
+  };
+
+  std::vector<Cached> last_;  // the last step's, in pair order
+  std::vector<Cached> next_;  // this step's
+  std::size_t cursor_ = 0;    // in last_: the first entry not below the pair looked up
+  const Cached* found_ = nullptr;  // the entry recycle() used, for keep()
+};
+
+}  // namespace cps

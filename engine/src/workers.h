@@ -1,0 +1,115 @@
+#pragma once
+// Threads that run one task together, in the single-program style of Box2D v3's solver stages
+// (erincatto/box2d src/solver.c, b2SolverStep): every thread runs the same task with its own
+// index and they meet at barriers between the stages, so a step wakes the threads once.
+
+#include <barrier>
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace cps {
+
+/// `count` threads (>= 1): the calling thread and count - 1 kept workers, which sleep between
+/// tasks. Not copyable. Errors: the constructor throws std::system_error when a thread cannot
+/// be started.
+class Workers {
+ public:
+  explicit Workers(int count);
+  ~Workers();
+  Workers(const Workers&) = delete;
+  Workers& operator=(const Workers&) = delete;
+
+  /// Threads, counting the caller.
+  int count() const { return count_; }
+
+  /// Runs task(t) for t in [0, count()) at once, t = 0 on the calling thread, and returns when
+  /// every one has returned. The task must not throw, and must call sync() the same number of
+  /// times on every thread.
+  template <class Task>
+  void run(Task& task) {
+    if (count_ == 1) {
+      task(0);
+      return;
+    }
+    call_ = [](void* f, int t) { (*static_cast<Task*>(f))(t); };
+    task_ = &task;
+    start();
+    task(0);
+    finish();
+  }
+
+  /// Waits until every thread of the running task has reached this call (a barrier); nothing
+  /// with one thread.
+  void sync() {
+    if (count_ > 1) barrier_.arrive_and_wait();
+  }
+
+ private:
+  void start();
+  void finish();
+  void loop(int t);
+
+  int count_ = 1;
+  std::barrier<> barrier_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::condition_variable done_;
+  std::uint64_t generation_ = 0;  // tasks started
+  int running_ = 0;               // workers still in the current task
+  bool stop_ = false;
+  void (*call_)(void*, int) = nullptr;
+  void* task_ = nullptr;
+  std::vector<std::thread> threads_;
+};
+
+inline Workers::Workers(int count) : count_(count < 1 ? 1 : count), barrier_(count_) {
+  threads_.reserve(static_cast<std::size_t>(count_ - 1));
+  for (int t = 1; t < count_; ++t) threads_.emplace_back([this, t] { loop(t); });
+}
+
+inline Workers::~Workers() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  for (std::thread& thread : threads_) thread.join();
+}
+
+inline void Workers::start() {
+  {
+    std::lock_guard lock(mutex_);
+    ++generation_;
+    running_ = count_ - 1;
+  }
+  wake_.notify_all();
+}
+
+inline void Workers::finish() {
+  std::unique_lock lock(mutex_);
+  done_.wait(lock, [this] { return running_ == 0; });
+}
+
+inline void Workers::loop(int t) {
+  std::uint64_t seen = 0;
+  for (;;) {
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+      if (stop_) return;
+      seen = generation_;
+    }
+    call_(task_, t);
+    bool last = false;
+    {
+      std::lock_guard lock(mutex_);
+      last = --running_ == 0;
+    }
+    if (last) done_.notify_one();
+  }
+}
+
+}  // namespace cps

@@ -304,35 +304,45 @@ class SoftStep final : public PushMethod {
     const std::vector<DistanceConstraint>& distances = *ctx.distances;
     colour(ctx.manifolds, distances, moving);
     // Each manifold's first contact row (its points' rows follow in order).
-    first_row_.resize(ctx.manifolds.size());
+    detail::resize_with_headroom(first_row_, ctx.manifolds.size());
     for (std::size_t k = 0, g = 0; k < ctx.manifolds.size(); ++k) {
       first_row_[k] = g;
       g += static_cast<std::size_t>(ctx.manifolds[k].count);
     }
     // The manifolds and their points stored colour by colour (manifold_order_), so that a
-    // colour's sweep reads them in order.
-    contacts_.clear();
-    detail::reserve_with_headroom(contacts_, points);
-    manifolds_.clear();
-    detail::reserve_with_headroom(manifolds_, ctx.manifolds.size());
-    for (const std::size_t k : manifold_order_) {
+    // colour's sweep reads them in order; written here in ctx's order, which reads ctx's
+    // manifolds, rows and warm start in order: manifold k goes to slot slot_[k], its points from
+    // point_start_[slot_[k]].
+    const std::size_t count = ctx.manifolds.size();
+    detail::resize_with_headroom(slot_, count);
+    for (std::size_t j = 0; j < count; ++j) slot_[manifold_order_[j]] = j;
+    detail::assign_with_headroom(point_start_, count + 1, std::size_t{0});
+    for (std::size_t k = 0; k < count; ++k) {
+      point_start_[slot_[k] + 1] = static_cast<std::size_t>(ctx.manifolds[k].count);
+    }
+    for (std::size_t j = 0; j < count; ++j) point_start_[j + 1] += point_start_[j];
+    detail::resize_with_headroom(contacts_, points);
+    detail::resize_with_headroom(manifolds_, count);
+    for (std::size_t k = 0; k < count; ++k) {
       const Manifold& m = ctx.manifolds[k];
       std::size_t g = first_row_[k];  // the point's index over the step: its contact row
       const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];
       const Body& body_b = bodies[static_cast<std::size_t>(m.body_b)];
       const SolverBody& a = solver_bodies_[static_cast<std::size_t>(m.body_a)];
       const SolverBody& b = solver_bodies_[static_cast<std::size_t>(m.body_b)];
-      ManifoldFriction& f = manifolds_.emplace_back();
+      ManifoldFriction& f = manifolds_[slot_[k]];
+      f = ManifoldFriction{};
       f.a = moving(m.body_a);
       f.b = moving(m.body_b);
-      f.begin = contacts_.size();
+      f.begin = point_start_[slot_[k]];
       f.normal = m.contacts[0].normal;
       Vec3 center_a = Vec3::Zero();
       Vec3 center_b = Vec3::Zero();
       double total_weight = 0.0;
       for (int i = 0; i < m.count; ++i, ++g) {
         const Contact& c = m.contacts[static_cast<std::size_t>(i)];
-        ContactPoint& p = contacts_.emplace_back();
+        ContactPoint& p = contacts_[f.begin + static_cast<std::size_t>(i)];
+        p = ContactPoint{};
         p.a = f.a;
         p.b = f.b;
         p.row = static_cast<int>(g);
@@ -347,7 +357,7 @@ class SoftStep final : public PushMethod {
         center_b += weight * p.r_b;
         total_weight += weight;
       }
-      f.end = contacts_.size();
+      f.end = f.begin + static_cast<std::size_t>(m.count);
       if (!friction) continue;
       const std::size_t first = points + 2 * first_row_[k];
       f.center_a = center_a / total_weight;
@@ -440,7 +450,7 @@ class SoftStep final : public PushMethod {
     start.fill(0);
     for (const int c : colours) ++start[static_cast<std::size_t>(c) + 1];
     for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
-    order.resize(colours.size());
+    detail::resize_with_headroom(order, colours.size());
     std::array<std::size_t, ConstraintGraph::kColours + 1> next = start;
     for (std::size_t i = 0; i < colours.size(); ++i) order[next[static_cast<std::size_t>(colours[i])]++] = i;
   }
@@ -793,7 +803,9 @@ class SoftStep final : public PushMethod {
   std::vector<std::size_t> manifold_order_;
   std::array<std::size_t, ConstraintGraph::kColours + 1> rod_start_{};
   std::array<std::size_t, ConstraintGraph::kColours + 1> manifold_start_{};
-  std::vector<std::size_t> first_row_;  // per manifold of ctx: its first contact row
+  std::vector<std::size_t> first_row_;    // per manifold of ctx: its first contact row
+  std::vector<std::size_t> slot_;         // per manifold of ctx: its place in manifolds_
+  std::vector<std::size_t> point_start_;  // per slot of manifolds_: its first point in contacts_
   std::vector<Mat3> inertia_;              // n: I (kg m^2, world frame) at the start of the step
   std::vector<ContactPoint> contacts_;     // one per contact row, by manifold in colour order
   std::vector<ManifoldFriction> manifolds_;     // one per manifold, in colour order

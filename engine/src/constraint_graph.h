@@ -10,9 +10,9 @@
 // colour (they are never written).
 
 #include <bit>
-#include <utility>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace cps {

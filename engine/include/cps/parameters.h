@@ -70,13 +70,13 @@ enum class RotationUpdate {
   exact,   ///< o = [cos(|w| dt / 2), sin(|w| dt / 2) w / |w|] o (Eq. 12.4.1)
 };
 
-/// Where the soft step's relax (push soft, engine/src/push/soft_step.cpp) starts each substep.
 /// Which of a manifold's clipped points become contact rows (WorldDef::manifold_points).
 enum class ManifoldPoints {
   all,   ///< every point of the clipping (up to 8), as the paper's Sec. 4
   four,  ///< reduced to 4 (collision.h, reduce_manifold), as Box3D, Jolt and Bullet do
 };
 
+/// Where the soft step's relax (push soft, engine/src/push/soft_step.cpp) starts each substep.
 enum class SoftRelax {
   continue_solve,  ///< from the soft solve's accumulated impulses, as Box3D and Box2D v3 relax
   restart,         ///< from the velocities before the soft solve and the last relax's impulses

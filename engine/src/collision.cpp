@@ -186,7 +186,9 @@ void reduce_manifold(Manifold& m, double tolerance) {
     return best;
   };
   const Vec3 origin = m.contacts[0].point;
-  keep(pick([&](const Contact& c) { return c.depth + across.dot(c.point - origin); }, -kInfinity));
+  const int extreme = pick([&](const Contact& c) { return c.depth + across.dot(c.point - origin); }, -kInfinity);
+  if (extreme < 0) return;  // a score that is not finite: left as it is
+  keep(extreme);
   const Vec3 a = m.contacts[0].point;
   const auto plane = [&n](const Vec3& d) { return Vec3(d - d.dot(n) * n); };
   int i = pick([&](const Contact& c) {

@@ -29,12 +29,12 @@ bool pair_below(int a, int b, int c, int d) { return a < c || (a == c && b < d);
 void ContactRecycler::begin_step() {
   next_.clear();
   cursor_ = 0;
-  found_ = nullptr;
+  found_ = kNone;
 }
 
 bool ContactRecycler::recycle(int a, int b, const std::vector<Body>& bodies, double distance,
                               Manifold& out) {
-  found_ = nullptr;
+  found_ = kNone;
   while (cursor_ < last_.size() && pair_below(last_[cursor_].a, last_[cursor_].b, a, b)) ++cursor_;
   if (cursor_ == last_.size() || last_[cursor_].a != a || last_[cursor_].b != b) return false;
   const Cached& c = last_[cursor_];
@@ -74,13 +74,13 @@ bool ContactRecycler::recycle(int a, int b, const std::vector<Body>& bodies, dou
     contact.depth = p.depth - c.normal.dot(moved_b - moved_a);
     contact.feature = p.feature;
   }
-  found_ = &c;
+  found_ = cursor_;
   return true;
 }
 
 void ContactRecycler::keep(const Manifold& m, const std::vector<Body>& bodies, bool recycled) {
-  if (recycled && found_ != nullptr && found_->a == m.body_a && found_->b == m.body_b) {
-    next_.push_back(*found_);  // the poses of its caching, so that motion adds up
+  if (recycled && found_ != kNone && last_[found_].a == m.body_a && last_[found_].b == m.body_b) {
+    next_.push_back(last_[found_]);  // the poses of its caching, so that motion adds up
     return;
   }
   const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];

@@ -65,7 +65,8 @@ class ContactRecycler {
   std::vector<Cached> last_;  // the last step's, in pair order
   std::vector<Cached> next_;  // this step's
   std::size_t cursor_ = 0;    // in last_: the first entry not below the pair looked up
-  const Cached* found_ = nullptr;  // the entry recycle() used, for keep()
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::size_t found_ = kNone;  // in last_: the entry recycle() used, for keep(); kNone: none
 };
 
 }  // namespace cps

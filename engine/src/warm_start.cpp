@@ -30,8 +30,10 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds) {
   const std::size_t points = point_count(manifolds);
   detail::assign_with_headroom(match_, points, -1);
   detail::resize_with_headroom(tangents_, points);
+  detail::assign_with_headroom(same_points_, manifolds.size(), static_cast<unsigned char>(0));
   matched_ = 0;
   std::size_t k = 0;  // this step's point
+  std::size_t index = 0;  // this step's manifold
   std::size_t j = 0;  // cached manifold
   for (const Manifold& m : manifolds) {
     // Both lists are in pair order: walk the cached one along (a missing or extra pair, or any
@@ -43,6 +45,7 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds) {
     const bool same_pair = j < manifolds_.size() && manifolds_[j].body_a == m.body_a &&
                            manifolds_[j].body_b == m.body_b;
     unsigned used = 0;  // cached points of this pair already matched (at most 8: one bit each)
+    int matched_here = 0;
     for (int i = 0; i < m.count; ++i, ++k) {
       const Contact& c = m.contacts[static_cast<std::size_t>(i)];
       Vec3 t1;
@@ -56,6 +59,7 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds) {
           used |= 1u << q;
           match_[k] = cm.first + q;
           ++matched_;
+          ++matched_here;
           // The cached t1 in the new contact plane: the friction rows keep their directions.
           const Vec3 projected = p.t1 - p.t1.dot(c.normal) * c.normal;
           if (projected.norm() > 0.5) t1 = projected.normalized();
@@ -64,6 +68,7 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds) {
       }
       tangents_[k] = t1;
     }
+    same_points_[index++] = same_pair && matched_here == m.count && manifolds_[j].count == m.count;
   }
 }
 
@@ -191,6 +196,7 @@ void WarmStartCache::clear() {
   has_second_ = false;
   has_friction_ = false;
   match_.clear();
+  same_points_.clear();
   matched_ = 0;
 }
 

@@ -88,9 +88,9 @@ class WarmStartCache {
   std::size_t cached_points() const { return points_.size(); }
   /// Points of the last match() that found their cached point (count), for tests.
   std::size_t matched_points() const { return matched_; }
-  /// Whether this step's contact point k (in row order, after match()) persisted from the last
-  /// step. No errors (false for k out of range).
-  bool matched(std::size_t k) const { return k < match_.size() && match_[k] >= 0; }
+  /// Whether this step's manifold m (after match()) has the same points as its pair's manifold
+  /// of the last step: as many, each matched. No errors (false for m out of range).
+  bool same_points(std::size_t m) const { return m < same_points_.size() && same_points_[m] != 0; }
 
  private:
   struct CachedManifold {
@@ -120,6 +120,7 @@ class WarmStartCache {
   // This step: per point, the cached point it matched (-1: none) and its t1.
   std::vector<int> match_;
   std::vector<Vec3> tangents_;
+  std::vector<unsigned char> same_points_;  // per manifold: same_points()
   std::size_t matched_ = 0;
 };
 

@@ -12,9 +12,9 @@
 
 namespace cps {
 
-/// `count` threads (>= 1): the calling thread and count - 1 kept workers, which sleep between
-/// tasks. Not copyable. Errors: the constructor throws std::system_error when a thread cannot
-/// be started.
+/// `count` threads (>= 1; less is taken as 1): the calling thread and count - 1 kept workers,
+/// which sleep between tasks. Not copyable. Errors: the constructor throws std::system_error
+/// when a thread cannot be started (or std::bad_alloc), after joining those it started.
 class Workers {
  public:
   explicit Workers(int count);
@@ -51,6 +51,7 @@ class Workers {
   void start();
   void finish();
   void loop(int t);
+  void stop_and_join();
 
   int count_ = 1;
   std::barrier<> barrier_;
@@ -66,17 +67,25 @@ class Workers {
 };
 
 inline Workers::Workers(int count) : count_(count < 1 ? 1 : count), barrier_(count_) {
-  threads_.reserve(static_cast<std::size_t>(count_ - 1));
-  for (int t = 1; t < count_; ++t) threads_.emplace_back([this, t] { loop(t); });
+  try {
+    threads_.reserve(static_cast<std::size_t>(count_ - 1));
+    for (int t = 1; t < count_; ++t) threads_.emplace_back([this, t] { loop(t); });
+  } catch (...) {
+    stop_and_join();  // the threads already started, before the members go
+    throw;
+  }
 }
 
-inline Workers::~Workers() {
+inline Workers::~Workers() { stop_and_join(); }
+
+inline void Workers::stop_and_join() {
   {
     std::lock_guard lock(mutex_);
     stop_ = true;
   }
   wake_.notify_all();
   for (std::thread& thread : threads_) thread.join();
+  threads_.clear();
 }
 
 inline void Workers::start() {

@@ -93,15 +93,18 @@ int collide(const Body& a, const Mat3& R_a, const Body& b, const Mat3& R_b, Mani
 
 /// Reduces a manifold of more than 4 points to 4 of them (fewer when the rest add nothing), the
 /// way Box3D reduces its manifolds (erincatto/box3d src/convex_manifold.c, b3ReduceManifoldPoints;
-/// the largest-area idea of Bullet's btPersistentManifold::sortCachedPoints): first the deepest
-/// point, ties broken along a fixed direction across the normal; then the one farthest from it
+/// the largest-area idea of Bullet's btPersistentManifold::sortCachedPoints): first the point
+/// with the largest depth plus its offset (m) along a fixed direction across the normal (an
+/// extreme point, the deeper the likelier); then the one farthest from it
 /// across the normal (depth counting twice); then the one that spans the largest triangle with
 /// the two; then the one that adds the most area outside that triangle. A later candidate
 /// replaces the best so far only when its score is 5 % better, so that the choice holds from step
 /// to step while the bodies barely move (Box3D's 0.95 bias). A candidate adds nothing, and the
 /// reduction stops, when its distance squared or its area (m^2) is below tolerance^2 (tolerance
 /// in m, >= 0; Box3D's is its speculative distance, 0.02 m). The kept points keep their normal,
-/// depth and feature id. A manifold of at most 4 points is left as it is. No errors.
+/// depth and feature id. A point whose score is not a number is never chosen (a manifold where
+/// no point has one is left as it is), and a manifold of at most 4 points is left as it is. No
+/// errors.
 void reduce_manifold(Manifold& m, double tolerance);
 
 /// A box in world space: centre c (m), rotation R (3 x 3, columns are the box axes in world

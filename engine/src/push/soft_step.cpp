@@ -122,7 +122,8 @@ Softness make_softness(double hertz, double zeta, double h) {
   return {omega / a1, a2 * a3, a3};
 }
 
-// A body's state in the solver (the last entry stands for the static world of a rod's fixed end).
+// A body's state in the solver (after the n bodies, one zero stand-in per thread for the static
+// bodies and the world: body()).
 struct SolverBody {
   Vec3 v = Vec3::Zero();   // m/s
   Vec3 w = Vec3::Zero();   // rad/s
@@ -381,23 +382,29 @@ class SoftStep final : public PushMethod {
       const double k_twist = f.normal.dot((a.inv_I + b.inv_I) * f.normal);
       f.twist_mass = k_twist > 0.0 ? 1.0 / k_twist : 0.0;
       // The warm start: the friction rows' initial lambdas (N, store() below) summed back into
-      // the force at the centre and its twist about the normal, as impulses over h. The twist
-      // only when every point of the manifold persisted: of a part of the points, their forces'
-      // moment about the new centre is not the twist they carried, and warm starting that
-      // spun large_pyramid's bottom boxes about their normals at up to 11 rad/s within 1 s.
+      // the force at the centre and its twist about the normal, as impulses over h. store()
+      // writes each point's force as an equal share of the centre's plus the twist's
+      // tangential force tau (n x d_i), so with the same points the twist is
+      // sum n . (d_i x (F_i - share)). Only then: from other points, or some of them, that
+      // moment is not the twist they carried, and warm starting it spun large_pyramid's bottom
+      // boxes about their normals at up to 11 rad/s within 1 s.
       if (warm != nullptr) {
         Vec3 P = Vec3::Zero();
-        double L = 0.0;
-        bool all_persisted = ctx.warm_start != nullptr;
         for (std::size_t i = f.begin; i < f.end; ++i) {
           const std::size_t r = first + 2 * (i - f.begin);
-          const Vec3 F = h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
-          P += F;
-          L += f.normal.dot((contacts_[i].r_a - f.center_a).cross(F));
-          all_persisted = all_persisted && ctx.warm_start->matched(static_cast<std::size_t>(contacts_[i].row));
+          P += h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
         }
         f.impulse = Eigen::Vector2d(P.dot(f.t1), P.dot(f.t2));
-        f.twist_impulse = all_persisted ? L : 0.0;
+        if (ctx.warm_start != nullptr && ctx.warm_start->same_points(k)) {
+          const Vec3 share = P / static_cast<double>(m.count);
+          double L = 0.0;
+          for (std::size_t i = f.begin; i < f.end; ++i) {
+            const std::size_t r = first + 2 * (i - f.begin);
+            const Vec3 F = h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
+            L += f.normal.dot((contacts_[i].r_a - f.center_a).cross(F - share));
+          }
+          f.twist_impulse = L;
+        }
       }
     }
 
@@ -424,6 +431,10 @@ class SoftStep final : public PushMethod {
                                           solver_bodies_[index(d.body_b)], 0.0);
       rod.mass = axial.mass;
       rod.impulse = guess(first_rod + r);
+    }
+    if (def.soft_relax == SoftRelax::restart) {  // save()'s buffers
+      detail::resize_with_headroom(saved_velocities_, solver_bodies_.size());
+      detail::resize_with_headroom(saved_impulses_, contacts_.size() + rods_.size());
     }
   }
 
@@ -527,14 +538,15 @@ class SoftStep final : public PushMethod {
 
   // SoftRelax::restart: keeps the velocities before the warm start and the impulses the relax
   // left (the soft solve changes the normal and rod impulses only), and puts them back.
+  // Writes only into buffers prepare() sized: it runs inside the threads' task, which must not
+  // throw.
   void save() {
-    saved_velocities_.resize(solver_bodies_.size());
     for (std::size_t i = 0; i < solver_bodies_.size(); ++i) {
       saved_velocities_[i] = {solver_bodies_[i].v, solver_bodies_[i].w};
     }
-    saved_impulses_.clear();
-    for (const ContactPoint& p : contacts_) saved_impulses_.push_back(p.normal.impulse);
-    for (const Rod& rod : rods_) saved_impulses_.push_back(rod.impulse);
+    std::size_t k = 0;
+    for (const ContactPoint& p : contacts_) saved_impulses_[k++] = p.normal.impulse;
+    for (const Rod& rod : rods_) saved_impulses_[k++] = rod.impulse;
   }
   void restore() {
     for (std::size_t i = 0; i < solver_bodies_.size(); ++i) {

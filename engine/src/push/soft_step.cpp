@@ -79,10 +79,10 @@
 // Differences from Box3D: double precision, no SIMD lanes; the manifolds as the collide stage
 // makes them (WorldDef::manifold_points and contact_recycle_distance choose Box3D's 4 points and
 // its recycling; Box3D's recycled anchors stay as they were, a cps point is midway between the
-// bodies' material points); the twist warm starts only when all of a manifold's points
-// persisted; no rolling resistance, no gyroscopic term (Box3D integrates one; for the spheres and
-// cubes of the scenes it is zero), no speed caps on the bodies (Box3D clamps at 400 m/s and a
-// quarter turn a step).
+// bodies' material points); the twist warm starts only when a manifold has the same points as
+// the step before; no rolling resistance, no gyroscopic term (Box3D integrates one; for the
+// spheres and cubes of the scenes it is zero), no speed caps on the bodies (Box3D clamps at
+// 400 m/s and a quarter turn a step).
 // The solvers of A lambda = b (--solver, --assembly) play no part: the rows are swept as the
 // source sweeps them, Gauss-Seidel over body velocities.
 

@@ -1,8 +1,10 @@
 // `cps render --video mp4|gif`, run as a user runs it: the video is made by ffmpeg from the
 // frames and checked with ffprobe (codec, frame count, even size). Without ffmpeg on this machine
-// the video tests WARN and skip; the missing-ffmpeg test always runs (it hides ffmpeg itself).
+// the video tests are reported SKIPPED (tests/skip.h); the missing-ffmpeg test always runs (it
+// hides ffmpeg itself).
 
 #include "cli_support.h"
+#include "skip.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -83,10 +85,7 @@ const std::string k_small = "--seconds 0.4 --fps 10";
 
 TEST_CASE("cps render --video mp4 writes H.264 with even dimensions from an odd size",
           "[cli][video]") {
-  if (!have_ffmpeg()) {
-    WARN("ffmpeg or ffprobe is not installed (apt-get install ffmpeg): video test skipped");
-    return;
-  }
+  if (!have_ffmpeg()) CPS_SKIP("ffmpeg or ffprobe is not installed (apt-get install ffmpeg)");
   const fs::path dir = fresh_dir("mp4");
   // An earlier, longer render wrote frames 5..9: the rerun removes them, the video has 5 frames.
   const Result longer = cps("", "render stack --size 65x49 --seconds 0.9 --fps 10 --out out", dir);
@@ -114,10 +113,7 @@ TEST_CASE("cps render --video mp4 writes H.264 with even dimensions from an odd 
 }
 
 TEST_CASE("cps render --video gif writes a GIF with every frame", "[cli][video]") {
-  if (!have_ffmpeg()) {
-    WARN("ffmpeg or ffprobe is not installed (apt-get install ffmpeg): video test skipped");
-    return;
-  }
+  if (!have_ffmpeg()) CPS_SKIP("ffmpeg or ffprobe is not installed (apt-get install ffmpeg)");
   const fs::path dir = fresh_dir("gif");
   const Result r = cps("", "render stack --size 64x48 " + k_small + " --video gif --out out", dir);
   INFO("stderr: " << r.err);
@@ -137,10 +133,7 @@ TEST_CASE("cps render --video gif writes a GIF with every frame", "[cli][video]"
 
 TEST_CASE("cps render --video with --compare names the video after the compare folder",
           "[cli][video]") {
-  if (!have_ffmpeg()) {
-    WARN("ffmpeg or ffprobe is not installed (apt-get install ffmpeg): video test skipped");
-    return;
-  }
+  if (!have_ffmpeg()) CPS_SKIP("ffmpeg or ffprobe is not installed (apt-get install ffmpeg)");
   const fs::path dir = fresh_dir("compare");
   const Result r =
       cps("", "render stack --size 640x360 " + k_small + " --compare push --video mp4 --out out", dir);
@@ -211,10 +204,7 @@ TEST_CASE("cps render --video refuses a video it did not write before rendering 
 
 TEST_CASE("cps render --video --force replaces a foreign video; its own is replaced without it",
           "[cli][video][output]") {
-  if (!have_ffmpeg()) {
-    WARN("ffmpeg or ffprobe is not installed (apt-get install ffmpeg): video test skipped");
-    return;
-  }
+  if (!have_ffmpeg()) CPS_SKIP("ffmpeg or ffprobe is not installed (apt-get install ffmpeg)");
   const fs::path dir = fresh_dir("force_video");
   fs::create_directories(dir / "out");
   std::ofstream(dir / "out" / "stack.mp4", std::ios::binary) << "not a video\n";

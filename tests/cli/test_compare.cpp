@@ -185,7 +185,7 @@ TEST_CASE("each comparison gets its own safe output name and run.json records it
   CHECK(j["values"] == nlohmann::json({0.05, 0.2, 0.5}));
   CHECK(j["layout"] == "overlay");
   nlohmann::json every_push = nlohmann::json::array();
-  for (const Choice& c : parameter("push").choices) every_push.push_back(std::string(c.name));
+  for (const Choice& choice : parameter("push").choices) every_push.push_back(std::string(choice.name));
   CHECK(comparison_json(push, false)["values"] == every_push);
   CHECK(comparison_json(parse_comparison("", {}), false).is_null());
 }

@@ -267,7 +267,7 @@ TEST_CASE("work that would not end and malformed numbers are refused before any 
   fs::remove_all(dir);
 }
 
-TEST_CASE("cps --version names the build; list and unknown scenes name the scaled families",
+TEST_CASE("cps --version names the build, list and unknown scenes name the scaled families",
           "[cli]") {
   const fs::path dir = fresh_dir("version");
   const Result version = cps("--version", dir);

@@ -202,7 +202,7 @@ TEST_CASE("cps render --video refuses a video it did not write before rendering 
   fs::remove_all(dir);
 }
 
-TEST_CASE("cps render --video --force replaces a foreign video; its own is replaced without it",
+TEST_CASE("cps render --video --force replaces a foreign video, its own is replaced without it",
           "[cli][video][output]") {
   if (!have_ffmpeg()) CPS_SKIP("ffmpeg or ffprobe is not installed (apt-get install ffmpeg)");
   const fs::path dir = fresh_dir("force_video");

@@ -308,7 +308,7 @@ TEST_CASE("plan_output refuses foreign targets and unusable folders before writi
   CHECK_FALSE(fs::exists(dir.path / "new"));
 }
 
-TEST_CASE("an exclusive folder lists exactly its run's files; a shared one every run's",
+TEST_CASE("an exclusive folder lists exactly its run's files, a shared one every run's",
           "[output]") {
   TempDir dir("manifests");
   const fs::path frames = dir.path / "frames";

@@ -47,7 +47,7 @@ TEST_CASE("a free fall never rises, and its scale is the height it fell", "[ener
   CHECK(e.scale_J > 2.0 * 10.0 * 0.1);
 }
 
-TEST_CASE("a bouncing cradle gains under the Baumgarte push and warns; under split it does not",
+TEST_CASE("a bouncing cradle gains under the Baumgarte push and warns, under split it does not",
           "[energy_rise]") {
   const SceneFile file = read_scene_file(kCradle);
   const Scene scene = scene_of(file, "cradle.json");

@@ -73,7 +73,7 @@ TEST_CASE("the stack stays on its base for 600 s with either friction model", "[
   }
 }
 
-TEST_CASE("a penetration slop leaves a resting box that deep; the push alone breaks contact",
+TEST_CASE("a penetration slop leaves a resting box that deep, the push alone breaks contact",
           "[world][slop]") {
   // The push (Eq. 5.3.1) with a slop s corrects beta (d - s) / dt of a depth d > s each step and
   // nothing below s, so once the box rests the excess shrinks by the factor (1 - beta) a step

@@ -231,7 +231,7 @@ TEST_CASE("renderer rejects invalid sizes", "[renderer]") {
   CHECK_NOTHROW(Renderer(1, 1));
 }
 
-TEST_CASE("encode_png refuses invalid images; read_png names the path it cannot read",
+TEST_CASE("encode_png refuses invalid images, read_png names the path it cannot read",
           "[renderer]") {
   TempDir dir;
   Image img;

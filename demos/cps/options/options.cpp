@@ -202,9 +202,19 @@ std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
   std::vector<std::string> known = {"all", "stress"};
   for (const scenes::Scene& s : scenes::all_scenes()) known.emplace_back(s.name);
   for (const std::string_view e : scenes::example_scene_names()) known.emplace_back(e);
-  throw UsageError("unknown scene '" + name + "'; did you mean '" +
-                   scenes::nearest_name(name, known) +
-                   "'? ('cps list' shows the paper's and stress scenes, the example scene files, "
+  for (const std::string_view help : scenes::scaled_families()) {
+    known.emplace_back(help.substr(0, help.find(' ')));
+  }
+  const std::string nearest = scenes::nearest_name(name, known);
+  std::string suggestion = "'" + nearest + "'";
+  // A scaled family ("pyramid_N"): its sizes, and a name that runs.
+  for (const std::string_view help : scenes::scaled_families()) {
+    if (help.substr(0, help.find(' ')) == nearest) {
+      suggestion = std::string(help) + ", e.g. " + nearest.substr(0, nearest.size() - 1) + "10";
+    }
+  }
+  throw UsageError("unknown scene '" + name + "'; did you mean " + suggestion +
+                   "? ('cps list' shows the paper's and stress scenes, the example scene files, "
                    "random_SEED and the scaled families; or give the path of a scene file ending "
                    "in .json)");
 }

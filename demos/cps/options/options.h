@@ -4,6 +4,7 @@
 #include "options/cli_fwd.h"
 #include "options/compare.h"
 #include "scene.h"
+#include "usage_error.h"
 
 #include <cstdint>
 #include <optional>
@@ -11,11 +12,6 @@
 #include <vector>
 
 namespace cps::cli {
-
-/// A usage error: a bad value on the command line. The command exits with code 2.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 /// The world parameter overrides every stepping command takes: one option per parameter of the
 /// table (cps/parameters.h) that has a flag, its help, unit and allowed values from the table.

@@ -1,6 +1,6 @@
 #include "output/output.h"
 
-#include "options/options.h"
+#include "usage_error.h"
 
 #include "cps_version.h"  // generated at build time by demos/cps/output/version.cmake
 

@@ -1,6 +1,6 @@
 #include "pictures/compose.h"
 
-#include "options/options.h"
+#include "usage_error.h"
 
 #include <cairo-pdf.h>
 #include <cairo-svg.h>

@@ -175,6 +175,11 @@ struct Overrides {
 /// The scene's WorldDef with the overrides applied. Not validated here: World's constructor does.
 WorldDef world_def_with(const Scene& scene, const Overrides& overrides);
 
+/// The stepping rule of every run to a time: true while `world` is more than half a step (dt, s)
+/// short of t (s), so that a run of t seconds takes round(t / dt) steps whatever the round-off
+/// in World::time(). Run::advance_to and every loop that steps to a time use it.
+inline bool short_of(const World& world, double t) { return world.time() + 0.5 * world.def().dt < t; }
+
 /// A world built from a scene, with its metrics, ready to step.
 struct Run {
   World world;
@@ -187,7 +192,7 @@ struct Run {
   }
   /// Steps until world.time() reaches t (s), within half a step.
   void advance_to(double t) {
-    while (world.time() + 0.5 * world.def().dt < t) step();
+    while (short_of(world, t)) step();
   }
 };
 
@@ -199,6 +204,17 @@ double deepest_contact(const World& world);
 
 /// Kinetic energy of all bodies (J), translational plus rotational.
 double kinetic_energy(const World& world);
+
+/// The full size (m) of the largest movable body: a box's longest edge, a ball's diameter; 0 if
+/// the world has no movable body.
+double largest_body_size(const World& world);
+
+/// Positions x (m) of the movable bodies, in body order: one Vec3 each.
+std::vector<Vec3> movable_positions(const World& world);
+
+/// RMS distance (m) between two lists of the same bodies' positions (the first min(|a|, |b|) of
+/// each, paired in order); 0 if either is empty.
+double rms_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b);
 
 /// Largest |distance - length| (m) over the world's distance constraints now; 0 if none.
 double max_rod_error(const World& world);

@@ -296,6 +296,31 @@ double kinetic_energy(const World& world) {
   return e;
 }
 
+double largest_body_size(const World& world) {
+  double size = 0.0;
+  for (const Body& b : world.bodies()) {
+    if (b.is_static()) continue;
+    size = std::max(size, b.shape.kind == ShapeKind::sphere ? 2.0 * b.shape.radius
+                                                            : 2.0 * b.shape.half_extents.maxCoeff());
+  }
+  return size;
+}
+
+std::vector<Vec3> movable_positions(const World& world) {
+  std::vector<Vec3> x;
+  for (const Body& b : world.bodies()) {
+    if (!b.is_static()) x.push_back(b.x);
+  }
+  return x;
+}
+
+double rms_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double sq = 0.0;
+  const std::size_t n = std::min(a.size(), b.size());
+  for (std::size_t i = 0; i < n; ++i) sq += (a[i] - b[i]).squaredNorm();
+  return n ? std::sqrt(sq / static_cast<double>(n)) : 0.0;
+}
+
 double max_rod_error(const World& world) {
   double worst = 0.0;
   for (const DistanceConstraint& d : world.distances()) {

@@ -73,7 +73,7 @@ StepCost step_cost(const scenes::Scene& scene, Assembly assembly, double start_s
   def.assembly = assembly;
   if (warm_start) def.warm_start = *warm_start;
   run.world.set_def(def);
-  while (run.world.time() + 0.5 * def.dt < start_s) run.world.step();
+  while (scenes::short_of(run.world, start_s)) run.world.step();
   StepCost cost;
   std::vector<double> times;
   for (int r = 0; r <= repeats; ++r) {

@@ -155,7 +155,7 @@ nlohmann::json simulate(const scenes::Scene& scene, scenes::Run& run, double sec
       if (energy != nullptr) energy->write(run.world);
     };
     write();
-    while (run.world.time() + 0.5 * run.world.def().dt < seconds) {  // as Run::advance_to
+    while (scenes::short_of(run.world, seconds)) {
       run.step();
       write();
     }

@@ -2,7 +2,7 @@
 
 #include "scene_file.h"
 
-#include "options/options.h"
+#include "usage_error.h"
 
 #include <algorithm>
 #include <array>
@@ -176,7 +176,7 @@ Bounds run_bounds(std::span<const World* const> worlds, double seconds) {
   for (const World* w : worlds) {
     World copy = *w;
     out.add(world_bounds(copy));
-    while (copy.time() + 0.5 * copy.def().dt < seconds) {
+    while (scenes::short_of(copy, seconds)) {
       copy.step();
       out.add(world_bounds(copy));
     }

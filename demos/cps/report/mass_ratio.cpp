@@ -36,7 +36,7 @@ PairOutcome run_pair(double ratio, SolverKind solver, PushMode push, int iterati
   def.iterations = iterations;
   World world(def);
   scenes::populate_mass_ratio(world, ratio);
-  while (world.time() + 0.5 * def.dt < seconds) {
+  while (scenes::short_of(world, seconds)) {
     world.step();
     if (!sane_state(world)) return {};
   }

@@ -16,31 +16,6 @@
 namespace cps::cli {
 namespace {
 
-// The size (m) of the largest movable body: a box's longest edge, a ball's diameter; 0 if none.
-double largest_size(const World& world) {
-  double size = 0.0;
-  for (const Body& b : world.bodies()) {
-    if (b.is_static()) continue;
-    size = std::max(size, b.shape.kind == ShapeKind::sphere ? 2.0 * b.shape.radius
-                                                            : 2.0 * b.shape.half_extents.maxCoeff());
-  }
-  return size;
-}
-
-// RMS distance (m) between the movable bodies of two worlds of the same scene.
-double rms_between(const World& a, const World& b) {
-  double sq = 0.0;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < a.bodies().size() && i < b.bodies().size(); ++i) {
-    if (a.bodies()[i].is_static()) continue;
-    sq += (a.bodies()[i].x - b.bodies()[i].x).squaredNorm();
-    ++n;
-  }
-  return n ? std::sqrt(sq / static_cast<double>(n)) : 0.0;
-}
-
-bool reached(const World& world, double t) { return world.time() + 0.5 * world.def().dt >= t; }
-
 bool is_paper_scene(const scenes::Scene& scene) {
   for (const scenes::Scene& s : scenes::paper_scenes()) {
     if (s.name == scene.name) return true;
@@ -63,7 +38,7 @@ std::vector<SolverErrorPoint> sample_solver_error(const RunSpec& spec, int sampl
   });
   no_solve = 0;
   std::int64_t sampled = 0;
-  while (!reached(world, horizon)) {
+  while (scenes::short_of(world, horizon)) {
     const std::size_t before = systems.size();
     const bool sample = world.counters().steps % every == every - 1;
     world.step();
@@ -134,7 +109,7 @@ ReferenceAgreement compare_references(const RunSpec& spec, double until_s, long 
   exact_spec.iterations = 1;  // the engine's sweeps are replaced by the exact solve
   scenes::Run exact = make_run_or_usage_error(scene, exact_spec.overrides());
   ReferenceAgreement a;
-  a.tolerance_m = kAgreementFraction * largest_size(pgs.world);
+  a.tolerance_m = kAgreementFraction * scenes::largest_body_size(pgs.world);
   std::string refused;
   exact.world.set_solve_override([&](const StepSystem& s, Eigen::VectorXd& lambda) {
     ++a.exact_solves;
@@ -149,7 +124,7 @@ ReferenceAgreement compare_references(const RunSpec& spec, double until_s, long 
   std::vector<double> t_all;
   std::vector<double> d_all;
   const int frame = kReferenceSubsteps;  // steps per 1/60 s
-  while (!reached(pgs.world, until_s)) {
+  while (scenes::short_of(pgs.world, until_s)) {
     if (a.exact_solves >= max_solves) {
       a.stopped = "the budget of " + std::to_string(max_solves) + " exact solves";
       break;
@@ -166,10 +141,11 @@ ReferenceAgreement compare_references(const RunSpec& spec, double until_s, long 
       a.stopped = "a reference blew up at " + number(pgs.world.time()) + " s";
       break;
     }
-    const double d = rms_between(pgs.world, exact.world);
+    const double d = scenes::rms_distance(scenes::movable_positions(pgs.world),
+                                          scenes::movable_positions(exact.world));
     t_all.push_back(pgs.world.time());
     d_all.push_back(d);
-    if (pgs.world.counters().steps % frame == 0 || reached(pgs.world, until_s)) {
+    if (pgs.world.counters().steps % frame == 0 || !scenes::short_of(pgs.world, until_s)) {
       a.t_s.push_back(pgs.world.time());
       a.distance_m.push_back(d);
     }
@@ -225,7 +201,7 @@ std::vector<EnergyTrace> energy_traces(const std::string& scene_name, int max_po
       e.rod_error_m.push_back(scenes::max_rod_error(world));
     };
     record();
-    while (!reached(world, horizon)) {
+    while (scenes::short_of(world, horizon)) {
       try {
         world.step();
       } catch (const std::exception&) {  // a blown-up state the step refuses (too many contacts)
@@ -236,7 +212,7 @@ std::vector<EnergyTrace> energy_traces(const std::string& scene_name, int max_po
         e.diverged_at_s = world.time();
         break;
       }
-      if (world.counters().steps % every == 0 || reached(world, horizon)) record();
+      if (world.counters().steps % every == 0 || !scenes::short_of(world, horizon)) record();
     }
     traces.push_back(std::move(e));
   }

@@ -17,48 +17,17 @@ namespace {
 // A measure at the CSV's precision (see RunResult).
 double csv(double v) { return at_csv_precision(v); }
 
-// The full size (m) of the largest movable body: a box's longest edge, a ball's diameter.
-double largest_body_size(const World& world) {
-  double size = 0.0;
-  for (const Body& b : world.bodies()) {
-    if (b.is_static()) continue;
-    size = std::max(size, b.shape.kind == ShapeKind::sphere ? 2.0 * b.shape.radius
-                                                            : 2.0 * b.shape.half_extents.maxCoeff());
-  }
-  return size > 0.0 ? size : kInfinity;
-}
-
-// Positions (m) of the movable bodies, in body order.
-std::vector<Vec3> positions(const World& world) {
-  std::vector<Vec3> x;
-  for (const Body& b : world.bodies()) {
-    if (!b.is_static()) x.push_back(b.x);
-  }
-  return x;
-}
-
-// True once `world` has stepped to time t (s), to half a step.
-bool reached(const World& world, double t) { return world.time() + 0.5 * world.def().dt >= t; }
-
 // Positions of the movable bodies (m) once `spec` has been stepped to time t (s), or nullopt if
 // the run blew up on the way (see sane_state).
 std::optional<std::vector<Vec3>> positions_at(const RunSpec& spec, double t) {
   scenes::Run run = scenes::make_run(spec.scene_def(), spec.overrides());
   run.world.step();  // at least one step, as every run
-  while (!reached(run.world, t)) {
+  while (scenes::short_of(run.world, t)) {
     if (!sane_state(run.world)) return std::nullopt;
     run.world.step();
   }
   if (!sane_state(run.world)) return std::nullopt;
-  return positions(run.world);
-}
-
-// RMS distance (m) between two lists of the same bodies' positions.
-double rms_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-  double sq = 0.0;
-  const std::size_t n = std::min(a.size(), b.size());
-  for (std::size_t i = 0; i < n; ++i) sq += (a[i] - b[i]).squaredNorm();
-  return n ? std::sqrt(sq / static_cast<double>(n)) : 0.0;
+  return scenes::movable_positions(run.world);
 }
 
 // The reference of a run at its scene's trajectory time: the positions (nullopt if the reference
@@ -90,7 +59,7 @@ const Reference& reference_of(const RunSpec& spec) {
   RunSpec half = ref;
   half.substeps = kReferenceSubsteps / 2;
   const std::optional<std::vector<Vec3>> check = positions_at(half, t);
-  if (r.positions && check) r.check_m = rms_distance(*r.positions, *check);
+  if (r.positions && check) r.check_m = scenes::rms_distance(*r.positions, *check);
   return cache[ref.id()] = r;
 }
 
@@ -141,8 +110,9 @@ ErrorRun error_run(const scenes::Scene& scene, scenes::Overrides o, double horiz
   o.set("measure_residual", true);
   ErrorRun e{scenes::make_run(scene, o), {}, {}, {}, {}, {}};
   World& world = e.run.world;
-  const double size_bound = largest_body_size(world);
-  while (!reached(world, horizon)) {
+  const double largest = scenes::largest_body_size(world);
+  const double size_bound = largest > 0.0 ? largest : kInfinity;
+  while (scenes::short_of(world, horizon)) {
     e.run.step();
     if (const std::string fault = state_fault(world); !fault.empty()) {
       e.diverged_at = world.time();
@@ -150,7 +120,7 @@ ErrorRun error_run(const scenes::Scene& scene, scenes::Overrides o, double horiz
       break;
     }
     observe_errors(world, e);
-    if (e.at_traj.empty() && reached(world, t_traj)) e.at_traj = positions(world);
+    if (e.at_traj.empty() && !scenes::short_of(world, t_traj)) e.at_traj = scenes::movable_positions(world);
     if (e.penetration.max > size_bound || e.rod_error.max > size_bound) {
       e.diverged_at = world.time();
       const bool pen = e.penetration.max > size_bound;
@@ -169,8 +139,8 @@ ErrorRun error_run(const scenes::Scene& scene, scenes::Overrides o, double horiz
 void step_on_to(ErrorRun& e, double t_traj) {
   try {
     World& world = e.run.world;
-    while (sane_state(world) && !reached(world, t_traj)) world.step();
-    if (sane_state(world)) e.at_traj = positions(world);
+    while (sane_state(world) && scenes::short_of(world, t_traj)) world.step();
+    if (sane_state(world)) e.at_traj = scenes::movable_positions(world);
   } catch (const std::exception&) {
     e.at_traj.clear();
   }
@@ -218,7 +188,7 @@ void record_errors(const ErrorRun& e, RunResult& r) {
 void step_copy(scenes::Run& run, TimedRun& t) {
   do {
     run.world.step();
-  } while (!reached(run.world, t.until_s));
+  } while (scenes::short_of(run.world, t.until_s));
   t.steps = run.world.counters().steps;
   t.simulated_s = run.world.time();
 }
@@ -278,7 +248,7 @@ MeasuredRun measure_errors(const RunSpec& spec) {
     r.trajectory_time_s = csv(t_traj);
     r.reference_check_m = csv(ref.check_m);
     if (!e.at_traj.empty() && ref.positions) {
-      r.trajectory_error_m = csv(rms_distance(e.at_traj, *ref.positions));
+      r.trajectory_error_m = csv(scenes::rms_distance(e.at_traj, *ref.positions));
       if (std::isfinite(ref.check_m)) {
         r.under_reference_error = *r.trajectory_error_m < *r.reference_check_m;
       }

@@ -78,7 +78,7 @@ MassRatioOutcome run_mass_ratio(double ratio, int iterations, double seconds) {
   World world(def);
   populate_mass_ratio(world, ratio);
   MassRatioOutcome out;
-  while (world.time() + 0.5 * def.dt < seconds) {
+  while (short_of(world, seconds)) {
     world.step();
     if (!all_finite(world)) return out;  // holds = false
     out.max_penetration_m = std::max(out.max_penetration_m, deepest_contact(world));

@@ -145,7 +145,7 @@ ColumnResult run_column(const scenes::Scene& scene, const Method& m, double seco
   const double rest_pe = rest_potential_energy(w, r.rest);
   double energy_max = scenes::kinetic_energy(w) + scenes::potential_energy(w);
   r.series.push_back({0.0, 0.0, largest_speed(w)});
-  while (w.time() + 0.5 * r.dt < seconds) {
+  while (scenes::short_of(w, seconds)) {
     run.step();
     r.series.back().overlap_m = manifold_overlap(w);  // the state the step started from
     if (!sane_state(w)) {
@@ -168,12 +168,11 @@ double window_us_per_step(const scenes::Scene& scene, const Method& m) {
   std::vector<double> us;
   for (int rep = 0; rep <= kCostRepeats; ++rep) {
     scenes::Run run = make_run_or_usage_error(scene, with_push(m));
-    const double dt = run.world.def().dt;
-    while (run.world.time() + 0.5 * dt < scene.bench.start_s) run.world.step();
+    while (scenes::short_of(run.world, scene.bench.start_s)) run.world.step();
     const double end = scene.bench.start_s + scene.bench.seconds;
     double cpu = 0.0;
     int steps = 0;
-    while (run.world.time() + 0.5 * dt < end) {
+    while (scenes::short_of(run.world, end)) {
       const double a = thread_cpu_seconds();
       run.world.step();
       cpu += thread_cpu_seconds() - a;
@@ -190,8 +189,7 @@ double window_us_per_step(const scenes::Scene& scene, const Method& m) {
 // step_cpu_s and the steps to `steps`. Returns when it stopped being sane (s), if it did.
 std::optional<double> step_observed(scenes::Run& run, double seconds, double& step_cpu_s,
                                     long long& steps) {
-  const double dt = run.world.def().dt;
-  while (run.world.time() + 0.5 * dt < seconds) {
+  while (scenes::short_of(run.world, seconds)) {
     const double start = thread_cpu_seconds();
     run.world.step();
     step_cpu_s += thread_cpu_seconds() - start;

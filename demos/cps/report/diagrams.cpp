@@ -598,15 +598,7 @@ bool draw_diagram(const fs::path& dir, const std::string& scene, const Measure& 
   const int width = 1100,
             height = 40 + static_cast<int>(key_height(*diagram)) + 300 * rows_of_panels;
   const std::string body = plot_script(*diagram, data, scene + ": " + m.label + title_note, m, height);
-  const std::string size = std::to_string(width) + "," + std::to_string(height);
-  std::ostringstream pdf_size;  // 100 pixels of the PNG per inch: its 10 pt text sits as in the PNG
-  pdf_size << width / 100.0 << "in," << height / 100.0 << "in";
-  draw_pictures(dir / "plots" / (stem + ".gp"),
-                {{dir / (stem + ".png"), "set terminal pngcairo size " + size + " font ',10' noenhanced"},
-                 {dir / (stem + ".svg"), "set terminal svg size " + size + " font ',10' noenhanced"},
-                 {dir / (stem + ".pdf"), "set terminal pdfcairo size " + pdf_size.str() +
-                                             " font ',10' noenhanced"}},
-                body, {"", "", "unset output\n"});
+  draw_png_svg_pdf(dir, stem, body, width, height);
   return true;
 }
 

@@ -153,4 +153,17 @@ void draw_pictures(const std::filesystem::path& script, const std::vector<Gnuplo
   for (const auto& f : files) f->commit();
 }
 
+void draw_png_svg_pdf(const std::filesystem::path& dir, const std::string& stem,
+                      const std::string& body, int width, int height) {
+  const std::string size = std::to_string(width) + "," + std::to_string(height);
+  std::ostringstream pdf_size;
+  pdf_size << width / 100.0 << "in," << height / 100.0 << "in";
+  draw_pictures(dir / "plots" / (stem + ".gp"),
+                {{dir / (stem + ".png"), "set terminal pngcairo size " + size + " font ',10' noenhanced"},
+                 {dir / (stem + ".svg"), "set terminal svg size " + size + " font ',10' noenhanced"},
+                 {dir / (stem + ".pdf"), "set terminal pdfcairo size " + pdf_size.str() +
+                                             " font ',10' noenhanced"}},
+                body, {"", "", "unset output\n"});
+}
+
 }  // namespace cps::cli

@@ -40,4 +40,11 @@ struct GnuplotFraming {
 void draw_pictures(const std::filesystem::path& script, const std::vector<GnuplotPicture>& pictures,
                    const std::string& body, const GnuplotFraming& framing);
 
+/// The report's three pictures of one plot, DIR/STEM.png, .svg and .pdf, width x height px
+/// (10 pt labels; the PDF at 100 px an inch, so its text sits as in the PNG), drawn from the
+/// script DIR/plots/STEM.gp with draw_pictures: `body` once per picture (begin it with "reset"
+/// to start each picture afresh), the PDF closed with "unset output". Throws as draw_pictures.
+void draw_png_svg_pdf(const std::filesystem::path& dir, const std::string& stem,
+                      const std::string& body, int width, int height);
+
 }  // namespace cps::cli

@@ -44,20 +44,6 @@ std::string cell(double v) {
   return number(v);
 }
 
-// Writes the three pictures of `stem` in DIR from gnuplot commands `body` (width x height px).
-void draw(const fs::path& dir, const std::string& stem, const std::string& body, int width,
-          int height) {
-  const std::string size = std::to_string(width) + "," + std::to_string(height);
-  std::ostringstream pdf_size;
-  pdf_size << width / 100.0 << "in," << height / 100.0 << "in";
-  draw_pictures(dir / "plots" / (stem + ".gp"),
-                {{dir / (stem + ".png"), "set terminal pngcairo size " + size + " font ',10' noenhanced"},
-                 {dir / (stem + ".svg"), "set terminal svg size " + size + " font ',10' noenhanced"},
-                 {dir / (stem + ".pdf"), "set terminal pdfcairo size " + pdf_size.str() +
-                                             " font ',10' noenhanced"}},
-                "reset\n" + body, {"", "", "unset output\n"});
-}
-
 // The gnuplot head of a picture of panels side by side with a title and a key row under them
 // (key_h: the key's height, a fraction of the picture).
 std::string multiplot_head(const std::string& title, double key_h) {
@@ -193,7 +179,7 @@ std::string solver_error_section(const fs::path& dir, const std::string& scene, 
                       gp_text(l.method + " " + std::to_string(l.sweeps) + " sweeps"));
   }
   gp << key_row(entries, key_h, 2);
-  draw(dir, stem, gp.str(), 1100, 520);
+  draw_png_svg_pdf(dir, stem, "reset\n" + gp.str(), 1100, 520);
 
   std::ostringstream md;
   md << "### Solver error per step\n\n"
@@ -273,7 +259,7 @@ std::string references_section(const fs::path& dir, const std::string& scene,
      << gp_text("tolerance " + number(a->tolerance_m) + " m") << ", "
      << "NaN with lines dt 4 lw 1.2 lc rgb '#b8860b' title "
      << gp_text("trajectory time used, " + number(t_used) + " s") << "\n";
-  draw(dir, stem, gp.str(), 900, 420);
+  draw_png_svg_pdf(dir, stem, "reset\n" + gp.str(), 900, 420);
 
   std::ostringstream md;
   md << "### Two references and the horizon\n\n"
@@ -365,7 +351,7 @@ std::string energy_section(const fs::path& dir, const std::string& scene,
     entries.push_back(style(i) + " title " + gp_text(traces[i].push));
   }
   gp << key_row(entries, key_h, 1);
-  draw(dir, stem, gp.str(), 1100, 480);
+  draw_png_svg_pdf(dir, stem, "reset\n" + gp.str(), 1100, 480);
 
   std::ostringstream md;
   md << "### Energy over time\n\n"

@@ -1,6 +1,6 @@
 #pragma once
 // The commands of `cps`, one file each in commands/ (list, simulate, scene, parameters, report,
-// bench, and with the renderer render, figure and export). Each owns its options: its add_*
+// bench, and with the renderer render, figure, export and diff). Each owns its options: its add_*
 // function registers a subcommand on the application with its options and returns how to run
 // it; main.cpp parses the command line and runs the command chosen.
 

@@ -89,7 +89,7 @@ TEST_CASE("times are taken as fractions wherever they are taken, as --dt is", "[
 TEST_CASE("a run's work, bodies x steps x substeps x iterations, is bounded by --max-work",
           "[cli][limits]") {
   const std::string folder = "cps_limits_work";
-  // Issue 24: 6 bodies x 6e6 steps x 1000 substeps x 1e4 iterations = 3.6e14, hundreds of hours.
+  // 6 bodies x 6e6 steps x 1000 substeps x 1e4 iterations = 3.6e14, hundreds of hours.
   const std::string huge = "simulate stack --push soft --soft-substeps 1000 --iterations 10000";
   check_refused(huge + " --seconds 1e5", "3.6e+14 body-iterations", folder);
   check_refused(huge + " --seconds 1e5", "budget of 1e+11 body-iterations", folder);

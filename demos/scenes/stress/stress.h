@@ -258,7 +258,7 @@ inline constexpr double kHeavyRopeLinkRadiusM = 0.05;        ///< m
 inline constexpr double kHeavyRopeRodLengthM = 0.25;         ///< m, every rod
 inline constexpr double kHeavyRopeBlockRatio = 1800.0;       ///< block mass / link mass (AVBD's HeavyRope)
 inline constexpr double kHeavyRopeBlockHalfM = 0.3;          ///< m, the block's half edge
-/// Steps of the long runs (the 10,000); their default duration is this times dt = 1/60 s.
+/// Steps of the long runs; their default duration is this times dt = 1/60 s.
 inline constexpr int kLongRunSteps = 10000;
 
 // random.cpp

@@ -13,7 +13,8 @@
 //                               engine/src/push/: baumgarte (Sec. 5.3: one solve, f_cv moves
 //                               positions and momenta), split (Sec. 8.1: a second solve without
 //                               the push sets the momenta), and the methods compared with the
-//                               paper's: split-impulse, soft, ngs.
+//                               paper's: split-impulse, soft, ngs, tgs, xpbd, avbd (the table:
+//                               cps::parameter("push").choices).
 
 #include "cps/body.h"
 #include "cps/collision.h"

@@ -178,7 +178,9 @@ WorldDef world_def_with(const Scene& scene, const Overrides& overrides);
 /// The stepping rule of every run to a time: true while `world` is more than half a step (dt, s)
 /// short of t (s), so that a run of t seconds takes round(t / dt) steps whatever the round-off
 /// in World::time(). Run::advance_to and every loop that steps to a time use it.
-inline bool short_of(const World& world, double t) { return world.time() + 0.5 * world.def().dt < t; }
+inline bool short_of(const World& world, double t) {
+  return world.time() + 0.5 * world.def().dt < t;
+}
 
 /// A world built from a scene, with its metrics, ready to step.
 struct Run {

@@ -9,11 +9,14 @@
 // free colour goes to the overflow, swept before the colours, in order. Static bodies belong to no
 // colour (they are never written).
 
+#include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
+
+#include "buffers.h"
 
 namespace cps {
 
@@ -58,5 +61,26 @@ class ConstraintGraph {
  private:
   std::vector<std::uint32_t> used_;  // per body: the colours it is in (bit k: colour k)
 };
+
+/// The first item of each colour in an order by colour: colour c's items are
+/// order[start[c], start[c + 1]).
+using ColourStarts = std::array<std::size_t, ConstraintGraph::kColours + 1>;
+
+/// A counting sort of item indices by colour (colours: one per item, each in [0, kOverflow]):
+/// order lists them colour by colour, each colour's in index order, and colour c's are
+/// order[start[c], start[c + 1]). No errors; allocates only to grow.
+inline void order_by_colour(const std::vector<int>& colours, ColourStarts& start,
+                            std::vector<std::size_t>& order) {
+  start.fill(0);
+  for (const int c : colours) ++start[static_cast<std::size_t>(c) + 1];
+  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  detail::resize_with_headroom(order, colours.size());
+  ColourStarts next = start;
+  for (std::size_t i = 0; i < colours.size(); ++i) order[next[static_cast<std::size_t>(colours[i])]++] = i;
+}
+
+/// The colour swept k-th (k in [0, kColours)): the overflow first, then colours 0 to
+/// kOverflow - 1 (Box3D's order, b3SolverStep).
+constexpr int sweep_colour(int k) { return k == 0 ? ConstraintGraph::kOverflow : k - 1; }
 
 }  // namespace cps

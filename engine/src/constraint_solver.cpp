@@ -4,6 +4,8 @@
 #include "matrix_free.h"
 #include "solver.h"
 
+#include <stdexcept>
+
 namespace cps {
 namespace {
 
@@ -11,10 +13,17 @@ namespace {
 // once a step, b (c) for each solve, lambda by solve_lcp over A.
 class ExplicitSolver final : public ConstraintSolver {
  public:
-  void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies) override {
+  void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
+               SolverKind kind) override {
     inv_inertia_.resize(bodies.size());
     for (std::size_t i = 0; i < bodies.size(); ++i) inv_inertia_[i] = bodies[i].inv_inertia_world();
     system_ = assemble_matrices(rows, bodies);
+    order_.clear();
+    if (kind == SolverKind::coloured_pgs) {
+      // The matrix-free path's runs and colours, so that both sweep the rows in one order.
+      colour_rows(rows, bodies, MatrixFreeSystem::kMaxRun, colours_);
+      cps::sweep_order(colours_, order_);
+    }
   }
 
   void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
@@ -29,9 +38,13 @@ class ExplicitSolver final : public ConstraintSolver {
       v1_.segment<3>(k + 3) = inv_inertia_[i] * bodies[i].l;
     }
     system_.b = assemble_rhs(rows, system_.J, system_.M_inv, v1_, f_ext, settings.dt, terms);
+    last_kind_ = settings.kind;
+    if (settings.kind == SolverKind::coloured_pgs && order_.size() != rows.size()) {
+      throw std::logic_error("explicit solve: coloured-pgs needs a prepare() for it");
+    }
     const Eigen::VectorXd x =
         solve_lcp(system_.A, system_.b, system_.limits, settings.friction, settings.kind,
-                  settings.iterations, initial != nullptr ? initial->data() : nullptr);
+                  settings.iterations, initial != nullptr ? initial->data() : nullptr, &order_);
     lambda.assign(x.data(), x.data() + x.size());
   }
 
@@ -51,8 +64,16 @@ class ExplicitSolver final : public ConstraintSolver {
     limits = system_.limits;
   }
 
+  void sweep_order(std::vector<int>& order) const override {
+    order.clear();
+    if (last_kind_ == SolverKind::coloured_pgs) order = order_;
+  }
+
  private:
   std::vector<Mat3> inv_inertia_;  // n: world inverse inertia per body at prepare()
+  RowColours colours_;             // coloured PGS: the rows' runs by colour
+  std::vector<int> order_;         // coloured PGS: the rows in sweep order (c); else empty
+  SolverKind last_kind_ = SolverKind::pgs;
   Eigen::VectorXd v1_;  // 6n: [v_i, w_i] per body at the solve (m/s, rad/s)
   System system_;
 };
@@ -61,16 +82,27 @@ class ExplicitSolver final : public ConstraintSolver {
 // allocation once its buffers have their working size.
 class MatrixFreeSolver final : public ConstraintSolver {
  public:
-  void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies) override {
-    cps::prepare(system_, rows, bodies);
+  void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
+               SolverKind kind) override {
+    cps::prepare(system_, rows, bodies, kind);
   }
 
   void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
              const Eigen::VectorXd& f_ext, TargetTerms terms, const SolveSettings& settings,
              std::vector<double>& lambda, const std::vector<double>* initial) override {
     rhs(system_, rows, bodies, f_ext, settings.dt, terms);
+    last_kind_ = settings.kind;
+    Workers* workers = nullptr;
+    if (settings.kind == SolverKind::coloured_pgs) {
+      if (settings.threads > 1) {
+        if (!workers_ || workers_->count() != settings.threads) {
+          workers_ = std::make_unique<Workers>(settings.threads);
+        }
+        workers = workers_.get();
+      }
+    }
     cps::solve(system_, rows, settings.friction, settings.kind, settings.iterations, lambda,
-               initial);
+               initial, workers);
   }
 
   void residual(const std::vector<ConstraintRow>& rows, FrictionModel friction,
@@ -83,8 +115,15 @@ class MatrixFreeSolver final : public ConstraintSolver {
     cps::explicit_system(system_, A, b, limits);
   }
 
+  void sweep_order(std::vector<int>& order) const override {
+    order.clear();
+    if (last_kind_ == SolverKind::coloured_pgs) order = system_.perm;
+  }
+
  private:
   MatrixFreeSystem system_;
+  std::unique_ptr<Workers> workers_;  // coloured PGS on more than one thread
+  SolverKind last_kind_ = SolverKind::pgs;
 };
 
 }  // namespace

@@ -19,13 +19,15 @@
 namespace cps {
 
 /// What one solve needs besides the rows and bodies: dt (s, > 0; a substep's length for the
-/// methods that substep), the number of sweeps (>= 1), PGS or Jacobi, and the friction model of
-/// the force limits.
+/// methods that substep), the number of sweeps (>= 1), PGS, Jacobi or coloured PGS, the friction
+/// model of the force limits, and the threads a coloured PGS sweep may share (count, >= 1; the
+/// matrix-free path only; the result is the same for every count).
 struct SolveSettings {
   double dt = 1.0 / 60.0;
   int iterations = 25;
   SolverKind kind = SolverKind::pgs;
   FrictionModel friction = FrictionModel::fixed;
+  int threads = 1;
 };
 
 /// A way to solve the step's bounded system A lambda = b.
@@ -35,15 +37,18 @@ class ConstraintSolver {
 
   /// Builds what every solve of this step shares, from the rows (c, bodies by index or
   /// kWorldBody) and the bodies (n) as they are before the integration: J, M^-1, A and v1
-  /// (explicit), or the packed rows and I^-1 per body (matrix-free).
-  virtual void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies) = 0;
+  /// (explicit), or the packed rows and I^-1 per body (matrix-free); for the sweeps of `kind`
+  /// (SolverKind::coloured_pgs: the rows' colours and sweep order too, row_colours.h).
+  virtual void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
+                       SolverKind kind) = 0;
 
   /// Solves A lambda = b with settings.iterations sweeps, b of Eq. 6.2.9 from the bodies'
   /// momenta as they are now (read with the world inverse inertia of prepare(), so that the
   /// substeps of one step share one A), f_ext (6n: force and torque per body, N and N m) and each row's target velocity
   /// (push and bias, or bias only: `terms`, Sec. 8.1), from `initial` (c values, N: the warm
   /// start of Sec. 6.2.3) when given, else from lambda = 0. lambda: resized to c (N). The rows
-  /// and bodies must be those given to prepare().
+  /// and bodies must be those given to prepare(), and settings.kind coloured PGS only when
+  /// prepare()'s was (std::logic_error otherwise).
   virtual void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
                      const Eigen::VectorXd& f_ext, TargetTerms terms,
                      const SolveSettings& settings, std::vector<double>& lambda,
@@ -60,6 +65,10 @@ class ConstraintSolver {
   /// request only (the matrix-free path multiplies its packed rows out, J times M^-1 J^T), never
   /// in a step that nobody observes. No errors.
   virtual void system(SparseRowMatrix& A, Eigen::VectorXd& b, RowLimits& limits) const = 0;
+
+  /// The order the last solve() swept the rows in, into order: c row indices for
+  /// SolverKind::coloured_pgs, empty for the methods that sweep in row order. No errors.
+  virtual void sweep_order(std::vector<int>& order) const = 0;
 };
 
 /// The implementation for `assembly`: Assembly::explicit_matrices or Assembly::matrix_free.

@@ -7,12 +7,29 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace cps {
 namespace {
 
 using PackedRow = MatrixFreeSystem::Row;
 using ConstMap6 = Eigen::Map<const Vec6, Eigen::Aligned16>;
+
+// The row index packed at position i.
+inline std::size_t row_at(const MatrixFreeSystem& s, std::size_t i) {
+  return s.perm.empty() ? i : static_cast<std::size_t>(s.perm[i]);
+}
+
+// Coloured PGS reads the rows in sweep order, which jumps between runs: it asks for the row
+// kPrefetch positions ahead early, as the hardware does by itself for rows read in order.
+constexpr std::size_t kPrefetch = 8;
+inline void prefetch_row(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
+                         std::size_t i) {
+  if (s.perm.empty() || i + kPrefetch >= s.perm.size()) return;
+  const char* p = reinterpret_cast<const char*>(&rows[static_cast<std::size_t>(s.perm[i + kPrefetch])]);
+  for (std::size_t line = 0; line < sizeof(ConstraintRow); line += 64) __builtin_prefetch(p + line);
+}
 
 // j_j . w over the row's bodies: sum_i A_ji lambda_i. 6-vector dot products (Eigen sums each in
 // pairs, so the additions do not form one long chain); a row on one movable body (its other
@@ -94,41 +111,77 @@ inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_ru
 // the same number Eq. 7.1.1 gives through w, in the same order; w_a and w_b take the run's
 // sum of M^-1 j_i^T delta_i at its end.
 template <bool kCoupled>
-void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
+inline void sweep_run(MatrixFreeSystem& s, const MatrixFreeSystem::Run& run, int fixed_slot,
+                      std::vector<double>& lambda) {
   const PackedRow* rows = s.rows.data();
   const double* b = s.b.data();
   double* l = lambda.data();
+  const auto first = static_cast<std::size_t>(run.begin);
+  const PackedRow& r0 = rows[first];
+  if (r0.a == fixed_slot) return;  // no movable body: every lambda stays 0
+  Vec6& w_a = s.w[static_cast<std::size_t>(r0.a)];
+  const bool two = r0.b != fixed_slot;
+  if (run.offset < 0) {  // a short run: row by row, through w
+    if (!two) {
+      Vec6 unused;
+      sweep_short_run<kCoupled, false>(rows + first, b + first, l + first, run.count, lambda, w_a, unused);
+    } else {
+      sweep_short_run<kCoupled, true>(rows + first, b + first, l + first, run.count, lambda, w_a,
+                                      s.w[static_cast<std::size_t>(r0.b)]);
+    }
+    return;
+  }
+  Vec6& w_b = s.w[static_cast<std::size_t>(r0.b)];
+  const double* g = s.coupling.data() + run.offset;
+  // Two contact points (a contact and two friction rows each), or any other size.
+  if (run.count == 6) {
+    two ? sweep_block<kCoupled, true, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b)
+        : sweep_block<kCoupled, false, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b);
+  } else {
+    two ? sweep_block<kCoupled, true, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b)
+        : sweep_block<kCoupled, false, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b);
+  }
+}
+
+// PGS over the runs (see MatrixFreeSystem::Run), in the order of s.runs. In a run of m rows on
+// bodies a and b, row k's value after rows i < k have changed by delta_i is
+//   lambda_k + (b_k - j_k . w_start) / A_kk - sum_{i < k} (A_ki / A_kk) delta_i,
+// the same number Eq. 7.1.1 gives through w, in the same order; w_a and w_b take the run's
+// sum of M^-1 j_i^T delta_i at its end.
+template <bool kCoupled>
+void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
   const int fixed_slot = static_cast<int>(s.w.size()) - 1;
   for (int it = 0; it < iterations; ++it) {
-    for (const MatrixFreeSystem::Run& run : s.runs) {
-      const auto first = static_cast<std::size_t>(run.begin);
-      if (run.offset < 0) {  // a short run: row by row, through w
-        const PackedRow& r0 = rows[first];
-        Vec6& w_a = s.w[static_cast<std::size_t>(r0.a)];
-        if (r0.a == fixed_slot) continue;  // no movable body: every lambda stays 0
-        if (r0.b == fixed_slot) {
-          Vec6 unused;
-          sweep_short_run<kCoupled, false>(rows + first, b + first, l + first, run.count, lambda, w_a, unused);
-        } else {
-          sweep_short_run<kCoupled, true>(rows + first, b + first, l + first, run.count, lambda, w_a,
-                                          s.w[static_cast<std::size_t>(r0.b)]);
-        }
-        continue;
-      }
-      const PackedRow& r0 = rows[first];
-      Vec6& w_a = s.w[static_cast<std::size_t>(r0.a)];
-      Vec6& w_b = s.w[static_cast<std::size_t>(r0.b)];
-      const double* g = s.coupling.data() + run.offset;
-      const bool two = r0.b != fixed_slot;
-      if (r0.a == fixed_slot) continue;  // no movable body: every lambda stays 0
-      // Two contact points (a contact and two friction rows each), or any other size.
-      if (run.count == 6) {
-        two ? sweep_block<kCoupled, true, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b)
-            : sweep_block<kCoupled, false, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b);
+    for (const MatrixFreeSystem::Run& run : s.runs) sweep_run<kCoupled>(s, run, fixed_slot, lambda);
+  }
+}
+
+// Coloured PGS, thread t of `workers` (every thread runs this with its own t): per sweep, the
+// overflow's runs on thread 0 in order, then each colour's runs split evenly among the threads,
+// with a barrier after each colour. The runs of a colour share no movable body: each writes only
+// its own lambdas and its bodies' w, and reads a contact row's lambda only from its own run
+// (a manifold's rows are one run or runs of different colours).
+template <bool kCoupled>
+void coloured_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda,
+                     Workers* workers, int t) {
+  const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+  const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
+  const auto k_t = static_cast<std::size_t>(t);
+  for (int it = 0; it < iterations; ++it) {
+    for (std::size_t k = 0; k < ConstraintGraph::kColours; ++k) {
+      const std::size_t begin = s.sweep_start[k];
+      const std::size_t count = s.sweep_start[k + 1] - begin;
+      if (count == 0) continue;  // every thread sees the same counts
+      std::size_t first = 0;
+      std::size_t last = count;
+      if (k == 0) {
+        if (t != 0) last = 0;
       } else {
-        two ? sweep_block<kCoupled, true, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b)
-            : sweep_block<kCoupled, false, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b);
+        first = count * k_t / threads;
+        last = count * (k_t + 1) / threads;
       }
+      for (std::size_t i = first; i < last; ++i) sweep_run<kCoupled>(s, s.runs[begin + i], fixed_slot, lambda);
+      if (workers != nullptr) workers->sync();
     }
   }
 }
@@ -158,19 +211,102 @@ void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lam
   }
 }
 
+// Coupling entries reserved per row: sum over runs of m (m - 1) / 2 <= (kMaxRun - 1) / 2 *
+// (sum of m), so this bound holds for any mix of manifolds (8 bytes x 12 = 96 bytes a row).
+constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun / 2;
+
+// The coupling blocks of s.runs (any order), at offsets set here (PGS and coloured PGS).
+void build_coupling(MatrixFreeSystem& s) {
+  std::size_t coupling_size = 0;
+  for (MatrixFreeSystem::Run& run : s.runs) {
+    const int m = run.count;
+    const bool block = m >= MatrixFreeSystem::kMinBlock;
+    run.offset = block ? static_cast<int>(coupling_size) : -1;
+    if (block) coupling_size += static_cast<std::size_t>(m * (m - 1) / 2);
+  }
+  // Room for the largest coupling these many rows can need (kCouplingPerRow): it then grows only
+  // when the row count does, not whenever more rows happen to sit in blocks than in any earlier
+  // step (which a long run meets after warm-up).
+  detail::reserve_with_headroom(s.coupling, std::max(coupling_size, kCouplingPerRow * s.rows.size()));
+  detail::resize_with_headroom(s.coupling, coupling_size);
+  for (const MatrixFreeSystem::Run& run : s.runs) {
+    if (run.offset < 0) continue;
+    const PackedRow* r = s.rows.data() + run.begin;
+    double* g = s.coupling.data() + run.offset;
+    for (int i = 0; i < run.count; g += run.count - 1 - i, ++i) {
+      // Column i: A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
+      for (int k = i + 1; k < run.count; ++k) {
+        const double a_ki = ConstMap6(r[k].j.data()).dot(ConstMap6(r[i].minv_jt.data())) +
+                            ConstMap6(r[k].j.data() + 6).dot(ConstMap6(r[i].minv_jt.data() + 6));
+        g[k - i - 1] = a_ki * r[k].inv_diagonal;
+      }
+    }
+  }
+}
+
+// Runs of consecutive rows on the same two slots in row order, and their coupling blocks (PGS).
+void build_runs(MatrixFreeSystem& s) {
+  const std::size_t c = s.rows.size();
+  s.runs.clear();
+  detail::reserve_with_headroom(s.runs, c);
+  for (std::size_t r = 0; r < c;) {
+    std::size_t end = r + 1;
+    while (end < c && end - r < static_cast<std::size_t>(MatrixFreeSystem::kMaxRun) &&
+           s.rows[end].a == s.rows[r].a && s.rows[end].b == s.rows[r].b) {
+      ++end;
+    }
+    s.runs.push_back({static_cast<int>(r), static_cast<int>(end - r), -1});
+    r = end;
+  }
+  build_coupling(s);
+  s.runs_ready = true;
+}
+
+// Coloured PGS: the runs of s.colours at their positions (the rows are packed in sweep order, so
+// a colour's runs are consecutive) and their coupling blocks.
+void build_coloured_runs(MatrixFreeSystem& s) {
+  s.runs.clear();
+  detail::reserve_with_headroom(s.runs, s.colours.runs.size());
+  int position = 0;
+  for (int k = 0; k < ConstraintGraph::kColours; ++k) {
+    const auto c = static_cast<std::size_t>(sweep_colour(k));
+    s.sweep_start[static_cast<std::size_t>(k)] = s.runs.size();
+    for (std::size_t i = s.colours.start[c]; i < s.colours.start[c + 1]; ++i) {
+      const int count = s.colours.runs[s.colours.order[i]].count;
+      s.runs.push_back({position, count, -1});
+      position += count;
+    }
+  }
+  s.sweep_start.back() = s.runs.size();
+  build_coupling(s);
+  s.runs_ready = true;
+}
+
+
 }  // namespace
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
-             const std::vector<Body>& bodies) {
+             const std::vector<Body>& bodies, SolverKind kind) {
   const int n = static_cast<int>(bodies.size());
+  s.runs_ready = false;  // built below (coloured PGS) or by the first PGS solve (Jacobi: never)
+  if (kind == SolverKind::coloured_pgs) {
+    colour_rows(rows, bodies, MatrixFreeSystem::kMaxRun, s.colours);
+    sweep_order(s.colours, s.perm);
+    detail::resize_with_headroom(s.position, rows.size());
+    for (std::size_t i = 0; i < s.perm.size(); ++i) s.position[static_cast<std::size_t>(s.perm[i])] = static_cast<int>(i);
+  } else {
+    s.perm.clear();
+    s.position.clear();
+  }
   detail::resize_with_headroom(s.inv_inertia, bodies.size());
   for (std::size_t i = 0; i < bodies.size(); ++i) s.inv_inertia[i] = bodies[i].inv_inertia_world();
   detail::resize_with_headroom(s.rows, rows.size());
   detail::resize_with_headroom(s.diagonal, rows.size());
   detail::resize_with_headroom(s.w, bodies.size() + 1);  // slot n: static bodies and the fixed world, always 0
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    const ConstraintRow& row = rows[r];
-    PackedRow& p = s.rows[r];
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    prefetch_row(s, rows, i);
+    const ConstraintRow& row = rows[row_at(s, i)];
+    PackedRow& p = s.rows[i];
     // Static bodies and the fixed world share slot n, whose w stays 0 (M^-1 = 0 there).
     const auto slot = [&](int body) {
       return body == kWorldBody || bodies[static_cast<std::size_t>(body)].is_static() ? n : body;
@@ -180,7 +316,9 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     p.c_min = row.c_min;
     p.c_max = row.c_max;
     p.mu = row.mu;
-    p.normal_row = row.normal_row;
+    p.normal_row = row.normal_row < 0 || s.perm.empty()
+                       ? row.normal_row
+                       : s.position[static_cast<std::size_t>(row.normal_row)];
     p.minv_jt.fill(0.0);
     double diagonal = 0.0;
     for (int half = 0; half < 2; ++half) {
@@ -207,10 +345,10 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
       std::swap_ranges(p.minv_jt.begin(), p.minv_jt.begin() + 6, p.minv_jt.begin() + 6);
       std::swap(p.a, p.b);
     }
-    s.diagonal[r] = diagonal;
+    s.diagonal[i] = diagonal;
     p.inv_diagonal = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
   }
-  s.runs_ready = false;  // built by the first PGS solve (Jacobi does not use them)
+  if (kind == SolverKind::coloured_pgs) build_coloured_runs(s);
 }
 
 void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
@@ -232,66 +370,29 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   }
   s.w.back().setZero();
   if (terms == TargetTerms::push_from_rest) {  // the bodies at rest, no external force: b = v / dt
-    for (std::size_t r = 0; r < rows.size(); ++r) s.b[r] = target_velocity(rows[r], terms) / dt;
+    for (std::size_t i = 0; i < rows.size(); ++i) s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt;
     return;
   }
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    const double v = target_velocity(rows[r], terms);
-    s.b[r] = v / dt - row_times_w(s.rows[r], s.w, static_cast<int>(bodies.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    prefetch_row(s, rows, i);
+    const double v = target_velocity(rows[row_at(s, i)], terms);
+    s.b[i] = v / dt - row_times_w(s.rows[i], s.w, static_cast<int>(bodies.size()));
   }
 }
 
-namespace {
-
-// Coupling entries reserved per row: sum over runs of m (m - 1) / 2 <= (kMaxRun - 1) / 2 *
-// (sum of m), so this bound holds for any mix of manifolds (8 bytes x 12 = 96 bytes a row).
-constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun / 2;
-
-// Runs of consecutive rows on the same two slots, and their coupling blocks (PGS only).
-void build_runs(MatrixFreeSystem& s) {
-  const std::size_t c = s.rows.size();
-  s.runs.clear();
-  detail::reserve_with_headroom(s.runs, c);
-  std::size_t coupling_size = 0;
-  for (std::size_t r = 0; r < c;) {
-    std::size_t end = r + 1;
-    while (end < c && end - r < static_cast<std::size_t>(MatrixFreeSystem::kMaxRun) &&
-           s.rows[end].a == s.rows[r].a && s.rows[end].b == s.rows[r].b) {
-      ++end;
-    }
-    const int m = static_cast<int>(end - r);
-    const bool block = m >= MatrixFreeSystem::kMinBlock;
-    s.runs.push_back({static_cast<int>(r), m, block ? static_cast<int>(coupling_size) : -1});
-    if (block) coupling_size += static_cast<std::size_t>(m * (m - 1) / 2);
-    r = end;
-  }
-  // Room for the largest coupling these many rows can need (kCouplingPerRow): it then grows only
-  // when the row count does, not whenever more rows happen to sit in blocks than in any earlier
-  // step (which a long run meets after warm-up).
-  detail::reserve_with_headroom(s.coupling, std::max(coupling_size, kCouplingPerRow * c));
-  detail::resize_with_headroom(s.coupling, coupling_size);
-  for (const MatrixFreeSystem::Run& run : s.runs) {
-    if (run.offset < 0) continue;
-    const PackedRow* r = s.rows.data() + run.begin;
-    double* g = s.coupling.data() + run.offset;
-    for (int i = 0; i < run.count; g += run.count - 1 - i, ++i) {
-      // Column i: A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
-      for (int k = i + 1; k < run.count; ++k) {
-        const double a_ki = ConstMap6(r[k].j.data()).dot(ConstMap6(r[i].minv_jt.data())) +
-                            ConstMap6(r[k].j.data() + 6).dot(ConstMap6(r[i].minv_jt.data() + 6));
-        g[k - i - 1] = a_ki * r[k].inv_diagonal;
-      }
-    }
-  }
-  s.runs_ready = true;
-}
-
-}  // namespace
 
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
            SolverKind kind, int iterations, std::vector<double>& lambda,
-           const std::vector<double>* initial) {
-  detail::assign_with_headroom(lambda, rows.size(), 0.0);  // initial guess 0 (Sec. 7.2) ...
+           const std::vector<double>* initial, Workers* workers) {
+  const bool coloured = kind == SolverKind::coloured_pgs;
+  if (coloured != !s.perm.empty() && !rows.empty()) {
+    throw std::logic_error(std::string("matrix-free solve: rows packed for ") +
+                           (s.perm.empty() ? "row order" : "coloured-pgs") + ", solved by " +
+                           std::string(name_of(kind)));
+  }
+  // The sweeps run on l, by position: lambda itself in row order, else s.swept.
+  std::vector<double>& l = coloured ? s.swept : lambda;
+  detail::assign_with_headroom(l, rows.size(), 0.0);  // initial guess 0 (Sec. 7.2) ...
   for (Vec6& w : s.w) w.setZero();
   if (initial != nullptr) {  // ... or the one given, with w = M^-1 J^T lambda to match
     const int fixed_slot = static_cast<int>(s.w.size()) - 1;
@@ -316,19 +417,32 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
         a = r.a;
         b = r.b;
       }
-      lambda[j] = (*initial)[j];
-      sum_a += lambda[j] * ConstMap6(r.minv_jt.data());
-      sum_b += lambda[j] * ConstMap6(r.minv_jt.data() + 6);
+      l[j] = (*initial)[row_at(s, j)];
+      sum_a += l[j] * ConstMap6(r.minv_jt.data());
+      sum_b += l[j] * ConstMap6(r.minv_jt.data() + 6);
     }
     flush();
   }
   const bool coupled = friction == FrictionModel::coupled;
   if (kind == SolverKind::jacobi) {
     detail::assign_with_headroom(s.next, rows.size(), 0.0);
-    coupled ? jacobi_sweeps<true>(s, iterations, lambda) : jacobi_sweeps<false>(s, iterations, lambda);
+    coupled ? jacobi_sweeps<true>(s, iterations, l) : jacobi_sweeps<false>(s, iterations, l);
+  } else if (coloured) {
+    if (workers == nullptr || workers->count() == 1) {
+      coupled ? coloured_sweeps<true>(s, iterations, l, nullptr, 0)
+              : coloured_sweeps<false>(s, iterations, l, nullptr, 0);
+    } else {
+      auto task = [&](int t) {
+        coupled ? coloured_sweeps<true>(s, iterations, l, workers, t)
+                : coloured_sweeps<false>(s, iterations, l, workers, t);
+      };
+      workers->run(task);
+    }
+    detail::resize_with_headroom(lambda, rows.size());
+    for (std::size_t j = 0; j < rows.size(); ++j) lambda[static_cast<std::size_t>(s.perm[j])] = l[j];
   } else {
     if (!s.runs_ready) build_runs(s);
-    coupled ? pgs_sweeps<true>(s, iterations, lambda) : pgs_sweeps<false>(s, iterations, lambda);
+    coupled ? pgs_sweeps<true>(s, iterations, l) : pgs_sweeps<false>(s, iterations, l);
   }
 }
 
@@ -340,15 +454,18 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   for (std::size_t j = 0; j < rows.size(); ++j) {
     const double diagonal = s.diagonal[j];
     if (!(diagonal > 0.0)) continue;
+    const PackedRow& p = s.rows[j];
+    // The bounds read lambda by row index: the contact row's index for a friction row.
+    const int normal_row = p.normal_row < 0 || s.perm.empty()
+                               ? p.normal_row
+                               : s.perm[static_cast<std::size_t>(p.normal_row)];
     double lo;
     double hi;
-    if (friction == FrictionModel::coupled) {
-      bounds<true>(s.rows[j], lambda, lo, hi);
-    } else {
-      bounds<false>(s.rows[j], lambda, lo, hi);
-    }
-    const double Ax = row_times_w(s.rows[j], s.w, static_cast<int>(s.w.size()) - 1);
-    const double r = detail::natural_map_residual(lambda[j], Ax - s.b[j], diagonal, lo, hi);
+    detail::force_limits(friction == FrictionModel::coupled, p.c_min, p.c_max, p.mu, normal_row,
+                         lambda.data(), lo, hi);
+    const double Ax = row_times_w(p, s.w, static_cast<int>(s.w.size()) - 1);
+    const double r =
+        detail::natural_map_residual(lambda[row_at(s, j)], Ax - s.b[j], diagonal, lo, hi);
     max = std::max(max, r);
     sum_squares += r * r;
   }
@@ -367,8 +484,10 @@ void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::Vecto
   limits.c_max.resize(c);
   limits.mu.resize(c);
   limits.normal_row.resize(static_cast<std::size_t>(c));
-  for (Eigen::Index r = 0; r < c; ++r) {
-    const PackedRow& p = s.rows[static_cast<std::size_t>(r)];
+  for (Eigen::Index i = 0; i < c; ++i) {
+    // Written at its row index: A, b and the limits in row order, as the explicit path's.
+    const PackedRow& p = s.rows[static_cast<std::size_t>(i)];
+    const auto r = static_cast<Eigen::Index>(row_at(s, static_cast<std::size_t>(i)));
     for (int half = 0; half < 2; ++half) {
       const Eigen::Index column = 6 * static_cast<Eigen::Index>(half == 0 ? p.a : p.b);
       for (int k = 0; k < 6; ++k) {
@@ -380,14 +499,16 @@ void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::Vecto
     limits.c_min[r] = p.c_min;
     limits.c_max[r] = p.c_max;
     limits.mu[r] = p.mu;
-    limits.normal_row[static_cast<std::size_t>(r)] = p.normal_row;
+    limits.normal_row[static_cast<std::size_t>(r)] =
+        p.normal_row < 0 || s.perm.empty() ? p.normal_row : s.perm[static_cast<std::size_t>(p.normal_row)];
   }
   SparseRowMatrix J(c, slots);
   SparseRowMatrix MJt(c, slots);
   J.setFromTriplets(j_entries.begin(), j_entries.end());
   MJt.setFromTriplets(m_entries.begin(), m_entries.end());
   A = J * SparseRowMatrix(MJt.transpose());
-  b = Eigen::Map<const Eigen::VectorXd>(s.b.data(), c);
+  b.resize(c);
+  for (Eigen::Index i = 0; i < c; ++i) b[static_cast<Eigen::Index>(row_at(s, static_cast<std::size_t>(i)))] = s.b[static_cast<std::size_t>(i)];
 }
 
 }  // namespace cps

@@ -6,8 +6,10 @@
 
 #include "cps/body.h"
 #include "cps/constraint.h"
+#include "row_colours.h"
 #include "solver.h"
 #include "system.h"
+#include "workers.h"
 
 #include <array>
 #include <vector>
@@ -31,7 +33,7 @@ struct MatrixFreeSystem {
     double c_min = 0.0;                ///< lower force limit (N)
     double c_max = 0.0;                ///< upper force limit (N)
     double mu = 0.0;                   ///< friction coefficient of a friction row (dimensionless)
-    int normal_row = -1;               ///< a friction row's contact row, for the coupled limit
+    int normal_row = -1;               ///< a friction row's contact row (its position), for the coupled limit
     int a = 0;                         ///< body slot of half a
     int b = 0;                         ///< body slot of half b
   };
@@ -49,24 +51,37 @@ struct MatrixFreeSystem {
   static constexpr int kMinBlock = 4;
   /// Most rows in a run: the rows of a full manifold (a contact and two friction rows a point).
   static constexpr int kMaxRun = 3 * kMaxManifoldPoints;
+  /// The packed rows in sweep order: position i holds row perm[i] (row order when perm is
+  /// empty). A friction row's normal_row is a position too.
   std::vector<Row> rows;
+  /// Coloured PGS: the row at each position (c), the rows' sweep order by graph colour
+  /// (row_colours.h); empty for PGS and Jacobi, which keep row order.
+  std::vector<int> perm;
+  std::vector<int> position;     ///< coloured PGS: perm's inverse (c; row index -> position)
+  /// The runs, in sweep order. Coloured PGS: sweep colour k's (the k-th swept, sweep_colour(k))
+  /// are runs[sweep_start[k], sweep_start[k + 1]).
   std::vector<Run> runs;
-  bool runs_ready = false;       ///< runs and coupling built for these rows (first PGS solve)
+  ColourStarts sweep_start{};
+  RowColours colours;            ///< coloured PGS: the rows' runs and colours
+  bool runs_ready = false;       ///< runs and coupling built for these rows (prepare or first PGS solve)
   /// Per block run of m rows: the strict lower triangle of its m x m coupling, column by column
   /// (column i: A_ki / A_kk for k = i+1..m-1; dimensionless).
   std::vector<double> coupling;
-  std::vector<double> diagonal;  ///< per row: A_jj = j M^-1 j^T (1/kg)
-  std::vector<double> b;         ///< per row: right-hand side of Eq. 6.2.9 (m/s^2)
+  std::vector<double> diagonal;  ///< per position: A_jj = j M^-1 j^T (1/kg)
+  std::vector<double> b;         ///< per position: right-hand side of Eq. 6.2.9 (m/s^2)
   std::vector<double> next;      ///< Jacobi: the sweep's new values (N)
+  std::vector<double> swept;     ///< coloured PGS: lambda by position (N)
   std::vector<Vec6> w;           ///< per body, and one zero slot: M^-1 J^T lambda
   std::vector<Mat3> inv_inertia; ///< per body: world inverse inertia this step (1/(kg m^2))
 };
 
-/// Packs the rows (c) for bodies (n): j, minv_jt, diagonal, 1 / A_jj and the bounds, and the
-/// world inverse inertia per body, resizing the buffers (no allocation once they are big enough).
-/// Rows refer to bodies by index or kWorldBody. Source: Eq. 6.2.9, A_jj = j M^-1 j^T.
+/// Packs the rows (c) for bodies (n) and the sweeps of `kind`: j, minv_jt, diagonal, 1 / A_jj
+/// and the bounds, and the world inverse inertia per body, resizing the buffers (no allocation
+/// once they are big enough). For SolverKind::coloured_pgs it colours the rows first
+/// (row_colours.h) and packs them in sweep order, so that the sweeps read them in order. Rows
+/// refer to bodies by index or kWorldBody. Source: Eq. 6.2.9, A_jj = j M^-1 j^T. No errors.
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
-             const std::vector<Body>& bodies);
+             const std::vector<Body>& bodies, SolverKind kind);
 
 /// Fills s.b (c): b_j = v_j / dt - j_j . (v1 / dt + M^-1 f_ext) (Eq. 6.2.9) with f_ext (6n:
 /// force and torque per body, N and N m; the explicit path reads the same vector), v1 from the
@@ -76,15 +91,17 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
          const std::vector<Body>& bodies, const Eigen::VectorXd& f_ext, double dt,
          TargetTerms terms);
 
-/// Solves the bounded system with `iterations` sweeps of PGS or Jacobi, the bounds of solve_lcp
+/// Solves the bounded system with `iterations` sweeps of PGS, coloured PGS (in the sweep order of
+/// prepare(), a colour's runs shared among `workers`' threads; nullptr: one thread; the same
+/// lambda for every thread count) or Jacobi, the bounds of solve_lcp
 /// (c_min, c_max from the rows, or the coupled friction limit), into lambda (resized to c, N).
 /// It starts from `initial` (c values, N; warm starting, Sec. 6.2.3) when given, with
 /// w = M^-1 J^T initial, else from lambda = 0 and w = 0; a row that touches no movable body
-/// starts at 0 whatever the guess (as solve_lcp). s must be prepared for these rows and s.b
-/// filled.
+/// starts at 0 whatever the guess (as solve_lcp). s must be prepared for these rows and this
+/// kind (coloured PGS or not), and s.b filled. Throws std::logic_error when it is not.
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
            SolverKind kind, int iterations, std::vector<double>& lambda,
-           const std::vector<double>* initial = nullptr);
+           const std::vector<double>* initial = nullptr, Workers* workers = nullptr);
 
 /// The natural-map residual of lcp_residual for the lambda that solve() left (using its w),
 /// per row: the largest value and the sum of squares (N, N^2).

@@ -69,6 +69,8 @@ constexpr std::array kPushChoices = {
 constexpr std::array kSolverChoices = {
     Choice{"pgs", static_cast<int>(SolverKind::pgs), "Sec. 7.2", "projected Gauss-Seidel"},
     Choice{"jacobi", static_cast<int>(SolverKind::jacobi), "Sec. 7.1", "projected Jacobi"},
+    Choice{"coloured-pgs", static_cast<int>(SolverKind::coloured_pgs), "Box2D v3",
+           "graph-coloured projected Gauss-Seidel: rows by colour, each colour on --threads"},
 };
 constexpr std::array kFrictionModelChoices = {
     Choice{"fixed", static_cast<int>(FrictionModel::fixed), "Sec. 5.4", "friction limit mu m |g.n|"},
@@ -193,7 +195,10 @@ const std::array kParameters = {
               .json_key = "solver",
               .type = ParameterType::choice,
               .choices = kSolverChoices,
-              .help = "pgs: projected Gauss-Seidel (Sec. 7.2); jacobi: projected Jacobi (Sec. 7.1)",
+              .help = "pgs: projected Gauss-Seidel (Sec. 7.2); jacobi: projected Jacobi (Sec. 7.1); "
+                      "coloured-pgs: PGS with the rows swept by graph colour (Box2D v3's "
+                      "constraint graph), each colour shared among --threads (push xpbd sweeps "
+                      "it as pgs)",
               .title = "solver",
               .get = &get_member<&WorldDef::solver>,
               .set = &set_member<&WorldDef::solver>},
@@ -326,9 +331,10 @@ const std::array kParameters = {
               .type = ParameterType::integer,
               .min = 1.0,
               .max = 64.0,
-              .help = "threads a step runs on: push soft shares each graph colour's rows among "
-                      "them, the other methods run on one; the same result for every count; "
-                      "typical: the machine's cores for large scenes",
+              .help = "threads a step runs on: push soft, and --solver coloured-pgs with "
+                      "--assembly matrix-free, share each graph colour's rows among them; the "
+                      "rest runs on one; the same result for every count; typical: the "
+                      "machine's cores for large scenes",
               .get = &get_member<&WorldDef::threads>,
               .set = &set_member<&WorldDef::threads>},
     Parameter{.name = "contact_hertz",

@@ -29,7 +29,7 @@ void row_sum(const SparseRowMatrix& A, const Eigen::VectorXd& b, const Eigen::Ve
 
 Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
                           const RowLimits& limits, FrictionModel friction, SolverKind kind,
-                          int iterations, const double* initial) {
+                          int iterations, const double* initial, const std::vector<int>* order) {
   const Eigen::Index c = b.size();
   if (A.rows() != c || A.cols() != c || limits.c_min.size() != c || limits.c_max.size() != c) {
     throw std::invalid_argument("solve_lcp: A is " + std::to_string(A.rows()) + " x " +
@@ -45,6 +45,15 @@ Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
   if (iterations < 0) {
     throw std::invalid_argument("solve_lcp: iterations " + std::to_string(iterations) +
                                 " must be >= 0");
+  }
+  const bool coloured = kind == SolverKind::coloured_pgs;
+  if (coloured) {
+    bool valid = order != nullptr && static_cast<Eigen::Index>(order->size()) == c;
+    for (std::size_t i = 0; valid && i < order->size(); ++i) valid = (*order)[i] >= 0 && (*order)[i] < c;
+    if (!valid) {
+      throw std::invalid_argument("solve_lcp: coloured-pgs needs the sweep order of the " +
+                                  std::to_string(c) + " rows (row indices in [0, c))");
+    }
   }
   // Bounds of row j given the lambda the row reads from.
   const auto bounds = [&](Eigen::Index j, const Eigen::VectorXd& lambda, double& lo, double& hi) {
@@ -63,7 +72,8 @@ Eigen::VectorXd solve_lcp(const SparseRowMatrix& A, const Eigen::VectorXd& b,
   Eigen::VectorXd next = Eigen::VectorXd::Zero(jacobi ? c : 0);
   for (int k = 0; k < iterations; ++k) {
     Eigen::VectorXd& out = jacobi ? next : lambda;
-    for (Eigen::Index j = 0; j < c; ++j) {
+    for (Eigen::Index i = 0; i < c; ++i) {
+      const Eigen::Index j = coloured ? (*order)[static_cast<std::size_t>(i)] : i;
       double sum;
       double diagonal;
       row_sum(A, b, lambda, j, sum, diagonal);

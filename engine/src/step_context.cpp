@@ -25,7 +25,7 @@ StepContext::StepContext(const StepContext& other)
 StepContext::~StepContext() = default;
 
 SolveSettings StepContext::settings(double dt) const {
-  return SolveSettings{dt, def->iterations, def->solver, def->friction_model};
+  return SolveSettings{dt, def->iterations, def->solver, def->friction_model, def->threads};
 }
 
 void StepContext::prepare() {
@@ -35,7 +35,7 @@ void StepContext::prepare() {
     solver_assembly = def->assembly;
   }
   StageTimer timer(*this, &StageTimes::prepare);
-  solver->prepare(rows, *bodies);
+  solver->prepare(rows, *bodies, def->solver);
 }
 
 void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<double>& out,
@@ -77,6 +77,7 @@ void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
   system.friction = s.friction;
   RowLimits limits;
   solver->system(system.A, system.b, limits);
+  solver->sweep_order(system.order);
   system.c_min = std::move(limits.c_min);
   system.c_max = std::move(limits.c_max);
   system.normal_row = std::move(limits.normal_row);

@@ -26,8 +26,12 @@ Eigen::VectorXd solve_sweeps(const StepSystem& s, SolverKind method, int sweeps,
     throw std::invalid_argument("solve_sweeps: the start has " + std::to_string(start->size()) +
                                 " entries; the system has " + std::to_string(s.rows()) + " rows");
   }
+  if (method == SolverKind::coloured_pgs && s.order.empty() && s.rows() > 0) {
+    throw std::invalid_argument("solve_sweeps: coloured-pgs on a system captured without its "
+                                "sweep order (a solve by " + std::string(name_of(s.solver)) + ")");
+  }
   return solve_lcp(s.A, s.b, limits_of(s), s.friction, method, sweeps,
-                   start != nullptr ? start->data() : nullptr);
+                   start != nullptr ? start->data() : nullptr, &s.order);
 }
 
 Eigen::VectorXd natural_map_residual(const StepSystem& s, const Eigen::VectorXd& lambda) {

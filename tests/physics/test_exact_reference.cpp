@@ -3,6 +3,7 @@
 // (cps/step_system.h), solved exactly with Siconos' Lemke method, judged by the per-step criteria
 // (demos/analysis/criteria.h), and the engine's own PGS and Jacobi sweeps (Sec. 7) measured
 // against it as their number grows.
+#include "capture.h"
 #include "criteria.h"
 #include "exact_lcp.h"
 #include "scene.h"
@@ -33,13 +34,7 @@ StepSystem capture(const char* scene, std::int64_t step,
   scenes::Overrides o;
   o.set("friction_model", friction);
   o.set("assembly", assembly);
-  scenes::Run run = scenes::make_run(*scenes::find_scene(scene), o);
-  std::optional<StepSystem> captured;
-  run.world.set_solve_observer([&](const StepSystem& s) {
-    if (s.step == step && s.solve == 0) captured = s;
-  });
-  while (!captured) run.step();
-  return *captured;
+  return test::capture(scene, step, o);
 }
 
 // The problem's force scale (N): the largest |lambda*_j| and |b_j| / A_jj over the rows that

@@ -1,5 +1,6 @@
 // The matrix-free solve gives the same lambda as the paper's explicit A = J M^-1 J^T, to
-// round-off, on every paper scene, for PGS and Jacobi, with and without the second solve.
+// round-off, on every paper scene, for PGS, Jacobi and coloured PGS, with and without the second
+// solve.
 #include "scene.h"
 
 #include <catch2/catch.hpp>
@@ -45,7 +46,8 @@ TEST_CASE("matrix-free lambda equals the explicit path's to round-off", "[solver
                               {"warm 1, coupled, eps 0.3", 1.0, FrictionModel::coupled, 0.3}};
   for (const scenes::Scene& scene : scenes::paper_scenes()) {
     for (const Variant& variant : variants) {
-      for (const SolverKind solver : {SolverKind::pgs, SolverKind::jacobi}) {
+      for (const Choice& solver_choice : parameter("solver").choices) {  // every solver
+        const auto solver = static_cast<SolverKind>(solver_choice.value);
         for (const Choice& choice : parameter("push").choices) {  // every push method
           const auto push = static_cast<PushMode>(choice.value);
           // The methods beyond the paper's share its solve paths: cold, and warm with coupled
@@ -77,7 +79,7 @@ TEST_CASE("matrix-free lambda equals the explicit path's to round-off", "[solver
           free_world.set_def(def);
           explicit_world.step();
           free_world.step();
-          INFO(scene.name << ", " << variant.name << (solver == SolverKind::pgs ? ", pgs" : ", jacobi")
+          INFO(scene.name << ", " << variant.name << ", " << solver_choice.name
                           << ", " << choice.name << ", "
                           << explicit_world.rows().size() << " rows");
           REQUIRE(!explicit_world.lambda().empty());

@@ -47,7 +47,7 @@ analysis::FclibText problem_text(const std::string& scene, const StepSystem& s,
                 "1/kg, q and s in m/s, r and l impulses in N s, u in m/s. Parameters: ",
                 engine_version(), scene.c_str(), static_cast<long long>(s.step),
                 static_cast<double>(s.step) * s.dt, s.solve, terms_name(s.terms), s.dt,
-                s.solver == SolverKind::pgs ? "pgs" : "jacobi", s.iterations,
+                std::string(name_of(s.solver)).c_str(), s.iterations,
                 s.friction == FrictionModel::fixed ? "fixed (a box of +-mu m g.n per tangent row)"
                                                    : "coupled (a box of +-mu lambda_n per tangent row)",
                 p.contacts(),

@@ -406,10 +406,11 @@ Command add_simulate(CLI::App& app, int argc, char** argv) {
   sub->add_option("--solver-error", o->solver_error,
                   "write, for the steps of --at, each solve's error against its exact solution "
                   "(Siconos' Lemke method, polished) to this CSV: step, t (s), solve, rows, "
-                  "method (exact, engine, pgs, jacobi), sweeps, then |lambda - lambda*| (N, to "
+                  "method (exact, engine, pgs, jacobi, and coloured-pgs under --solver "
+                  "coloured-pgs), sweeps, then |lambda - lambda*| (N, to "
                   "the nearest exact solution), relative, impulse error (N s), velocity error "
                   "(m/s), Signorini force (N), velocity (m/s) and complementarity (W), friction "
-                  "violation (N), natural-map residual (N); pgs and jacobi start from 0. Missing "
+                  "violation (N), natural-map residual (N); the sweeps start from 0. Missing "
                   "folders are created; --force as for --trace")
       ->check(kNotEmpty);
   sub->add_option("--at", o->at,
@@ -417,7 +418,7 @@ Command add_simulate(CLI::App& app, int argc, char** argv) {
                   "step indices in [0, steps - 1] (0 is the first step; default: the last)")
       ->check(kNotEmpty);
   sub->add_option("--sweeps", o->sweeps,
-                  "with --solver-error: the sweep counts of pgs and jacobi, comma-separated "
+                  "with --solver-error: the sweep counts of the re-solves, comma-separated "
                   "integers in [0, " + std::to_string(kMaxSolverErrorSweeps) + "] (default " +
                   std::string(kDefaultSweeps) + ")")
       ->check(kNotEmpty);

@@ -41,8 +41,6 @@ std::vector<long long> parse_counts(const std::string& text, long long lo, long 
   return out;
 }
 
-const char* method_name(SolverKind k) { return k == SolverKind::pgs ? "pgs" : "jacobi"; }
-
 }  // namespace
 
 std::vector<std::int64_t> parse_steps(const std::string& at, std::int64_t total_steps,
@@ -116,8 +114,11 @@ long SolverErrorWriter::finish() {
     };
     row("exact", 0, exact.lambda);
     row("engine", s.iterations, s.lambda);
-    for (const SolverKind method : {SolverKind::pgs, SolverKind::jacobi}) {
-      for (const int k : plan_.sweeps) row(method_name(method), k, solve_sweeps(s, method, k));
+    for (const SolverKind method : {SolverKind::pgs, SolverKind::jacobi, SolverKind::coloured_pgs}) {
+      // Coloured PGS sweeps in the order of the engine's coloured solve: a run with it only.
+      if (method == SolverKind::coloured_pgs && s.order.empty()) continue;
+      const std::string name(name_of(method));
+      for (const int k : plan_.sweeps) row(name.c_str(), k, solve_sweeps(s, method, k));
     }
   }
   write_text_atomic(plan_.path, text);

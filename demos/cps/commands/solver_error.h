@@ -1,7 +1,8 @@
 #pragma once
 // `cps simulate --solver-error FILE.csv`: the systems of chosen steps captured
 // (World::set_solve_observer, cps/step_system.h), solved exactly (demos/analysis/exact_lcp.h),
-// and the engine's PGS and Jacobi sweeps (Sec. 7) at chosen counts judged against the exact
+// and the engine's PGS and Jacobi sweeps (Sec. 7; and coloured PGS in the captured order when the
+// run uses it) at chosen counts judged against the exact
 // solution (demos/analysis/criteria.h), one CSV row per step, solve, method and sweep count.
 
 #include "output/output.h"
@@ -66,7 +67,8 @@ class SolverErrorWriter {
   /// outlive the steps.
   void observe(World& world);
   /// Solves each captured system exactly and writes one row per step, solve, method (exact,
-  /// engine, pgs, jacobi) and sweep count, then lists the file in run.json. Returns the rows
+  /// engine, pgs, jacobi, coloured-pgs for a run under it) and sweep count, then lists the file
+  /// in run.json. Returns the rows
   /// written. A planned step with no solve (no contact or rod) is named on stderr. Throws
   /// std::runtime_error when an exact solve fails (naming the step) or the file cannot be
   /// written.

@@ -55,6 +55,10 @@ PushReads push_reads(PushMode push);
 enum class SolverKind {
   pgs,     ///< projected Gauss-Seidel: new values used at once (Sec. 7.2)
   jacobi,  ///< projected Jacobi: new values used after the sweep (Sec. 7.1)
+  /// Graph-coloured projected Gauss-Seidel: PGS with the rows swept colour by colour, the rows of
+  /// a colour sharing no movable body (Box2D v3's and Box3D's constraint graph,
+  /// engine/src/row_colours.h), each colour shared among WorldDef::threads threads.
+  coloured_pgs,
 };
 
 /// How friction rows are bounded.
@@ -146,8 +150,8 @@ struct WorldDef {
   /// Soft step only: where each substep's relax starts (SoftRelax). Box3D's: continue_solve.
   SoftRelax soft_relax = SoftRelax::continue_solve;
   /// Threads a step runs on (count, in [1, 64]; the calling thread is one of them). The soft
-  /// step shares each graph colour's rows among them (engine/src/constraint_graph.h); the
-  /// other methods run on one thread. The result is the same for every count, bit for bit.
+  /// step, and the matrix-free solve of SolverKind::coloured_pgs, share each graph colour's rows
+  /// among them (engine/src/constraint_graph.h); everything else runs on one thread. The result is the same for every count, bit for bit.
   /// Typical: the machine's cores for large scenes; 1 (the default) for small ones.
   int threads = 1;
   /// Soft step only: the contact rows' stiffness (Hz, >= 0; 0 = rigid rows without push), capped

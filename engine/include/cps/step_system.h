@@ -48,6 +48,9 @@ struct StepSystem {
   std::vector<RowKind> kinds;  ///< c: contact, friction or distance (Sec. 5)
   Eigen::VectorXd initial;  ///< c, N: the solve's initial guess (0, or the warm start, Sec. 6.2.3)
   Eigen::VectorXd lambda;   ///< c, N: what the engine's solve returned
+  /// c row indices, the order a SolverKind::coloured_pgs solve swept the rows in (by graph
+  /// colour, engine/src/row_colours.h); empty for the other methods, which sweep in row order.
+  std::vector<int> order;
 
   /// The number of rows, c.
   Eigen::Index rows() const { return b.size(); }
@@ -64,11 +67,12 @@ using SolveObserver = std::function<void(const StepSystem&)>;
 using SolveOverride = std::function<void(const StepSystem&, Eigen::VectorXd& lambda)>;
 
 /// The engine's own sweeps (engine/src/solver.cpp, solve_lcp: the same code the explicit path of
-/// every step runs) on a captured system: `sweeps` sweeps of projected Gauss-Seidel (Sec. 7.2) or
-/// projected Jacobi (Sec. 7.1), lambda_j = clamp((b_j - sum_{i != j} A_ji lambda_i) / A_jj, lo_j,
+/// every step runs) on a captured system: `sweeps` sweeps of projected Gauss-Seidel (Sec. 7.2),
+/// projected Jacobi (Sec. 7.1) or coloured PGS (in s.order), lambda_j = clamp((b_j - sum_{i != j} A_ji lambda_i) / A_jj, lo_j,
 /// hi_j) (Eq. 7.1.1), with the bounds of s.friction (fixed c_min, c_max, or +-mu lambda_n). From
 /// `start` (c values, N) when given, else from lambda = 0 (Sec. 7.2). Returns lambda (c, N).
-/// Throws std::invalid_argument on mismatched sizes, a start of the wrong size, or sweeps < 0.
+/// Throws std::invalid_argument on mismatched sizes, a start of the wrong size, sweeps < 0, or
+/// coloured PGS on a system captured without its order (s.order empty).
 Eigen::VectorXd solve_sweeps(const StepSystem& s, SolverKind method, int sweeps,
                              const Eigen::VectorXd* start = nullptr);
 

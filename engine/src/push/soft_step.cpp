@@ -453,20 +453,6 @@ class SoftStep final : public PushMethod {
     order_by_colour(manifold_colour_, manifold_start_, manifold_order_);
   }
 
-  // A counting sort of item indices by colour: order lists them colour by colour, each colour's
-  // in index order, and colour c's are order[start[c], start[c + 1]).
-  static void order_by_colour(const std::vector<int>& colours,
-                              std::array<std::size_t, ConstraintGraph::kColours + 1>& start,
-                              std::vector<std::size_t>& order) {
-    start.fill(0);
-    for (const int c : colours) ++start[static_cast<std::size_t>(c) + 1];
-    for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
-    detail::resize_with_headroom(order, colours.size());
-    std::array<std::size_t, ConstraintGraph::kColours + 1> next = start;
-    for (std::size_t i = 0; i < colours.size(); ++i) order[next[static_cast<std::size_t>(colours[i])]++] = i;
-  }
-
-
   // The substeps, as thread t of workers_ runs them (every thread runs this with its own t and
   // they meet at workers_->sync()): each sweeps its share of every colour's rods and manifolds
   // and of the bodies; thread 0 alone sweeps the overflow, runs the restart variant's save and
@@ -519,7 +505,7 @@ class SoftStep final : public PushMethod {
   void sweep_colours(int t, RodFn&& rod_fn, ManifoldFn&& manifold_fn) {
     for (int k = 0; k < ConstraintGraph::kColours; ++k) {
       const bool overflow = k == 0;
-      const auto c = static_cast<std::size_t>(overflow ? ConstraintGraph::kOverflow : k - 1);
+      const auto c = static_cast<std::size_t>(sweep_colour(k));
       const std::size_t rods = rod_start_[c + 1] - rod_start_[c];
       const std::size_t manifolds = manifold_start_[c + 1] - manifold_start_[c];
       if (rods + manifolds == 0) continue;  // every thread sees the same counts
@@ -813,8 +799,8 @@ class SoftStep final : public PushMethod {
   std::vector<int> manifold_colour_;
   std::vector<std::size_t> rod_order_;
   std::vector<std::size_t> manifold_order_;
-  std::array<std::size_t, ConstraintGraph::kColours + 1> rod_start_{};
-  std::array<std::size_t, ConstraintGraph::kColours + 1> manifold_start_{};
+  ColourStarts rod_start_{};
+  ColourStarts manifold_start_{};
   std::vector<std::size_t> first_row_;    // per manifold of ctx: its first contact row
   std::vector<std::size_t> slot_;         // per manifold of ctx: its place in manifolds_
   std::vector<std::size_t> point_start_;  // per slot of manifolds_: its first point in contacts_

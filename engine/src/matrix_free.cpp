@@ -55,7 +55,7 @@ inline void bounds(const PackedRow& r, const std::vector<double>& lambda, double
 
 // A short run row by row through w (Eq. 7.1.1): rows r[0..m) all on w_a and, when kTwoBodies, w_b.
 template <bool kCoupled, bool kTwoBodies>
-inline void sweep_short_run(const PackedRow* r, const double* b, double* l, int m,
+[[gnu::always_inline]] inline void sweep_short_run(const PackedRow* r, const double* b, double* l, int m,
                             const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
   for (int i = 0; i < m; ++i) {
     const PackedRow& row = r[i];
@@ -77,7 +77,7 @@ inline void sweep_short_run(const PackedRow* r, const double* b, double* l, int 
 // loops then unroll), 0 otherwise. g: the run's coupling, the strict lower triangle of its m x m
 // block column by column (column i: A_ki / A_kk for k = i+1..m-1).
 template <bool kCoupled, bool kTwoBodies, int kM>
-inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_runtime,
+[[gnu::always_inline]] inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_runtime,
                         const double* g, const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
   const int m = kM > 0 ? kM : m_runtime;
   // Unclamped new values against w at the start of the run: independent of each other.
@@ -110,36 +110,52 @@ inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_ru
 //   lambda_k + (b_k - j_k . w_start) / A_kk - sum_{i < k} (A_ki / A_kk) delta_i,
 // the same number Eq. 7.1.1 gives through w, in the same order; w_a and w_b take the run's
 // sum of M^-1 j_i^T delta_i at its end.
+// What a sweep reads and writes, taken out of s once per solve.
+struct SweepData {
+  const PackedRow* rows;
+  const double* b;
+  double* l;  // lambda by position
+  Vec6* w;
+  const double* coupling;
+  int fixed_slot;
+};
+
+SweepData sweep_data(MatrixFreeSystem& s, std::vector<double>& lambda) {
+  return {s.rows.data(), s.b.data(), lambda.data(), s.w.data(), s.coupling.data(),
+          static_cast<int>(s.w.size()) - 1};
+}
+
+// One run (see MatrixFreeSystem::Run): a short run row by row through w, a longer one as a block.
+// Inlined into the sweeps' loops: as a call per run it cost the pendulum wave's single-row runs
+// 20 % more instructions.
 template <bool kCoupled>
-inline void sweep_run(MatrixFreeSystem& s, const MatrixFreeSystem::Run& run, int fixed_slot,
-                      std::vector<double>& lambda) {
-  const PackedRow* rows = s.rows.data();
-  const double* b = s.b.data();
-  double* l = lambda.data();
+[[gnu::always_inline]] inline void sweep_run(const SweepData& d, const MatrixFreeSystem::Run& run,
+                      const std::vector<double>& lambda) {
   const auto first = static_cast<std::size_t>(run.begin);
-  const PackedRow& r0 = rows[first];
-  if (r0.a == fixed_slot) return;  // no movable body: every lambda stays 0
-  Vec6& w_a = s.w[static_cast<std::size_t>(r0.a)];
-  const bool two = r0.b != fixed_slot;
+  const PackedRow* r = d.rows + first;
+  const double* b = d.b + first;
+  double* l = d.l + first;
+  if (r->a == d.fixed_slot) return;  // no movable body: every lambda stays 0
+  Vec6& w_a = d.w[static_cast<std::size_t>(r->a)];
+  const bool two = r->b != d.fixed_slot;
   if (run.offset < 0) {  // a short run: row by row, through w
     if (!two) {
       Vec6 unused;
-      sweep_short_run<kCoupled, false>(rows + first, b + first, l + first, run.count, lambda, w_a, unused);
+      sweep_short_run<kCoupled, false>(r, b, l, run.count, lambda, w_a, unused);
     } else {
-      sweep_short_run<kCoupled, true>(rows + first, b + first, l + first, run.count, lambda, w_a,
-                                      s.w[static_cast<std::size_t>(r0.b)]);
+      sweep_short_run<kCoupled, true>(r, b, l, run.count, lambda, w_a, d.w[static_cast<std::size_t>(r->b)]);
     }
     return;
   }
-  Vec6& w_b = s.w[static_cast<std::size_t>(r0.b)];
-  const double* g = s.coupling.data() + run.offset;
+  Vec6& w_b = d.w[static_cast<std::size_t>(r->b)];
+  const double* g = d.coupling + run.offset;
   // Two contact points (a contact and two friction rows each), or any other size.
   if (run.count == 6) {
-    two ? sweep_block<kCoupled, true, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b)
-        : sweep_block<kCoupled, false, 6>(rows + first, b + first, l + first, 6, g, lambda, w_a, w_b);
+    two ? sweep_block<kCoupled, true, 6>(r, b, l, 6, g, lambda, w_a, w_b)
+        : sweep_block<kCoupled, false, 6>(r, b, l, 6, g, lambda, w_a, w_b);
   } else {
-    two ? sweep_block<kCoupled, true, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b)
-        : sweep_block<kCoupled, false, 0>(rows + first, b + first, l + first, run.count, g, lambda, w_a, w_b);
+    two ? sweep_block<kCoupled, true, 0>(r, b, l, run.count, g, lambda, w_a, w_b)
+        : sweep_block<kCoupled, false, 0>(r, b, l, run.count, g, lambda, w_a, w_b);
   }
 }
 
@@ -150,9 +166,9 @@ inline void sweep_run(MatrixFreeSystem& s, const MatrixFreeSystem::Run& run, int
 // sum of M^-1 j_i^T delta_i at its end.
 template <bool kCoupled>
 void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
-  const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+  const SweepData d = sweep_data(s, lambda);
   for (int it = 0; it < iterations; ++it) {
-    for (const MatrixFreeSystem::Run& run : s.runs) sweep_run<kCoupled>(s, run, fixed_slot, lambda);
+    for (const MatrixFreeSystem::Run& run : s.runs) sweep_run<kCoupled>(d, run, lambda);
   }
 }
 
@@ -164,7 +180,7 @@ void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda
 template <bool kCoupled>
 void coloured_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda,
                      Workers* workers, int t) {
-  const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+  const SweepData d = sweep_data(s, lambda);
   const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
   const auto k_t = static_cast<std::size_t>(t);
   for (int it = 0; it < iterations; ++it) {
@@ -180,7 +196,7 @@ void coloured_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& l
         first = count * k_t / threads;
         last = count * (k_t + 1) / threads;
       }
-      for (std::size_t i = first; i < last; ++i) sweep_run<kCoupled>(s, s.runs[begin + i], fixed_slot, lambda);
+      for (std::size_t i = first; i < last; ++i) sweep_run<kCoupled>(d, s.runs[begin + i], lambda);
       if (workers != nullptr) workers->sync();
     }
   }
@@ -303,22 +319,18 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   detail::resize_with_headroom(s.rows, rows.size());
   detail::resize_with_headroom(s.diagonal, rows.size());
   detail::resize_with_headroom(s.w, bodies.size() + 1);  // slot n: static bodies and the fixed world, always 0
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    prefetch_row(s, rows, i);
-    const ConstraintRow& row = rows[row_at(s, i)];
-    PackedRow& p = s.rows[i];
-    // Static bodies and the fixed world share slot n, whose w stays 0 (M^-1 = 0 there).
-    const auto slot = [&](int body) {
-      return body == kWorldBody || bodies[static_cast<std::size_t>(body)].is_static() ? n : body;
-    };
+  // Static bodies and the fixed world share slot n, whose w stays 0 (M^-1 = 0 there).
+  const auto slot = [&](int body) {
+    return body == kWorldBody || bodies[static_cast<std::size_t>(body)].is_static() ? n : body;
+  };
+  // Packs `row` into p, with A_jj; normal_row: the contact row's position.
+  const auto pack = [&](const ConstraintRow& row, int normal_row, PackedRow& p) {
     p.a = slot(row.body_a);
     p.b = slot(row.body_b);
     p.c_min = row.c_min;
     p.c_max = row.c_max;
     p.mu = row.mu;
-    p.normal_row = row.normal_row < 0 || s.perm.empty()
-                       ? row.normal_row
-                       : s.position[static_cast<std::size_t>(row.normal_row)];
+    p.normal_row = normal_row;
     p.minv_jt.fill(0.0);
     double diagonal = 0.0;
     for (int half = 0; half < 2; ++half) {
@@ -345,8 +357,21 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
       std::swap_ranges(p.minv_jt.begin(), p.minv_jt.begin() + 6, p.minv_jt.begin() + 6);
       std::swap(p.a, p.b);
     }
-    s.diagonal[i] = diagonal;
     p.inv_diagonal = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
+    return diagonal;
+  };
+  if (s.perm.empty()) {
+    for (std::size_t i = 0; i < rows.size(); ++i) s.diagonal[i] = pack(rows[i], rows[i].normal_row, s.rows[i]);
+  } else {
+    // Coloured PGS: read in row order and stored at the row's position (scattered stores cost
+    // less than scattered loads, which the next instructions wait on), built in one place first.
+    PackedRow p;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const int normal_row = rows[i].normal_row;
+      const auto at = static_cast<std::size_t>(s.position[i]);
+      s.diagonal[at] = pack(rows[i], normal_row < 0 ? normal_row : s.position[static_cast<std::size_t>(normal_row)], p);
+      s.rows[at] = p;
+    }
   }
   if (kind == SolverKind::coloured_pgs) build_coloured_runs(s);
 }
@@ -373,10 +398,17 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     for (std::size_t i = 0; i < rows.size(); ++i) s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt;
     return;
   }
+  const int fixed_slot = static_cast<int>(bodies.size());
+  if (s.perm.empty()) {
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      s.b[i] = target_velocity(rows[i], terms) / dt - row_times_w(s.rows[i], s.w, fixed_slot);
+    }
+    return;
+  }
   for (std::size_t i = 0; i < rows.size(); ++i) {
     prefetch_row(s, rows, i);
-    const double v = target_velocity(rows[row_at(s, i)], terms);
-    s.b[i] = v / dt - row_times_w(s.rows[i], s.w, static_cast<int>(bodies.size()));
+    const double v = target_velocity(rows[static_cast<std::size_t>(s.perm[i])], terms);
+    s.b[i] = v / dt - row_times_w(s.rows[i], s.w, fixed_slot);
   }
 }
 

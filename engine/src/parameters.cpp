@@ -70,7 +70,7 @@ constexpr std::array kSolverChoices = {
     Choice{"pgs", static_cast<int>(SolverKind::pgs), "Sec. 7.2", "projected Gauss-Seidel"},
     Choice{"jacobi", static_cast<int>(SolverKind::jacobi), "Sec. 7.1", "projected Jacobi"},
     Choice{"coloured-pgs", static_cast<int>(SolverKind::coloured_pgs), "Box2D v3",
-           "graph-coloured projected Gauss-Seidel: rows by colour, each colour on --threads"},
+           "graph-coloured projected Gauss-Seidel"},
 };
 constexpr std::array kFrictionModelChoices = {
     Choice{"fixed", static_cast<int>(FrictionModel::fixed), "Sec. 5.4", "friction limit mu m |g.n|"},

@@ -1,5 +1,5 @@
-// The matrix-free solve (see matrix_free.h): PGS and Jacobi over rows, with w = M^-1 J^T lambda
-// per body in place of A = J M^-1 J^T.
+// The matrix-free solve (see matrix_free.h): PGS, coloured PGS and Jacobi over rows, with
+// w = M^-1 J^T lambda per body in place of A = J M^-1 J^T.
 #include "matrix_free.h"
 
 #include "buffers.h"
@@ -298,7 +298,6 @@ void build_coloured_runs(MatrixFreeSystem& s) {
   s.runs_ready = true;
 }
 
-
 }  // namespace
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
@@ -411,7 +410,6 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     s.b[i] = v / dt - row_times_w(s.rows[i], s.w, fixed_slot);
   }
 }
-
 
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,
            SolverKind kind, int iterations, std::vector<double>& lambda,

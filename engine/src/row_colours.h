@@ -25,7 +25,9 @@ struct RowColours {
     int b = -1;     ///< its second movable body, or -1 (always -1 when a is)
   };
   std::vector<Run> runs;            ///< in row order
-  std::vector<std::size_t> order;   ///< run indices in sweep order: colour by colour (ColourStarts)
+  /// Run indices colour by colour, in colour index order (sweep_order() takes the overflow
+  /// first); each colour's in row order.
+  std::vector<std::size_t> order;
   ColourStarts start{};             ///< colour c's runs are order[start[c], start[c + 1])
   ConstraintGraph graph;
   std::vector<int> colours;         ///< per run: its colour

@@ -21,16 +21,6 @@ inline std::size_t row_at(const MatrixFreeSystem& s, std::size_t i) {
   return s.perm.empty() ? i : static_cast<std::size_t>(s.perm[i]);
 }
 
-// Coloured PGS reads the rows in sweep order, which jumps between runs: it asks for the row
-// kPrefetch positions ahead early, as the hardware does by itself for rows read in order.
-constexpr std::size_t kPrefetch = 8;
-inline void prefetch_row(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
-                         std::size_t i) {
-  if (s.perm.empty() || i + kPrefetch >= s.perm.size()) return;
-  const char* p = reinterpret_cast<const char*>(&rows[static_cast<std::size_t>(s.perm[i + kPrefetch])]);
-  for (std::size_t line = 0; line < sizeof(ConstraintRow); line += 64) __builtin_prefetch(p + line);
-}
-
 // j_j . w over the row's bodies: sum_i A_ji lambda_i. 6-vector dot products (Eigen sums each in
 // pairs, so the additions do not form one long chain); a row on one movable body (its other
 // half, in slot b, is the fixed slot whose w is 0) takes one.
@@ -405,7 +395,6 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     return;
   }
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    prefetch_row(s, rows, i);
     const double v = target_velocity(rows[static_cast<std::size_t>(s.perm[i])], terms);
     s.b[i] = v / dt - row_times_w(s.rows[i], s.w, fixed_slot);
   }

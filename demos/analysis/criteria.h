@@ -23,14 +23,19 @@ namespace cps::analysis {
 
 /// How far one lambda is from solving a StepSystem, and from its exact solution.
 struct Criteria {
-  /// N: |lambda - lambda*|, the Euclidean distance to the nearest exact solution
-  /// (ExactSolution::nearest; for coupled friction, to the one solution found).
+  /// N: |lambda - lambda*|, the Euclidean distance to the nearest exact solution found
+  /// (ExactSolution::distance's upper_N: the distance to the solution set when
+  /// lambda_error_exact; for coupled friction, to the one solution found).
   double lambda_error_N = 0.0;
-  /// lambda_error_N / |lambda*| (dimensionless; 0 when lambda* = 0).
+  /// N: a lower bound of the distance to the solution set (ExactSolution::distance's lower_N;
+  /// equal to lambda_error_N when lambda_error_exact; 0 for coupled friction).
+  double lambda_error_lower_N = 0.0;
+  /// lambda_error_N / |lambda*|, with |lambda*| the smallest norm of an exact solution
+  /// (ExactSolution::smallest_norm_N; dimensionless). Where lambda* = 0 (no row pushes) the
+  /// error is over the problem's force scale instead (ExactSolution::force_scale_N).
   double lambda_error_relative = 0.0;
-  /// Whether lambda_error_N is the distance to the solution set (true), or a lower bound of it
-  /// (the projection onto its affine hull left the bounds), or for coupled friction the distance
-  /// to the one solution found (false).
+  /// Whether lambda_error_N is the distance to the solution set (the interval
+  /// [lambda_error_lower_N, lambda_error_N] is certified narrow), or only an upper bound of it.
   bool lambda_error_exact = false;
   /// N s: the impulse error dt |lambda - lambda*|, the change of momentum it makes over the step.
   double impulse_error_Ns = 0.0;
@@ -54,21 +59,24 @@ struct Criteria {
   /// |lambda_j - clamp(lambda_j - w_j / A_jj, lo_j, hi_j)|, a force so that rows of every kind
   /// compare; 0 exactly at a solution).
   double natural_map_N = 0.0;
+  /// Whether lambda or a criterion is not finite (a diverged sweep): every number above is +inf.
+  bool diverged = false;
 };
 
-/// The criteria of `lambda` (c, N) on s against `exact` (solve_exact(s)); every one +inf (and
-/// lambda_error_exact false) when lambda has a non-finite entry (a diverged sweep). Throws
-/// std::invalid_argument when lambda does not have c entries.
+/// The criteria of `lambda` (c, N) on s against `exact` (solve_exact(s)). A lambda with a
+/// non-finite entry (a diverged sweep), or whose criteria overflow, is `diverged`: every
+/// criterion is then +inf (lambda_error_exact false), never NaN. Throws std::invalid_argument
+/// when lambda does not have c entries.
 Criteria evaluate(const StepSystem& s, const ExactSolution& exact, const Eigen::VectorXd& lambda);
 
 /// The CSV columns of a row of criteria (comma-separated), in the order csv_fields writes them.
 inline constexpr std::string_view kCriteriaColumns =
-    "lambda_error_N,lambda_error_relative,lambda_error_exact,impulse_error_Ns,"
-    "velocity_error_mps,signorini_force_N,signorini_velocity_mps,complementarity_W,"
-    "friction_violation_N,natural_map_N";
+    "lambda_error_N,lambda_error_lower_N,lambda_error_relative,lambda_error_exact,"
+    "impulse_error_Ns,velocity_error_mps,signorini_force_N,signorini_velocity_mps,"
+    "complementarity_W,friction_violation_N,natural_map_N,diverged";
 
 /// The fields of kCriteriaColumns for c, comma-separated, numbers with 17 significant digits
-/// (read back exactly), the flag as 0 or 1. No errors.
+/// (read back exactly; a diverged row's as "inf"), the flags as 0 or 1. No errors.
 std::string csv_fields(const Criteria& c);
 
 }  // namespace cps::analysis

@@ -23,8 +23,8 @@
 namespace cps::analysis {
 namespace {
 
-// Polishing: a row whose post-solve w is further from 0 than this part of the problem's scale is
-// held at its bound; eigenvalues of A_FF below this part of the largest count as 0.
+// The solution set: a row whose |w*_j| / A_jj is over this part of the force scale is held at its
+// bound in every exact solution; eigenvalues of A_FF below kNullTolerance of the largest count as 0.
 constexpr double kActiveTolerance = 1e-9;
 constexpr double kNullTolerance = 1e-10;
 // Coupled friction: at most this many polish rounds (each with the bounds of the last lambda).
@@ -469,40 +469,24 @@ ExactSolution solve_exact(const StepSystem& s) {
     }
     out = std::move(retry);
   }
-  // The solution set's free directions: the null space of A_FF (fixed friction).
+  out.force_scale_N = force_scale(A, s.b, out.lambda);
   if (!coupled) {
+    // The solution set's free rows (w*_j = 0 to the tolerance, inside a bound or on it) and
+    // free directions, the null space of A_FF.
+    out.free_rows.clear();
+    for (Eigen::Index j = 0; j < s.rows(); ++j) {
+      if (movable[static_cast<std::size_t>(j)] &&
+          std::abs(out.w[j]) <= kActiveTolerance * out.force_scale_N * A(j, j)) {
+        out.free_rows.push_back(static_cast<int>(j));
+      }
+    }
     out.null_basis = restricted_inverse(A, out.free_rows).null_basis;
+    out.smallest_norm_N = out.distance(s, Eigen::VectorXd::Zero(s.rows())).upper_N;
   } else {
     out.null_basis.resize(static_cast<Eigen::Index>(out.free_rows.size()), 0);
+    out.smallest_norm_N = out.lambda.norm();
   }
   return out;
-}
-
-Eigen::VectorXd ExactSolution::nearest(const StepSystem& s, const Eigen::VectorXd& y,
-                                       bool& exact) const {
-  if (y.size() != lambda.size()) {
-    throw std::invalid_argument("nearest: lambda has " + std::to_string(y.size()) +
-                                " entries; the system has " + std::to_string(lambda.size()) + " rows");
-  }
-  exact = false;
-  if (s.friction != FrictionModel::fixed) return lambda;
-  const auto f = static_cast<Eigen::Index>(free_rows.size());
-  Eigen::VectorXd x = lambda;
-  if (null_basis.cols() > 0) {
-    Eigen::VectorXd d(f);
-    for (Eigen::Index k = 0; k < f; ++k) {
-      const auto j = free_rows[static_cast<std::size_t>(k)];
-      d[k] = y[j] - lambda[j];
-    }
-    const Eigen::VectorXd step = null_basis * (null_basis.transpose() * d);
-    for (Eigen::Index k = 0; k < f; ++k) x[free_rows[static_cast<std::size_t>(k)]] += step[k];
-  }
-  const double tol = 1e-9 * std::max(1.0, lambda.cwiseAbs().maxCoeff());
-  exact = true;
-  for (Eigen::Index j = 0; j < x.size(); ++j) {
-    if (x[j] < s.c_min[j] - tol || x[j] > s.c_max[j] + tol) exact = false;
-  }
-  return x;
 }
 
 }  // namespace cps::analysis

@@ -25,10 +25,11 @@
 //
 // A = J M^-1 J^T is only positive semi-definite: a box resting on four contact points, or a pile
 // of balls with more contact rows than degrees of freedom, has many lambda that solve the
-// problem (they differ by a null vector of A), while w = A lambda - b and the contact forces on
-// each body, J^T lambda, are the same for all (a convex quadratic program's minimisers share
-// A lambda). ExactSolution::nearest gives the solution closest to any lambda, so that an
-// iterate's error is its distance to the set of exact solutions, not to an arbitrary member.
+// problem, while w = A lambda - b and the contact forces on each body, J^T lambda, are the same
+// for all (a convex quadratic program's minimisers share A lambda). For fixed friction the set of
+// exact solutions is therefore S = {x in the box : x_j = lambda*_j where w*_j != 0, A x = A lambda*},
+// a polytope; ExactSolution::distance projects any lambda onto it (solution_set.cpp), so that an
+// iterate's error is its distance to the set, not to an arbitrary member.
 
 #include "cps/step_system.h"
 
@@ -56,20 +57,45 @@ struct ExactSolution {
   int polish_rounds = 0;
   /// The largest natural-map residual of lambda (N; cps::natural_map_residual).
   double residual_max = 0.0;
-  /// Rows free to move within the solution set (F: not held at a bound by a non-zero w, and
-  /// touching a movable body), by index; the others are the same in every exact solution.
+  /// Rows free to move within the solution set (F: touching a movable body, with w*_j = 0 to
+  /// the tolerance, whether lambda*_j lies inside its bounds or on one), by index; the others are
+  /// the same in every exact solution (fixed friction).
   std::vector<int> free_rows;
   /// |F| x d, orthonormal columns: a basis of the null space of A_FF; the exact solutions are
   /// lambda + [N z on the rows F] within the bounds (d = 0: lambda is the only one).
   Eigen::MatrixXd null_basis;
+  /// N: |lambda*|, the smallest norm of an exact solution (fixed friction: distance(0)'s
+  /// nearest, the least-norm member of the set when certified, else the least found; coupled:
+  /// |lambda|). The scale of the relative force error.
+  double smallest_norm_N = 0.0;
+  /// N: the problem's force scale, max of |lambda_j| and |b_j| / A_jj over the rows touching a
+  /// movable body (1 when all are 0); the tolerances above are parts of it.
+  double force_scale_N = 1.0;
 
-  /// The exact solution nearest `y` (c, N) in the Euclidean norm: the projection of y onto
-  /// {lambda + N z on F}, when that lies within the bounds (to round-off; `exact` is then set
-  /// true), else the projection itself with `exact` false (its distance to y is then a lower
-  /// bound of y's distance to the solutions). For coupled friction the solution set is not
-  /// described: returns lambda with exact false. Throws std::invalid_argument when y has the
-  /// wrong size.
-  Eigen::VectorXd nearest(const StepSystem& s, const Eigen::VectorXd& y, bool& exact) const;
+  /// How far y is from the set of exact solutions. Throws std::invalid_argument when y has the
+  /// wrong size or a non-finite entry.
+  struct Distance;
+  Distance distance(const StepSystem& s, const Eigen::VectorXd& y) const;
+};
+
+/// The distance of a lambda to the exact solutions: an interval [lower_N, upper_N] that holds
+/// it, and the member `nearest` at upper_N. Fixed friction: the Euclidean projection onto the
+/// solution set S (exact_lcp.h's file comment) by Dykstra's alternating projections between the
+/// affine set and the box (Boyle & Dykstra 1986), finished by active-set steps; lower_N is the
+/// Lagrangian dual bound of the projection's multipliers (weak duality), so the interval is
+/// certified whatever the iteration did. Coupled friction: the set is not described, the
+/// distance is to the one solution found and lower_N is 0.
+struct ExactSolution::Distance {
+  /// c, N: an exact solution (within the bounds and on the affine set to 1e-9 of the force
+  /// scale), the nearest to y found.
+  Eigen::VectorXd nearest;
+  /// N: |y - nearest|, an upper bound of y's distance to S.
+  double upper_N = 0.0;
+  /// N: a lower bound of y's distance to S (0 for coupled friction).
+  double lower_N = 0.0;
+  /// Whether upper_N - lower_N is within 1e-6 of force_scale_N or of upper_N, whichever is
+  /// larger: upper_N is then the distance.
+  bool exact = false;
 };
 
 /// Solves s exactly (see the file comment). Throws std::invalid_argument for a system whose

@@ -128,7 +128,7 @@ std::string solver_error_section(const fs::path& dir, const std::string& scene, 
   }
   write_csv(dir / (stem + ".csv"), csv);
 
-  // Per line: times, relative errors, velocity errors; counts of non-finite values.
+  // Per line: times, relative errors, velocity errors; counts of diverged sweeps (non-finite).
   const std::vector<Line> lines = solver_lines();
   std::ostringstream data;
   std::vector<std::vector<double>> rel(lines.size()), vel(lines.size());
@@ -188,7 +188,9 @@ std::string solver_error_section(const fs::path& dir, const std::string& scene, 
      << " steps sampled evenly to the horizon: each solve of a sampled step is solved exactly "
         "(Siconos' Lemke method, polished: docs/exact_reference.md), and the engine's PGS and "
         "Jacobi sweeps, from lambda = 0 on the same system, are judged against it: the force "
-        "error to the nearest exact solution, relative to |lambda*|, and the velocity error it "
+        "error, the distance to the set of exact solutions (certified by a dual bound, or else to "
+        "the nearest member found: docs/exact_reference.md), over |lambda*| (the least-norm exact "
+        "solution), and the velocity error it "
         "leaves, dt |A (lambda - lambda*)| (m/s). This is the solver's error alone, step by "
         "step; the trajectory error below mixes it with the time step's. "
      << solves << " solves" << (no_solve ? ", " + std::to_string(no_solve) +
@@ -206,7 +208,7 @@ std::string solver_error_section(const fs::path& dir, const std::string& scene, 
     md << ".\n\n";
   }
   md << "| method | sweeps | median relative force error | largest | median velocity error "
-        "(m/s) | largest | overflowed |\n|---|---|---|---|---|---|---|\n";
+        "(m/s) | largest | diverged |\n|---|---|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < lines.size(); ++i) {
     md << "| " << lines[i].method << " | " << lines[i].sweeps << " | " << number(median(rel[i]))
        << " | " << number(largest(rel[i])) << " | " << number(median(vel[i])) << " | "

@@ -94,6 +94,7 @@ class PyramidMetrics final : public Metrics {
     watch_.observe(world);
     top_m_ = highest_point(world);
   }
+  void diverged_since(double since_s) override { watch_.diverged_since(since_s); }
   nlohmann::json report() const override {
     nlohmann::json j = nlohmann::json::object();
     watch_.add_to(j);

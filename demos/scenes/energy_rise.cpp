@@ -2,6 +2,8 @@
 // EnergyRise (energy_rise.h), and the warning that names the push method and the fix.
 #include "energy_rise.h"
 
+#include "divergence.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,7 +18,7 @@ double EnergyRise::fraction() const {
   return scale_J > 0.0 ? rise / scale_J : kInfinity;
 }
 
-bool EnergyRise::warns() const { return fraction() > kEnergyRiseWarnFraction; }
+bool EnergyRise::warns() const { return fraction() > kEnergyRiseWarnFraction || thrown.has_value(); }
 
 MechanicalEnergy mechanical_energy(const World& world) {
   const Vec3& g = world.def().gravity;
@@ -57,7 +59,13 @@ void EnergyRiseTracker::observe(const World& world) {
       start_h_[i] = up.dot(b.x);
       const double r = b.shape.kind == ShapeKind::sphere ? b.shape.radius : b.shape.half_extents.norm();
       size_J_ += b.mass * g_norm * r;
+      start_speed_mps_ = std::max(start_speed_mps_, b.velocity().norm());
+      top_h_ = std::max(top_h_, start_h_[i] + r);
     }
+    if (bodies.empty() || std::all_of(bodies.begin(), bodies.end(), [](const Body& b) { return b.is_static(); })) {
+      top_h_ = 0.0;
+    }
+    peaks_.emplace_back(world.time(), energy);
     lowest_h_ = start_h_;
     previous_x_.assign(bodies.size(), Vec3::Zero());
     previous_time_s_ = world.time();
@@ -84,6 +92,20 @@ void EnergyRiseTracker::observe(const World& world) {
   if (energy - rise_.lift_J > rise_.max_J) {
     rise_.max_J = energy - rise_.lift_J;
     rise_.max_time_s = world.time();
+    if (rise_.max_J - peaks_.back().second >= 1e-3 * size_J_) peaks_.emplace_back(world.time(), rise_.max_J);
+  }
+  if (!rise_.thrown) {
+    const double bounce = 1.0 + world.def().restitution;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (mass_[i] == 0.0) continue;
+      const double limit = std::sqrt(1.0 + kEnergyRiseWarnFraction) * bounce *
+                           (start_speed_mps_ + std::sqrt(2.0 * g_ * std::max(0.0, top_h_ - lowest_h_[i])));
+      const double speed = bodies[i].velocity().norm();
+      if (speed > limit) {
+        rise_.thrown = EnergyRise::Thrown{static_cast<int>(i), mass_[i], speed, limit, world.time()};
+        break;
+      }
+    }
   }
 }
 
@@ -92,6 +114,15 @@ EnergyRise EnergyRiseTracker::result() const {
   double available = start_kinetic_J_;
   for (std::size_t i = 0; i < mass_.size(); ++i) available += mass_[i] * g_ * (start_h_[i] - lowest_h_[i]);
   out.scale_J = std::max(available, size_J_);
+  // The first kept peak past the threshold; the last peak is the maximum itself.
+  const double threshold = rise_.start_J + kEnergyRiseWarnFraction * out.scale_J;
+  for (const auto& [t, e] : peaks_) {
+    if (e > threshold) {
+      out.warn_time_s = t;
+      break;
+    }
+  }
+  if (std::isnan(out.warn_time_s) && out.max_J > threshold) out.warn_time_s = out.max_time_s;
   return out;
 }
 
@@ -146,32 +177,52 @@ std::shared_ptr<const EnergyRiseTracker> watch_energy_rise(Run& run) {
 
 std::string energy_rise_warning(std::string_view what, const WorldDef& def, const EnergyRise& rise) {
   if (!rise.warns()) return {};
-  char share[64];
-  if (std::isfinite(rise.fraction())) {
-    std::snprintf(share, sizeof share, "%.0f %%", 100.0 * rise.fraction());
-  } else {
-    std::snprintf(share, sizeof share, "from nothing");
+  const std::string fix = "the push is --push " + std::string(name_of(def.push)) + ": " +
+                          fix_for(def.push, rise.constrained);
+  char text[512];
+  std::string out(what);
+  if (rise.fraction() > kEnergyRiseWarnFraction) {
+    char share[64];
+    if (std::isfinite(rise.fraction())) {
+      std::snprintf(share, sizeof share, "%.0f %%", 100.0 * rise.fraction());
+    } else {
+      std::snprintf(share, sizeof share, "from nothing");
+    }
+    std::snprintf(text, sizeof text,
+                  ": the energy (kinetic + potential) rose %s above its start with nothing driving "
+                  "the scene, more than the %.0f %% that warns (it passed that at t = %.3g s; the "
+                  "largest, +%.3g J, at t = %.3g s; 100 %% = %.3g J, the start's energy above the "
+                  "bodies' lowest points or their size, see docs/findings.md)",
+                  share, 100.0 * kEnergyRiseWarnFraction, rise.warn_time_s, rise.rise_J(),
+                  rise.max_time_s, rise.scale_J);
+    out += text;
   }
-  char numbers[256];
-  std::snprintf(numbers, sizeof numbers,
-                "+%.3g J at t = %.3g s; 100 %% = %.3g J, the start's energy above the bodies' "
-                "lowest points or their size, see docs/findings.md",
-                rise.rise_J(), rise.max_time_s, rise.scale_J);
-  std::string push(name_of(def.push));
-  char limit[32];
-  std::snprintf(limit, sizeof limit, "%.0f %%", 100.0 * kEnergyRiseWarnFraction);
-  return std::string(what) + ": the energy (kinetic + potential) rose " + share +
-         " above its start (" + numbers + ") with nothing driving the scene, more than the " +
-         limit + " that warns; the push is --push " + push + ": " + fix_for(def.push, rise.constrained);
+  if (rise.thrown) {
+    const EnergyRise::Thrown& t = *rise.thrown;
+    std::snprintf(text, sizeof text,
+                  "%s body %d (%.3g kg) was thrown at %.3g m/s at t = %.3g s, faster than anything "
+                  "in the scene could make it without a gain (%.3g m/s: a fall from the scene's "
+                  "highest point plus its fastest start, times 1 + restitution, with %.0f %% more kinetic "
+                  "energy than that allowed)",
+                  out.size() > what.size() ? "; and" : ":", t.body, t.mass_kg, t.speed_mps,
+                  t.time_s, t.limit_mps, 100.0 * kEnergyRiseWarnFraction);
+    out += text;
+  }
+  return out + "; " + fix;
 }
 
-void print_energy_rise_warning(std::string_view scene, std::string_view label, const WorldDef& def,
-                               const EnergyRiseTracker& tracker) {
+void print_run_warnings(std::string_view scene, std::string_view label, const Run& run,
+                        const EnergyRiseTracker& tracker) {
   const std::string_view first_line = label.substr(0, label.find('\n'));
   std::string what(scene);
   if (!first_line.empty()) what += " (" + std::string(first_line) + ")";
-  const std::string warning = energy_rise_warning(what, def, tracker.result());
-  if (!warning.empty()) std::fprintf(stderr, "cps: warning: %s\n", warning.c_str());
+  const std::optional<Divergence> diverged =
+      run.divergence ? run.divergence->found() : std::optional<Divergence>();
+  for (const std::string& warning :
+       {diverged ? divergence_warning(what, *diverged) : std::string(),
+        energy_rise_warning(what, run.world.def(), tracker.result())}) {
+    if (!warning.empty()) std::fprintf(stderr, "cps: warning: %s\n", warning.c_str());
+  }
 }
 
 }  // namespace cps::scenes

@@ -11,9 +11,12 @@
 
 #include "scene.h"
 
+#include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace cps::scenes {
@@ -50,6 +53,10 @@ struct EnergyRise {
   /// without giving them velocity (split, split-impulse, ngs, soft) is not counted as a gain
   double max_J = 0.0;
   double max_time_s = 0.0;  ///< the world's time at that step (s)
+  /// The first time E - lift passed start_J + kEnergyRiseWarnFraction scale_J (s; to 1e-3 of
+  /// the bodies' size term), when it did: when the rise happened, where max_time_s may be a
+  /// round-off peak of the plateau after it. NaN when it never passed.
+  double warn_time_s = std::numeric_limits<double>::quiet_NaN();
   /// The potential energy the positions' own corrections added up to the last step (J, >= 0):
   /// the sum over steps and movable bodies of max(0, -m g . (x2 - x1 - v2 dt)), the lift of the
   /// part of each step's move that is not the stored velocity's (stress.h, W_split). 0 for the
@@ -68,18 +75,39 @@ struct EnergyRise {
   /// rise is the integrator's own (the warning then says so instead of naming a push).
   bool constrained = false;
 
+  /// A body thrown: faster than anything in the scene could make it without a gain (see
+  /// EnergyRiseTracker). The total can miss it: a light body thrown out while a heavy one falls.
+  struct Thrown {
+    int body = -1;           ///< its index in World::bodies()
+    double mass_kg = 0.0;    ///< kg
+    double speed_mps = 0.0;  ///< m/s, its centre's speed then
+    double limit_mps = 0.0;  ///< m/s, the speed it passed
+    double time_s = 0.0;     ///< s, the first step it was past the limit
+  };
+  std::optional<Thrown> thrown;
+
   /// max_J - start_J (J, >= 0).
   double rise_J() const;
   /// rise_J() / scale_J (dimensionless); +inf for a rise from a scale of 0 (no motion and no
   /// gravity at the start), 0 when nothing rose.
   double fraction() const;
-  /// fraction() > kEnergyRiseWarnFraction.
+  /// fraction() > kEnergyRiseWarnFraction, or a body was thrown.
   bool warns() const;
 };
 
 /// Keeps the running maximum of E, the start, and each movable body's lowest height over a run.
 /// observe() the world as built, then after every step. No errors; states that are not finite
 /// are skipped (and set EnergyRise::nonfinite).
+///
+/// A body i is thrown when its centre's speed passes
+///   sqrt(1 + kEnergyRiseWarnFraction) (1 + eps) (v0 + sqrt(2 |g| max(0, H - h_i)))
+/// with v0 the fastest start speed of any movable body, H the highest point of any movable body
+/// at the start (centre plus bounding radius, along -g), h_i the lowest height body i's centre
+/// has reached and eps the world's restitution: the speed of a fall from the scene's top plus
+/// the fastest start, doubled at most by a bounce (a contact that does not bounce gives a body at
+/// most the speed of what hits it), with the total's margin on its kinetic energy. A lever (a
+/// heavy body landing on the long arm of a see-saw) can pass it without a gain; no built-in
+/// scene has one.
 class EnergyRiseTracker {
  public:
   void observe(const World& world);
@@ -97,6 +125,11 @@ class EnergyRiseTracker {
   std::vector<Vec3> previous_x_;    // m, positions at the last observe()
   double previous_time_s_ = 0.0;    // s, the world's time then
   double size_J_ = 0.0;             // sum m |g| r (J)
+  // New maxima of E - lift, each at least 1e-3 of size_J_ above the last kept (time s, J), for
+  // warn_time_s once the scale is known.
+  std::vector<std::pair<double, double>> peaks_;
+  double start_speed_mps_ = 0.0;    // v0 (m/s)
+  double top_h_ = 0.0;              // H (m)
 };
 
 /// Wraps run.metrics so that every step also feeds a tracker, which has already observed the
@@ -112,11 +145,12 @@ std::shared_ptr<const EnergyRiseTracker> watch_energy_rise(Run& run);
 /// naming the push method in use and the fix to try for it (docs/findings.md). No errors.
 std::string energy_rise_warning(std::string_view what, const WorldDef& def, const EnergyRise& rise);
 
-/// Prints energy_rise_warning as "cps: warning: ..." and a newline on stderr when the tracked run
-/// warns, naming it `scene`, or "scene (label)" with the first line of a --compare variant's
-/// non-empty `label` ("push = baumgarte").
-/// Writes nothing else: no file and no exit code depends on it.
-void print_energy_rise_warning(std::string_view scene, std::string_view label, const WorldDef& def,
-                               const EnergyRiseTracker& tracker);
+/// Prints the run's warnings as "cps: warning: ..." lines on stderr: its divergence
+/// (divergence_warning of run.divergence) and its energy rise (energy_rise_warning of the
+/// tracker), naming it `scene`, or "scene (label)" with the first line of a --compare variant's
+/// non-empty `label` ("push = baumgarte"). Writes nothing else: no file and no exit code depends
+/// on it.
+void print_run_warnings(std::string_view scene, std::string_view label, const Run& run,
+                        const EnergyRiseTracker& tracker);
 
 }  // namespace cps::scenes

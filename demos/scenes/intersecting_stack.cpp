@@ -15,13 +15,16 @@ namespace {
 // that moved sideways by half the edge of the one under it has its centre over that edge.
 constexpr double kLeaveM = 1.2;
 
-// When the stack has recovered: from then on to the end of the run, every contact the steps find
-// is at most kRecoveredOverlapM deep and every movable body is slower than kRecoveredSpeedMps.
+// When the stack has recovered: the first time from which, for kRecoveredHoldS, every contact the
+// steps find is at most kRecoveredOverlapM deep and every movable body is slower than
+// kRecoveredSpeedMps. A hold window, not "to the end of the run", so that the time does not move
+// with the run's length (a run shorter than the window after it cannot show a recovery).
 // 1 cm is under 0.5 % of a cube's 2.4 m edge; 0.1 m/s is under the 0.17 m/s that gravity adds
 // in one 1/60 s step, so a body that stays under it is held, neither falling nor thrown (the
 // bounds of the scene's test of the paper's Fig. 7 c, tests/physics/test_scenes.cpp).
 constexpr double kRecoveredOverlapM = 0.01;
 constexpr double kRecoveredSpeedMps = 0.1;
+constexpr double kRecoveredHoldS = 0.5;
 
 // The heights and speeds at the end, the recovery time, and the hard cases' measures with the
 // column resting on the ground as the resting places (the cubes start away from them, so
@@ -41,8 +44,20 @@ class IntersectingStackMetrics final : public Metrics {
     }
     last_overlap_ = deepest_contact(world);
     const bool at_rest = last_overlap_ <= kRecoveredOverlapM && speed <= kRecoveredSpeedMps;
-    if (!at_rest) recovered_at_.reset();
-    if (at_rest && !recovered_at_) recovered_at_ = world.time();
+    if (!at_rest) {
+      rest_since_.reset();
+    } else if (!rest_since_) {
+      rest_since_ = world.time();
+    }
+    if (!recovered_at_ && rest_since_ &&
+        world.time() - *rest_since_ + 0.5 * world.def().dt >= kRecoveredHoldS) {
+      recovered_at_ = rest_since_;
+    }
+  }
+
+  void diverged_since(double since_s) override {
+    watch_.diverged_since(since_s);
+    if (recovered_at_ && *recovered_at_ >= since_s) recovered_at_.reset();
   }
 
   nlohmann::json report() const override {
@@ -62,6 +77,7 @@ class IntersectingStackMetrics final : public Metrics {
                         {"max_speed_mps", max_speed},
                         {"overlap_end_m", last_overlap_},
                         {"recovered", recovered_at_.has_value()},
+                        {"at_rest_end", rest_since_.has_value()},
                         {"recovery_time_s", recovered_at_ ? nlohmann::json(*recovered_at_) : nlohmann::json()}};
     watch_.add_to(j);
     return j;
@@ -71,7 +87,8 @@ class IntersectingStackMetrics final : public Metrics {
   const World* world_ = nullptr;
   HardCaseWatch watch_;
   double last_overlap_ = 0.0;           // m, the deepest contact of the last step
-  std::optional<double> recovered_at_;  // s, unset while not recovered
+  std::optional<double> rest_since_;    // s, the start of the current time at rest
+  std::optional<double> recovered_at_;  // s, the start of the first kRecoveredHoldS at rest
 };
 
 }  // namespace

@@ -28,6 +28,10 @@ class Metrics {
   virtual void observe(const World& world) = 0;
   /// The measurements so far.
   virtual nlohmann::json report() const = 0;
+  /// Called once when the run is found diverged (divergence.h), its signs seen from since_s (s)
+  /// on: an event of the run at or after since_s (a slide-off, a body leaving its place) is the
+  /// divergence's, not the run's, and is dropped. Observing stops after this call.
+  virtual void diverged_since(double since_s) { (void)since_s; }
 };
 
 /// Where the camera of a scene's pictures stands: eye and target (m), vertical field of view
@@ -182,10 +186,16 @@ inline bool short_of(const World& world, double t) {
   return world.time() + 0.5 * world.def().dt < t;
 }
 
+class DivergenceWatch;  // divergence.h
+
 /// A world built from a scene, with its metrics, ready to step.
 struct Run {
   World world;
   std::unique_ptr<Metrics> metrics;
+  /// Whether and when the run diverged (divergence.h), fed through `metrics` (make_run wraps
+  /// them); read it, not the metrics' report, once the run may have moved (a report can read
+  /// the world a scene's metrics saw last).
+  std::shared_ptr<const DivergenceWatch> divergence;
 
   /// Steps once and feeds the metrics.
   void step() {

@@ -1,4 +1,5 @@
 #include "box3d_pyramids.h"
+#include "divergence.h"
 #include "scene.h"
 #include "scene_file.h"
 #include "stress/stress.h"
@@ -56,17 +57,18 @@ const std::array kScenes = {
                     .reason = "the first 0.1 s, while the push factor pushes the overlapping "
                               "cubes apart (with the default Baumgarte push they are in free "
                               "flight from about 0.12 s to 3.4 s)"},
-          // Judged by its recovery time within 0.5 s (the right answer is a stack at rest with
-          // its overlaps resolved): its trajectory has no converged reference under Baumgarte,
-          // whose correcting velocity beta d / dt grows as dt shrinks, and a low speed alone
-          // also rewards a run that has not yet pushed the overlaps out.
-          .report = {.horizon_s = 0.5,
-                     .horizon_reason = "judged at 0.5 s, the time the paper's Fig. 7 shows",
+          // Judged by its recovery time (the right answer is a stack at rest with its overlaps
+          // resolved): its trajectory has no converged reference under Baumgarte, whose
+          // correcting velocity beta d / dt grows as dt shrinks, and a low speed alone also
+          // rewards a run that has not yet pushed the overlaps out.
+          .report = {.horizon_s = 1.0,
+                     .horizon_reason = "the 0.5 s of the paper's Fig. 7 and the 0.5 s a recovery "
+                                       "must hold to count",
                      .primary_measure = "metric.recovery_time_s",
                      .headline_reason =
-                         "the time from which every contact stays under 1 cm deep and every "
-                         "cube under 0.1 m/s to the end (0.5 s); a run that never gets there "
-                         "ranks after every run that does. Not the largest speed at the end: "
+                         "the first time from which every contact stays under 1 cm deep and every "
+                         "cube under 0.1 m/s for 0.5 s; a run that does not get there within the "
+                         "1 s ranks after every run that does. Not the largest speed at the end: "
                          "every Baumgarte run throws the cubes up, and a slower throw (Jacobi "
                          "at 1 or 2 iterations) is a push that resolved the overlaps later, not "
                          "a better answer, while a soft push comes to rest with the cubes still "
@@ -279,7 +281,9 @@ WorldDef world_def_with(const Scene& scene, const Overrides& o) {
 Run make_run(const Scene& scene, const Overrides& overrides) {
   Run run{World(world_def_with(scene, overrides)), nullptr};
   scene.populate(run.world);
-  run.metrics = scene.make_metrics(run.world);
+  auto divergence = std::make_shared<DivergenceWatch>();
+  run.metrics = watch_divergence(scene.make_metrics(run.world), divergence);
+  run.divergence = std::move(divergence);
   return run;
 }
 

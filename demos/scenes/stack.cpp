@@ -19,8 +19,12 @@ constexpr double kMass = 1.2;       // kg
 // A cube has slid off the column once its centre leaves this radius around the column's axis
 // (m, a fifth of the edge) ...
 constexpr double kSlideOffDrift = 0.5;
-// ... or it tilts further than this (degrees).
+// ... or it tilts further than this (degrees) ...
 constexpr double kSlideOffTilt = 10.0;
+// ... and stays so for this long (s): a cube that rocks past 10 deg and back (the landing under a
+// stiff push, --beta 0.9) has not slid off. A slide-off that began less than this before the
+// run's end is not seen.
+constexpr double kSlideOffHold = 0.5;
 // The landing is over by this time (s): the fifth cube touches down at about 0.8 s and the
 // column is still from about 1.5 s. creep_m is measured from the cubes' positions here.
 constexpr double kLandedTime = 3.0;
@@ -46,8 +50,15 @@ class StackMetrics final : public Metrics {
       const double tilt = tilt_deg(b);
       max_drift_ = std::max(max_drift_, drift);
       max_tilt_ = std::max(max_tilt_, tilt);
-      if (!slide_off_time_ && (drift > kSlideOffDrift || tilt > kSlideOffTilt)) {
-        slide_off_time_ = world.time();
+      if (off_since_.size() != world.bodies().size()) off_since_.assign(world.bodies().size(), -1.0);
+      double& since = off_since_[i];
+      if (drift > kSlideOffDrift || tilt > kSlideOffTilt) {
+        if (since < 0.0) since = world.time();
+        if (!slide_off_time_ && world.time() - since + 0.5 * world.def().dt >= kSlideOffHold) {
+          slide_off_time_ = since;
+        }
+      } else {
+        since = -1.0;
       }
       if (landed && i < landed_at_.size()) {
         const Vec3 d = b.x - landed_at_[i];
@@ -55,6 +66,10 @@ class StackMetrics final : public Metrics {
       }
     }
     max_penetration_ = std::max(max_penetration_, deepest_contact(world));
+  }
+
+  void diverged_since(double since_s) override {
+    if (slide_off_time_ && *slide_off_time_ >= since_s) slide_off_time_.reset();
   }
 
   nlohmann::json report() const override {
@@ -67,7 +82,8 @@ class StackMetrics final : public Metrics {
   }
 
  private:
-  std::optional<double> slide_off_time_;  // s: first time a cube slid off (kSlideOff*)
+  std::optional<double> slide_off_time_;  // s: when the first cube to stay off began (kSlideOff*)
+  std::vector<double> off_since_;          // s: per body, since when it is off (-1: it is not)
   std::vector<Vec3> landed_at_;            // m: every body's centre at kLandedTime
   double creep_ = 0.0;                     // m: largest horizontal move since kLandedTime
   double max_drift_ = 0.0;

@@ -1,4 +1,6 @@
 // Whole-world behaviour: resting contact and the paper's stack (Sec. 10.1).
+#include "divergence.h"
+#include "pendulum_reference.h"
 #include "scene.h"
 
 #include <catch2/catch.hpp>
@@ -224,6 +226,41 @@ scenes::Run run_scene(const char* name, const scenes::Overrides& o = {}) {
 
 }  // namespace
 
+TEST_CASE("a run that drives bodies through the ground is flagged diverged, and reports no "
+          "slide-off after it", "[scene][stack]") {
+  scenes::Overrides o;
+  o.set("dt", 1.0);  // s: the cubes fall 5 m or more in one step and sink through the ground
+  scenes::Run run = run_scene("stack", o);
+  run.advance_to(10.0);
+  const nlohmann::json m = run.metrics->report();
+  INFO(m.dump());
+  REQUIRE(m["diverged"].get<bool>());
+  // A cube (edge 2.4 m) more than its edge deep: by the second step it has fallen 2 g dt^2 = 20 m.
+  CHECK(m["diverged_at_s"].get<double>() <= 2.0);
+  CHECK(m["slide_off_time_s"].is_null());
+  // The paper's stack does not diverge.
+  scenes::Run paper = run_scene("stack");
+  paper.advance_to(2.0);
+  CHECK_FALSE(paper.metrics->report()["diverged"].get<bool>());
+}
+
+TEST_CASE("a stack that rocks past 10 deg on landing and stands has not slid off",
+          "[scene][stack]") {
+  scenes::Overrides o;
+  o.set("beta", 0.9);  // a stiff push: the landing tilts a cube by 11 deg for a moment
+  scenes::Run run = run_scene("stack", o);
+  run.advance_to(6.0);
+  const nlohmann::json m = run.metrics->report();
+  INFO(m.dump());
+  CHECK(m["max_tilt_deg"].get<double>() > 10.0);  // the transient the slide-off must not count
+  CHECK(m["slide_off_time_s"].is_null());
+  CHECK_FALSE(m["diverged"].get<bool>());
+  // Standing at the end: every cube's centre within 0.5 m of the axis.
+  for (const Body& b : run.world.bodies()) {
+    if (!b.is_static()) CHECK(std::hypot(b.x.x(), b.x.z()) < 0.5);
+  }
+}
+
 TEST_CASE("intersecting stack at 0.5 s: split comes to rest, baumgarte flies apart",
           "[scene][intersecting_stack]") {
   // The paper's Fig. 7 (b) and (c).
@@ -246,13 +283,37 @@ TEST_CASE("intersecting stack at 0.5 s: split comes to rest, baumgarte flies apa
   CHECK(fly.world.bodies().back().velocity().norm() > 5.0);
 }
 
+TEST_CASE("max_penetration_m is the deepest contact over the whole run in every scene that "
+          "reports it", "[scene]") {
+  for (const char* name : {"stack", "intersecting_stack", "funnel", "pendulum_grid", "sphere_in_box",
+                           "heavy_on_light"}) {
+    INFO(name);
+    scenes::Run run = run_scene(name);
+    double deepest = 0.0;  // m, over the steps so far, up to a divergence (metrics stop there)
+    bool diverged = false;
+    while (scenes::short_of(run.world, 1.5)) {
+      run.step();
+      diverged = diverged || scenes::divergence_sign(run.world).has_value();
+      if (!diverged) deepest = std::max(deepest, scenes::deepest_contact(run.world));
+    }
+    const nlohmann::json m = run.metrics->report();
+    REQUIRE(m.contains("max_penetration_m"));
+    CHECK(m["max_penetration_m"].get<double>() >= deepest);
+    // Not trivially: something penetrated on the way.
+    CHECK(deepest > 0.0);
+  }
+}
+
 TEST_CASE("funnel at 10 s: the balls are at rest without deep penetration", "[scene][funnel]") {
   scenes::Run run = run_scene("funnel");
   run.advance_to(10.0);
   const nlohmann::json m = run.metrics->report();
   INFO(m.dump());
   CHECK(m["kinetic_energy_J"].get<double>() < 1e-3);
-  CHECK(m["max_penetration_m"].get<double>() < 5e-3);
+  CHECK(m["final_penetration_m"].get<double>() < 5e-3);
+  // The deepest contact of the run is a ball landing (measured: 0.15 m), less than its radius.
+  CHECK(m["max_penetration_m"].get<double>() < 0.5);
+  CHECK(m["final_penetration_m"].get<double>() <= m["max_penetration_m"].get<double>());
   // Every ball is inside the funnel (y > |x|, y > |z|, less the penetration) and below its start.
   for (const Body& b : run.world.bodies()) {
     if (b.is_static()) continue;
@@ -283,8 +344,9 @@ TEST_CASE("pendulum wave: rods hold, phases follow the reference, the wave reali
           "[scene][pendulum_wave]") {
   // Tolerances derived for dt = 1/600 s:
   // - semi-implicit Euler runs a harmonic swing fast by (w dt)^2 / 24; the fastest pendulum
-  //   (w = 2 pi 100 / 60 s = 10.5 rad/s) gains 1.3e-5 of its 100 swings in T, 0.46 degrees:
-  //   the phase error against the reduced-coordinate reference is held to 0.5 degrees;
+  //   (w = 2 pi 100 / 60 s = 10.5 rad/s) gains 1.3e-5 of its 103 swings in 62 s, 0.47 degrees:
+  //   the phase error against the reduced-coordinate reference, the largest over the run, is
+  //   held to 0.55 degrees (measured 0.49: the next-order terms);
   // - at realignment every pendulum is within that of its ideal phase, so the spread is held to
   //   twice the phase bound, 1 degree;
   // - a 15 degree swing lengthens every period alike by theta0^2 / 16 (0.43 %), so the wave
@@ -295,7 +357,7 @@ TEST_CASE("pendulum wave: rods hold, phases follow the reference, the wave reali
   const nlohmann::json m = run.metrics->report();
   INFO(m.dump());
   CHECK(m["max_rod_error_rel"].get<double>() < 1e-3);
-  CHECK(m["max_phase_error_deg"].get<double>() < 0.5);
+  CHECK(m["max_phase_error_deg"].get<double>() < 0.55);
   REQUIRE(m["realign_spread_deg"].is_number());
   CHECK(m["realign_spread_deg"].get<double>() < 1.0);
   const double theta0 = 15.0 * M_PI / 180.0;
@@ -430,4 +492,96 @@ TEST_CASE("a scene's report headline is its trajectory error only where the traj
       CHECK(neighbours >= 0.5 * e);
     }
   }
+}
+
+namespace {
+
+// The times (s) a sampled angle passes 0 upwards, by linear interpolation between samples.
+void add_crossing(double t0, double a0, double t1, double a1, std::vector<double>& crossings) {
+  if (a0 < 0.0 && a1 >= 0.0) crossings.push_back(t0 + (t1 - t0) * (-a0) / (a1 - a0));
+}
+
+}  // namespace
+
+TEST_CASE("the pendulum wave's phase error is a phase: it matches the zero crossings of the "
+          "exact pendulum and is not bounded by the swing", "[scene][pendulum_wave]") {
+  // At dt = 1/60 s semi-implicit Euler runs the fastest pendulum (100 swings in 60 s) fast by
+  // about (w dt)^2 / 24 of its rate: tens of degrees of phase over the 62 s, while the swing
+  // angles can differ by at most twice the 15 degree amplitude.
+  scenes::Overrides o;
+  o.set("dt", 1.0 / 60.0);
+  scenes::Run run = run_scene("pendulum_wave", o);
+  constexpr double kEnd = 62.0;  // s
+  const int n = 49;              // the fastest pendulum
+  const DistanceConstraint rod = run.world.distances()[n];
+  REQUIRE(rod.body_b == kWorldBody);
+  const auto angle = [&] {
+    const Vec3 d = run.world.body(rod.body_a).x - rod.local_b;
+    return std::atan2(d.z(), -d.y());
+  };
+  std::vector<double> sim;  // s, upward zero crossings of the simulated swing
+  double t0 = run.world.time();
+  double a0 = angle();
+  while (scenes::short_of(run.world, kEnd)) {
+    run.step();
+    const double a1 = angle();
+    add_crossing(t0, a0, run.world.time(), a1, sim);
+    t0 = run.world.time();
+    a0 = a1;
+  }
+  // The exact pendulum's crossings: the reduced model by RK4, sampled every 1 ms.
+  const scenes::PinnedBallPendulum p{rod.length, 0.02, 10.0};
+  const double release = 15.0 * M_PI / 180.0;
+  scenes::PendulumState s{release, release, 0.0, 0.0};
+  std::vector<double> exact;
+  double r0 = scenes::centre_angle(p, s);
+  for (int k = 1; k * 1e-3 <= kEnd; ++k) {
+    s = scenes::integrate_rk4(p, s, 1e-3, 1e-4);
+    const double r1 = scenes::centre_angle(p, s);
+    add_crossing((k - 1) * 1e-3, r0, k * 1e-3, r1, exact);
+    r0 = r1;
+  }
+  REQUIRE(exact.size() >= 100);
+  REQUIRE(sim.size() >= exact.size());
+  const double period = (exact.back() - exact.front()) / static_cast<double>(exact.size() - 1);
+  double largest = 0.0;  // deg, the largest phase error at a crossing
+  for (std::size_t k = 0; k < exact.size(); ++k) {
+    largest = std::max(largest, 360.0 * std::abs(exact[k] - sim[k]) / period);
+  }
+  const nlohmann::json m = run.metrics->report();
+  INFO(m.dump() << "\nphase error at the zero crossings: " << largest << " deg");
+  CHECK(largest > 2.0 * 15.0);  // past what an angle difference can show
+  // The metric samples every 0.02 s and takes the worst pendulum: at least this one's, and
+  // within a crossing's interpolation (a step, dt / period of a turn) plus 2 % of it.
+  const double metric = m["max_phase_error_deg"].get<double>();
+  CHECK(metric >= largest - 360.0 * (1.0 / 60.0) / period);
+  CHECK(metric <= 1.02 * largest + 360.0 * (1.0 / 60.0) / period);
+  CHECK(m["max_angle_error_deg"].get<double>() <= 2.0 * 15.0 + 1.0);
+  CHECK(m["final_angle_error_deg"].get<double>() <= 2.0 * 15.0 + 1.0);
+}
+
+TEST_CASE("the intersecting stack's recovery time does not move with the run's length",
+          "[scene][intersecting_stack]") {
+  // Under the split push the stack comes to rest within about 1.2 s; before the hold window the
+  // time was "at rest from then to the end", which a later flicker over 0.1 m/s moved (1.93,
+  // 2.30, 3.42 and 10.0 s for runs of 2, 3, 4 and 10 s).
+  scenes::Overrides split;
+  split.set("push", PushMode::split);
+  std::vector<double> times;
+  for (const double seconds : {3.0, 4.0, 10.0}) {
+    scenes::Run run = run_scene("intersecting_stack", split);
+    run.advance_to(seconds);
+    const nlohmann::json m = run.metrics->report();
+    INFO(seconds << " s: " << m.dump());
+    REQUIRE(m["recovered"].get<bool>());
+    times.push_back(m["recovery_time_s"].get<double>());
+    // A recovery held 0.5 s within the run.
+    CHECK(times.back() + 0.5 <= seconds + 1e-9);
+  }
+  CHECK(times[0] == times[1]);
+  CHECK(times[0] == times[2]);
+  // Under the Baumgarte push the cubes fly apart: no recovery within 1 s.
+  scenes::Run thrown = run_scene("intersecting_stack");
+  thrown.advance_to(1.0);
+  CHECK_FALSE(thrown.metrics->report()["recovered"].get<bool>());
 }

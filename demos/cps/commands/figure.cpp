@@ -166,7 +166,7 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
     }
   }
   for (std::size_t r = 0; r < runs.size(); ++r) {
-    scenes::print_energy_rise_warning(scene.name, spec.variants[r].label, runs[r].world.def(), *energy[r]);
+    scenes::print_run_warnings(scene.name, spec.variants[r].label, runs[r], *energy[r]);
   }
   const bool lettered = out.panels.size() > 1;
   for (std::size_t k = 0; k < out.panels.size(); ++k) {

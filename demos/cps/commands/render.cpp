@@ -512,7 +512,7 @@ long long write_frames(const RenderOptions& o, const RenderPlan& plan, SceneRend
   const long long frames = render_frames(job.style, panels, job.spec, renderer, writer, &progress);
   end_output(job.output, info);
   for (std::size_t v = 0; v < job.runs.size(); ++v) {
-    scenes::print_energy_rise_warning(job.scene->name, plan.variants[v].label, job.runs[v].world.def(), *job.energy[v]);
+    scenes::print_run_warnings(job.scene->name, plan.variants[v].label, job.runs[v], *job.energy[v]);
   }
   std::printf("%s: %lld frames in %s\n", job.spec.folder.filename().c_str(), frames, job.spec.folder.c_str());
   return frames;

@@ -319,7 +319,7 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
   const nlohmann::json summary = simulate(*scene, r, seconds, trace ? &*trace : nullptr,
                                           energy_csv ? &*energy_csv : nullptr);
   progress.finish();
-  scenes::print_energy_rise_warning(scene->name, "", r.world.def(), *energy);
+  scenes::print_run_warnings(scene->name, "", r, *energy);
   if (files) files->finish();
   if (trace) {
     std::cerr << "trace: " << trace->rows() << " rows (" << r.world.bodies().size()

@@ -39,6 +39,7 @@ class SphereInBoxMetrics final : public Metrics {
       if (!b.is_static()) max_speed_ = std::max(max_speed_, b.velocity().norm());
     }
   }
+  void diverged_since(double since_s) override { watch_.diverged_since(since_s); }
 
   nlohmann::json report() const override {
     const bool ok = world_ && !nonfinite_;

@@ -107,11 +107,13 @@ class EnergyMetrics : public Metrics {
 /// or are pushed into place). A body has left its place when its centre is farther than
 /// `leave_m` (m, > 0) from it. Keys of add_to (units as suffixes):
 /// - leave_distance_m: leave_m.
-/// - arrival_s: the first observed time (s) at which every movable body is within leave_m of its
-///   resting place; 0 for a scene built at rest; null if that never happened.
-/// - survival_s: the world time (s) of the first observation after the arrival at which a body
-///   is farther than leave_m from its resting place; if none is, the time observed so far (the
-///   run's duration); 0 if the bodies never arrived.
+/// - arrival_s: the first observed time (s) from which every movable body stays within leave_m
+///   of its resting place for kHoldS; 0 for a scene built at rest that stays so; null if that
+///   never happened.
+/// - survival_s: after the arrival, the first observed time (s) from which a body stays farther
+///   than leave_m from its resting place for kHoldS (a body that sags out for a moment and comes
+///   back has not left); if none, the time observed so far (the run's duration), and at most the
+///   time the run diverged from (Metrics::diverged_since); 0 if the bodies never arrived.
 /// - final_displacement_m: the largest distance of a movable body from its resting place at the
 ///   last observation (m).
 /// - max_penetration_m: the deepest contact of any step (deepest_contact, m).
@@ -122,8 +124,9 @@ class EnergyMetrics : public Metrics {
 /// - max_rod_stretch_m: the largest |distance - length| of any rod at any observation (m; 0
 ///   without rods).
 /// - mass_ratio: the largest movable mass over the smallest (dimensionless).
-/// - holds: every state was finite, the bodies arrived, and at the last observation every
-///   movable body is within leave_m of its resting place.
+/// - holds: every state was finite, the run did not diverge, the bodies arrived and did not
+///   leave, and at the last observation every movable body is within leave_m of its resting
+///   place; so "holds" and a survival shorter than the run never come together.
 /// - nan: a state was not finite (the measures stop there).
 class HardCaseWatch {
  public:
@@ -134,6 +137,13 @@ class HardCaseWatch {
   void add_to(nlohmann::json& j) const;
   /// True as add_to's "holds" says.
   bool holds() const;
+  /// The run diverged from since_s (s; Metrics::diverged_since): it holds no more, and it
+  /// survived at most until then.
+  void diverged_since(double since_s);
+
+  /// s: how long the bodies must stay in place to arrive, or out of it to have left. Typical
+  /// 0.5 s: a rope sagging to its rest length under a heavy load leaves and comes back within it.
+  static constexpr double kHoldS = 0.5;
 
  private:
   std::vector<Vec3> rest_;
@@ -142,6 +152,10 @@ class HardCaseWatch {
   std::optional<double> start_energy_J_;
   std::optional<double> arrival_s_;
   std::optional<double> left_s_;
+  std::optional<double> in_place_since_;  // s, the start of the current time in place
+  std::optional<double> out_since_;       // s, the start of the current time out of place
+  std::optional<double> diverged_s_;      // s, Metrics::diverged_since's
+  bool in_place_now_ = false;
   double observed_s_ = 0.0;
   double final_displacement_m_ = 0.0;
   double max_penetration_m_ = 0.0;
@@ -157,6 +171,7 @@ class HardCaseMetrics final : public Metrics {
   HardCaseMetrics(std::vector<Vec3> resting_places, double leave_m)
       : watch_(std::move(resting_places), leave_m) {}
   void observe(const World& world) override { watch_.observe(world); }
+  void diverged_since(double since_s) override { watch_.diverged_since(since_s); }
   nlohmann::json report() const override;
 
  private:

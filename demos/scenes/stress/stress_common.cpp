@@ -140,22 +140,42 @@ void HardCaseWatch::observe(const World& world) {
     }
   }
   const bool in_place = final_displacement_m_ <= leave_m_;
-  if (!arrival_s_ && in_place) arrival_s_ = observed_s_;
-  if (arrival_s_ && !left_s_ && !in_place) left_s_ = observed_s_;
+  in_place_now_ = in_place;
+  if (in_place) {
+    out_since_.reset();
+    if (!in_place_since_) in_place_since_ = observed_s_;
+  } else {
+    in_place_since_.reset();
+    if (arrival_s_ && !out_since_) out_since_ = observed_s_;
+  }
+  // Held for kHoldS: observed_s_ - since is a whole number of steps, up to round-off.
+  const double half_step = 0.5 * world.def().dt;
+  if (!arrival_s_ && in_place_since_ && observed_s_ - *in_place_since_ + half_step >= kHoldS) {
+    arrival_s_ = in_place_since_;
+  }
+  if (arrival_s_ && !left_s_ && out_since_ && observed_s_ - *out_since_ + half_step >= kHoldS) {
+    left_s_ = out_since_;
+  }
   max_penetration_m_ = std::max(max_penetration_m_, deepest_contact(world));
   max_energy_J_ = std::max(max_energy_J_, total_energy(world));
   max_rod_stretch_m_ = std::max(max_rod_stretch_m_, max_rod_error(world));
 }
 
 bool HardCaseWatch::holds() const {
-  return !nonfinite_ && arrival_s_.has_value() && final_displacement_m_ <= leave_m_;
+  return !nonfinite_ && !diverged_s_ && arrival_s_.has_value() && !left_s_ && in_place_now_;
+}
+
+void HardCaseWatch::diverged_since(double since_s) {
+  diverged_s_ = since_s;
+  if (left_s_ && *left_s_ >= since_s) left_s_.reset();
+  if (arrival_s_ && *arrival_s_ >= since_s) arrival_s_.reset();
 }
 
 void HardCaseWatch::add_to(nlohmann::json& j) const {
   const double reference = std::max(start_energy_J_.value_or(0.0), rest_energy_J_);
   j["leave_distance_m"] = leave_m_;
   j["arrival_s"] = arrival_s_ ? nlohmann::json(*arrival_s_) : nlohmann::json();
-  j["survival_s"] = !arrival_s_ ? 0.0 : left_s_.value_or(observed_s_);
+  j["survival_s"] = !arrival_s_ ? 0.0 : std::min(left_s_.value_or(observed_s_), diverged_s_.value_or(kInfinity));
   j["final_displacement_m"] = final_displacement_m_;
   j["max_penetration_m"] = max_penetration_m_;
   j["energy_injected_J"] = start_energy_J_ ? std::max(0.0, max_energy_J_ - reference) : 0.0;

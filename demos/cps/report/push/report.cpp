@@ -211,9 +211,10 @@ std::string legend(const PushPlan& p) {
      << number(grid_seconds) << " s (its default " << number(grid.default_seconds)
      << " s): the largest |rod length - its length| over the run. **wave rod error**, **wave phase error "
         "(deg)**: the pendulum wave's metrics max_rod_error_rel (the largest |rod length - "
-        "its length| / its length over the run) and max_phase_error_deg (at the end of the run, "
-        "the largest difference over its 50 pendulums between a ball's swing angle and that of "
-        "the reduced-coordinate reference, wrapped to [-180, 180] deg), run "
+        "its length| / its length over the run) and max_phase_error_deg (the largest phase error "
+        "over the run and its 50 pendulums against the reduced-coordinate reference: the angle "
+        "of a swing in the plane (angle, -rate / w), sampled every 0.02 s and unwrapped, so it "
+        "is not bounded by the amplitude), run "
      << number(wave_seconds) << " s"
      << (wave_seconds < wave.default_seconds
              ? " (--quick; its default is " + number(wave.default_seconds) + " s)"
@@ -410,11 +411,13 @@ std::string hard_legend(const PushPlan& p) {
        << number(kQuickLongRunSteps * p.hard.back().scene->world_def().dt) << " s); the full report runs all 10,000.";
   }
   md << "\n\n"
-     << "- **survival (s)**: the time a body first leaves its place after every body had arrived "
-        "(survival_s); **never**: no body left its place at any step, held to the end of the run; "
-        "0 with arrival \"never\": the bodies never arrived.\n"
-     << "- **arrival (s)**: the first time every body is within the leave distance of its place "
-        "(0 for a scene built at rest).\n"
+     << "- **survival (s)**: the time from which a body stays out of its place for 0.5 s, after "
+        "every body had arrived (survival_s; a body that sags out and comes back within 0.5 s "
+        "has not left); **never**: no body left its place, held to the end of the run; 0 with "
+        "arrival \"never\": the bodies never arrived; a diverged run survives until it "
+        "diverged.\n"
+     << "- **arrival (s)**: the first time from which every body stays within the leave distance "
+        "of its place for 0.5 s (0 for a scene built at rest).\n"
      << "- **final displacement (m)**: the largest distance of a body from its place at the end.\n"
      << "- **max penetration (m)**: the deepest contact of any step.\n"
      << "- **energy injected (J)**: the largest rise of KE + PE above the larger of the start's "

@@ -125,12 +125,12 @@ void check_export(const char* scene, double seconds, std::int64_t step) {
                                      dir);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
-  // Only the file and run.json: the temporary was renamed.
+  // Only the file, its rows and run.json: the temporaries were renamed.
   std::vector<std::string> names;
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "out")) {
     names.push_back(e.path().filename().string());
   }
-  std::vector<std::string> expected = {file, "run.json"};
+  std::vector<std::string> expected = {file, fs::path(file).stem().string() + "-rows.csv", "run.json"};
   std::sort(names.begin(), names.end());
   std::sort(expected.begin(), expected.end());
   CHECK(names == expected);
@@ -317,6 +317,70 @@ TEST_CASE("export --fclib writes the pendulum grid's rods as the bilateral rows 
   fs::remove_all(dir);
 }
 
+TEST_CASE("export --fclib writes each row's bounds and lambda beside the file, from which cps's "
+          "box problem is solved again", "[fclib]") {
+  const fs::path dir = cli_test::fresh_dir("cps-test-fclib-rows");
+  const cli_test::Result r = run_cps("export stack --seconds 6 --at 300 --fclib out/s.hdf5", dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const StepSystem s = capture("stack", kStackStep);
+  // The rows file: a header and one line per cps row.
+  std::FILE* f = std::fopen((dir / "out" / "s-rows.csv").c_str(), "r");
+  REQUIRE(f != nullptr);
+  std::vector<std::vector<std::string>> table;
+  char buffer[1024];
+  while (std::fgets(buffer, sizeof buffer, f) != nullptr) {
+    std::vector<std::string> cells(1);
+    for (const char* c = buffer; *c != '\0' && *c != '\n'; ++c) {
+      if (*c == ',') cells.emplace_back(); else cells.back() += *c;
+    }
+    table.push_back(cells);
+  }
+  std::fclose(f);
+  REQUIRE(table.size() == static_cast<std::size_t>(s.rows()) + 1);
+  REQUIRE(table[0].size() == 11);
+  CHECK(table[0][2] == "fclib");
+  CHECK(table[0][10] == "lambda_exact_N");
+  // From the FCLIB file's W and q and the rows' bounds: the natural map of the box problem at
+  // the exact lambda of the rows file is 0 to the exact solve's tolerances (1e-9 of the force
+  // scale for its residual, and as much for the least-norm member's bounds); and the engine's
+  // lambda is the captured one, to the digit.
+  Local local(dir / "out" / "s.hdf5");
+  REQUIRE(local.p != nullptr);
+  const Eigen::MatrixXd W = dense(*local.p->W);
+  const int m = local.p->W->m;
+  Eigen::VectorXd r_local = Eigen::VectorXd::Zero(m);
+  std::vector<int> cps_row(static_cast<std::size_t>(m), -1);
+  double scale = 0.0;
+  for (std::size_t k = 1; k < table.size(); ++k) {
+    const std::vector<std::string>& row = table[k];
+    REQUIRE(row.size() == 11);
+    const int j = std::stoi(row[0]);
+    CHECK(std::stod(row[9]) == s.lambda[j]);
+    CHECK(std::stod(row[3]) == s.c_min[j]);
+    scale = std::max(scale, std::abs(std::stod(row[10])));
+    if (row[2].rfind("r[", 0) == 0) {
+      const int i = std::stoi(row[2].substr(2));
+      REQUIRE(i < m);
+      cps_row[static_cast<std::size_t>(i)] = j;
+      r_local[i] = s.dt * std::stod(row[10]);
+    }
+  }
+  REQUIRE(std::count(cps_row.begin(), cps_row.end(), -1) == 0);
+  const Eigen::VectorXd u = W * r_local + Eigen::Map<const Eigen::VectorXd>(local.p->q, m);
+  double residual = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const std::vector<std::string>& row = table[static_cast<std::size_t>(cps_row[static_cast<std::size_t>(i)]) + 1];
+    const double lambda = r_local[i] / s.dt;
+    const double w = u[i] / s.dt;
+    const double fixed = std::clamp(lambda - w / W(i, i), std::stod(row[3]), std::stod(row[4]));
+    residual = std::max(residual, std::abs(lambda - fixed));
+  }
+  CHECK(residual <= 2e-9 * scale);
+  CHECK(scale > 1.0);  // not vacuous: the stack pushes
+  fs::remove_all(dir);
+}
+
 TEST_CASE("export --fclib with several steps writes one file per step", "[fclib]") {
   const fs::path dir = cli_test::fresh_dir("cps-test-fclib-steps");
   const cli_test::Result r = run_cps("export intersecting_stack --seconds 0.1 --at 5,1 --fclib out/is.hdf5", dir);
@@ -330,6 +394,8 @@ TEST_CASE("export --fclib with several steps writes one file per step", "[fclib]
     const StepSystem s = capture("intersecting_stack", step);
     CHECK(local.p->W->m == static_cast<int>(expected_rows(s).size()));
   }
+  CHECK(fs::exists(dir / "out" / "is-step1-rows.csv"));
+  CHECK(fs::exists(dir / "out" / "is-step5-rows.csv"));
   CHECK_FALSE(fs::exists(dir / "out" / "is.hdf5"));
   fs::remove_all(dir);
 }

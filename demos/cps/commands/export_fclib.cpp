@@ -9,9 +9,11 @@
 #include "cps/step_system.h"
 
 #ifdef CPS_HAVE_FCLIB
+#include "exact_lcp.h"
 #include "fclib_problem.h"
 #endif
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -56,6 +58,57 @@ analysis::FclibText problem_text(const std::string& scene, const StepSystem& s,
           analysis::fclib_mapping_text()};
 }
 
+const char* kind_name(RowKind k) {
+  switch (k) {
+    case RowKind::contact: return "contact";
+    case RowKind::friction: return "friction";
+    case RowKind::distance: return "rod";
+  }
+  return "?";
+}
+
+// The rows of s beside its FCLIB file, so that cps's own box problem can be solved again from
+// the file: per cps row, its FCLIB place (r[i]: the i-th local row; l[k]: the k-th rod row; -:
+// none), bounds, coefficient, contact row, b, and the engine's and an exact lambda (N). The
+// exact one is the least-norm exact solution (demos/analysis/exact_lcp.h), or with coupled
+// friction the one found; `exact_note` says why the column is empty when the exact solve
+// refused.
+std::string rows_csv(const StepSystem& s, const analysis::FclibLocal& p, std::string& exact_note) {
+  std::vector<std::string> place(static_cast<std::size_t>(s.rows()), "-");
+  for (std::size_t i = 0; i < p.local_rows.size(); ++i) {
+    if (p.local_rows[i] >= 0) place[static_cast<std::size_t>(p.local_rows[i])] = "r[" + std::to_string(i) + "]";
+  }
+  for (std::size_t k = 0; k < p.rod_rows.size(); ++k) {
+    place[static_cast<std::size_t>(p.rod_rows[k])] = "l[" + std::to_string(k) + "]";
+  }
+  Eigen::VectorXd exact;
+  try {
+    const analysis::ExactSolution solution = analysis::solve_exact(s);
+    exact = s.friction == FrictionModel::fixed
+                ? solution.distance(s, Eigen::VectorXd::Zero(s.rows())).nearest
+                : solution.lambda;
+  } catch (const std::exception& e) {
+    exact_note = e.what();
+  }
+  std::string text =
+      "row,kind,fclib,c_min_N,c_max_N,mu,normal_row,b_mps2,A_jj_per_kg,lambda_engine_N,lambda_exact_N\n";
+  char line[512];
+  for (Eigen::Index j = 0; j < s.rows(); ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    const int n = std::snprintf(line, sizeof line, "%lld,%s,%s,%.17g,%.17g,%.17g,%d,%.17g,%.17g,%.17g,",
+                                static_cast<long long>(j), kind_name(s.kinds[k]), place[k].c_str(),
+                                s.c_min[j], s.c_max[j], s.mu[j], s.normal_row[k], s.b[j],
+                                s.A.coeff(j, j), s.lambda[j]);
+    text.append(line, static_cast<std::size_t>(std::clamp(n, 0, static_cast<int>(sizeof line) - 1)));
+    if (exact.size() == s.rows()) {
+      std::snprintf(line, sizeof line, "%.17g", exact[j]);
+      text += line;
+    }
+    text += "\n";
+  }
+  return text;
+}
+
 }  // namespace
 #endif
 
@@ -86,11 +139,17 @@ int run_fclib_export(const FclibExportOptions& o, int argc, char** argv) {
     names[step] = steps.size() == 1 ? path.filename().string()
                                     : path.stem().string() + "-step" + std::to_string(step) + ".hdf5";
   }
+  // Beside each, STEM-rows.csv: cps's rows, bounds and lambda (rows_csv).
+  const auto rows_name = [](const std::string& name) {
+    return std::filesystem::path(name).stem().string() + "-rows.csv";
+  };
   std::vector<std::string> files;
   std::map<std::string, std::string> sources;
   for (const auto& [step, name] : names) {
     files.push_back(name);
+    files.push_back(rows_name(name));
     sources[name] = scene_source(scene->name);
+    sources[rows_name(name)] = scene_source(scene->name);
   }
 #ifndef CPS_HAVE_FCLIB
   // The options are checked as in a build with FCLIB, so that their errors read the same.
@@ -172,6 +231,13 @@ int run_fclib_export(const FclibExportOptions& o, int argc, char** argv) {
               << " contacts and " << problem.rod_rows.size() << " rods (W " << problem.W.rows()
               << " x " << problem.W.cols() << ", " << problem.W.nonZeros() << " entries), "
               << bytes << " bytes in " << target.string() << "\n";
+    std::string exact_note;
+    const std::filesystem::path rows = path.parent_path() / rows_name(names[step]);
+    write_text_atomic(rows, rows_csv(captured.at(step), problem, exact_note));
+    std::cerr << "export " << scene_name << ": step " << step << ", its rows, bounds and lambda in "
+              << rows.string()
+              << (exact_note.empty() ? std::string() : " (no exact lambda: " + exact_note + ")")
+              << "\n";
   }
   end_output(output, info);
   return 0;

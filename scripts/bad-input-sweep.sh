@@ -99,7 +99,7 @@ declare -A BASE=(
   [parameters]='parameters --format tsv'
   [diff]='diff prior/x/frame_000000.png prior/x/frame_000000.png --out out'
 )
-RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.06 s
+RUN_ID=intersecting_stack.pgs.baumgarte.fixed.it1.ss1  # 0.1 s
 MERGE_SRC=$root/merge-src                              # a complete sweep, made below
 PRIOR=$root/prior                    # a/x.json (a valid scene file) and its render into out/x
 DROP='{"seconds": 0.2, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0}, {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1, "position_m": [0, 0.6, 0]}]}'
@@ -351,7 +351,7 @@ CONTROLS=(
   "report intersecting_stack --list-runs --out out --max-work 1e18"
   "report intersecting_stack --list-runs --out out --repeats 3"  # the ends of --repeats' range
   "report intersecting_stack --list-runs --out out --repeats 100"
-  "report --run $RUN_ID --out out --repeats 3 --max-work 1800"  # exactly (3 + 2) x 360
+  "report --run $RUN_ID --out out --repeats 3 --max-work 3600"  # exactly (3 + 2) x 720
 )
 
 # ---------------------------------------------------------------------------------------------

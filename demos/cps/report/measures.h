@@ -34,7 +34,7 @@ inline constexpr Measure kMeasures[] = {
     {"energy_drift_rel", "largest relative energy drift |E(t) / E(0) - 1|", "|E / E0 - 1|", "",
      1e-12},
     {"metric.recovery_time_s",
-     "time from which every overlap stays under 1 cm and every speed under 0.1 m/s (s)",
+     "first time from which every overlap stays under 1 cm and every speed under 0.1 m/s for 0.5 s (s)",
      "recovery time (s)", "s", 1e-10},
     {"metric.max_speed_mps",
      "largest body speed at the end of the run (m/s; 0 is right only once the overlaps are "

@@ -52,6 +52,7 @@ void EnergyRiseTracker::observe(const World& world) {
     rise_.max_time_s = world.time();
     mass_.assign(bodies.size(), 0.0);
     start_h_.assign(bodies.size(), 0.0);
+    top_h_ = -kInfinity;  // no movable body: no fall, the limit is the start speed
     for (std::size_t i = 0; i < bodies.size(); ++i) {
       const Body& b = bodies[i];
       if (b.is_static()) continue;
@@ -61,9 +62,6 @@ void EnergyRiseTracker::observe(const World& world) {
       size_J_ += b.mass * g_norm * r;
       start_speed_mps_ = std::max(start_speed_mps_, b.velocity().norm());
       top_h_ = std::max(top_h_, start_h_[i] + r);
-    }
-    if (bodies.empty() || std::all_of(bodies.begin(), bodies.end(), [](const Body& b) { return b.is_static(); })) {
-      top_h_ = 0.0;
     }
     peaks_.emplace_back(world.time(), energy);
     lowest_h_ = start_h_;

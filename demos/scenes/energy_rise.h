@@ -129,7 +129,7 @@ class EnergyRiseTracker {
   // warn_time_s once the scale is known.
   std::vector<std::pair<double, double>> peaks_;
   double start_speed_mps_ = 0.0;    // v0 (m/s)
-  double top_h_ = 0.0;              // H (m)
+  double top_h_ = -kInfinity;       // H (m)
 };
 
 /// Wraps run.metrics so that every step also feeds a tracker, which has already observed the

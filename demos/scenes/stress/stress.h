@@ -155,7 +155,6 @@ class HardCaseWatch {
   std::optional<double> in_place_since_;  // s, the start of the current time in place
   std::optional<double> out_since_;       // s, the start of the current time out of place
   std::optional<double> diverged_s_;      // s, Metrics::diverged_since's
-  bool in_place_now_ = false;
   double observed_s_ = 0.0;
   double final_displacement_m_ = 0.0;
   double max_penetration_m_ = 0.0;

@@ -140,7 +140,6 @@ void HardCaseWatch::observe(const World& world) {
     }
   }
   const bool in_place = final_displacement_m_ <= leave_m_;
-  in_place_now_ = in_place;
   if (in_place) {
     out_since_.reset();
     if (!in_place_since_) in_place_since_ = observed_s_;
@@ -162,7 +161,8 @@ void HardCaseWatch::observe(const World& world) {
 }
 
 bool HardCaseWatch::holds() const {
-  return !nonfinite_ && !diverged_s_ && arrival_s_.has_value() && !left_s_ && in_place_now_;
+  return !nonfinite_ && !diverged_s_ && arrival_s_.has_value() && !left_s_ &&
+         final_displacement_m_ <= leave_m_;
 }
 
 void HardCaseWatch::diverged_since(double since_s) {

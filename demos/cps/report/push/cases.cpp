@@ -5,6 +5,7 @@
 #include "report/mass_ratio.h"
 #include "report/run.h"
 #include "report/timing.h"
+#include "divergence.h"
 #include "scene_file.h"
 
 #include <algorithm>
@@ -121,6 +122,15 @@ void finish_column(const World& w, double energy_max, double rest_pe, ColumnResu
   }
 }
 
+// When `run` diverged, as every run's watch finds it (divergence.h: a state not finite, or a
+// contact past a body's size for kDivergedSteps steps; its time the first step that showed it),
+// or when its state left sane_state's bounds (1e6 m, 1e6 m/s); nullopt while neither.
+std::optional<double> diverged_at_of(const scenes::Run& run) {
+  if (run.divergence && run.divergence->found()) return run.divergence->found()->at_s;
+  if (!sane_state(run.world)) return run.world.time();
+  return std::nullopt;
+}
+
 // Runs `scene` with push `m` for `seconds` (s) and measures, from the state after every step:
 //  - the largest overlap (m): at the state of time t - dt the largest contact depth over
 //    World::manifolds() after the step to t (its collide stage saw that state), and at the
@@ -133,8 +143,8 @@ void finish_column(const World& w, double energy_max, double rest_pe, ColumnResu
 //    column at rest (rest_heights, from the bodies' masses, shapes and the world's gravity);
 //  - the final heights of the movable bodies' centres and height_error_m, the largest
 //    |final - rest| among them.
-// A run whose state stops being sane (sane_state) ends there (diverged_at) with nothing
-// resolved and no final heights.
+// A run that diverges (diverged_at_of) ends there (diverged_at) with nothing resolved and no
+// final heights.
 ColumnResult run_column(const scenes::Scene& scene, const Method& m, double seconds) {
   scenes::Run run = make_run_or_usage_error(scene, with_push(m));
   const World& w = run.world;
@@ -148,8 +158,8 @@ ColumnResult run_column(const scenes::Scene& scene, const Method& m, double seco
   while (scenes::short_of(w, seconds)) {
     run.step();
     r.series.back().overlap_m = manifold_overlap(w);  // the state the step started from
-    if (!sane_state(w)) {
-      r.diverged_at = w.time();
+    if (const std::optional<double> at = diverged_at_of(run)) {
+      r.diverged_at = at;
       break;
     }
     r.series.push_back({w.time(), 0.0, largest_speed(w)});
@@ -184,9 +194,9 @@ double window_us_per_step(const scenes::Scene& scene, const Method& m) {
   return us.empty() ? std::nan("") : us[us.size() / 2];
 }
 
-// Steps `run` to `seconds` (s), its metrics observing every step, and stops early where the
-// state stops being sane (sane_state); adds the CPU time of this thread in World::step (s) to
-// step_cpu_s and the steps to `steps`. Returns when it stopped being sane (s), if it did.
+// Steps `run` to `seconds` (s), its metrics observing every step, and stops early where it
+// diverges (diverged_at_of); adds the CPU time of this thread in World::step (s) to step_cpu_s
+// and the steps to `steps`. Returns when it diverged (s), if it did.
 std::optional<double> step_observed(scenes::Run& run, double seconds, double& step_cpu_s,
                                     long long& steps) {
   while (scenes::short_of(run.world, seconds)) {
@@ -195,7 +205,7 @@ std::optional<double> step_observed(scenes::Run& run, double seconds, double& st
     step_cpu_s += thread_cpu_seconds() - start;
     ++steps;
     run.metrics->observe(run.world);
-    if (!sane_state(run.world)) return run.world.time();
+    if (const std::optional<double> at = diverged_at_of(run)) return at;
   }
   return std::nullopt;
 }

@@ -2,6 +2,7 @@
 // method (push/cases.h), then push.csv, push.md and the diagrams written from their results.
 #include "report/push/report.h"
 
+#include "divergence.h"
 #include "options/progress.h"
 #include "output/atomic_file.h"
 #include "output/output.h"
@@ -173,8 +174,10 @@ std::string legend(const PushPlan& p) {
                      " s instead of its " + number(wave.default_seconds) + " s"
                : std::string())
      << ". \"-\": the measure does not apply; \"never\": the time was not reached; "
-        "\"diverged at T s\": the state stopped being finite or passed 1e6 m or 1e6 m/s at T, "
-        "and the case's measures stop there.\n\n"
+        "\"diverged at T s\": at T the state stopped being finite or passed 1e6 m or 1e6 m/s, "
+        "or a contact was deeper than the smallest size of a body it touches for "
+     << scenes::kDivergedSteps << " steps in a row from T (as `cps simulate` flags it), and the "
+        "case's measures stop there.\n\n"
      << "- **IS** is the intersecting stack (Sec. 10.2: five cubes of half extent 1.2 m started "
         "0.4 m overlapping, the bottom one 1.2 m into the ground), **SiB** the stress scene "
         "sphere_in_box (a ball of radius 0.4 m started 0.7 m into a box of half extent 1 m "

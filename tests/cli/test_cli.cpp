@@ -841,5 +841,26 @@ TEST_CASE("the exact solve opens Siconos when it first runs: without the library
     CHECK(value(row, "signorini_velocity_mps") <= 1e-9);
   }
   CHECK(exact_rows == 1);
+  // Beside it, e-rows.csv: every row of the solve with its bounds and the least-norm exact
+  // lambda, inside its bounds, whose norm is the |lambda*| the CSV's relative errors divide by
+  // (lambda_error_N / lambda_error_relative of the engine's row).
+  const auto errors = read_table(dir / "out" / "e.csv");
+  const auto rows = read_table(dir / "out" / "e-rows.csv");
+  REQUIRE(!rows.empty());
+  CHECK(static_cast<double>(rows.size()) == value(errors.at(0), "rows"));
+  double norm_sq = 0.0;
+  for (const auto& row : rows) {
+    CHECK(value(row, "step") == 30);
+    const double lambda = value(row, "lambda_exact_N");
+    CHECK(lambda >= value(row, "c_min_N") - 1e-9 * std::max(1.0, std::abs(lambda)));
+    CHECK(lambda <= value(row, "c_max_N") + 1e-9 * std::max(1.0, std::abs(lambda)));
+    norm_sq += lambda * lambda;
+  }
+  for (const auto& row : errors) {
+    if (row.at("method") != "engine") continue;
+    REQUIRE(value(row, "lambda_error_relative") > 0.0);
+    CHECK(std::sqrt(norm_sq) ==
+          Approx(value(row, "lambda_error_N") / value(row, "lambda_error_relative")).epsilon(1e-6));
+  }
   fs::remove_all(dir);
 }

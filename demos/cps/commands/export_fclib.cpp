@@ -2,6 +2,7 @@
 #include "commands/export_fclib.h"
 
 #include "commands/solver_error.h"
+#include "commands/system_rows.h"
 #include "options/options.h"
 #include "options/progress.h"
 #include "output/output.h"
@@ -58,15 +59,6 @@ analysis::FclibText problem_text(const std::string& scene, const StepSystem& s,
           analysis::fclib_mapping_text()};
 }
 
-const char* kind_name(RowKind k) {
-  switch (k) {
-    case RowKind::contact: return "contact";
-    case RowKind::friction: return "friction";
-    case RowKind::distance: return "rod";
-  }
-  return "?";
-}
-
 // The rows of s beside its FCLIB file, so that cps's own box problem can be solved again from
 // the file: per cps row, its FCLIB place (r[i]: the i-th local row; l[k]: the k-th rod row; -:
 // none), bounds, coefficient, contact row, b, and the engine's and an exact lambda (N). The
@@ -90,23 +82,7 @@ std::string rows_csv(const StepSystem& s, const analysis::FclibLocal& p, std::st
   } catch (const std::exception& e) {
     exact_note = e.what();
   }
-  std::string text =
-      "row,kind,fclib,c_min_N,c_max_N,mu,normal_row,b_mps2,A_jj_per_kg,lambda_engine_N,lambda_exact_N\n";
-  char line[512];
-  for (Eigen::Index j = 0; j < s.rows(); ++j) {
-    const auto k = static_cast<std::size_t>(j);
-    const int n = std::snprintf(line, sizeof line, "%lld,%s,%s,%.17g,%.17g,%.17g,%d,%.17g,%.17g,%.17g,",
-                                static_cast<long long>(j), kind_name(s.kinds[k]), place[k].c_str(),
-                                s.c_min[j], s.c_max[j], s.mu[j], s.normal_row[k], s.b[j],
-                                s.A.coeff(j, j), s.lambda[j]);
-    text.append(line, static_cast<std::size_t>(std::clamp(n, 0, static_cast<int>(sizeof line) - 1)));
-    if (exact.size() == s.rows()) {
-      std::snprintf(line, sizeof line, "%.17g", exact[j]);
-      text += line;
-    }
-    text += "\n";
-  }
-  return text;
+  return system_rows_header("fclib") + "\n" + system_rows(s, "", place, exact);
 }
 
 }  // namespace

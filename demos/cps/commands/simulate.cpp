@@ -331,7 +331,9 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
   }
   if (errors) {
     const long rows = errors->finish();
-    std::cerr << "solver-error: " << rows << " rows in " << o.solver_error << "\n";
+    std::cerr << "solver-error: " << rows << " rows in " << o.solver_error
+              << "; the solves' rows, bounds and exact lambda in "
+              << solver_error_rows_path(o.solver_error).string() << "\n";
   }
   if (o.json) {
     std::cout << summary.dump(2) << "\n";

@@ -1,6 +1,7 @@
 // `cps simulate --solver-error` (see solver_error.h).
 #include "commands/solver_error.h"
 
+#include "commands/system_rows.h"
 #include "criteria.h"
 #include "exact_lcp.h"
 #include "options/options.h"
@@ -70,10 +71,15 @@ std::string solver_error_header() {
   return "step,t_s,solve,rows,method,sweeps," + std::string(analysis::kCriteriaColumns);
 }
 
+std::filesystem::path solver_error_rows_path(const std::filesystem::path& path) {
+  return path.parent_path() / (path.stem().string() + "-rows.csv");
+}
+
 SolverErrorWriter::SolverErrorWriter(SolverErrorPlan plan, bool force, nlohmann::json info)
     : plan_(std::move(plan)), info_(std::move(info)) {
   output_ = plan_output({.folder = plan_.path.parent_path(),
-                         .files = {plan_.path.filename().string()},
+                         .files = {plan_.path.filename().string(),
+                                   solver_error_rows_path(plan_.path).filename().string()},
                          .command = "simulate",
                          .use = FolderUse::shared,
                          .scenes = {},
@@ -90,6 +96,7 @@ void SolverErrorWriter::observe(World& world) {
 
 long SolverErrorWriter::finish() {
   std::string text = solver_error_header() + "\n";
+  std::string rows_text = "step,solve," + system_rows_header("") + "\n";
   long rows = 0;
   for (const std::int64_t step : plan_.steps) {
     const bool solved = std::any_of(systems_.begin(), systems_.end(),
@@ -104,6 +111,12 @@ long SolverErrorWriter::finish() {
       throw std::runtime_error("solver-error: step " + std::to_string(s.step) + ", solve " +
                                std::to_string(s.solve) + ": " + e.what());
     }
+    // The least-norm exact solution (fixed friction), or the one found (coupled friction).
+    const Eigen::VectorXd exact_lambda =
+        s.friction == FrictionModel::fixed ? exact.distance(s, Eigen::VectorXd::Zero(s.rows())).nearest
+                                           : exact.lambda;
+    rows_text += system_rows(s, std::to_string(s.step) + "," + std::to_string(s.solve) + ",", {},
+                             exact_lambda);
     const double t = static_cast<double>(s.step) * s.dt;
     const auto row = [&](const char* method, int sweeps, const Eigen::VectorXd& lambda) {
       char head[128];
@@ -122,6 +135,7 @@ long SolverErrorWriter::finish() {
     }
   }
   write_text_atomic(plan_.path, text);
+  write_text_atomic(solver_error_rows_path(plan_.path), rows_text);
   end_output(output_, info_);
   return rows;
 }

@@ -52,13 +52,20 @@ SolverErrorPlan plan_solver_error(const std::string& path, const std::string& at
 /// The first line of the CSV: the columns with their units (criteria.h for the criteria).
 std::string solver_error_header();
 
+/// The file of the solves' rows beside the CSV at `path`: STEM-rows.csv in its folder
+/// ("out/se.csv" gives "out/se-rows.csv"): per captured solve and row, step, solve, then
+/// system_rows (bounds, b, A_jj, the engine's lambda and the least-norm exact lambda, or with
+/// coupled friction the exact solution found).
+std::filesystem::path solver_error_rows_path(const std::filesystem::path& path);
+
 /// Captures the planned steps' systems from a world and writes the CSV under the output rule
 /// (output.h: the file's folder is a shared output folder; the file is written atomically).
 class SolverErrorWriter {
  public:
-  /// Checks the path (plan_output with option "--solver-error": UsageError if it exists and no
-  /// earlier cps run wrote it, unless `force`; a folder of that name; a folder that cannot be
-  /// written), creates the folder and records the run in its run.json (begin_output with `info`).
+  /// Checks the path and the rows file beside it (plan_output with option "--solver-error":
+  /// UsageError if one exists and no earlier cps run wrote it, unless `force`; a folder of that
+  /// name; a folder that cannot be written), creates the folder and records the run in its
+  /// run.json (begin_output with `info`).
   SolverErrorWriter(SolverErrorPlan plan, bool force, nlohmann::json info);
   SolverErrorWriter(const SolverErrorWriter&) = delete;
   SolverErrorWriter& operator=(const SolverErrorWriter&) = delete;
@@ -67,8 +74,8 @@ class SolverErrorWriter {
   /// outlive the steps.
   void observe(World& world);
   /// Solves each captured system exactly and writes one row per step, solve, method (exact,
-  /// engine, pgs, jacobi, coloured-pgs for a run under it) and sweep count, then lists the file
-  /// in run.json. Returns the rows
+  /// engine, pgs, jacobi, coloured-pgs for a run under it) and sweep count, and the solves' rows
+  /// (solver_error_rows_path), then lists both files in run.json. Returns the rows
   /// written. A planned step with no solve (no contact or rod) is named on stderr. Throws
   /// std::runtime_error when an exact solve fails (naming the step) or the file cannot be
   /// written.

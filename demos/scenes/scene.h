@@ -60,6 +60,9 @@ struct ReportTraits {
   /// Simulated time every run of the report's sweep lasts (s, > 0); unset: the scene's
   /// default_seconds (see Scene::report_horizon_s).
   std::optional<double> horizon_s;
+  /// The horizon of the quick sweep (`cps report --quick`, s, > 0); unset: horizon_s. For a
+  /// scene whose runs are long and whose step costs the same all along (the pendulum wave).
+  std::optional<double> quick_horizon_s;
   /// Why the horizon is what it is, in one line (report.md prints it with the horizon).
   std::string_view horizon_reason = "the scene's default duration";
   /// The CSV column of the report's headline measure: the error whose value at the paper's
@@ -104,8 +107,12 @@ struct Scene {
   /// How `cps report` runs and judges the scene.
   ReportTraits report;
 
-  /// The simulated time of each run of `cps report` (s): report.horizon_s, or default_seconds.
-  double report_horizon_s() const { return report.horizon_s.value_or(default_seconds); }
+  /// The horizon of `cps report`'s runs (s): report.horizon_s or default_seconds; in the quick
+  /// sweep report.quick_horizon_s where set.
+  double report_horizon_s(bool quick = false) const {
+    if (quick && report.quick_horizon_s) return *report.quick_horizon_s;
+    return report.horizon_s.value_or(default_seconds);
+  }
   /// The time of `cps report`'s trajectory error (s): report.trajectory_time_s, or 1 s, or the
   /// horizon if that is shorter.
   double report_trajectory_time_s() const {

@@ -147,6 +147,7 @@ const std::array kScenes = {
           .bench = {.start_s = 1.0, .seconds = 3.0,
                     .reason = "from 1 s: the pendulums swing on their rods (the scene has no contacts)"},
           .report = {.horizon_s = std::nullopt,
+                     .quick_horizon_s = 10.0,
                      .horizon_reason = "its default duration covers the realignment near 60.26 s",
                      .primary_measure = "phase_error_deg",
                      .headline_reason =

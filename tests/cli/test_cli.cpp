@@ -353,15 +353,27 @@ TEST_CASE("cps report's quick funnel sweep: trajectory errors where the balls ar
       CHECK(listed == std::isnan(value(row, "trajectory_error_m")));
       CHECK(row.at("diverged_why").empty());
     }
-    // A trajectory error under its reference's own error is flagged, and only then.
-    if (!std::isnan(value(row, "trajectory_error_m")) && !std::isnan(value(row, "reference_check_m"))) {
+    // A trajectory error under its reference's own error (the Richardson estimate), or whose
+    // reference has none (its distances do not shrink with dt), is flagged, and only then.
+    if (!std::isnan(value(row, "trajectory_error_m"))) {
+      const double own = value(row, "reference_error_m");
       CHECK(row.at("under_reference_error") ==
-            (value(row, "trajectory_error_m") < value(row, "reference_check_m") ? "1" : "0"));
+            (std::isnan(own) || value(row, "trajectory_error_m") < own ? "1" : "0"));
+      // The estimate is d2 / (2^p - 1) from the order p and the distance d2 beside it.
+      if (!std::isnan(own) && own > 0.0) {
+        CHECK(own == Approx(value(row, "reference_check_m") /
+                            (std::exp2(value(row, "reference_order")) - 1.0)).epsilon(1e-4));
+      }
     }
   }
-  // The runs flagged are drawn with their own mark and key entry; PGS, Baumgarte at 4 substeps
-  // is one of them (the 60 Hz step's error gone, what is left is under the reference's own).
-  CHECK(find("pgs", "baumgarte", 25, 4).at("under_reference_error") == "1");
+  // The paper's push converges in dt on the funnel at its trajectory time (the references at 2,
+  // 4 and 8 substeps shrink their distances), and its run at 4 substeps is resolved against it;
+  // the runs flagged (soft and xpbd, whose references do not converge there) are drawn with
+  // their own mark and key entry.
+  CHECK(value(find("pgs", "baumgarte", 25, 4), "reference_order") > 0.0);
+  CHECK(find("pgs", "baumgarte", 25, 4).at("under_reference_error") == "0");
+  CHECK(std::any_of(rows.begin(), rows.end(),
+                    [](const auto& row) { return row.at("under_reference_error") == "1"; }));
   CHECK(slurp(dir / "q/plots/funnel_trajectory_error_m.gp").find("below the reference''s own error: not resolved") !=
         std::string::npos);
   // The headline states the dt of the paper's run: the paper's 1/60 s.
@@ -448,8 +460,35 @@ TEST_CASE("cps bench --scene --json times each scene over a window where it is i
 
 TEST_CASE("cps report never overwrites a foreign report.md, CSV or run.json", "[cli][output]") {
   const fs::path dir = fresh_dir("report_foreign");
-  // A complete sweep to merge (the intersecting stack's quick one: 24 short runs).
-  REQUIRE(cps("report intersecting_stack --quick --out src", dir).exit_code == 0);
+  // A complete sweep to merge (the intersecting stack's quick one), computed and timed on one
+  // thread; and the same on three threads at once, whose errors, studies and mass ratio table
+  // must be the same to the digit (each run and study is computed by one thread alone from the
+  // same inputs), only the times differ.
+  REQUIRE(cps("report intersecting_stack --quick --jobs 1 --out src", dir).exit_code == 0);
+  REQUIRE(cps("report intersecting_stack --quick --jobs 3 --out threads", dir).exit_code == 0);
+  for (const char* file : {"intersecting_stack.csv", "mass_ratio.csv",
+                           "intersecting_stack_solver_error.csv", "intersecting_stack_references.csv",
+                           "intersecting_stack_energy.csv"}) {
+    INFO(file);
+    const cli_test::CsvRows one = cli_test::read_report_csv(dir / "src" / file);
+    const cli_test::CsvRows three = cli_test::read_report_csv(dir / "threads" / file);
+    REQUIRE(one.rows.size() == three.rows.size());
+    REQUIRE(!one.rows.empty());
+    CHECK(one.columns == three.columns);
+    for (std::size_t i = 0; i < one.rows.size(); ++i) {
+      for (const auto& [column, cell] : one.rows[i]) {
+        const bool timed = column.rfind("cpu_s_per_sim_s", 0) == 0 || column == "us_per_step" ||
+                           column == "runs_per_repeat" || column == "timing_threads";
+        if (timed) continue;
+        INFO("row " << i << ", " << column);
+        CHECK(three.rows[i].at(column) == cell);
+      }
+    }
+    if (std::string(file) == "intersecting_stack.csv") {
+      CHECK(one.rows[0].at("timing_threads") == "1");
+      CHECK(three.rows[0].at("timing_threads") == "3");
+    }
+  }
   // Its warm starting table agrees with its CSV (the scene's measure: the largest body speed
   // at the end; the paper's run flings the boxes apart fastest, so few iterations reach it).
   check_warm_table(slurp(dir / "src/report.md"), "intersecting_stack",
@@ -540,9 +579,11 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
       REQUIRE(r.exit_code == 0);
       CHECK(fs::exists(dir / "runs" / (std::string(id) + ".csv")));
     }
-    // Timed by the default 5 repeats (--repeats), the median between the quartiles.
+    // Timed by the quick sweep's default 3 repeats (--repeats), the least repeat under the
+    // first quartile, the median between the quartiles.
     const auto timed = read_table(dir / "runs/stack.pgs.split.fixed.it4.ss1.csv").at(0);
-    CHECK(value(timed, "timing_repeats") == 5);
+    CHECK(value(timed, "timing_repeats") == 3);
+    CHECK(value(timed, "cpu_s_per_sim_s_min") <= value(timed, "cpu_s_per_sim_s_q1"));
     CHECK(value(timed, "cpu_s_per_sim_s_q1") <= value(timed, "cpu_s_per_sim_s"));
     CHECK(value(timed, "cpu_s_per_sim_s") <= value(timed, "cpu_s_per_sim_s_q3"));
     const Result merged = cps("report --merge runs --out merged", dir);

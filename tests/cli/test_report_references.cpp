@@ -18,6 +18,43 @@
 using namespace cps;
 using namespace cps::cli;
 
+TEST_CASE("the observed order and the finest run's error from three step sizes (Richardson)",
+          "[report][references]") {
+  // Runs of a method with error C h^p, against the exact solution x*: x(h) = x* + C h^p. The
+  // distances between successive halvings give p back and the finest run's error C (h/4)^p.
+  for (const double p : {0.26, 0.5, 1.0, 2.0}) {
+    const double C = 3.0, h = 0.1;
+    const auto x = [&](double step) { return C * std::pow(step, p); };  // error of a run
+    const double d_coarse = x(h) - x(h / 2), d_fine = x(h / 2) - x(h / 4);
+    const ObservedOrder o = observed_order(d_coarse, d_fine);
+    CHECK(o.order == Approx(p).epsilon(1e-12));
+    CHECK(o.error == Approx(x(h / 4)).epsilon(1e-12));
+    // First order: the error of the finest is the distance itself; below first order, more.
+    if (p == 1.0) CHECK(o.error == Approx(d_fine).epsilon(1e-12));
+    if (p < 1.0) CHECK(o.error > d_fine);
+  }
+  // Distances that do not shrink (chaos, or an error that another error dominates) bound nothing.
+  CHECK(std::isnan(observed_order(0.1, 0.1).error));
+  CHECK(std::isnan(observed_order(0.1, 0.2).error));
+  CHECK(observed_order(0.1, 0.2).order == Approx(-1.0));
+  // The same positions at both finer steps: no error left.
+  CHECK(observed_order(0.1, 0.0).error == 0.0);
+  CHECK(std::isnan(observed_order(0.0, 0.0).order));
+  CHECK(observed_order(0.0, 0.0).error == 0.0);  // three runs that agree exactly
+  CHECK(std::isnan(observed_order(std::nan(""), 0.1).order));
+}
+
+TEST_CASE("the local order between two runs is the slope of the error in the count on log axes",
+          "[report][references]") {
+  // e = C n^-p: doubling n divides the error by 2^p.
+  CHECK(local_order(0.8, 1, 0.2, 4) == Approx(1.0));
+  CHECK(local_order(0.8, 2, 0.1, 4) == Approx(3.0));
+  CHECK(local_order(0.1, 8, 0.2, 16) == Approx(-1.0));  // the error grew
+  CHECK(std::isnan(local_order(0.0, 1, 0.1, 2)));
+  CHECK(std::isnan(local_order(0.1, 2, 0.1, 2)));
+  CHECK(std::isnan(local_order(std::numeric_limits<double>::infinity(), 1, 0.1, 2)));
+}
+
 TEST_CASE("the agreement horizon is the last time before the references part", "[report][references]") {
   const std::vector<double> t = {0.1, 0.2, 0.3, 0.4};
   // Two identical references: distance 0 at every step, so they never part.

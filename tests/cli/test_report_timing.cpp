@@ -1,11 +1,18 @@
 // The report's timing method in-process (demos/cps/report/timing.h): quartiles of the repeats,
 // the significant digits a spread supports, the machine read from /proc/cpuinfo's text, and
-// the build. No test here times anything against a limit.
+// the build; the threads that compute a report's runs. No test here times anything against a
+// limit.
 #include "report/timing.h"
+
+#include "report/tasks.h"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -95,4 +102,46 @@ TEST_CASE("the thread's CPU clock advances with work done and never runs backwar
     }
   }
   CHECK(thread_cpu_seconds() > start);
+}
+
+TEST_CASE("run_tasks runs each task once on any number of threads and rethrows the first failure",
+          "[report][timing]") {
+  for (const int jobs : {1, 2, 7}) {
+    std::vector<std::atomic<int>> ran(50);
+    std::vector<std::function<void()>> tasks;
+    for (std::size_t i = 0; i < ran.size(); ++i) tasks.push_back([&ran, i] { ++ran[i]; });
+    std::vector<std::size_t> done;
+    run_tasks(tasks, jobs, [&](std::size_t i) { done.push_back(i); });
+    for (const std::atomic<int>& n : ran) CHECK(n == 1);
+    std::sort(done.begin(), done.end());
+    CHECK(done.size() == ran.size());
+    CHECK(std::adjacent_find(done.begin(), done.end()) == done.end());
+  }
+  // A failing task: its exception reaches the caller (the lowest-numbered one if several fail),
+  // and with one thread no task after it is begun.
+  std::vector<int> order;
+  const std::vector<std::function<void()>> failing = {
+      [&] { order.push_back(0); }, [&] { throw std::runtime_error("task 1"); },
+      [&] { order.push_back(2); }};
+  CHECK_THROWS_WITH(run_tasks(failing, 1, {}), "task 1");
+  CHECK(order == std::vector<int>{0});
+  CHECK_THROWS_WITH(run_tasks(failing, 3, {}), "task 1");
+  // No tasks: nothing runs, nothing is reported.
+  run_tasks({}, 4, [](std::size_t) { FAIL("no task ran"); });
+}
+
+TEST_CASE("OnceCache makes a key's value once however many threads ask at once", "[report][timing]") {
+  OnceCache<int> cache;
+  std::atomic<int> made{0};
+  std::vector<int> got(40, 0);  // each task writes its own entry; checked after the threads end
+  std::vector<std::function<void()>> tasks;
+  for (int i = 0; i < 40; ++i) {
+    tasks.push_back([&, i] {
+      got[static_cast<std::size_t>(i)] =
+          cache.get(i % 2 ? "odd" : "even", [&] { ++made; return i % 2 ? 1 : 2; });
+    });
+  }
+  run_tasks(tasks, 4, {});
+  CHECK(made == 2);
+  for (int i = 0; i < 40; ++i) CHECK(got[static_cast<std::size_t>(i)] == (i % 2 ? 1 : 2));
 }

@@ -7,7 +7,9 @@
 #include "output/output.h"
 #include "report/push/report.h"
 #include "report/result.h"
+#include "report/run.h"
 #include "report/sweep.h"
+#include "report/tasks.h"
 #include "report/timing.h"
 
 #include <CLI/CLI.hpp>
@@ -32,7 +34,8 @@ struct ReportOptions {
   std::string run;
   bool force = false;
   double max_work = kDefaultMaxWork;  // body-iterations a run
-  int repeats = kDefaultRepeats;      // timed repeats a run
+  int repeats = 0;                    // timed repeats a run; 0: default_repeats(quick)
+  int jobs = 0;                       // threads that compute; 0: default_jobs()
 };
 
 // CLI11 validator for --repeats: a whole number (decimal digits) in [kMinRepeats, kMaxRepeats].
@@ -68,9 +71,9 @@ void check_runs_work(const std::vector<RunSpec>& runs, double max_work, int repe
       it = bodies.emplace(r.scene, make_run_or_usage_error(scene, {}).world.bodies().size()).first;
     }
     const WorldDef def = scenes::world_def_with(scene, r.overrides());
-    check_work("run " + r.id(), it->second, def, scene.report_horizon_s(), max_work,
+    check_work("run " + r.id(), it->second, def, r.horizon_s(), max_work,
                "give a run with fewer substeps or iterations, or raise --max-work");
-    const double work = run_work(it->second, def, scene.report_horizon_s());
+    const double work = run_work(it->second, def, r.horizon_s());
     const double total = work * (repeats + 2);
     if (total > max_work) {
       throw UsageError("run " + r.id() + ": its error run, the warm-up and " +
@@ -107,7 +110,8 @@ int run_push(const ReportOptions& o, const nlohmann::json& info) {
   const char* sweep_only = !o.run.empty() ? "--run" : !o.merge.empty() ? "--merge"
                            : o.list        ? "--list-runs"
                            : o.max_work != kDefaultMaxWork ? "--max-work"
-                           : o.repeats != kDefaultRepeats  ? "--repeats" : nullptr;
+                           : o.repeats != 0                ? "--repeats"
+                           : o.jobs != 0                   ? "--jobs" : nullptr;
   if (sweep_only) {
     throw UsageError(std::string("report push: ") + sweep_only +
                      " applies to the sweeps (a scene, 'all' or 'stress'), not to the push "
@@ -116,12 +120,14 @@ int run_push(const ReportOptions& o, const nlohmann::json& info) {
   return run_push_report(o.out, o.quick, o.force, info);
 }
 
-int run_report(const ReportOptions& o, int argc, char** argv) {
+int run_report(ReportOptions o, int argc, char** argv) {
+  if (o.scene != kPushReport && o.repeats == 0) o.repeats = default_repeats(o.quick);
   nlohmann::json merged = nlohmann::json::array();
   for (const std::string& m : o.merge) merged.push_back(m);
   nlohmann::json info = run_info(
       "report", argc, argv,
-      {{"scene", o.scene}, {"quick", o.quick}, {"repeats", o.repeats}, {"merge", merged},
+      {{"scene", o.scene}, {"quick", o.quick}, {"repeats", o.repeats},
+       {"jobs", o.jobs != 0 ? o.jobs : default_jobs()}, {"merge", merged},
        {"run", o.run.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.run)}});
   if (o.scene == kPushReport) return run_push(o, info);
   // What the times are measured on (report/timing.h); a merge's times were measured by the
@@ -132,10 +138,12 @@ int run_report(const ReportOptions& o, int argc, char** argv) {
                       {"build", this_build()},
                       {"load_average_at_start", load_average()}};
   }
-  const SweepOutput to{o.scene, o.quick, o.out, o.force, info, o.repeats, o.max_work};
+  const SweepOutput to{o.scene, o.quick, o.out,      o.force, info,
+                       o.repeats, o.max_work, o.jobs != 0 ? o.jobs : default_jobs()};
   if (!o.merge.empty()) return merge_report(to, {o.merge.begin(), o.merge.end()});
   if (!o.run.empty()) {
-    const RunSpec spec = RunSpec::parse(o.run);
+    RunSpec spec = RunSpec::parse(o.run);
+    spec.quick = o.quick;
     report_scenes(o.scene);  // the sweep it belongs to must be one
     check_runs_work({spec}, o.max_work, o.repeats);
     return run_one(to, spec);
@@ -177,8 +185,10 @@ Command add_report(CLI::App& app, int argc, char** argv) {
   sub->add_flag("--quick", o->quick,
                 "a reduced sweep: iterations 1, 4, 16, 25, 64 and 4 substeps, fixed friction "
                 "only, Jacobi for the paper's push methods only, and warm-started PGS (warm "
-                "start 0.8 and 1) at iterations 1, 4, 16, 25 with Baumgarte push; each run "
-                "timed by --repeats as in the full sweep (the paper's five "
+                "start 0.8 and 1) at iterations 1, 4, 16, 25 with Baumgarte push; references "
+                "at " + std::to_string(kQuickReferenceSubsteps) + " substeps, the pendulum "
+                "wave over its first " + shortest_decimal(*scenes::find_scene("pendulum_wave")->report.quick_horizon_s) +
+                " s, " + std::to_string(kQuickRepeats) + " timed repeats (the paper's five "
                 "scenes: " + std::to_string(quick_runs) + " runs; its time: docs/benchmarks.md); "
                 "with 'push': the stack over 60 s "
                 "and the pendulum wave over 10 s");
@@ -199,15 +209,24 @@ Command add_report(CLI::App& app, int argc, char** argv) {
   add_max_work_option(*sub, o->max_work);
   sub->add_option("--repeats", o->repeats,
                   "timed repeats of each run, in [" + std::to_string(kMinRepeats) + ", " +
-                      std::to_string(kMaxRepeats) + "]: the CPU time of the stepping thread, "
+                      std::to_string(kMaxRepeats) + "]; default " +
+                      std::to_string(kDefaultRepeats) + ", " + std::to_string(kQuickRepeats) +
+                      " with --quick: the CPU time of the stepping thread, "
                       "after one untimed warm-up repeat, a repeat stepping a short run several "
                       "times over to last " + shortest_decimal(kMinRepeatSeconds) + " s; the "
-                      "repeats of a sweep's runs are interleaved; the CSV gives their median and "
-                      "quartiles; the error run, the warm-up and the repeats together must stay "
-                      "within --max-work")
+                      "repeats of a sweep's runs are interleaved; the CSV gives their median, "
+                      "quartiles and least; the error run, the warm-up and the repeats together "
+                      "must stay within --max-work")
       ->type_name("N")
-      ->capture_default_str()
       ->check(repeats_in_range());
+  sub->add_option("--jobs", o->jobs,
+                  "threads that compute the runs' errors and the scenes' studies and step the "
+                      "timed repeats, in [1, " + std::to_string(kMaxJobs) + "]; default: the "
+                      "machine's logical CPUs. The errors do not depend on it; each repeat is "
+                      "charged its own thread's CPU time, and --jobs 1 times with nothing else "
+                      "of the report running beside it")
+      ->type_name("N")
+      ->check(CLI::Range(1, kMaxJobs));
   run->excludes(merge)->excludes(list);
   merge->excludes(list);
   sub->add_flag("--force", o->force,

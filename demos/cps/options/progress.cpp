@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <utility>
 
@@ -46,6 +47,11 @@ Progress::~Progress() {
   if (line_open_) std::fputc('\n', stderr);
 }
 
+void Progress::update(long long done, double seconds_left) {
+  seconds_left_ = std::isnan(seconds_left) ? std::nan("") : std::max(0.0, seconds_left);
+  update(done);
+}
+
 void Progress::update(long long done) {
   done_ = std::clamp(done, 0LL, total_);
   const Clock::time_point now = Clock::now();
@@ -77,12 +83,14 @@ void Progress::finish() {
 void Progress::print(bool final_line) {
   const double elapsed = seconds(Clock::now() - start_);
   const double rate = elapsed > 0.0 ? static_cast<double>(done_) / elapsed : 0.0;
-  const double left = rate > 0.0 ? static_cast<double>(total_ - done_) / rate : 0.0;
+  const double left = seconds_left_ >= 0.0 || std::isnan(seconds_left_)
+                          ? seconds_left_
+                          : rate > 0.0 ? static_cast<double>(total_ - done_) / rate : 0.0;
   const int percent = static_cast<int>(100 * done_ / total_);
   char rate_text[48];
   std::snprintf(rate_text, sizeof rate_text, "%.*f %s/s", rate < 10.0 ? 2 : 1, rate, unit_.c_str());
   std::string tail = final_line ? "in " + duration_text(elapsed)
-                     : done_ > 0 ? "about " + duration_text(left) + " left"
+                     : done_ > 0 && !std::isnan(left) ? "about " + duration_text(left) + " left"
                                  : "";
   if (terminal_) {
     const int filled = static_cast<int>(k_bar_width * done_ / total_);

@@ -32,6 +32,11 @@ class Progress {
   /// read), so it can be called every step.
   void update(long long done);
 
+  /// As update(done), with the time left (s, >= 0) estimated by the caller instead of from the
+  /// rate of units so far: for a task whose units differ in cost (a report's runs, then their
+  /// timed repeats). NaN: no estimate is printed.
+  void update(long long done, double seconds_left);
+
   /// Reports the end: done = total, and the elapsed time.
   void finish();
 
@@ -49,6 +54,7 @@ class Progress {
   bool line_open_ = false; // a terminal line without its newline yet
   bool finished_ = false;
   int next_decile_ = 1;
+  double seconds_left_ = -1.0;  // the caller's estimate (update(done, s)); < 0: from the rate
   Clock::time_point start_;
   Clock::time_point last_print_;
 };

@@ -210,7 +210,7 @@ Panel make_panel(const Measure& m, const std::vector<const RunResult*>& runs, Di
   if (p.substeps.size() > 1) p.labels_ss.push_back(p.substeps.back());
   // A reference whose own error is under the floor (the same positions to round-off) has no
   // line: it would lie on the floor's.
-  const double ref = first.reference_check_m.value_or(std::nan(""));
+  const double ref = first.reference_error_m.value_or(std::nan(""));
   if (std::string(m.column) == "trajectory_error_m" && ref >= d.floor) {
     p.reference = ref;
     d.any_reference = true;

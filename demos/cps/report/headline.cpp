@@ -40,7 +40,7 @@ bool comparable(const RunResult& r, const RunResult& base, const std::string& me
 const RunResult* cheapest_halving(const std::vector<const RunResult*>& runs,
                                   const std::string& measure, const RunResult& base) {
   const double e0 = ranked_value(base, measure);
-  if (measure == "trajectory_error_m" && !(0.5 * e0 > base.value("reference_check_m"))) {
+  if (measure == "trajectory_error_m" && !(0.5 * e0 > base.value("reference_error_m"))) {
     return nullptr;
   }
   const RunResult* best = nullptr;

@@ -30,14 +30,14 @@ bool reaches(double v, double e0);
 
 /// True if the runs of `measure` can be compared with the paper's run `base`: for the trajectory
 /// error only runs of base's push and friction model, which are measured against the same
-/// reference run (kReferenceIterations, kReferenceSubsteps of that push and friction model);
+/// reference run (kReferenceIterations, reference_substeps of that push and friction model);
 /// every run for any other measure.
 bool comparable(const RunResult& r, const RunResult& base, const std::string& measure);
 
 /// The cheapest run (least cpu_s_per_sim_s) among `runs` that has a time, did not diverge, is
 /// comparable with `base` and whose ranked value of `measure` is at_most_half of base's; for
 /// the trajectory error only if half of base's value is above base's reference's own error
-/// (reference_check_m), else the halving is not resolved. nullptr if none.
+/// (reference_error_m; none: not resolved either), else the halving is not resolved. nullptr if none.
 const RunResult* cheapest_halving(const std::vector<const RunResult*>& runs,
                                   const std::string& measure, const RunResult& base);
 

@@ -2,11 +2,13 @@
 
 #include "report/headline.h"
 #include "report/mass_ratio.h"
+#include "report/references.h"
 #include "report/run.h"
 #include "report/timing.h"
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -65,18 +67,19 @@ void write_missing(std::ostream& md, const ReportContent& c) {
   md << ".\n\n";
 }
 
-// How many timed repeats each run's time is the median of: "5", "3 to 5", or "the".
-std::string repeats_text(const ReportContent& c) {
+// The range of a count column over the runs: "5", "3 to 5", or `none` where no run has it.
+std::string count_range(const ReportContent& c, std::optional<int> RunResult::*field,
+                        const std::string& none) {
   int least = 1 << 30, most = 0;
   for (const auto& [scene, runs] : c.runs) {
     for (const RunResult* r : runs) {
-      const int n = r->timing_repeats.value_or(0);
+      const int n = (r->*field).value_or(0);
       if (n > 0) least = std::min(least, n), most = std::max(most, n);
     }
   }
   if (most > 0 && least == most) return std::to_string(most);
   if (most > 0) return std::to_string(least) + " to " + std::to_string(most);
-  return "the";
+  return none;
 }
 
 // The distinct values of a text column of the runs (machine, build), sorted; "" left out.
@@ -122,30 +125,44 @@ void write_definitions(std::ostream& md, const ReportContent& c) {
      << "- **Time (s/s)**: physics CPU time per simulated second (column cpu_s_per_sim_s): the "
         "CPU time of the thread that steps (CLOCK_THREAD_CPUTIME_ID, so other processes on the "
         "machine do not add to it), of the step alone (no metrics, no residual), the median of "
-     << repeats_text(c)
+     << count_range(c, &RunResult::timing_repeats, "the")
      << " timed repeats (column timing_repeats), each on a fresh world, after one untimed "
-        "warm-up repeat; a run shorter than " << number(kMinRepeatSeconds)
+        "warm-up repeat, stepped on "
+     << count_range(c, &RunResult::timing_threads, "an unrecorded number of")
+     << " threads at once (column timing_threads; `cps report --jobs`): each repeat is charged "
+        "its own thread's CPU time, but threads at once share the machine's caches and memory "
+        "(docs/benchmarks.md measures what that changes); a run shorter than " << number(kMinRepeatSeconds)
      << " s of CPU is stepped several times over in each repeat (runs_per_repeat) and its "
         "time is per run. The repeats of a sweep's runs are interleaved, a round of every run "
         "after another, so that a change of the machine's load or clock falls on all of them "
         "alike. The first and third quartiles of the repeats are cpu_s_per_sim_s_q1 and _q3 "
-        "(the error bars of the diagrams). Times are printed with the digits their spread "
+        "(the error bars of the diagrams), the least repeat cpu_s_per_sim_s_min (the one the "
+        "machine disturbed least). Times are printed with the digits their spread "
         "supports (one past the first that the interquartile range leaves uncertain, 2 to 4); "
         "a time ratio with the digits of its two times' spreads together and, in brackets, the "
-        "range their quartiles allow. A diverged run is timed until it diverged.\n";
+        "range their quartiles allow. **Quartiles and brackets cover the repeats of this one "
+        "report**: a report made at another time, or under another load, can put a run's time "
+        "outside them (docs/benchmarks.md, \"Can the report's times be trusted?\"), so check a "
+        "ratio against a second report before quoting it. A diverged run is timed until it "
+        "diverged.\n";
   write_timed_on(md, c);
   md << "- **Diverged**: the state stopped being finite, or a penetration or rod error passed "
         "the size of the largest movable body (the time: diverged_at_s). Its other measures "
         "stop there and are left out of the headline. In the diagrams it is a red x on the top "
         "edge, at its time until it diverged.\n"
      << "- **Trajectory error (m)**: RMS distance of the movable bodies from a reference run "
-        "(PGS, " << kReferenceIterations << " iterations, " << kReferenceSubsteps
-     << " substeps, the run's push and friction model) at the scene's trajectory time, given "
+        "(PGS, " << kReferenceIterations << " iterations, S substeps, the run's push and friction "
+        "model; S = reference_substeps, " << kReferenceSubsteps << " in the full sweep and "
+     << kQuickReferenceSubsteps << " in the quick one) at the scene's trajectory time, given "
         "with its reason under each scene. A run that diverged before that time steps on to it "
-        "(the physics alone) while its state stays finite. **The reference's own error** (reference_check_m) is its "
-        "distance from the same run at " << kReferenceSubsteps / 2
-     << " substeps: halving dt halves a first-order method's error, so that distance is about "
-        "the reference's error. Trajectory errors under it are not resolved.\n"
+        "(the physics alone) while its state stays finite. **The reference's own error** "
+        "(reference_error_m) comes from the reference run at S / 4, S / 2 and S substeps "
+        "(Richardson): with d1 its distance between S / 4 and S / 2 substeps and d2 = "
+        "reference_check_m between S / 2 and S, the observed order is p = log2(d1 / d2) "
+        "(reference_order) and the error d2 / (2^p - 1) "
+        "(d2 itself for a first-order method, more where p is below 1). Where the distances do "
+        "not shrink (p <= 0) the error is unknown. Trajectory errors under it, or with it "
+        "unknown, are not resolved.\n"
      << "- **LCP residual (N)**: the natural-map residual |lambda - clamp(lambda - (A lambda - "
         "b) / A_jj, c_min, c_max)| over every row of every solve. A run that made no solve of "
         "A lambda = b has none (an empty cell): xpbd and avbd correct positions and solve per "
@@ -187,9 +204,29 @@ std::string settings_text(const RunResult& r) {
          (r.warm_start != 0.0 ? ", warm start " + shortest_decimal(r.warm_start) : std::string());
 }
 
+// Where run r solves A lambda = b with a method whose sweeps diverge on the paper run's sampled
+// steps (solver_error_medians: the median relative force error above 1 at the largest sampled
+// count up to r's iterations), a note that says so and what r's own solves left (its largest
+// LCP residual); "" otherwise.
+std::string diverging_solve_note(const RunResult& r,
+                                 const std::map<std::string, std::map<int, double>>& solver_error) {
+  const auto method = solver_error.find(r.solver);
+  if (method == solver_error.end() || !r.reads().solver) return "";
+  const std::pair<const int, double>* at = nullptr;
+  for (const auto& entry : method->second) {
+    if (entry.first <= r.iterations) at = &entry;
+  }
+  if (at == nullptr || !(at->second > 1.0)) return "";
+  return " (but " + r.solver + "'s sweeps diverge on the paper run's steps: median force error " +
+         number(at->second) + " |lambda*| at " + std::to_string(at->first) +
+         " sweeps, under Solver error per step; this run's own solves ended with LCP residuals "
+         "up to " + (r.residual_max_N ? number(*r.residual_max_N) + " N" : std::string("?")) + ")";
+}
+
 // The headline row of one scene: its measure at the paper's settings, their dt, and the cheapest
 // run with at most half of it.
-void write_headline_row(std::ostream& md, const std::string& scene, const Runs& runs) {
+void write_headline_row(std::ostream& md, const std::string& scene, const Runs& runs,
+                        const std::map<std::string, std::map<int, double>>& solver_error) {
   const std::string measure = primary_measure(scene);
   const RunResult* base = paper_run(runs);
   md << "| " << scene << " | " << label_of(measure) << " | ";
@@ -200,8 +237,10 @@ void write_headline_row(std::ostream& md, const std::string& scene, const Runs& 
   }
   const double e0 = ranked_value(*base, measure);
   md << dt_text(*base) << own_dt_note(scene, *base) << " | " << value_text(e0);
-  if (base->under_reference_error.value_or(false)) {
-    md << " (under its reference's own error, " << text(*base, "reference_check_m") << ")";
+  if (measure == "trajectory_error_m" && base->under_reference_error.value_or(false)) {
+    md << (base->reference_error_m
+               ? " (under its reference's own error, " + text(*base, "reference_error_m") + ")"
+               : std::string(" (not resolved: its reference's own error is unknown)"));
   }
   md << " | " << time_text(*base) << " | ";
   const RunResult* best = cheapest_halving(runs, measure, *base);
@@ -210,8 +249,8 @@ void write_headline_row(std::ostream& md, const std::string& scene, const Runs& 
     return;
   }
   md << settings_text(*best) << " (dt " << dt_text(*best) << "): "
-     << value_text(ranked_value(*best, measure)) << " | " << time_text(*best) << " | "
-     << ratio_text(*best, *base) << " |\n";
+     << value_text(ranked_value(*best, measure)) << diverging_solve_note(*best, solver_error)
+     << " | " << time_text(*best) << " | " << ratio_text(*best, *base) << " |\n";
 }
 
 // The headline: per scene, the paper's settings and the cheapest run with at most half their
@@ -226,7 +265,8 @@ void write_headline(std::ostream& md, const ReportContent& c) {
         "so where the paper's run never recovers any run that does counts. For the trajectory "
         "error only the runs measured against the paper's run's reference count (its push and "
         "friction model: the reference is PGS at " << kReferenceIterations << " iterations and "
-     << kReferenceSubsteps << " substeps of the run's own push and friction model, and the "
+     << kReferenceSubsteps << " substeps (" << kQuickReferenceSubsteps << " in the quick sweep) "
+        "of the run's own push and friction model, and the "
         "distances of runs of other pushes from their own references do not compare with it), "
         "and only if half the paper's value is above that reference's own error. The paper's "
         "settings are PGS, Baumgarte push, fixed friction, " << kPaperIterations
@@ -239,7 +279,12 @@ void write_headline(std::ostream& md, const ReportContent& c) {
         "fixed friction, " << kPaperIterations << " it, 1 step per frame, cold) "
         "| its time (s/s) | cheapest run with at most half of it | its time (s/s) | time ratio |\n"
         "|---|---|---|---|---|---|---|---|\n";
-  for (const std::string& scene : c.scenes) write_headline_row(md, scene, c.runs.at(scene));
+  for (const std::string& scene : c.scenes) {
+    const auto se = c.solver_error.find(scene);
+    write_headline_row(md, scene, c.runs.at(scene),
+                       se != c.solver_error.end() ? se->second
+                                                  : std::map<std::string, std::map<int, double>>{});
+  }
   md << "\nWhy each scene's measure:\n\n";
   for (const std::string& scene : c.scenes) {
     const scenes::Scene* s = scenes::find_scene(scene);
@@ -354,10 +399,14 @@ void write_warm_table(std::ostream& md, const std::string& scene, const Runs& ru
   md << (std::isinf(e0) ? "; the paper's run never recovers, so the table gives the fewest "
                           "iterations that do."
                         : ".");
-  if (base->under_reference_error.value_or(false)) {
+  if (measure == "trajectory_error_m" && base->under_reference_error.value_or(false)) {
     md << " The paper's value is under its reference's own error ("
-       << number(base->value("reference_check_m"))
-       << " m): the counts compare differences the reference does not resolve.";
+       << (base->reference_error_m
+               ? number(*base->reference_error_m) + " m"
+               : "unknown: its runs at a quarter, half and all of its " +
+                     std::to_string(base->reference_substeps.value_or(kReferenceSubsteps)) +
+                     " substeps do not converge")
+       << "): the counts compare differences the reference does not resolve.";
   }
   md << "\n\n| warm start factor | fewest iterations | its " << label_of(measure)
      << " | its time (s/s) | time ratio to the paper's run | iterations saved |\n"
@@ -379,8 +428,15 @@ void write_warm_table(std::ostream& md, const std::string& scene, const Runs& ru
 // A scene's horizon and trajectory time with their reasons, and the references' own errors.
 void write_scene_facts(std::ostream& md, const std::string& scene, const Runs& runs) {
   if (const scenes::Scene* s = scenes::find_scene(scene)) {
-    md << "- **Horizon** " << number(s->report_horizon_s()) << " s: " << s->report.horizon_reason
-       << ".\n- **Trajectory time** ";
+    // The quick sweep's horizon where its runs are the quick sweep's and it has one.
+    const bool quick = std::any_of(runs.begin(), runs.end(),
+                                   [](const RunResult* r) { return r->quick.value_or(false); });
+    md << "- **Horizon** " << number(s->report_horizon_s(quick)) << " s: " << s->report.horizon_reason;
+    if (quick && s->report.quick_horizon_s) {
+      md << "; the quick sweep runs its first " << number(*s->report.quick_horizon_s)
+         << " s (of " << number(s->report_horizon_s()) << " s), where its step costs the same";
+    }
+    md << ".\n- **Trajectory time** ";
     if (s->report.has_reference_solution) {
       md << s->report.trajectory_reason << ".";
     } else {
@@ -392,7 +448,13 @@ void write_scene_facts(std::ostream& md, const std::string& scene, const Runs& r
   std::map<std::string, std::string> checks;  // push, friction -> reference's own error
   for (const RunResult* r : runs) {
     const std::string check = text(*r, "reference_check_m");
-    if (!check.empty()) checks[r->push + ", " + r->friction_model + " friction"] = check;
+    if (check.empty()) continue;
+    checks[r->push + ", " + r->friction_model + " friction"] =
+        (r->reference_error_m ? text(*r, "reference_error_m") : std::string("unknown")) +
+        " (order " + (r->reference_order ? text(*r, "reference_order") : std::string("not measured")) +
+        ", " + std::to_string(r->reference_substeps.value_or(kReferenceSubsteps) / 2) +
+        " against " + std::to_string(r->reference_substeps.value_or(kReferenceSubsteps)) +
+        " substeps " + check + ")";
   }
   if (checks.empty()) return;
   md << "- **The reference's own error** at the trajectory time (m):";
@@ -404,6 +466,72 @@ void write_scene_facts(std::ostream& md, const std::string& scene, const Runs& r
   md << ".\n";
 }
 
+// One line of the convergence table: the runs of PGS, Baumgarte, fixed friction, cold, not
+// diverged, with a value of `measure`, along substeps (at the paper's iterations) or along
+// iterations (at 1 substep), by count ascending.
+std::vector<std::pair<int, double>> convergence_line(const Runs& runs, const std::string& measure,
+                                                     bool substeps) {
+  std::map<int, double> line;
+  for (const RunResult* r : runs) {
+    if (r->solver != "pgs" || r->push != "baumgarte" || r->friction_model != "fixed" ||
+        r->warm_start != 0.0 || r->diverged) {
+      continue;
+    }
+    const double v = r->value(measure);
+    if (!std::isfinite(v)) continue;
+    if (substeps && r->iterations == kPaperIterations) line[r->substeps] = v;
+    if (!substeps && r->substeps == 1) line[r->iterations] = v;
+  }
+  return {line.begin(), line.end()};
+}
+
+// The convergence table of a scene: for its trajectory error and its phase error (the measures
+// against a reference), the local orders between successive runs of the paper's method along
+// substeps and along iterations, and the reference's own order.
+void write_convergence(std::ostream& md, const Runs& runs) {
+  bool head = false;
+  for (const char* measure : {"trajectory_error_m", "phase_error_deg"}) {
+    for (const bool substeps : {true, false}) {
+      const std::vector<std::pair<int, double>> line = convergence_line(runs, measure, substeps);
+      if (line.size() < 2) continue;
+      if (!head) {
+        md << "**Convergence order** of the paper's method (PGS, Baumgarte, fixed friction, "
+              "cold): between successive runs along the substeps (at " << kPaperIterations
+           << " iterations) and along the iterations (at 1 substep), the local order log(e_a / "
+              "e_b) / log(n_b / n_a) of the error e at n_a and n_b (1: the error halves when the "
+              "count doubles; near 0: it no longer falls with that count, another error "
+              "dominates: the other count's, or the reference's own).\n\n"
+              "| measure | along | from | to | error from | error to | local order |\n"
+              "|---|---|---|---|---|---|---|\n";
+        head = true;
+      }
+      for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+        const auto [na, ea] = line[i];
+        const auto [nb, eb] = line[i + 1];
+        md << "| " << label_of(measure) << " | " << (substeps ? "substeps" : "iterations") << " | "
+           << na << " | " << nb << " | " << number(ea) << " | " << number(eb) << " | "
+           << number(local_order(ea, na, eb, nb)) << " |\n";
+      }
+    }
+  }
+  if (head) md << "\n";
+  // The reference's own order (the same for every run of the paper's push and friction model).
+  for (const RunResult* r : runs) {
+    if (r->push != "baumgarte" || r->friction_model != "fixed" || !r->reference_check_m) continue;
+    const int s = r->reference_substeps.value_or(kReferenceSubsteps);
+    md << "The trajectory error's reference (PGS, " << kReferenceIterations << " iterations, "
+       << "Baumgarte, fixed friction) at " << s / 4 << ", " << s / 2 << " and " << s
+       << " substeps: order "
+       << (r->reference_order ? number(*r->reference_order) : std::string("not measured"))
+       << ", so its own error is "
+       << (r->reference_error_m ? number(*r->reference_error_m) + " m"
+                                : std::string("unknown (its distances do not shrink with dt)"))
+       << " (" << number(*r->reference_check_m) << " m between " << s / 2 << " and " << s
+       << " substeps).\n\n";
+    break;
+  }
+}
+
 // A run's quartiles of time, "Q1 to Q3", with the digits of its time; "" where it has none.
 std::string quartiles_text(const RunResult& r) {
   const double q1 = r.value("cpu_s_per_sim_s_q1"), q3 = r.value("cpu_s_per_sim_s_q3");
@@ -412,20 +540,30 @@ std::string quartiles_text(const RunResult& r) {
   return number_with_digits(q1, digits) + " to " + number_with_digits(q3, digits);
 }
 
+// A run's least repeat's time with the digits of its median's; "" where it has none.
+std::string least_time_text(const RunResult& r) {
+  const double q1 = r.value("cpu_s_per_sim_s_q1"), q3 = r.value("cpu_s_per_sim_s_q3");
+  const double least = r.value("cpu_s_per_sim_s_min");
+  if (!std::isfinite(least)) return "";
+  return number_with_digits(least, std::isfinite(q1) && std::isfinite(q3)
+                                       ? significant_digits(q1, time_of(r), q3)
+                                       : 3);
+}
+
 // A scene's table of runs: settings, time and its quartiles, its primary measure, residual, penetration, rod
 // error, and when it diverged.
 void write_run_table(std::ostream& md, const std::string& scene, const Runs& runs) {
   const std::string measure = primary_measure(scene);
   md << "| solver | push | friction | iterations | substeps | warm start | time (s/s) | "
-        "time Q1 to Q3 (s/s) | "
+        "time Q1 to Q3 (s/s) | least time (s/s) | "
      << label_of(measure)
      << " | under the reference's own error | residual RMS (N) | penetration max (m) | rod error "
         "max (m) | diverged at (s) |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const RunResult* r : runs) {
     md << "| " << r->solver << " | " << r->push << " | " << r->friction_model << " | "
        << r->iterations << " | " << r->substeps << " | " << shortest_decimal(r->warm_start)
-       << " | " << time_text(*r) << " | " << quartiles_text(*r) << " | "
+       << " | " << time_text(*r) << " | " << quartiles_text(*r) << " | " << least_time_text(*r) << " | "
        << (std::isinf(ranked_value(*r, measure)) ? "never" : text(*r, measure)) << " | "
        << (r->under_reference_error ? (*r->under_reference_error ? "yes: not resolved" : "no") : "")
        << " | " << text(*r, "residual_rms_N") << " | " << text(*r, "penetration_max_m") << " | "
@@ -443,6 +581,7 @@ void write_scene(std::ostream& md, const ReportContent& c, const std::string& sc
   md << "## " << scene << "\n\n";
   write_scene_facts(md, scene, runs);
   md << "\nAll runs: [" << stem << ".csv](" << stem << ".csv).\n\n";
+  write_convergence(md, runs);
   write_warm_table(md, scene, runs);
   const auto drawn = c.diagrams.find(scene);
   if (drawn != c.diagrams.end()) {

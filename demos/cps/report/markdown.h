@@ -32,6 +32,9 @@ struct ReportContent {
   std::size_t run_count = 0;
   /// What the machine's load was while the runs were timed (a sentence), or "" (a merge).
   std::string load;
+  /// Per paper scene, its solver error's medians (solver_error_medians): method -> sweeps ->
+  /// median relative force error on the paper run's sampled steps.
+  std::map<std::string, std::map<std::string, std::map<int, double>>> solver_error;
 };
 
 /// The text of report.md. If `missing` is not empty it opens with INCOMPLETE and names the first

@@ -43,22 +43,32 @@ PairOutcome run_pair(double ratio, SolverKind solver, PushMode push, int iterati
   return pair_outcome(world);
 }
 
-std::vector<PairRow> mass_ratio_study() {
+std::vector<PairRow> mass_ratio_rows() {
   std::vector<PairRow> rows;
   for (const double ratio : kMassRatios) {
     for (const Choice& c : parameter("push").choices) {
       const auto push = static_cast<PushMode>(c.value);
       for (const SolverKind solver : {SolverKind::pgs, SolverKind::jacobi}) {
         if (solver != SolverKind::pgs && !push_reads(push).solver) continue;  // the same run again
-        PairRow r{ratio, solver, push, run_pair(ratio, solver, push, kPairTableIterations, kPairSeconds), {}};
-        for (int n = 1; n <= 256; n *= 2) {
-          const PairOutcome q = run_pair(ratio, solver, push, n, kPairSeconds);
-          if (q.held && q.overlap_m < kHoldingOverlapM) r.iterations_holding.push_back(n);
-        }
-        rows.push_back(std::move(r));
+        rows.push_back({ratio, solver, push, {}, {}});
       }
     }
   }
+  return rows;
+}
+
+void run_pair_row(PairRow& r) {
+  r.outcome = run_pair(r.mass_ratio, r.solver, r.push, kPairTableIterations, kPairSeconds);
+  r.iterations_holding.clear();
+  for (int n = 1; n <= 256; n *= 2) {
+    const PairOutcome q = run_pair(r.mass_ratio, r.solver, r.push, n, kPairSeconds);
+    if (q.held && q.overlap_m < kHoldingOverlapM) r.iterations_holding.push_back(n);
+  }
+}
+
+std::vector<PairRow> mass_ratio_study() {
+  std::vector<PairRow> rows = mass_ratio_rows();
+  for (PairRow& r : rows) run_pair_row(r);
   return rows;
 }
 

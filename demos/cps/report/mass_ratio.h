@@ -62,9 +62,17 @@ struct PairRow {
   std::vector<int> iterations_holding;
 };
 
-/// The mass ratio table: a row per ratio of kMassRatios, push method (every choice of the world
-/// parameter push, in the table's order) and solver (pgs, jacobi; pgs alone for a push that does
-/// not read the solver, push_reads), in that order.
+/// The rows of the mass ratio table, not yet run (outcome and iterations_holding empty): a row
+/// per ratio of kMassRatios, push method (every choice of the world parameter push, in the
+/// table's order) and solver (pgs, jacobi; pgs alone for a push that does not read the solver,
+/// push_reads), in that order.
+std::vector<PairRow> mass_ratio_rows();
+
+/// Runs one row of mass_ratio_rows: its outcome at kPairTableIterations and the iteration
+/// counts 1, 2, 4, ..., 256 that hold (run_pair, kPairSeconds each). Rows are independent.
+void run_pair_row(PairRow& row);
+
+/// mass_ratio_rows, each run (run_pair_row) in order on this thread.
 std::vector<PairRow> mass_ratio_study();
 
 /// The table as mass_ratio.csv: columns solver, push, iterations, mass_ratio, seconds (s), held

@@ -135,6 +135,8 @@ const scenes::Scene& RunSpec::scene_def() const {
   return *s;
 }
 
+double RunSpec::horizon_s() const { return scene_def().report_horizon_s(quick); }
+
 scenes::Overrides RunSpec::overrides() const {
   const scenes::Scene& s = scene_def();
   scenes::Overrides o;
@@ -183,6 +185,7 @@ std::vector<RunSpec> plan_runs(const std::vector<const scenes::Scene*>& scenes, 
       }
     }
   }
+  for (RunSpec& r : runs) r.quick = quick;
   return runs;
 }
 

@@ -34,6 +34,13 @@ struct RunSpec {
   int iterations = kPaperIterations;
   int substeps = 1;
   double warm_start = 0.0;
+  /// The run belongs to the quick sweep: it lasts the scene's quick horizon
+  /// (Scene::report_horizon_s) and its reference runs at kQuickReferenceSubsteps. Not in id():
+  /// the sweep a run belongs to is recorded beside it (RunResult::quick).
+  bool quick = false;
+
+  /// The run's horizon (s): the scene's report_horizon_s(quick). Throws as scene_def().
+  double horizon_s() const;
 
   /// "scene.solver.push.friction.itN.ssM", e.g. "stack.pgs.baumgarte.fixed.it25.ss1", with
   /// ".wsF" after it only when warm_start is not 0 (F its shortest decimal form that reads back

@@ -23,8 +23,6 @@ namespace fs = std::filesystem;
 constexpr double kSolverErrorFloor = 1e-16;
 constexpr double kDistanceFloor = 1e-12;
 constexpr double kConstraintFloor = 1e-9;
-// The most recorded steps of an energy trace (count).
-constexpr int kEnergyPoints = 1500;
 
 const char* const kPgsColours[] = {"#9ecae1", "#4292c6", "#08519c", "#08306b"};
 const char* const kJacobiColours[] = {"#fcae91", "#fb6a4a", "#cb181d", "#67000d"};
@@ -107,13 +105,12 @@ double largest(const std::vector<double>& v) {
   return m;
 }
 
-std::string solver_error_section(const fs::path& dir, const std::string& scene, bool quick,
-                                 const std::string& title_note) {
+std::string solver_error_section(const fs::path& dir, const std::string& scene,
+                                 const SceneStudies& studies, const std::string& title_note) {
   const std::string stem = file_stem(scene) + "_solver_error";
-  const int samples = quick ? kSolverErrorSamplesQuick : kSolverErrorSamples;
-  int no_solve = 0;
-  const RunSpec paper{scene};
-  const std::vector<SolverErrorPoint> points = sample_solver_error(paper, samples, no_solve);
+  const int samples = studies.samples;
+  const int no_solve = studies.no_solve;
+  const std::vector<SolverErrorPoint>& points = studies.solver_error;
 
   CsvTable csv;
   csv.columns = {"step", "t_s", "solve", "rows", "method", "sweeps", "lambda_error_relative",
@@ -221,10 +218,10 @@ std::string solver_error_section(const fs::path& dir, const std::string& scene, 
 // --- The two references --------------------------------------------------------------------
 
 std::string references_section(const fs::path& dir, const std::string& scene,
-                               const std::string& title_note) {
+                               const SceneStudies& studies, const std::string& title_note) {
   const scenes::Scene* s = scenes::find_scene(scene);
-  const ReferenceAgreement* a = s ? scene_agreement(*s) : nullptr;
-  if (a == nullptr) return "";
+  const ReferenceAgreement* a = studies.agreement;
+  if (s == nullptr || a == nullptr) return "";
   const std::string stem = file_stem(scene) + "_references";
   CsvTable csv;
   csv.columns = {"t_s", "distance_m", "tolerance_m"};
@@ -303,9 +300,9 @@ std::string references_section(const fs::path& dir, const std::string& scene,
 // --- Energy over time ------------------------------------------------------------------------
 
 std::string energy_section(const fs::path& dir, const std::string& scene,
-                           const std::string& title_note) {
+                           const SceneStudies& studies, const std::string& title_note) {
   const std::string stem = file_stem(scene) + "_energy";
-  const std::vector<EnergyTrace> traces = energy_traces(scene, kEnergyPoints);
+  const std::vector<EnergyTrace>& traces = studies.energy;
   CsvTable csv;
   csv.columns = {"push", "t_s", "kinetic_J", "potential_J", "total_J", "penetration_m",
                  "rod_error_m"};
@@ -391,11 +388,48 @@ bool has_reference_sections(const std::string& scene) {
   return false;
 }
 
-std::string write_reference_sections(const fs::path& dir, const std::string& scene, bool quick,
-                                     const std::string& title_note) {
-  if (!has_reference_sections(scene)) return "";
-  return solver_error_section(dir, scene, quick, title_note) +
-         references_section(dir, scene, title_note) + energy_section(dir, scene, title_note);
+std::map<std::string, std::map<int, double>> solver_error_medians(const SceneStudies& studies) {
+  std::map<std::string, std::map<int, std::vector<double>>> values;
+  for (const SolverErrorPoint& p : studies.solver_error) {
+    if (p.method == "exact" || std::isnan(p.relative)) continue;
+    values[p.method][p.sweeps].push_back(p.relative);
+  }
+  std::map<std::string, std::map<int, double>> out;
+  for (auto& [method, by_sweeps] : values) {
+    for (auto& [sweeps, v] : by_sweeps) {
+      std::sort(v.begin(), v.end());
+      const std::size_t n = v.size();
+      out[method][sweeps] = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    }
+  }
+  return out;
+}
+
+std::vector<std::function<void()>> scene_study_tasks(const std::string& scene, bool quick,
+                                                      SceneStudies& into) {
+  if (!has_reference_sections(scene)) return {};
+  into.samples = quick ? kSolverErrorSamplesQuick : kSolverErrorSamples;
+  RunSpec paper{scene};
+  paper.quick = quick;
+  return {
+      [paper, &into] { into.solver_error = sample_solver_error(paper, into.samples, into.no_solve); },
+      [paper, &into] { into.agreement = scene_agreement(paper.scene_def()); },
+      [paper, &into] { into.energy = energy_traces(paper.scene, kEnergyPoints, paper.quick); },
+  };
+}
+
+SceneStudies scene_studies(const std::string& scene, bool quick) {
+  SceneStudies s;
+  for (const std::function<void()>& task : scene_study_tasks(scene, quick, s)) task();
+  return s;
+}
+
+std::string write_reference_sections(const fs::path& dir, const std::string& scene,
+                                     const SceneStudies& studies, const std::string& title_note) {
+  if (!has_reference_sections(scene) || studies.samples == 0) return "";
+  return solver_error_section(dir, scene, studies, title_note) +
+         references_section(dir, scene, studies, title_note) +
+         energy_section(dir, scene, studies, title_note);
 }
 
 std::vector<std::string> reference_files(const std::vector<std::string>& scenes) {

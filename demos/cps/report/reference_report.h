@@ -1,9 +1,14 @@
 #pragma once
 // The report's sections on solver error and time-step error apart, and on energy over time
-// (references.h computes them): per paper scene three CSVs, three diagrams (gnuplot) and the
-// paragraphs of report.md that read them.
+// (references.h computes them): per paper scene the studies, computed before anything is
+// written, then three CSVs, three diagrams (gnuplot) and the paragraphs of report.md that read
+// them.
+
+#include "report/references.h"
 
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -15,16 +20,47 @@ inline constexpr const char* kReferenceParts[] = {"solver_error", "references", 
 /// Whether `scene` (a scene name) gets the reference sections: one of the paper's scenes.
 bool has_reference_sections(const std::string& scene);
 
-/// Computes and writes a paper scene's sections into DIR: SCENE_solver_error.csv and its diagram
-/// (sample_solver_error at the paper's settings, kSolverErrorSamplesQuick samples when `quick`,
-/// else kSolverErrorSamples), SCENE_references.csv and its diagram (scene_agreement; not for a
-/// scene judged by its own reference solution), SCENE_energy.csv and its diagram
-/// (energy_traces), each diagram as .png, .svg and .pdf with its data and script in DIR/plots
-/// (SCENE_<part>.dat, .gp). `title_note` is appended to the diagrams' titles. Returns the
-/// markdown of the sections, "" for a scene that has none (has_reference_sections). Throws
-/// std::runtime_error if a file cannot be written or gnuplot fails.
+/// What a paper scene's sections show, computed apart from writing them (scene_studies).
+struct SceneStudies {
+  int samples = 0;  ///< steps sampled for the solver error (count); 0: no sections
+  std::vector<SolverErrorPoint> solver_error;  ///< sample_solver_error at the paper's settings
+  int no_solve = 0;  ///< sampled steps without a solve (count)
+  /// scene_agreement: nullptr for a scene judged by its own reference solution.
+  const ReferenceAgreement* agreement = nullptr;
+  std::vector<EnergyTrace> energy;  ///< energy_traces, kEnergyPoints recorded steps at most
+};
+
+/// The most recorded steps of an energy trace (count).
+inline constexpr int kEnergyPoints = 1500;
+
+/// The tasks that fill `into` for a paper scene (none for another scene: has_reference_sections),
+/// independent of each other, to be run once each in any order or at once (run_tasks): the
+/// solver error of kSolverErrorSamplesQuick sampled steps when `quick`, else
+/// kSolverErrorSamples (sample_solver_error at the paper's settings); the references'
+/// agreement (scene_agreement); the energy traces (energy_traces). `into` must outlive them. A
+/// task throws UsageError for a scene this build does not know.
+std::vector<std::function<void()>> scene_study_tasks(const std::string& scene, bool quick,
+                                                      SceneStudies& into);
+
+/// scene_study_tasks of `scene`, run in order on this thread.
+SceneStudies scene_studies(const std::string& scene, bool quick);
+
+/// The median relative force error of each line of the solver error (method "pgs" or "jacobi" ->
+/// sweeps -> median over the sampled solves of |lambda - lambda*| / |lambda*|, dimensionless;
+/// overflowed sweeps count as +inf, refused solves not at all). lambda = 0 has the relative
+/// error 1 exactly (|lambda*| is the least-norm solution, the nearest to 0), so a median above 1
+/// means the sweeps end further from the solutions than they began: they diverge.
+std::map<std::string, std::map<int, double>> solver_error_medians(const SceneStudies& studies);
+
+/// Writes a paper scene's sections from its `studies` into DIR: SCENE_solver_error.csv,
+/// SCENE_references.csv (not for a scene judged by its own reference solution) and
+/// SCENE_energy.csv, each with its diagram as .png, .svg and .pdf and their data and scripts in
+/// DIR/plots (SCENE_<part>.dat, .gp). Steps no world. `title_note` is appended to the diagrams'
+/// titles. Returns the markdown of the sections, "" for a scene that has none
+/// (has_reference_sections). Throws std::runtime_error if a file cannot be written or gnuplot
+/// fails.
 std::string write_reference_sections(const std::filesystem::path& dir, const std::string& scene,
-                                     bool quick, const std::string& title_note);
+                                     const SceneStudies& studies, const std::string& title_note);
 
 /// The files write_reference_sections may write into DIR for these scenes (SCENE_<part>.csv,
 /// .png, .svg, .pdf), and into DIR/plots (SCENE_<part>.dat, .gp).

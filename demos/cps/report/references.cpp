@@ -6,11 +6,10 @@
 #include "options/options.h"
 #include "report/csv.h"
 #include "report/run.h"
+#include "report/tasks.h"
 #include "report/timing.h"
 
 #include <algorithm>
-#include <map>
-#include <mutex>
 #include <stdexcept>
 
 namespace cps::cli {
@@ -29,7 +28,7 @@ std::vector<SolverErrorPoint> sample_solver_error(const RunSpec& spec, int sampl
   const scenes::Scene& scene = spec.scene_def();
   scenes::Run run = make_run_or_usage_error(scene, spec.overrides());
   World& world = run.world;
-  const double horizon = scene.report_horizon_s();
+  const double horizon = spec.horizon_s();
   const auto total = static_cast<std::int64_t>(std::llround(horizon / world.def().dt));
   const std::int64_t every = std::max<std::int64_t>(1, total / std::max(1, samples));
   std::vector<StepSystem> systems;
@@ -156,18 +155,37 @@ ReferenceAgreement compare_references(const RunSpec& spec, double until_s, long 
   return a;
 }
 
+ObservedOrder observed_order(double d_coarse, double d_fine) {
+  ObservedOrder o;
+  if (std::isnan(d_coarse) || std::isnan(d_fine)) return o;
+  if (d_coarse == 0.0 && d_fine == 0.0) {  // the three runs agree exactly: no error left
+    o.error = 0.0;
+    return o;
+  }
+  if (d_fine == 0.0) {
+    o.order = std::numeric_limits<double>::infinity();
+    o.error = 0.0;
+    return o;
+  }
+  o.order = std::log2(d_coarse / d_fine);
+  if (o.order > 0.0) o.error = d_fine / (std::exp2(o.order) - 1.0);
+  return o;
+}
+
+double local_order(double e_a, int n_a, double e_b, int n_b) {
+  const auto usable = [](double e) { return e > 0.0 && std::isfinite(e); };
+  if (!usable(e_a) || !usable(e_b) || !(n_b > n_a) || n_a < 1) return std::nan("");
+  return std::log(e_a / e_b) / std::log(static_cast<double>(n_b) / n_a);
+}
+
 const ReferenceAgreement* scene_agreement(const scenes::Scene& scene) {
   if (scene.report.has_reference_solution || !is_paper_scene(scene)) return nullptr;
-  static std::mutex mutex;
-  static std::map<std::string, ReferenceAgreement> cache;
-  const std::lock_guard<std::mutex> lock(mutex);
+  static OnceCache<ReferenceAgreement> cache;
   const std::string name(scene.name);
-  auto it = cache.find(name);
-  if (it == cache.end()) {
+  return &cache.get(name, [&] {
     const double t = std::min(scene.report_trajectory_time_s(), scene.report_horizon_s());
-    it = cache.emplace(name, compare_references(RunSpec{name}, t, kAgreementSolves)).first;
-  }
-  return &it->second;
+    return compare_references(RunSpec{name}, t, kAgreementSolves);
+  });
 }
 
 double trajectory_time_of(const scenes::Scene& scene) {
@@ -178,7 +196,7 @@ double trajectory_time_of(const scenes::Scene& scene) {
   return std::max(1.0, std::floor(a->horizon_s / frame + 1e-9)) * frame;
 }
 
-std::vector<EnergyTrace> energy_traces(const std::string& scene_name, int max_points) {
+std::vector<EnergyTrace> energy_traces(const std::string& scene_name, int max_points, bool quick) {
   std::vector<EnergyTrace> traces;
   for (const Choice& push : parameter("push").choices) {
     RunSpec spec{scene_name};
@@ -186,7 +204,7 @@ std::vector<EnergyTrace> energy_traces(const std::string& scene_name, int max_po
     const scenes::Scene& scene = spec.scene_def();
     scenes::Run run = make_run_or_usage_error(scene, spec.overrides());
     World& world = run.world;
-    const double horizon = scene.report_horizon_s();
+    const double horizon = scene.report_horizon_s(quick);
     const auto total = static_cast<std::int64_t>(std::llround(horizon / world.def().dt));
     const std::int64_t every = std::max<std::int64_t>(1, (total + max_points - 2) / (max_points - 1));
     EnergyTrace e;

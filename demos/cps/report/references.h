@@ -43,12 +43,30 @@ struct SolverErrorPoint {
 };
 
 /// The solver error of `samples` (>= 1) steps spread evenly over the run of `spec` to its
-/// scene's report horizon: every solve of each sampled step captured (World::set_solve_observer),
+/// horizon (RunSpec::horizon_s): every solve of each sampled step captured (World::set_solve_observer),
 /// solved exactly, and PGS and Jacobi at kSolverErrorSweepCounts sweeps from 0 judged against
 /// it; one "exact" point per solve (its residual) and one per method and count. `no_solve`
 /// counts the sampled steps without a solve (no contact or rod). A run that blows up ends the
 /// sampling. Throws UsageError for an unknown scene.
 std::vector<SolverErrorPoint> sample_solver_error(const RunSpec& spec, int samples, int& no_solve);
+
+/// The order a method shows between three runs at steps h, h / 2 and h / 4 (Richardson), and the
+/// error that leaves the finest: with an error C h^p, the distances between successive runs are
+/// d_coarse = C h^p (1 - 2^-p) (h against h / 2) and d_fine = d_coarse / 2^p (h / 2 against
+/// h / 4), so p = log2(d_coarse / d_fine) and the finest run's error is d_fine / (2^p - 1).
+/// Distances in any unit (m, deg), the error in the same.
+struct ObservedOrder {
+  double order = std::nan("");  ///< p (dimensionless); NaN if a distance is NaN or both are 0
+  /// d_fine / (2^p - 1); 0 when d_fine is 0 (both 0: the runs agree exactly); NaN when p <= 0
+  /// or a distance is NaN: the distances do not shrink with the step, and bound no error.
+  double error = std::nan("");
+};
+ObservedOrder observed_order(double d_coarse, double d_fine);
+
+/// The local order between two runs of errors e_a and e_b at n_a < n_b substeps (or iterations):
+/// log(e_a / e_b) / log(n_b / n_a) (dimensionless; 1: the error halves when n doubles). NaN where
+/// an error is not positive and finite or n_b <= n_a.
+double local_order(double e_a, int n_a, double e_b, int n_b);
 
 /// The distance (m) within which the two references must stay: this fraction (dimensionless) of
 /// the largest movable body's size, 1 % (2.4 cm on the stack's 2.4 m cubes, 1 cm between the
@@ -115,8 +133,8 @@ struct EnergyTrace {
 };
 
 /// The energy traces of `scene` for every push method of the table (parameter("push")), each
-/// to the scene's report horizon with at most `max_points` (>= 2) recorded steps. Throws
-/// UsageError for an unknown scene.
-std::vector<EnergyTrace> energy_traces(const std::string& scene, int max_points);
+/// to the scene's report horizon (of the quick sweep when `quick`: Scene::report_horizon_s)
+/// with at most `max_points` (>= 2) recorded steps. Throws UsageError for an unknown scene.
+std::vector<EnergyTrace> energy_traces(const std::string& scene, int max_points, bool quick);
 
 }  // namespace cps::cli

@@ -10,6 +10,7 @@
 namespace cps::cli {
 
 void write_report(const std::filesystem::path& dir, const std::vector<RunResult>& runs,
+                  const std::map<std::string, SceneStudies>& studies,
                   const std::vector<PairRow>& pairs, const std::vector<std::string>& missing,
                   std::size_t planned, const std::string& load) {
   ReportContent c;
@@ -33,9 +34,10 @@ void write_report(const std::filesystem::path& dir, const std::vector<RunResult>
       if (draw_diagram(dir, scene, m, c.runs[scene], title_note)) c.diagrams[scene].push_back(&m);
     }
     // Solver error, the two references and energy over time (reference_report.h).
-    const bool quick = std::any_of(c.runs[scene].begin(), c.runs[scene].end(),
-                                   [](const RunResult* r) { return r->quick.value_or(false); });
-    c.scene_sections[scene] = write_reference_sections(dir, scene, quick, title_note);
+    if (const auto s = studies.find(scene); s != studies.end()) {
+      c.scene_sections[scene] = write_reference_sections(dir, scene, s->second, title_note);
+      c.solver_error[scene] = solver_error_medians(s->second);
+    }
   }
   c.pairs = mass_ratio_table(pairs);
   write_csv(dir / "mass_ratio.csv", c.pairs);

@@ -3,10 +3,12 @@
 // work-precision diagrams (gnuplot), the mass ratio table and report.md.
 
 #include "report/mass_ratio.h"
+#include "report/reference_report.h"
 #include "report/result.h"
 
 #include <cstddef>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -15,12 +17,14 @@ namespace cps::cli {
 /// Writes DIR/SCENE.csv (one per scene present in `runs`, columns as results_table), the
 /// work-precision diagrams DIR/SCENE_<measure>.png, .svg and .pdf (draw_diagram, their data and
 /// scripts in DIR/plots), DIR/mass_ratio.csv (`pairs`, mass_ratio_table) and DIR/report.md
-/// (report_markdown). If `missing` (run ids, of `planned`) is not empty, report.md opens with
+/// (report_markdown), and each paper scene's sections from its `studies` (write_reference_sections;
+/// a scene missing from the map gets none). Steps no world. If `missing` (run ids, of `planned`) is not empty, report.md opens with
 /// INCOMPLETE and names them, and every diagram's title says so. Throws std::runtime_error if a
 /// file cannot be written or gnuplot fails (the message says to install gnuplot-nox when it is
 /// missing; the CSVs are kept). `load` (ReportContent::load): the machine's load while the runs
 /// were timed, a sentence for report.md, or "".
 void write_report(const std::filesystem::path& dir, const std::vector<RunResult>& runs,
+                  const std::map<std::string, SceneStudies>& studies,
                   const std::vector<PairRow>& pairs, const std::vector<std::string>& missing,
                   std::size_t planned, const std::string& load = "");
 

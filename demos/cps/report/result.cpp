@@ -26,10 +26,13 @@ constexpr std::pair<std::string_view, NumberField> kNumberColumns[] = {
     {"cpu_s_per_sim_s", &RunResult::cpu_s_per_sim_s},
     {"cpu_s_per_sim_s_q1", &RunResult::cpu_s_per_sim_s_q1},
     {"cpu_s_per_sim_s_q3", &RunResult::cpu_s_per_sim_s_q3},
+    {"cpu_s_per_sim_s_min", &RunResult::cpu_s_per_sim_s_min},
     {"us_per_step", &RunResult::us_per_step},
     {"trajectory_time_s", &RunResult::trajectory_time_s},
     {"trajectory_error_m", &RunResult::trajectory_error_m},
     {"reference_check_m", &RunResult::reference_check_m},
+    {"reference_order", &RunResult::reference_order},
+    {"reference_error_m", &RunResult::reference_error_m},
     {"phase_error_deg", &RunResult::phase_error_deg},
     {"residual_max_N", &RunResult::residual_max_N},
     {"residual_rms_N", &RunResult::residual_rms_N},
@@ -45,8 +48,10 @@ constexpr std::pair<std::string_view, NumberField> kNumberColumns[] = {
 constexpr std::string_view kColumnOrder[] = {
     "scene", "solver", "push", "friction_model", "iterations", "substeps", "warm_start", "dt_s",
     "horizon_s", "diverged", "diverged_at_s", "diverged_why", "cpu_s_per_sim_s", "cpu_s_per_sim_s_q1",
-    "cpu_s_per_sim_s_q3", "us_per_step", "timing_repeats", "runs_per_repeat",
-    "trajectory_time_s", "trajectory_error_m", "reference_check_m", "under_reference_error",
+    "cpu_s_per_sim_s_q3", "cpu_s_per_sim_s_min", "us_per_step", "timing_repeats", "runs_per_repeat",
+    "timing_threads", "reference_substeps",
+    "trajectory_time_s", "trajectory_error_m", "reference_check_m", "reference_order",
+    "reference_error_m", "under_reference_error",
     "phase_error_deg",
     "residual_max_N", "residual_rms_N", "penetration_max_m", "penetration_rms_m",
     "rod_error_max_m", "rod_error_rms_m", "energy_drift_rel", "sweep", "quick", "machine",
@@ -117,13 +122,16 @@ bool set_cell(RunResult& r, const std::string& column, const std::string& text) 
   } else if (column == "friction_model") {
     r.friction_model = text;
   } else if (column == "iterations" || column == "substeps" || column == "timing_repeats" ||
-             column == "runs_per_repeat") {
+             column == "runs_per_repeat" || column == "timing_threads" ||
+             column == "reference_substeps") {
     const std::optional<int> n = parse_count(text);
     if (!n) return false;
     if (column == "iterations") r.iterations = *n;
     if (column == "substeps") r.substeps = *n;
     if (column == "timing_repeats") r.timing_repeats = *n;
     if (column == "runs_per_repeat") r.runs_per_repeat = *n;
+    if (column == "timing_threads") r.timing_threads = *n;
+    if (column == "reference_substeps") r.reference_substeps = *n;
   } else if (column == "warm_start") {
     const double w = parse_number(text);
     r.warm_start = std::isnan(w) ? 0.0 : w;
@@ -221,6 +229,13 @@ std::optional<std::string> RunResult::cell(std::string_view column) const {
   }
   if (column == "runs_per_repeat") {
     return runs_per_repeat ? std::optional<std::string>(std::to_string(*runs_per_repeat)) : std::nullopt;
+  }
+  if (column == "timing_threads") {
+    return timing_threads ? std::optional<std::string>(std::to_string(*timing_threads)) : std::nullopt;
+  }
+  if (column == "reference_substeps") {
+    return reference_substeps ? std::optional<std::string>(std::to_string(*reference_substeps))
+                              : std::nullopt;
   }
   if (column == "diverged_why") return diverged_why;
   if (column == "under_reference_error") {

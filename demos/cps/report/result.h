@@ -41,19 +41,32 @@ struct RunResult {
   /// 3.1 m past the largest body's size 2.4 m", ...); only for a diverged run of this build.
   std::optional<std::string> diverged_why;
   /// Physics CPU time per simulated second (s/s): the median over the timed repeats of the CPU
-  /// time of the thread that stepped (report/timing.h), and the repeats' first and third
-  /// quartiles.
+  /// time of the thread that stepped (report/timing.h), the repeats' first and third
+  /// quartiles, and the least of them (the repeat that the machine disturbed least).
   std::optional<double> cpu_s_per_sim_s;
   std::optional<double> cpu_s_per_sim_s_q1;
   std::optional<double> cpu_s_per_sim_s_q3;
+  std::optional<double> cpu_s_per_sim_s_min;
   std::optional<double> us_per_step;       ///< the median's CPU time per step (us)
   std::optional<int> timing_repeats;       ///< timed repeats the quartiles are taken over
   std::optional<int> runs_per_repeat;      ///< copies of the run stepped in one timed repeat
+  std::optional<int> timing_threads;       ///< threads that stepped timed repeats at once (time_runs jobs)
   std::optional<double> trajectory_time_s;   ///< when positions are compared (s)
   std::optional<double> trajectory_error_m;  ///< RMS distance from the reference run (m)
-  std::optional<double> reference_check_m;   ///< the reference's own error (m)
-  /// True where trajectory_error_m is under reference_check_m: a difference the reference does
-  /// not resolve (column under_reference_error, 0 or 1); only with both.
+  /// The substeps per 1/60 s frame of the trajectory error's reference (kReferenceSubsteps, or
+  /// kQuickReferenceSubsteps in the quick sweep).
+  std::optional<int> reference_substeps;
+  /// The reference's distance from the same run at half its substeps (m).
+  std::optional<double> reference_check_m;
+  /// The order the reference's runs at a quarter, half and all of its substeps show
+  /// (observed_order, dimensionless); none where it cannot be measured.
+  std::optional<double> reference_order;
+  /// The reference's own error (m) from that order: reference_check_m / (2^order - 1); none
+  /// where the order is not positive (the distances do not shrink with dt).
+  std::optional<double> reference_error_m;
+  /// True where trajectory_error_m is under reference_error_m, or the reference has no error
+  /// estimate: a difference the reference does not resolve (column under_reference_error, 0 or
+  /// 1); only with a trajectory error.
   std::optional<bool> under_reference_error;
   std::optional<double> phase_error_deg;     ///< the metric max_phase_error_deg (deg)
   std::optional<double> residual_max_N;      ///< largest LCP residual of any row (N)

@@ -2,12 +2,11 @@
 
 #include "options/options.h"
 #include "report/references.h"
+#include "report/tasks.h"
 #include "report/timing.h"
 
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <mutex>
 #include <optional>
 #include <random>
 
@@ -31,36 +30,42 @@ std::optional<std::vector<Vec3>> positions_at(const RunSpec& spec, double t) {
 }
 
 // The reference of a run at its scene's trajectory time: the positions (nullopt if the reference
-// blew up), and its own error estimate check_m (m), the RMS distance between the reference and
-// the same run at half its substeps. For a first-order method halving dt halves the error, so
-// the distance between the two is about the reference's own error; where contacts make the
-// scene chaotic it is large, and trajectory errors below it mean nothing.
+// blew up); check_m (m), the RMS distance between the reference and the same run at half its
+// substeps; and the order the three runs at 4, 8 and 16 substeps show and the reference's own
+// error it gives (observed_order). Where contacts make the scene chaotic the distances do not
+// shrink with dt, and trajectory errors below them mean nothing.
 struct Reference {
   std::optional<std::vector<Vec3>> positions;
   double check_m = std::nan("");
+  ObservedOrder observed;
 };
 
 // The reference of `spec` (its solver, iterations and substeps replaced); computed once per
-// process and kept.
+// process and kept (threads that ask for another reference do not wait for this one).
 const Reference& reference_of(const RunSpec& spec) {
-  static std::mutex mutex;
-  static std::map<std::string, Reference> cache;
+  static OnceCache<Reference> cache;
   RunSpec ref = spec;
   ref.solver = SolverKind::pgs;
   ref.iterations = kReferenceIterations;
-  ref.substeps = kReferenceSubsteps;
+  ref.substeps = reference_substeps(spec.quick);
   ref.warm_start = 0.0;  // one reference for the cold and the warm runs: the paper's start
-  const std::lock_guard<std::mutex> lock(mutex);
-  const auto it = cache.find(ref.id());
-  if (it != cache.end()) return it->second;
-  const double t = trajectory_time_of(ref.scene_def());
-  Reference r;
-  r.positions = positions_at(ref, t);
-  RunSpec half = ref;
-  half.substeps = kReferenceSubsteps / 2;
-  const std::optional<std::vector<Vec3>> check = positions_at(half, t);
-  if (r.positions && check) r.check_m = scenes::rms_distance(*r.positions, *check);
-  return cache[ref.id()] = r;
+  // The quick sweep's runs have shorter horizons but the same trajectory time: one reference.
+  return cache.get(ref.id(), [&] {
+    const double t = trajectory_time_of(ref.scene_def());
+    Reference r;
+    r.positions = positions_at(ref, t);
+    RunSpec half = ref;
+    half.substeps = ref.substeps / 2;
+    const std::optional<std::vector<Vec3>> at_half = positions_at(half, t);
+    RunSpec quarter = ref;
+    quarter.substeps = ref.substeps / 4;
+    const std::optional<std::vector<Vec3>> at_quarter = positions_at(quarter, t);
+    if (r.positions && at_half) r.check_m = scenes::rms_distance(*r.positions, *at_half);
+    if (at_quarter && at_half && r.positions) {
+      r.observed = observed_order(scenes::rms_distance(*at_quarter, *at_half), r.check_m);
+    }
+    return r;
+  });
 }
 
 // Largest and RMS of a measure over samples.
@@ -202,7 +207,7 @@ void step_copy(scenes::Run& run, TimedRun& t) {
 // wrong data without doing anything obviously wrong"). A guard, not a measured cure: see
 // docs/benchmarks.md (Run time of cps report) for what it did and did not change here.
 double time_repeat(TimedRun& t) {
-  static std::mt19937 layout(26);
+  thread_local std::mt19937 layout(26);
   const std::vector<char> pad(16 * static_cast<std::size_t>(layout() % 4096), 1);
   std::vector<scenes::Run> copies;
   copies.reserve(static_cast<std::size_t>(t.copies));
@@ -232,7 +237,7 @@ bool sane_state(const World& world) { return state_fault(world).empty(); }
 
 MeasuredRun measure_errors(const RunSpec& spec) {
   const scenes::Scene& scene = spec.scene_def();
-  const double horizon = scene.report_horizon_s();
+  const double horizon = spec.horizon_s();
   const bool has_trajectory = !scene.report.has_reference_solution;
   const double t_traj = trajectory_time_of(scene);
   scenes::Overrides o = spec.overrides();
@@ -240,65 +245,77 @@ MeasuredRun measure_errors(const RunSpec& spec) {
   r.dt_s = csv(std::get<double>(*o.find("dt")));
   r.horizon_s = csv(horizon);
 
+  const double cpu_start = thread_cpu_seconds();
   ErrorRun e = error_run(scene, o, horizon, t_traj);
+  const double error_cpu_s = thread_cpu_seconds() - cpu_start;
   if (has_trajectory && e.diverged_at && e.at_traj.empty()) step_on_to(e, t_traj);
   record_errors(e, r);
   if (has_trajectory) {
     const Reference& ref = reference_of(spec);
     r.trajectory_time_s = csv(t_traj);
+    r.reference_substeps = reference_substeps(spec.quick);
     r.reference_check_m = csv(ref.check_m);
+    if (std::isfinite(ref.observed.order)) r.reference_order = csv(ref.observed.order);
+    if (std::isfinite(ref.observed.error)) r.reference_error_m = csv(ref.observed.error);
     if (!e.at_traj.empty() && ref.positions) {
       r.trajectory_error_m = csv(scenes::rms_distance(e.at_traj, *ref.positions));
-      if (std::isfinite(ref.check_m)) {
-        r.under_reference_error = *r.trajectory_error_m < *r.reference_check_m;
-      }
+      // Not resolved where the reference's error is unknown (its runs do not converge).
+      r.under_reference_error =
+          !r.reference_error_m || *r.trajectory_error_m < *r.reference_error_m;
     }
   }
   const double until = e.diverged_at.value_or(horizon);
   const double work = run_work(e.run.world.bodies().size(), e.run.world.def(), until);
   o.set("measure_residual", false);
-  return {std::move(r), TimedRun{&scene, std::move(o), until, work, 1, 0, 0.0, {}}};
+  return {std::move(r), TimedRun{&scene, std::move(o), until, work, 1, 0, 0.0, {}, error_cpu_s}};
 }
 
-void time_runs(const std::vector<TimedRun*>& runs, int repeats, double max_work,
+void time_runs(const std::vector<TimedRun*>& runs, int repeats, double max_work, int jobs,
                const std::function<void(long long)>& progress) {
   long long done = 0;
+  const auto report = [&](std::size_t) { progress(++done); };
+  std::vector<std::function<void()>> warm_ups;
   for (TimedRun* t : runs) {
-    t->copies = 1;
-    t->repeat_s.clear();
-    const double warm_up = time_repeat(*t);  // untimed: discarded
-    const double budget = t->work > 0.0 ? max_work / (t->work * repeats) : kMaxCopies;
-    const double wanted = warm_up > 0.0 ? std::ceil(kMinRepeatSeconds / warm_up) : kMaxCopies;
-    t->copies = static_cast<int>(std::clamp(std::min(wanted, std::floor(budget)), 1.0,
-                                            static_cast<double>(kMaxCopies)));
-    progress(++done);
+    warm_ups.push_back([t, repeats, max_work] {
+      t->copies = 1;
+      t->repeat_s.clear();
+      const double warm_up = time_repeat(*t);  // untimed: discarded
+      const double budget = t->work > 0.0 ? max_work / (t->work * repeats) : kMaxCopies;
+      const double wanted = warm_up > 0.0 ? std::ceil(kMinRepeatSeconds / warm_up) : kMaxCopies;
+      t->copies = static_cast<int>(std::clamp(std::min(wanted, std::floor(budget)), 1.0,
+                                              static_cast<double>(kMaxCopies)));
+    });
   }
+  run_tasks(warm_ups, jobs, report);
   for (int round = 0; round < repeats; ++round) {
+    std::vector<std::function<void()>> repeats_of_round;
     for (std::size_t i = 0; i < runs.size(); ++i) {
-      TimedRun& t = *runs[round % 2 == 0 ? i : runs.size() - 1 - i];
-      t.repeat_s.push_back(time_repeat(t));
-      progress(++done);
+      TimedRun* t = runs[round % 2 == 0 ? i : runs.size() - 1 - i];
+      repeats_of_round.push_back([t] { t->repeat_s.push_back(time_repeat(*t)); });
     }
+    run_tasks(repeats_of_round, jobs, report);
   }
 }
 
-void record_timing(const TimedRun& t, RunResult& r) {
+void record_timing(const TimedRun& t, int jobs, RunResult& r) {
   if (t.repeat_s.empty() || !(t.simulated_s > 0.0)) return;
   const Quartiles q = quartiles(t.repeat_s);
   r.cpu_s_per_sim_s = csv(q.median / t.simulated_s);
   r.cpu_s_per_sim_s_q1 = csv(q.q1 / t.simulated_s);
   r.cpu_s_per_sim_s_q3 = csv(q.q3 / t.simulated_s);
+  r.cpu_s_per_sim_s_min = csv(*std::min_element(t.repeat_s.begin(), t.repeat_s.end()) / t.simulated_s);
   r.us_per_step = csv(1e6 * q.median / static_cast<double>(std::max<std::int64_t>(t.steps, 1)));
   r.timing_repeats = static_cast<int>(t.repeat_s.size());
   r.runs_per_repeat = t.copies;
+  r.timing_threads = jobs;
   r.machine = this_machine();
   r.build = this_build();
 }
 
 RunResult execute_run(const RunSpec& spec, int repeats, double max_work) {
   MeasuredRun m = measure_errors(spec);
-  time_runs({&m.timing}, repeats, max_work, [](long long) {});
-  record_timing(m.timing, m.result);
+  time_runs({&m.timing}, repeats, max_work, 1, [](long long) {});
+  record_timing(m.timing, 1, m.result);
   return m.result;
 }
 

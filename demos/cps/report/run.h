@@ -17,6 +17,11 @@ namespace cps::cli {
 /// frame, and the run's own push and friction model, cold.
 inline constexpr int kReferenceIterations = 256;
 inline constexpr int kReferenceSubsteps = 16;
+/// The reference's substeps in the quick sweep (count per 1/60 s frame): twice the quick sweep's
+/// finest run (4 substeps), at half the full reference's cost.
+inline constexpr int kQuickReferenceSubsteps = 8;
+/// The reference's substeps for a run of the full sweep or of the quick one.
+constexpr int reference_substeps(bool quick) { return quick ? kQuickReferenceSubsteps : kReferenceSubsteps; }
 
 /// The timing of one run, carried out apart from its error run so that a sweep can interleave
 /// the repeats of all its runs (time_runs): the physics step alone (residuals off, metrics not
@@ -32,6 +37,9 @@ struct TimedRun {
   std::int64_t steps = 0;            ///< steps of one copy
   double simulated_s = 0.0;          ///< simulated time of one copy (s)
   std::vector<double> repeat_s;      ///< per timed repeat: CPU seconds per copy
+  /// CPU seconds (thread clock) of the error run's steps: a little more than one copy costs
+  /// (the error run also measures residuals), for estimating the timing's duration.
+  double error_run_cpu_s = 0.0;
 };
 
 /// A run's error run done: its result (settings and errors, no time yet) and its timing to do.
@@ -53,22 +61,26 @@ struct MeasuredRun {
 MeasuredRun measure_errors(const RunSpec& spec);
 
 /// Times `runs` (each TimedRun of measure_errors) with `repeats` (>= 1) timed repeats each, by the
-/// CPU time of the calling thread (thread_cpu_seconds). First one untimed warm-up repeat of each
-/// run, which also sets its copies: enough for a repeat to last kMinRepeatSeconds, at most as
-/// many as keep repeats x copies x work within `max_work` (body-iterations; at least 1). Then
-/// `repeats` rounds, each timing one repeat of every run, in plan order and backwards in every
-/// other round: the repeats of the runs a report compares are spread over the same stretch of
-/// time, so that a change of the machine's load or clock speed falls on all of them alike.
-/// `progress` is called after each repeat with the repeats done so far, of runs.size() x
-/// (repeats + 1).
-void time_runs(const std::vector<TimedRun*>& runs, int repeats, double max_work,
+/// CPU time of the thread that steps the repeat (thread_cpu_seconds), on `jobs` threads (>= 1;
+/// 1: the calling thread alone). First one untimed warm-up repeat of each run, which also sets
+/// its copies: enough for a repeat to last kMinRepeatSeconds, at most as many as keep repeats x
+/// copies x work within `max_work` (body-iterations; at least 1). Then `repeats` rounds, each
+/// timing one repeat of every run, in plan order and backwards in every other round, a round
+/// ending before the next begins: the repeats of the runs a report compares are spread over the
+/// same stretch of time, so that a change of the machine's load or clock speed falls on all of
+/// them alike. With several jobs, repeats of different runs step at once on different threads:
+/// each is charged its own thread's CPU time, but they share the machine's caches and memory.
+/// `progress` is called after each repeat (one call at a time) with the repeats done so far, of
+/// runs.size() x (repeats + 1).
+void time_runs(const std::vector<TimedRun*>& runs, int repeats, double max_work, int jobs,
                const std::function<void(long long)>& progress);
 
 /// The run's time from its repeats (at least one; else nothing is set): cpu_s_per_sim_s and its
-/// quartiles cpu_s_per_sim_s_q1, _q3 (CPU seconds per simulated second), us_per_step (the median
-/// per step, us), timing_repeats and runs_per_repeat, and the machine and build (this_machine,
+/// quartiles cpu_s_per_sim_s_q1, _q3 and least cpu_s_per_sim_s_min (CPU seconds per simulated
+/// second), us_per_step (the median per step, us), timing_repeats, runs_per_repeat and
+/// timing_threads (`jobs` of time_runs, >= 1), and the machine and build (this_machine,
 /// this_build).
-void record_timing(const TimedRun& t, RunResult& r);
+void record_timing(const TimedRun& t, int jobs, RunResult& r);
 
 /// One run alone: measure_errors, time_runs of it alone and record_timing.
 RunResult execute_run(const RunSpec& spec, int repeats, double max_work);

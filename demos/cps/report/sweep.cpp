@@ -6,8 +6,10 @@
 #include "report/mass_ratio.h"
 #include "report/report.h"
 #include "report/run.h"
+#include "report/tasks.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -86,31 +88,90 @@ std::vector<std::string> scenes_of(const std::vector<RunResult>& runs) {
   return scenes;
 }
 
+// The tasks that compute, independently of each other, the studies of `scenes` into `studies`
+// (the quick sweep's where quick(scene); scene_study_tasks) and the mass ratio table into `pairs`
+// (its rows made here, each run by its own task). Both must outlive the tasks.
+template <class Quick>
+std::vector<std::function<void()>> study_tasks(const std::vector<std::string>& scenes, Quick quick,
+                                               std::map<std::string, SceneStudies>& studies,
+                                               std::vector<PairRow>& pairs) {
+  std::vector<std::function<void()>> tasks;
+  for (const std::string& scene : scenes) {
+    for (std::function<void()>& t : scene_study_tasks(scene, quick(scene), studies[scene])) {
+      tasks.push_back(std::move(t));
+    }
+  }
+  pairs = mass_ratio_rows();
+  for (PairRow& p : pairs) tasks.push_back([&p] { run_pair_row(p); });
+  return tasks;
+}
+
 }  // namespace
 
 int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& scenes) {
   const std::vector<RunSpec> runs = plan_runs(scenes, to.quick);
   ReportOutput output(to.out, scene_names(scenes), to.force, to.info, /*record_scenes=*/true);
-  std::vector<MeasuredRun> measured;
-  measured.reserve(runs.size());
-  {
-    Progress progress("report " + to.sweep, static_cast<long long>(runs.size()), "runs");
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-      measured.push_back(measure_errors(runs[i]));
-      progress.update(static_cast<long long>(i + 1));
-    }
-    progress.finish();
+
+  // What is computed before anything is written: the scenes' studies, the mass ratio rows and
+  // the error runs, on to.jobs threads, the long studies first.
+  std::map<std::string, SceneStudies> studies;
+  std::vector<PairRow> pairs;
+  std::vector<std::function<void()>> tasks =
+      study_tasks(scene_names(scenes), [&](const std::string&) { return to.quick; }, studies, pairs);
+  const std::size_t first_run = tasks.size();
+  std::vector<MeasuredRun> measured(runs.size());
+  std::vector<bool> run_done(runs.size(), false);
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    tasks.push_back([&measured, &runs, i] { measured[i] = measure_errors(runs[i]); });
   }
+
+  // One progress line over every phase. The time left: the computing's rate so far over what
+  // is left of it, plus the timing's estimate (each run's error run as the cost of a repeat, at
+  // least kMinRepeatSeconds; the median of those measured for the others; spread over the
+  // threads), then the timing's own rate once it has begun. Writing the files is not estimated.
+  const long long repeats_total = static_cast<long long>(runs.size()) * (to.repeats + 1);
+  Progress progress("report " + to.sweep,
+                    static_cast<long long>(tasks.size()) + repeats_total + 1, "tasks");
+  const auto timing_estimate = [&] {
+    std::vector<double> known;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      if (run_done[i]) known.push_back(std::max(measured[i].timing.error_run_cpu_s, kMinRepeatSeconds));
+    }
+    const double typical = known.empty() ? kMinRepeatSeconds : quartiles(known).median;
+    double sum = 0.0;
+    for (const double k : known) sum += k;
+    sum += typical * static_cast<double>(runs.size() - known.size());
+    const auto threads = static_cast<double>(std::clamp<std::size_t>(runs.size(), 1, to.jobs));
+    return sum * (to.repeats + 1) / threads;
+  };
+  const auto started = std::chrono::steady_clock::now();
+  const auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
+  long long done = 0;
+  run_tasks(tasks, to.jobs, [&](std::size_t i) {
+    if (i >= first_run) run_done[i - first_run] = true;
+    ++done;
+    const double compute_left =
+        since(started) * static_cast<double>(static_cast<long long>(tasks.size()) - done) /
+        static_cast<double>(done);
+    progress.update(done, compute_left + timing_estimate());
+  });
+
   // The timed repeats of every run, interleaved (time_runs).
   std::vector<TimedRun*> timed;
   for (MeasuredRun& m : measured) timed.push_back(&m.timing);
   const std::string load_before = load_average();
-  {
-    Progress progress("report " + to.sweep + " timing",
-                      static_cast<long long>(runs.size()) * (to.repeats + 1), "repeats");
-    time_runs(timed, to.repeats, to.max_work, [&](long long done) { progress.update(done); });
-    progress.finish();
-  }
+  const long long computed = done;
+  const double timing_first_estimate = timing_estimate();
+  const auto timing_started = std::chrono::steady_clock::now();
+  time_runs(timed, to.repeats, to.max_work, to.jobs, [&](long long repeats_done) {
+    const double left =
+        repeats_done > 0 ? since(timing_started) * static_cast<double>(repeats_total - repeats_done) /
+                               static_cast<double>(repeats_done)
+                         : timing_first_estimate;
+    progress.update(computed + repeats_done, left);
+  });
   const std::string load_after = load_average();
   const std::string load = "Load averages (1, 5, 15 min, /proc/loadavg) " + load_before +
                            " when the timing began and " + load_after + " when it ended.";
@@ -120,10 +181,11 @@ int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& sc
   }
   std::vector<RunResult> results;
   for (MeasuredRun& m : measured) {
-    record_timing(m.timing, m.result);
+    record_timing(m.timing, static_cast<int>(std::min<std::size_t>(to.jobs, measured.size())), m.result);
     results.push_back(in_sweep(to, std::move(m.result)));
   }
-  output.write([&] { write_report(to.out, results, mass_ratio_study(), {}, results.size(), load); });
+  output.write([&] { write_report(to.out, results, studies, pairs, {}, results.size(), load); });
+  progress.finish();
   std::printf("%zu runs: %s/report.md\n", results.size(), to.out.c_str());
   return 0;
 }
@@ -150,7 +212,7 @@ std::vector<std::string> run_commands(const std::string& exe, const SweepOutput&
   for (const RunSpec& r : runs) {
     lines.push_back("'" + exe + "' report '" + to.sweep + "' --run " + r.id() + " --out '" + out +
                     "/runs'" + (to.quick ? " --quick" : "") +
-                    (to.repeats != kDefaultRepeats ? " --repeats " + std::to_string(to.repeats) : ""));
+                    (to.repeats != default_repeats(to.quick) ? " --repeats " + std::to_string(to.repeats) : ""));
   }
   lines.push_back("# when all have finished: '" + exe + "' report --merge '" + out +
                   "/runs' --out '" + out + "'");
@@ -187,8 +249,25 @@ int merge_report(const SweepOutput& to, const std::vector<fs::path>& dirs) {
   if (runs.empty()) throw UsageError("--merge: no report CSV found below the given folders");
   std::size_t planned = 0;
   const std::vector<std::string> missing = missing_runs(runs, planned);
-  ReportOutput output(to.out, scenes_of(runs), to.force, to.info, /*record_scenes=*/false);
-  output.write([&] { write_report(to.out, runs, mass_ratio_study(), missing, planned); });
+  const std::vector<std::string> scenes = scenes_of(runs);
+  ReportOutput output(to.out, scenes, to.force, to.info, /*record_scenes=*/false);
+  // The studies of the scenes (quick where a run of the scene is) and the mass ratio rows, on
+  // to.jobs threads.
+  std::map<std::string, SceneStudies> studies;
+  std::vector<PairRow> pairs;
+  const std::vector<std::function<void()>> tasks =
+      study_tasks(scenes, [&](const std::string& scene) {
+        return std::any_of(runs.begin(), runs.end(), [&](const RunResult& r) {
+          return r.scene == scene && r.quick.value_or(false);
+        });
+      }, studies, pairs);
+  {
+    Progress progress("report --merge", static_cast<long long>(tasks.size()), "tasks", 2.0);
+    long long done = 0;
+    run_tasks(tasks, to.jobs, [&](std::size_t) { progress.update(++done); });
+    progress.finish();
+  }
+  output.write([&] { write_report(to.out, runs, studies, pairs, missing, planned); });
   if (missing.empty()) {
     std::printf("merged %zu runs into %s/report.md\n", runs.size(), to.out.c_str());
     return 0;

@@ -25,11 +25,15 @@ struct SweepOutput {
   nlohmann::json info;         ///< run_info for the folders' run.json
   int repeats = kDefaultRepeats;   ///< timed repeats per run (time_runs), in [kMinRepeats, kMaxRepeats]
   double max_work = kDefaultMaxWork;  ///< work budget of a run (body-iterations, --max-work)
+  int jobs = 1;  ///< threads that compute the runs and studies (>= 1; --jobs); timing uses one
 };
 
-/// Runs every run of plan_runs(scenes, quick) (their error runs, then to.repeats timed repeats of
-/// each, interleaved across the sweep: time_runs; progress on stderr) and the mass ratio study, and writes the report (write_report) into `to.out` and
-/// `to.out`/plots, both shared folders (output.h). Every target is checked before any work:
+/// Computes the scenes' studies (scene_study_tasks), the mass ratio rows and the error runs of
+/// plan_runs(scenes, quick) on to.jobs threads; then times the runs on this thread alone
+/// (to.repeats timed repeats of each, interleaved across the sweep: time_runs); then writes the
+/// report (write_report), which steps no world, into `to.out` and
+/// `to.out`/plots, both shared folders (output.h). One progress line on stderr covers every
+/// phase, with the time left. The results do not depend on to.jobs. Every target is checked before any work:
 /// throws UsageError naming a foreign file it would replace (without force) or an unusable
 /// folder; std::runtime_error if a file cannot be written or gnuplot fails. Prints "N runs:
 /// OUT/report.md" on stdout. Returns the exit code, 0.
@@ -41,7 +45,7 @@ int run_one(const SweepOutput& to, const RunSpec& spec);
 
 /// The commands of `--list-runs`: per run of `runs`, `'EXE' report 'SWEEP' --run ID --out
 /// 'OUT/runs'` (with --quick for a quick sweep, and --repeats N where to.repeats is not
-/// kDefaultRepeats), then a comment line with the merge command.
+/// default_repeats(to.quick)), then a comment line with the merge command.
 std::vector<std::string> run_commands(const std::string& exe, const SweepOutput& to,
                                       const std::vector<RunSpec>& runs);
 
@@ -52,8 +56,8 @@ std::vector<std::string> run_commands(const std::string& exe, const SweepOutput&
 /// number of distinct planned runs.
 std::vector<std::string> missing_runs(const std::vector<RunResult>& runs, std::size_t& planned);
 
-/// Reads the CSVs below `dirs` (read_results), runs the mass ratio study and writes one report
-/// of them into `to.out` (as run_sweep; `to.sweep` and `to.quick` are not used). Throws
+/// Reads the CSVs below `dirs` (read_results), computes the scenes' studies and the mass ratio
+/// rows (on to.jobs threads) and writes one report of them into `to.out` (as run_sweep; `to.sweep` and `to.quick` are not used). Throws
 /// UsageError if no report CSV is found or a file is not one, and as run_sweep does. If planned
 /// runs are missing (missing_runs), the report is marked INCOMPLETE, stderr names the first 5
 /// and the return is 1; else stdout says "merged N runs into OUT/report.md" and the return is 0.

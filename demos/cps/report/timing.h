@@ -8,8 +8,11 @@
 
 namespace cps::cli {
 
-/// Timed repeats per run (`cps report --repeats`): the default, and the range accepted.
+/// Timed repeats per run (`cps report --repeats`): the default, the quick sweep's default, and
+/// the range accepted.
 inline constexpr int kDefaultRepeats = 5;
+inline constexpr int kQuickRepeats = 3;
+constexpr int default_repeats(bool quick) { return quick ? kQuickRepeats : kDefaultRepeats; }
 inline constexpr int kMinRepeats = 3;
 inline constexpr int kMaxRepeats = 100;
 

@@ -66,7 +66,7 @@ declare -A KIND=(
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
   ['export:scene']=scene_one ['export:--out']=out_glb ['*:--max-work']=max_work
   ['export:--fclib']=out_hdf5 ['export:--at']=steps
-  ['report:--repeats']=repeats
+  ['report:--repeats']=repeats ['report:--jobs']='param:integer:1:256:0:threads'
   # The sweep puts a positional's bad value in the first place, so reference's values cover frames.
   ['diff:reference']=png_in ['diff:frames']=skip ['diff:--out']=out_folder
   ['diff:--threshold']='param:real:0:255:0:levels' ['diff:--tolerance']='param:real:0:100:0:%'

@@ -38,21 +38,21 @@ struct ReportOptions {
   int jobs = 0;                       // threads that compute; 0: default_jobs()
 };
 
-// CLI11 validator for --repeats: a whole number (decimal digits) in [kMinRepeats, kMaxRepeats].
-// Its message names the text and the range.
-CLI::Validator repeats_in_range() {
-  const std::string range =
-      "[" + std::to_string(kMinRepeats) + ", " + std::to_string(kMaxRepeats) + "]";
+// CLI11 validator for a count option: a whole number (decimal digits) in [lo, hi]. Its message
+// names the text, what is counted (`things`: "timed repeats"), what must be in range (`bound`:
+// "timed repeats per run") and the range.
+CLI::Validator count_in_range(int lo, int hi, const std::string& things, const std::string& bound) {
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
   return CLI::Validator(
-      [range](std::string& input) -> std::string {
+      [range, lo, hi, things, bound](std::string& input) -> std::string {
         int n = 0;
         const char* last = input.c_str() + input.size();
         const auto [end, ec] = std::from_chars(input.c_str(), last, n);
         if (input.empty() || ec == std::errc::invalid_argument || end != last) {
-          return "'" + input + "' is not a whole number; give a count of timed repeats in " + range;
+          return "'" + input + "' is not a whole number; give a count of " + things + " in " + range;
         }
-        if (ec == std::errc::result_out_of_range || n < kMinRepeats || n > kMaxRepeats) {
-          return "'" + input + "': timed repeats per run must be in " + range;
+        if (ec == std::errc::result_out_of_range || n < lo || n > hi) {
+          return "'" + input + "': " + bound + " must be in " + range;
         }
         return {};
       },
@@ -218,7 +218,7 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                       "quartiles and least; the error run, the warm-up and the repeats together "
                       "must stay within --max-work")
       ->type_name("N")
-      ->check(repeats_in_range());
+      ->check(count_in_range(kMinRepeats, kMaxRepeats, "timed repeats", "timed repeats per run"));
   sub->add_option("--jobs", o->jobs,
                   "threads that compute the runs' errors and the scenes' studies and step the "
                       "timed repeats, in [1, " + std::to_string(kMaxJobs) + "]; default: the "
@@ -226,7 +226,7 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                       "charged its own thread's CPU time, and --jobs 1 times with nothing else "
                       "of the report running beside it")
       ->type_name("N")
-      ->check(CLI::Range(1, kMaxJobs));
+      ->check(count_in_range(1, kMaxJobs, "threads", "threads"));
   run->excludes(merge)->excludes(list);
   merge->excludes(list);
   sub->add_flag("--force", o->force,

@@ -34,8 +34,8 @@ const std::array kScenes = {
                      .headline_reason =
                          "the trajectory error at the trajectory time: not chaotic there (runs "
                          "at 24 and 26 iterations end nearer the 25's than a fifth of its error; "
-                         "tests/physics/test_scenes.cpp) and resolved (the reference's own error "
-                         "is under half of it)",
+                         "tests/physics/test_scenes.cpp); a halving counts only where the "
+                         "reference's own error is under half of it",
                      .has_reference_solution = false,
                      .trajectory_time_s = 0.8,
                      .trajectory_reason =
@@ -98,8 +98,8 @@ const std::array kScenes = {
                          "the trajectory error at the trajectory time: not chaotic there (runs "
                          "at 24 and 26 iterations end nearer the 25's than a fifth of its error; "
                          "tests/physics/test_scenes.cpp), so its plateau over the iteration "
-                         "counts is the 60 Hz step's error, which substeps cut; resolved (the "
-                         "reference's own error is under half of it)",
+                         "counts is the 60 Hz step's error, which substeps cut; a halving counts "
+                         "only where the reference's own error is under half of it",
                      .has_reference_solution = false,
                      .trajectory_time_s = 3.5,
                      .trajectory_reason =

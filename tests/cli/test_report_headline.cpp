@@ -3,6 +3,8 @@
 // omissions are exactly the runs it leaves out.
 #include "report/headline.h"
 
+#include "report/markdown.h"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -113,11 +115,18 @@ TEST_CASE("the trajectory error's headline compares runs of the paper's referenc
   runs.push_back(run_with(measure, "pgs", "baumgarte", 25, 1, 1e-3, 0.1));
   runs.push_back(run_with(measure, "jacobi", "split", 4, 1, 1e-4, 0.001));      // another reference
   runs.push_back(run_with(measure, "pgs", "baumgarte", 25, 4, 4e-3, 0.02));     // same reference
-  for (RunResult& r : runs) r.reference_check_m = 0.01;
+  for (RunResult& r : runs) r.reference_error_m = 0.01;
   const std::vector<const RunResult*> ptrs = pointers(runs);
   CHECK(cheapest_halving(ptrs, measure, runs[0]) == &runs[2]);
   // A reference whose own error is above half the paper's value resolves no halving.
-  for (RunResult& r : runs) r.reference_check_m = 0.06;
+  for (RunResult& r : runs) r.reference_error_m = 0.06;
+  CHECK(cheapest_halving(ptrs, measure, runs[0]) == nullptr);
+  // Nor one whose own error is unknown (its runs at 4, 8 and 16 substeps do not converge),
+  // however small its distance at half its substeps.
+  for (RunResult& r : runs) {
+    r.reference_error_m.reset();
+    r.reference_check_m = 1e-6;
+  }
   CHECK(cheapest_halving(ptrs, measure, runs[0]) == nullptr);
 }
 
@@ -157,4 +166,37 @@ TEST_CASE("report.md gives a run's dt as a fraction where it is one", "[report][
   CHECK(dt_text(r) == "1/600 s");
   r.dt_s = 0.003;
   CHECK(dt_text(r) == "0.003 s");
+}
+
+TEST_CASE("the headline says so when its cheapest run's solver diverges on the paper run's steps",
+          "[report][headline]") {
+  const std::string measure = "trajectory_error_m";
+  std::deque<RunResult> runs;
+  runs.push_back(run_with(measure, "pgs", "baumgarte", 25, 1, 1e-3, 0.03));
+  runs.push_back(run_with(measure, "jacobi", "baumgarte", 25, 4, 3e-3, 0.004));
+  runs.back().residual_max_N = 516.0;
+  for (RunResult& r : runs) r.reference_error_m = 0.001;
+  ReportContent c;
+  c.scenes = {"stack"};
+  c.runs["stack"] = pointers(runs);
+  c.run_count = runs.size();
+  const auto headline_row = [&] {
+    const std::string md = report_markdown(c);
+    const std::size_t at = md.find("| stack | ");
+    REQUIRE(at != std::string::npos);
+    return md.substr(at, md.find('\n', at) - at);
+  };
+  // Jacobi's sweeps end further from the solutions than lambda = 0 (relative error 1) at 25
+  // sweeps on the paper run's steps: the row names the halving run and says so.
+  c.solver_error["stack"]["jacobi"] = {{1, 0.95}, {5, 0.85}, {25, 8.7}, {100, 8.1}};
+  const std::string diverging = headline_row();
+  CHECK(diverging.find("jacobi, baumgarte, fixed, 25 it, 4 substeps") != std::string::npos);
+  CHECK(diverging.find("jacobi's sweeps diverge on the paper run's steps") != std::string::npos);
+  CHECK(diverging.find("8.7 |lambda*| at 25 sweeps") != std::string::npos);
+  CHECK(diverging.find("up to 516 N") != std::string::npos);
+  // Sweeps that converge (under 1 at 25), or a count past the run's iterations (100 > 25): no note.
+  c.solver_error["stack"]["jacobi"] = {{1, 0.95}, {25, 0.7}, {100, 8.1}};
+  const std::string converging = headline_row();
+  CHECK(converging.find("jacobi, baumgarte, fixed, 25 it, 4 substeps") != std::string::npos);
+  CHECK(converging.find("diverge") == std::string::npos);
 }

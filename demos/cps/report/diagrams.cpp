@@ -544,11 +544,11 @@ std::string script_key(const Diagram& d, const Measure& m, double key_h) {
   }
   if (d.any_unresolved) {
     gp << ", NaN with points pt 8 ps 2 lw 1.5 lc rgb '#b8860b' title "
-          "'below the reference''s own error: not resolved'";
+          "'below the reference''s own error, or it unknown: not resolved'";
   }
   if (d.any_reference) {
     gp << ", NaN with lines dt 4 lw 1.2 lc rgb '#b8860b' title "
-          "'reference''s own error (16 vs 8 substeps)'";
+          "'reference''s own error (from its order over 3 substep counts)'";
   }
   gp << "\nunset multiplot\n";
   return gp.str();

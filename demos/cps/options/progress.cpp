@@ -49,10 +49,15 @@ Progress::~Progress() {
 
 void Progress::update(long long done, double seconds_left) {
   seconds_left_ = std::isnan(seconds_left) ? std::nan("") : std::max(0.0, seconds_left);
-  update(done);
+  advance(done);
 }
 
 void Progress::update(long long done) {
+  seconds_left_ = -1.0;  // from the rate
+  advance(done);
+}
+
+void Progress::advance(long long done) {
   done_ = std::clamp(done, 0LL, total_);
   const Clock::time_point now = Clock::now();
   const double elapsed = seconds(now - start_);

@@ -34,7 +34,7 @@ class Progress {
 
   /// As update(done), with the time left (s, >= 0) estimated by the caller instead of from the
   /// rate of units so far: for a task whose units differ in cost (a report's runs, then their
-  /// timed repeats). NaN: no estimate is printed.
+  /// timed repeats). NaN: no estimate is printed. A later update(done) goes back to the rate.
   void update(long long done, double seconds_left);
 
   /// Reports the end: done = total, and the elapsed time.
@@ -42,6 +42,7 @@ class Progress {
 
  private:
   using Clock = std::chrono::steady_clock;
+  void advance(long long done);  // update's work once seconds_left_ is set
   void print(bool final_line);
 
   std::string label_;

@@ -57,12 +57,20 @@ void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
 void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
                         const BodyVelocity& vel_a, const BodyVelocity& vel_b,
                         const RowParams& params, std::vector<ConstraintRow>& rows) {
+  const std::size_t first = rows.size();
+  rows.resize(first + static_cast<std::size_t>(m.count));
+  write_normal_rows(m, bodies, vel_a, vel_b, params, rows.data() + first);
+}
+
+void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
+                       const BodyVelocity& vel_a, const BodyVelocity& vel_b,
+                       const RowParams& params, ConstraintRow* out) {
   const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
   const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
   for (int i = 0; i < m.count; ++i) {
     const Contact& c = m.contacts[static_cast<std::size_t>(i)];
-    // Built in place (no copy of the 12-vector j per row).
-    ConstraintRow& contact = rows.emplace_back();
+    ConstraintRow& contact = out[i];
+    contact = ConstraintRow{};
     contact.kind = RowKind::contact;
     contact.body_a = m.body_a;
     contact.body_b = m.body_b;
@@ -100,6 +108,15 @@ void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
                           const RowParams& params, int first_normal_row,
                           std::vector<ConstraintRow>& rows, const Vec3* tangents) {
   if (params.friction <= 0.0 || m.count == 0) return;
+  const std::size_t first = rows.size();
+  rows.resize(first + 2 * static_cast<std::size_t>(m.count));
+  write_friction_rows(m, bodies, params, first_normal_row, rows.data() + first, tangents);
+}
+
+void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
+                         const RowParams& params, int first_normal_row, ConstraintRow* out,
+                         const Vec3* tangents) {
+  if (params.friction <= 0.0 || m.count == 0) return;
   const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
   const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
   // Sec. 5.4: m is the combined mass of both bodies divided over the contact points (a static
@@ -118,7 +135,8 @@ void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
       tangent_basis(c.normal, t[0], t[1]);
     }
     for (const Vec3& tangent : t) {
-      ConstraintRow& friction = rows.emplace_back();
+      ConstraintRow& friction = *out++;
+      friction = ConstraintRow{};
       friction.kind = RowKind::friction;
       friction.body_a = m.body_a;
       friction.body_b = m.body_b;

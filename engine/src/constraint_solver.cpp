@@ -14,7 +14,7 @@ namespace {
 class ExplicitSolver final : public ConstraintSolver {
  public:
   void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-               SolverKind kind) override {
+               SolverKind kind, Workers* /*workers*/) override {
     inv_inertia_.resize(bodies.size());
     for (std::size_t i = 0; i < bodies.size(); ++i) inv_inertia_[i] = bodies[i].inv_inertia_world();
     system_ = assemble_matrices(rows, bodies);
@@ -83,26 +83,17 @@ class ExplicitSolver final : public ConstraintSolver {
 class MatrixFreeSolver final : public ConstraintSolver {
  public:
   void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-               SolverKind kind) override {
-    cps::prepare(system_, rows, bodies, kind);
+               SolverKind kind, Workers* workers) override {
+    cps::prepare(system_, rows, bodies, kind, workers);
   }
 
   void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
              const Eigen::VectorXd& f_ext, TargetTerms terms, const SolveSettings& settings,
              std::vector<double>& lambda, const std::vector<double>* initial) override {
-    rhs(system_, rows, bodies, f_ext, settings.dt, terms);
+    rhs(system_, rows, bodies, f_ext, settings.dt, terms, settings.workers);
     last_kind_ = settings.kind;
-    Workers* workers = nullptr;
-    if (settings.kind == SolverKind::coloured_pgs) {
-      if (settings.threads > 1) {
-        if (!workers_ || workers_->count() != settings.threads) {
-          workers_ = std::make_unique<Workers>(settings.threads);
-        }
-        workers = workers_.get();
-      }
-    }
     cps::solve(system_, rows, settings.friction, settings.kind, settings.iterations, lambda,
-               initial, workers);
+               initial, settings.kind == SolverKind::coloured_pgs ? settings.workers : nullptr);
   }
 
   void residual(const std::vector<ConstraintRow>& rows, FrictionModel friction,
@@ -122,7 +113,6 @@ class MatrixFreeSolver final : public ConstraintSolver {
 
  private:
   MatrixFreeSystem system_;
-  std::unique_ptr<Workers> workers_;  // coloured PGS on more than one thread
   SolverKind last_kind_ = SolverKind::pgs;
 };
 

@@ -10,6 +10,7 @@
 #include "cps/constraint.h"
 #include "cps/parameters.h"
 #include "system.h"
+#include "workers.h"
 
 #include <Eigen/Core>
 
@@ -20,14 +21,15 @@ namespace cps {
 
 /// What one solve needs besides the rows and bodies: dt (s, > 0; a substep's length for the
 /// methods that substep), the number of sweeps (>= 1), PGS, Jacobi or coloured PGS, the friction
-/// model of the force limits, and the threads a coloured PGS sweep may share (count, >= 1; the
-/// matrix-free path only; the result is the same for every count).
+/// model of the force limits, and the threads a solve may share (nullptr: the calling thread
+/// only; the matrix-free path shares a coloured PGS sweep and the right-hand side among them; the
+/// result is the same for every count).
 struct SolveSettings {
   double dt = 1.0 / 60.0;
   int iterations = 25;
   SolverKind kind = SolverKind::pgs;
   FrictionModel friction = FrictionModel::fixed;
-  int threads = 1;
+  Workers* workers = nullptr;
 };
 
 /// A way to solve the step's bounded system A lambda = b.
@@ -38,9 +40,11 @@ class ConstraintSolver {
   /// Builds what every solve of this step shares, from the rows (c, bodies by index or
   /// kWorldBody) and the bodies (n) as they are before the integration: J, M^-1, A and v1
   /// (explicit), or the packed rows and I^-1 per body (matrix-free); for the sweeps of `kind`
-  /// (SolverKind::coloured_pgs: the rows' colours and sweep order too, row_colours.h).
+  /// (SolverKind::coloured_pgs: the rows' colours and sweep order too, row_colours.h). The
+  /// matrix-free path packs the rows on `workers`' threads (nullptr: the calling thread), with
+  /// the same result for every count.
   virtual void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-                       SolverKind kind) = 0;
+                       SolverKind kind, Workers* workers) = 0;
 
   /// Solves A lambda = b with settings.iterations sweeps, b of Eq. 6.2.9 from the bodies'
   /// momenta as they are now (read with the world inverse inertia of prepare(), so that the

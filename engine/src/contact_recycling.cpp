@@ -26,18 +26,23 @@ bool pair_below(int a, int b, int c, int d) { return a < c || (a == c && b < d);
 
 }  // namespace
 
-void ContactRecycler::begin_step() {
-  next_.clear();
-  cursor_ = 0;
-  found_ = kNone;
+void ContactRecycler::begin_step() { next_.clear(); }
+
+ContactRecycler::Cursor ContactRecycler::cursor_at(int a, int b) const {
+  const auto first = std::lower_bound(last_.begin(), last_.end(), std::pair{a, b},
+                                      [](const Cached& c, const std::pair<int, int>& p) {
+                                        return pair_below(c.a, c.b, p.first, p.second);
+                                      });
+  return Cursor{static_cast<std::size_t>(first - last_.begin()), kNone};
 }
 
 bool ContactRecycler::recycle(int a, int b, const std::vector<Body>& bodies, double distance,
-                              Manifold& out) {
-  found_ = kNone;
-  while (cursor_ < last_.size() && pair_below(last_[cursor_].a, last_[cursor_].b, a, b)) ++cursor_;
-  if (cursor_ == last_.size() || last_[cursor_].a != a || last_[cursor_].b != b) return false;
-  const Cached& c = last_[cursor_];
+                              Manifold& out, Cursor& cursor) const {
+  cursor.found = kNone;
+  std::size_t& at = cursor.at;
+  while (at < last_.size() && pair_below(last_[at].a, last_[at].b, a, b)) ++at;
+  if (at == last_.size() || last_[at].a != a || last_[at].b != b) return false;
+  const Cached& c = last_[at];
   const Body& body_a = bodies[static_cast<std::size_t>(a)];
   const Body& body_b = bodies[static_cast<std::size_t>(b)];
   // Each body's own turn since caching: the quaternion dot product is cos of half the angle.
@@ -74,13 +79,13 @@ bool ContactRecycler::recycle(int a, int b, const std::vector<Body>& bodies, dou
     contact.depth = p.depth - c.normal.dot(moved_b - moved_a);
     contact.feature = p.feature;
   }
-  found_ = cursor_;
+  cursor.found = at;
   return true;
 }
 
-void ContactRecycler::keep(const Manifold& m, const std::vector<Body>& bodies, bool recycled) {
-  if (recycled && found_ != kNone && last_[found_].a == m.body_a && last_[found_].b == m.body_b) {
-    next_.push_back(last_[found_]);  // the poses of its caching, so that motion adds up
+void ContactRecycler::keep(const Manifold& m, const std::vector<Body>& bodies, std::size_t found) {
+  if (found != kNone && last_[found].a == m.body_a && last_[found].b == m.body_b) {
+    next_.push_back(last_[found]);  // the poses of its caching, so that motion adds up
     return;
   }
   const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];

@@ -23,22 +23,37 @@ namespace cps {
 /// poses when the narrow phase made it.
 class ContactRecycler {
  public:
-  /// Starts a step: its pairs are then looked up in the order the collide stage tests them
-  /// (ascending pairs). No errors.
+  /// No entry of the last step (Cursor::found).
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  /// Where a run of ascending lookups stands in the last step's manifolds: `at`, the first entry
+  /// not below the pair looked up last; `found`, the entry the last recycle() used, or kNone.
+  /// Each thread of the collide stage keeps its own.
+  struct Cursor {
+    std::size_t at = 0;
+    std::size_t found = kNone;
+  };
+
+  /// Starts a step's cache (keep()). No errors.
   void begin_step();
 
-  /// For the pair (a, b) of the collide stage (a < b, ascending over a step): when the last step
-  /// had a manifold for it and the bodies have moved relative to its cached poses by less than
-  /// `distance` (m, > 0) at every point within their bounding radius, and neither has turned by
-  /// more than about 10 degrees, writes the recycled manifold into `out` (each point midway
-  /// between where the two bodies have carried it, its depth changed by their relative motion
-  /// along the cached normal) and returns true; else returns false and `out` is untouched. No errors.
-  bool recycle(int a, int b, const std::vector<Body>& bodies, double distance, Manifold& out);
+  /// A cursor for lookups that start at the pair (a, b), a < b. No errors.
+  Cursor cursor_at(int a, int b) const;
 
-  /// Caches the manifold `m` the narrow phase has just made for its pair at the bodies' current
-  /// poses (m.count > 0), or carries over the one just recycled; call once per manifold of the
-  /// step, in the collide stage's order. No errors.
-  void keep(const Manifold& m, const std::vector<Body>& bodies, bool recycled);
+  /// For the pair (a, b) of the collide stage (a < b, ascending over the lookups of `cursor`):
+  /// when the last step had a manifold for it and the bodies have moved relative to its cached
+  /// poses by less than `distance` (m, > 0) at every point within their bounding radius, and
+  /// neither has turned by more than about 10 degrees, writes the recycled manifold into `out`
+  /// (each point midway between where the two bodies have carried it, its depth changed by their
+  /// relative motion along the cached normal), sets cursor.found and returns true; else returns
+  /// false with cursor.found = kNone and `out` untouched. Reads only the last step's cache, so
+  /// threads may look up at once. No errors.
+  bool recycle(int a, int b, const std::vector<Body>& bodies, double distance, Manifold& out,
+               Cursor& cursor) const;
+
+  /// Caches the manifold `m` the narrow phase has made for its pair at the bodies' current poses
+  /// (m.count > 0), or carries over the last step's entry `found` that recycle() used for it
+  /// (kNone: none); call once per manifold of the step, in the collide stage's order. No errors.
+  void keep(const Manifold& m, const std::vector<Body>& bodies, std::size_t found);
 
   /// Ends the step: this step's cache replaces the last one. No errors.
   void end_step();
@@ -64,9 +79,6 @@ class ContactRecycler {
 
   std::vector<Cached> last_;  // the last step's, in pair order
   std::vector<Cached> next_;  // this step's
-  std::size_t cursor_ = 0;    // in last_: the first entry not below the pair looked up
-  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-  std::size_t found_ = kNone;  // in last_: the entry recycle() used, for keep(); kNone: none
 };
 
 }  // namespace cps

@@ -217,12 +217,17 @@ void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lam
   }
 }
 
+// Fewest items (rows, bodies, runs) a stage shares among threads (count): below it waking them
+// (microseconds, tens on a virtual machine) costs about what the work does.
+constexpr std::size_t kMinParallel = 256;
+
 // Coupling entries reserved per row: sum over runs of m (m - 1) / 2 <= (kMaxRun - 1) / 2 *
 // (sum of m), so this bound holds for any mix of manifolds (8 bytes x 12 = 96 bytes a row).
 constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun / 2;
 
-// The coupling blocks of s.runs (any order), at offsets set here (PGS and coloured PGS).
-void build_coupling(MatrixFreeSystem& s) {
+// The coupling blocks of s.runs (any order), at offsets set here (PGS and coloured PGS), the
+// blocks computed on `workers`' threads.
+void build_coupling(MatrixFreeSystem& s, Workers* workers = nullptr) {
   std::size_t coupling_size = 0;
   for (MatrixFreeSystem::Run& run : s.runs) {
     const int m = run.count;
@@ -235,19 +240,22 @@ void build_coupling(MatrixFreeSystem& s) {
   // step (which a long run meets after warm-up).
   detail::reserve_with_headroom(s.coupling, std::max(coupling_size, kCouplingPerRow * s.rows.size()));
   detail::resize_with_headroom(s.coupling, coupling_size);
-  for (const MatrixFreeSystem::Run& run : s.runs) {
-    if (run.offset < 0) continue;
-    const PackedRow* r = s.rows.data() + run.begin;
-    double* g = s.coupling.data() + run.offset;
-    for (int i = 0; i < run.count; g += run.count - 1 - i, ++i) {
-      // Column i: A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
-      for (int k = i + 1; k < run.count; ++k) {
-        const double a_ki = ConstMap6(r[k].j.data()).dot(ConstMap6(r[i].minv_jt.data())) +
-                            ConstMap6(r[k].j.data() + 6).dot(ConstMap6(r[i].minv_jt.data() + 6));
-        g[k - i - 1] = a_ki * r[k].inv_diagonal;
+  parallel_for(workers, s.runs.size(), kMinParallel, [&s](int, std::size_t begin, std::size_t end) {
+    for (std::size_t n = begin; n < end; ++n) {
+      const MatrixFreeSystem::Run& run = s.runs[n];
+      if (run.offset < 0) continue;
+      const PackedRow* r = s.rows.data() + run.begin;
+      double* g = s.coupling.data() + run.offset;
+      for (int i = 0; i < run.count; g += run.count - 1 - i, ++i) {
+        // Column i: A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
+        for (int k = i + 1; k < run.count; ++k) {
+          const double a_ki = ConstMap6(r[k].j.data()).dot(ConstMap6(r[i].minv_jt.data())) +
+                              ConstMap6(r[k].j.data() + 6).dot(ConstMap6(r[i].minv_jt.data() + 6));
+          g[k - i - 1] = a_ki * r[k].inv_diagonal;
+        }
       }
     }
-  }
+  });
 }
 
 // Runs of consecutive rows on the same two slots in row order, and their coupling blocks (PGS).
@@ -270,7 +278,7 @@ void build_runs(MatrixFreeSystem& s) {
 
 // Coloured PGS: the runs of s.colours at their positions (the rows are packed in sweep order, so
 // a colour's runs are consecutive) and their coupling blocks.
-void build_coloured_runs(MatrixFreeSystem& s) {
+void build_coloured_runs(MatrixFreeSystem& s, Workers* workers) {
   s.runs.clear();
   detail::reserve_with_headroom(s.runs, s.colours.runs.size());
   int position = 0;
@@ -284,14 +292,14 @@ void build_coloured_runs(MatrixFreeSystem& s) {
     }
   }
   s.sweep_start.back() = s.runs.size();
-  build_coupling(s);
+  build_coupling(s, workers);
   s.runs_ready = true;
 }
 
 }  // namespace
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
-             const std::vector<Body>& bodies, SolverKind kind) {
+             const std::vector<Body>& bodies, SolverKind kind, Workers* workers) {
   const int n = static_cast<int>(bodies.size());
   s.runs_ready = false;  // built below (coloured PGS) or by the first PGS solve (Jacobi: never)
   if (kind == SolverKind::coloured_pgs) {
@@ -304,7 +312,9 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     s.position.clear();
   }
   detail::resize_with_headroom(s.inv_inertia, bodies.size());
-  for (std::size_t i = 0; i < bodies.size(); ++i) s.inv_inertia[i] = bodies[i].inv_inertia_world();
+  parallel_for(workers, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) s.inv_inertia[i] = bodies[i].inv_inertia_world();
+  });
   detail::resize_with_headroom(s.rows, rows.size());
   detail::resize_with_headroom(s.diagonal, rows.size());
   detail::resize_with_headroom(s.w, bodies.size() + 1);  // slot n: static bodies and the fixed world, always 0
@@ -349,55 +359,54 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     p.inv_diagonal = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
     return diagonal;
   };
-  if (s.perm.empty()) {
-    for (std::size_t i = 0; i < rows.size(); ++i) s.diagonal[i] = pack(rows[i], rows[i].normal_row, s.rows[i]);
-  } else {
+  parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    if (s.perm.empty()) {
+      for (std::size_t i = begin; i < end; ++i) s.diagonal[i] = pack(rows[i], rows[i].normal_row, s.rows[i]);
+      return;
+    }
     // Coloured PGS: read in row order and stored at the row's position (scattered stores cost
     // less than scattered loads, which the next instructions wait on), built in one place first.
     PackedRow p;
-    for (std::size_t i = 0; i < rows.size(); ++i) {
+    for (std::size_t i = begin; i < end; ++i) {
       const int normal_row = rows[i].normal_row;
       const auto at = static_cast<std::size_t>(s.position[i]);
       s.diagonal[at] = pack(rows[i], normal_row < 0 ? normal_row : s.position[static_cast<std::size_t>(normal_row)], p);
       s.rows[at] = p;
     }
-  }
-  if (kind == SolverKind::coloured_pgs) build_coloured_runs(s);
+  });
+  if (kind == SolverKind::coloured_pgs) build_coloured_runs(s, workers);
 }
 
 void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
          const std::vector<Body>& bodies, const Eigen::VectorXd& f_ext, double dt,
-         TargetTerms terms) {
+         TargetTerms terms, Workers* workers) {
   detail::resize_with_headroom(s.b, rows.size());
   // a = v1 / dt + M^-1 f_ext per body, in w's storage (solve() overwrites it).
   detail::resize_with_headroom(s.w, bodies.size() + 1);
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const Body& body = bodies[i];
-    Vec6& a = s.w[i];
-    a.head<3>() = body.inv_mass * body.p / dt;
-    a.tail<3>() = s.inv_inertia[i] * body.l / dt;
-    if (!body.is_static()) {
-      const auto k = static_cast<Eigen::Index>(6 * i);
-      a.head<3>() += body.inv_mass * f_ext.segment<3>(k);
-      a.tail<3>() += s.inv_inertia[i] * f_ext.segment<3>(k + 3);
+  parallel_for(workers, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Body& body = bodies[i];
+      Vec6& a = s.w[i];
+      a.head<3>() = body.inv_mass * body.p / dt;
+      a.tail<3>() = s.inv_inertia[i] * body.l / dt;
+      if (!body.is_static()) {
+        const auto k = static_cast<Eigen::Index>(6 * i);
+        a.head<3>() += body.inv_mass * f_ext.segment<3>(k);
+        a.tail<3>() += s.inv_inertia[i] * f_ext.segment<3>(k + 3);
+      }
     }
-  }
+  });
   s.w.back().setZero();
-  if (terms == TargetTerms::push_from_rest) {  // the bodies at rest, no external force: b = v / dt
-    for (std::size_t i = 0; i < rows.size(); ++i) s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt;
-    return;
-  }
   const int fixed_slot = static_cast<int>(bodies.size());
-  if (s.perm.empty()) {
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      s.b[i] = target_velocity(rows[i], terms) / dt - row_times_w(s.rows[i], s.w, fixed_slot);
+  parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    if (terms == TargetTerms::push_from_rest) {  // the bodies at rest, no external force: b = v / dt
+      for (std::size_t i = begin; i < end; ++i) s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt;
+      return;
     }
-    return;
-  }
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const double v = target_velocity(rows[static_cast<std::size_t>(s.perm[i])], terms);
-    s.b[i] = v / dt - row_times_w(s.rows[i], s.w, fixed_slot);
-  }
+    for (std::size_t i = begin; i < end; ++i) {
+      s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt - row_times_w(s.rows[i], s.w, fixed_slot);
+    }
+  });
 }
 
 void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, FrictionModel friction,

@@ -79,17 +79,20 @@ struct MatrixFreeSystem {
 /// and the bounds, and the world inverse inertia per body, resizing the buffers (no allocation
 /// once they are big enough). For SolverKind::coloured_pgs it colours the rows first
 /// (row_colours.h) and packs them in sweep order, so that the sweeps read them in order. Rows
-/// refer to bodies by index or kWorldBody. Source: Eq. 6.2.9, A_jj = j M^-1 j^T. No errors.
+/// refer to bodies by index or kWorldBody. The packing and the coupling blocks are shared among
+/// `workers`' threads (nullptr: the calling thread; the same numbers for every count; the
+/// colouring stays on one). Source: Eq. 6.2.9, A_jj = j M^-1 j^T. No errors.
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
-             const std::vector<Body>& bodies, SolverKind kind);
+             const std::vector<Body>& bodies, SolverKind kind, Workers* workers = nullptr);
 
 /// Fills s.b (c): b_j = v_j / dt - j_j . (v1 / dt + M^-1 f_ext) (Eq. 6.2.9) with f_ext (6n:
 /// force and torque per body, N and N m; the explicit path reads the same vector), v1 from the
 /// bodies' momenta now and the inverse inertia of prepare(), and v_j the row's push and bias
-/// (TargetTerms as in assemble_rhs; push_from_rest: b_j = push_j / dt). dt in s, > 0.
+/// (TargetTerms as in assemble_rhs; push_from_rest: b_j = push_j / dt). dt in s, > 0. Shared
+/// among `workers`' threads as prepare(). No errors.
 void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
          const std::vector<Body>& bodies, const Eigen::VectorXd& f_ext, double dt,
-         TargetTerms terms);
+         TargetTerms terms, Workers* workers = nullptr);
 
 /// Solves the bounded system with `iterations` sweeps of PGS, coloured PGS (in the sweep order of
 /// prepare(), a colour's runs shared among `workers`' threads; nullptr: one thread; the same

@@ -333,8 +333,10 @@ const std::array kParameters = {
               .max = 64.0,
               .help = "threads a step runs on: push soft, and --solver coloured-pgs with "
                       "--assembly matrix-free, share each graph colour's rows among them; the "
-                      "rest runs on one; the same result for every count; typical: the "
-                      "machine's cores for large scenes",
+                      "narrow phase, the matrix-free packing and right-hand side and the soft "
+                      "step's prepare and store are shared under every method; the rest runs "
+                      "on one; the same result for every count; typical: the machine's cores "
+                      "for large scenes",
               .get = &get_member<&WorldDef::threads>,
               .set = &set_member<&WorldDef::threads>},
     Parameter{.name = "contact_hertz",

@@ -25,7 +25,16 @@ StepContext::StepContext(const StepContext& other)
 StepContext::~StepContext() = default;
 
 SolveSettings StepContext::settings(double dt) const {
-  return SolveSettings{dt, def->iterations, def->solver, def->friction_model, def->threads};
+  return SolveSettings{dt, def->iterations, def->solver, def->friction_model, workers()};
+}
+
+void StepContext::update_workers() {
+  if (def->threads <= 1) {
+    pool.reset();
+  } else if (!pool || pool->count() != def->threads) {
+    pool.reset();  // the old threads end before the new ones start
+    pool = std::make_unique<Workers>(def->threads);
+  }
 }
 
 void StepContext::prepare() {
@@ -35,7 +44,7 @@ void StepContext::prepare() {
     solver_assembly = def->assembly;
   }
   StageTimer timer(*this, &StageTimes::prepare);
-  solver->prepare(rows, *bodies, def->solver);
+  solver->prepare(rows, *bodies, def->solver, workers());
 }
 
 void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<double>& out,

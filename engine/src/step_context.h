@@ -67,6 +67,9 @@ struct StepContext {
   Eigen::VectorXd f_cv;               ///< 6n: f_ext + J^T lambda, the force that moves positions
   Eigen::VectorXd f_c0;               ///< 6n: the force of the stored momenta (Sec. 8.1)
   std::unique_ptr<ConstraintSolver> solver;  ///< for def->assembly, made by prepare()
+  /// def->threads threads for the stages that share their work (workers.h); null for one thread.
+  /// Kept from step to step (update_workers); not copied with the context.
+  std::unique_ptr<Workers> pool;
   Assembly solver_assembly = Assembly::matrix_free;
   /// Warm starting (Sec. 6.2.3): the last step's contacts and lambdas (made when first needed),
   /// and this step's initial guesses of the two solves (c each, N).
@@ -75,6 +78,15 @@ struct StepContext {
   std::vector<double> initial_second;
   /// Contact recycling (WorldDef::contact_recycle_distance > 0): the manifolds that may be kept.
   std::unique_ptr<ContactRecycler> recycler;
+  /// One chunk of the narrow phase (World::collide on several threads): the manifolds of the
+  /// touching pairs of its consecutive pairs, in pair order, and for each the last step's
+  /// recycled entry (ContactRecycler::kNone: made anew).
+  struct NarrowShare {
+    std::vector<Manifold> manifolds;
+    std::vector<std::size_t> found;
+  };
+  std::vector<NarrowShare> narrow_shares;  ///< per chunk; not copied with the context
+  std::vector<std::size_t> first_points;   ///< per manifold: its points before it (World::build_rows)
   StepCounters counters;
   ResidualStats residual;
   /// World::set_solve_observer's callback, or empty (the usual case: one branch a solve). Not
@@ -85,6 +97,12 @@ struct StepContext {
   int solves_this_step = 0;  ///< solves made in the current step (StepSystem::solve)
   bool time_stages = false;  ///< World::set_stage_timing
   StageTimes stage_times;    ///< s, summed while time_stages is on
+
+  /// Makes or drops `pool` to match def->threads (World::step calls it first). Throws
+  /// std::system_error when a thread cannot be started.
+  void update_workers();
+  /// The step's threads, or nullptr for one thread.
+  Workers* workers() const { return pool.get(); }
 
   /// Warm starting is on (WorldDef::warm_start > 0).
   bool warm() const { return def->warm_start > 0.0; }

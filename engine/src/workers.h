@@ -4,6 +4,7 @@
 // index and they meet at barriers between the stages, so a step wakes the threads once.
 
 #include <atomic>
+#include <cstddef>
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
@@ -69,6 +70,46 @@ class Workers {
   void* task_ = nullptr;
   std::vector<std::thread> threads_;
 };
+
+/// Runs fn(t, begin, end) for each thread t of `workers` on its share [begin, end) of the items
+/// [0, count), split evenly in order (the same shares for a given thread count), and returns when
+/// all have returned; with no workers, one thread, or fewer than `min_parallel` items (count;
+/// below it waking the threads costs more than the work), fn(0, 0, count) on the calling thread.
+/// For work whose items write only their own results, so the result is the same for every thread
+/// count. fn must not throw.
+template <class Fn>
+void parallel_for(Workers* workers, std::size_t count, std::size_t min_parallel, Fn&& fn) {
+  if (workers == nullptr || workers->count() == 1 || count < min_parallel) {
+    fn(0, std::size_t{0}, count);
+    return;
+  }
+  const auto threads = static_cast<std::size_t>(workers->count());
+  auto share = [&](int t) {
+    const auto k = static_cast<std::size_t>(t);
+    fn(t, count * k / threads, count * (k + 1) / threads);
+  };
+  workers->run(share);
+}
+
+/// Runs fn(k) for every chunk k in [0, chunks) on the threads of `workers`, each thread taking
+/// the next chunk no thread has taken yet (so uneven chunks even out); with no workers or one
+/// thread, in order on the calling thread. For chunks that write only their own results, so the
+/// result is the same for every thread count and schedule. fn must not throw.
+template <class Fn>
+void parallel_chunks(Workers* workers, std::size_t chunks, Fn&& fn) {
+  if (workers == nullptr || workers->count() == 1 || chunks <= 1) {
+    for (std::size_t k = 0; k < chunks; ++k) fn(k);
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  auto take = [&](int) {
+    for (std::size_t k = next.fetch_add(1, std::memory_order_relaxed); k < chunks;
+         k = next.fetch_add(1, std::memory_order_relaxed)) {
+      fn(k);
+    }
+  };
+  workers->run(take);
+}
 
 inline Workers::Workers(int count) : count_(count < 1 ? 1 : count) {
   try {

@@ -19,6 +19,14 @@
 namespace cps {
 namespace {
 
+// Fewest bodies or manifolds the row stage shares among threads (count): below it waking them
+// (microseconds, tens on a virtual machine) costs about what the work does.
+constexpr std::size_t kMinParallelRows = 256;
+
+// Candidate pairs in a chunk of the narrow phase on several threads (count): small enough that
+// the threads' loads even out, large enough that taking a chunk costs nothing against it.
+constexpr std::size_t kPairsPerChunk = 256;
+
 // Every component finite and within +-limit (isfinite first: no exception on NaN).
 bool within(const Vec3& v, double limit) {
   for (int k = 0; k < 3; ++k) {
@@ -115,6 +123,7 @@ void World::step() {
     push_mode_ = def_.push;
   }
   ctx.solves_this_step = 0;
+  ctx.update_workers();
   {
     StageTimer timer(ctx, &StageTimes::collide);
     external_forces();  // Sec. 6.1: f_ext
@@ -174,63 +183,113 @@ void World::collide() {
   } else {
     ctx_->recycler.reset();
   }
-  std::size_t points = 0;
-  for (const auto& [a, b] : pairs_) {
-    ++counters.pairs_tested;
-    // Built in place (no copy of the 8 contact slots); dropped again if the pair does not touch.
-    Manifold& m = manifolds.emplace_back();
+  ContactRecycler* recycler = ctx_->recycler.get();
+  using Cursor = ContactRecycler::Cursor;
+  // The narrow phase of one pair into m: true when the pair touches (its manifold recycled, or
+  // made and reduced as the world asks). Reads only: threads may run it at once.
+  const auto narrow = [&](std::pair<int, int> pair, Manifold& m, Cursor& cursor) {
+    const auto [a, b] = pair;
     m.body_a = a;
     m.body_b = b;
     const auto ia = static_cast<std::size_t>(a);
     const auto ib = static_cast<std::size_t>(b);
     const double margin =
         per_body ? def_.contact_margin + margins_[ia] + margins_[ib] : def_.contact_margin;
-    const bool recycled = recycle > 0.0 && ctx_->recycler->recycle(a, b, bodies_, recycle, m);
-    if (recycled || cps::collide(bodies_[ia], rotations_[ia], bodies_[ib], rotations_[ib], m, margin) > 0) {
-      if (!recycled && def_.manifold_points == ManifoldPoints::four) reduce_manifold(m, def_.contact_margin);
-      if (recycle > 0.0) ctx_->recycler->keep(m, bodies_, recycled);
-      counters.recycled += recycled ? 1 : 0;
-      counters.contacts += m.count;
-      points += static_cast<std::size_t>(m.count);
-      if (points > kMaxContactPoints) {
-        throw std::length_error("the narrow phase found more than " +
-                                std::to_string(kMaxContactPoints) + " contact points among " +
-                                std::to_string(bodies_.size()) +
-                                " bodies in one step: the bodies are too crowded; spread them out");
+    if (recycler != nullptr && recycler->recycle(a, b, bodies_, recycle, m, cursor)) return true;
+    cursor.found = ContactRecycler::kNone;
+    if (cps::collide(bodies_[ia], rotations_[ia], bodies_[ib], rotations_[ib], m, margin) == 0) return false;
+    if (def_.manifold_points == ManifoldPoints::four) reduce_manifold(m, def_.contact_margin);
+    return true;
+  };
+  // A touching pair's manifold, in pair order: cached for recycling, counted and bounded.
+  std::size_t points = 0;
+  const auto accept = [&](const Manifold& m, std::size_t found) {
+    if (recycler != nullptr) recycler->keep(m, bodies_, found);
+    counters.recycled += found != ContactRecycler::kNone ? 1 : 0;
+    counters.contacts += m.count;
+    points += static_cast<std::size_t>(m.count);
+    if (points > kMaxContactPoints) {
+      throw std::length_error("the narrow phase found more than " +
+                              std::to_string(kMaxContactPoints) + " contact points among " +
+                              std::to_string(bodies_.size()) +
+                              " bodies in one step: the bodies are too crowded; spread them out");
+    }
+  };
+  counters.pairs_tested += static_cast<std::int64_t>(pairs_.size());
+  Workers* workers = ctx_->workers();
+  if (workers == nullptr) {
+    Cursor cursor;
+    for (const std::pair<int, int>& pair : pairs_) {
+      // Built in place (no copy of the 8 contact slots); dropped again if the pair does not touch.
+      Manifold& m = manifolds.emplace_back();
+      if (narrow(pair, m, cursor)) {
+        accept(m, cursor.found);
+      } else {
+        manifolds.pop_back();
       }
-    } else {
-      manifolds.pop_back();
+    }
+  } else {
+    // The pairs in chunks of consecutive pairs, each into its own list (the threads take the
+    // chunks as they come free: the pairs' cost is uneven, and a plane's pairs come together);
+    // the lists are joined in chunk order, so the manifolds are those of one thread, in the same
+    // order.
+    std::vector<StepContext::NarrowShare>& shares = ctx_->narrow_shares;
+    const std::size_t chunks = (pairs_.size() + kPairsPerChunk - 1) / kPairsPerChunk;
+    if (shares.size() < chunks) shares.resize(chunks);
+    parallel_chunks(workers, chunks, [&](std::size_t k) {
+      const std::size_t begin = k * kPairsPerChunk;
+      const std::size_t end = std::min(begin + kPairsPerChunk, pairs_.size());
+      StepContext::NarrowShare& share = shares[k];
+      share.manifolds.clear();
+      share.found.clear();
+      Cursor cursor = recycler != nullptr ? recycler->cursor_at(pairs_[begin].first, pairs_[begin].second) : Cursor{};
+      for (std::size_t i = begin; i < end; ++i) {
+        Manifold& m = share.manifolds.emplace_back();
+        if (narrow(pairs_[i], m, cursor)) {
+          share.found.push_back(cursor.found);
+        } else {
+          share.manifolds.pop_back();
+        }
+      }
+    });
+    for (std::size_t k = 0; k < chunks; ++k) {
+      const StepContext::NarrowShare& share = shares[k];
+      for (std::size_t i = 0; i < share.manifolds.size(); ++i) {
+        accept(share.manifolds[i], share.found[i]);
+        manifolds.push_back(share.manifolds[i]);
+      }
     }
   }
-  if (recycle > 0.0) ctx_->recycler->end_step();
+  if (recycler != nullptr) recycler->end_step();
 }
 // Stage 2, Sec. 5: contact rows, friction rows, then distance rows.
 void World::build_rows() {
   StepContext& ctx = *ctx_;
   std::vector<ConstraintRow>& rows = ctx.rows;
-  rows.clear();
-  // The row count is known from the manifolds: make room once, with headroom (no allocation in
-  // steady state).
-  detail::reserve_with_headroom(rows, contact_point_count(ctx.manifolds) *
-                                          (def_.friction > 0.0 ? 3 : 1) +
-                                      distances_.size());
   RowParams params{def_.beta,        def_.dt,
                    def_.friction,    def_.gravity,
                    def_.restitution, def_.restitution_threshold,
                    def_.penetration_slop};
   push_->adjust_rows(def_, params);  // the paper's methods leave params as they are
-  // Each body's v and w (w needs I^-1 = R I_body^-1 R^T) once, for the bodies in a manifold;
-  // a body typically sits in several.
+  // The row count is known from the manifolds: make room once, with headroom (no allocation in
+  // steady state).
+  const std::size_t points = contact_point_count(ctx.manifolds);
+  const bool friction = params.friction > 0.0;  // two friction rows a point (write_friction_rows)
+  detail::reserve_with_headroom(rows, points * (friction ? 3 : 1) + distances_.size());
+  // Each body's v and w (w needs I^-1 = R I_body^-1 R^T) once, for the bodies in a manifold
+  // (velocity_known_ marks them); a body typically sits in several.
   velocity_known_.assign(bodies_.size(), 0);  // n bytes: no allocation once grown
   velocities_.resize(bodies_.size());
-  const auto velocity = [this](int i) -> const BodyVelocity& {
-    const auto k = static_cast<std::size_t>(i);
-    if (!velocity_known_[k]) {
-      velocities_[k] = body_velocity(bodies_[k]);
-      velocity_known_[k] = 1;
+  for (const Manifold& m : ctx.manifolds) {
+    velocity_known_[static_cast<std::size_t>(m.body_a)] = 1;
+    velocity_known_[static_cast<std::size_t>(m.body_b)] = 1;
+  }
+  Workers* workers = ctx.workers();
+  parallel_for(workers, bodies_.size(), kMinParallelRows, [this](int, std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      if (velocity_known_[k]) velocities_[k] = body_velocity(bodies_[k]);
     }
-    return velocities_[k];
-  };
+  });
   // Warm starting: which contacts persist from the last step, and the friction directions that
   // carry their lambdas over (warm_start.h). Without it the cache is dropped.
   const bool warm = def_.warm_start > 0.0;
@@ -248,16 +307,26 @@ void World::build_rows() {
   // later in a sweep no longer disturb the sliding velocity the friction rows set
   // (docs/findings.md, "Why the paper's stack drifts": the stack slid 2.4 m in 600 s with each
   // point's friction rows right after its contact row).
-  for (const Manifold& m : ctx.manifolds) {
-    append_normal_rows(m, bodies_, velocity(m.body_a), velocity(m.body_b), params, rows);
+  // Manifold k's contact rows start at its first point, its friction rows at points plus twice
+  // that: each manifold writes only its own rows, so the threads share the manifolds.
+  std::vector<std::size_t>& first_point = ctx.first_points;
+  detail::resize_with_headroom(first_point, ctx.manifolds.size());
+  for (std::size_t k = 0, p = 0; k < ctx.manifolds.size(); ++k) {
+    first_point[k] = p;
+    p += static_cast<std::size_t>(ctx.manifolds[k].count);
   }
-  int first_normal_row = 0;
-  for (const Manifold& m : ctx.manifolds) {
-    const std::size_t first = static_cast<std::size_t>(first_normal_row);
-    append_friction_rows(m, bodies_, params, first_normal_row, rows,
-                         warm ? ctx.warm_start->tangents(first) : nullptr);
-    first_normal_row += m.count;
-  }
+  rows.resize(points * (friction ? 3 : 1));  // rows left from the last step are written whole
+  parallel_for(workers, ctx.manifolds.size(), kMinParallelRows, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const Manifold& m = ctx.manifolds[k];
+      const std::size_t first = first_point[k];
+      write_normal_rows(m, bodies_, velocities_[static_cast<std::size_t>(m.body_a)],
+                        velocities_[static_cast<std::size_t>(m.body_b)], params, rows.data() + first);
+      if (!friction) continue;
+      write_friction_rows(m, bodies_, params, static_cast<int>(first), rows.data() + points + 2 * first,
+                          warm ? ctx.warm_start->tangents(first) : nullptr);
+    }
+  });
   for (const DistanceConstraint& d : distances_) append_distance_row(d, bodies_, params, rows);
   ctx.counters.rows += static_cast<std::int64_t>(rows.size());
   if (warm) {

@@ -450,9 +450,15 @@ TEST_CASE("contact recycling keeps a manifold while the bodies barely move, with
   first.body_a = 0;  // as the collide stage names them
   first.body_b = 1;
   ContactRecycler recycler;
+  // The lookups below ask for (0, 1) or later pairs, in ascending order: one cursor serves them.
+  ContactRecycler::Cursor fresh_cursor;
   recycler.begin_step();
-  recycler.keep(first, bodies, false);
+  recycler.keep(first, bodies, ContactRecycler::kNone);
   recycler.end_step();
+  // A thread's cursor starts at the first cached pair not below its first pair.
+  CHECK(recycler.cursor_at(0, 1).at == 0);
+  CHECK(recycler.cursor_at(0, 2).at == 1);
+  CHECK(recycler.cursor_at(0, 0).at == 0);
 
   const auto moved = [&](const Vec3& dx, double turn_deg) {
     std::vector<Body> b = bodies;
@@ -464,7 +470,9 @@ TEST_CASE("contact recycling keeps a manifold while the bodies barely move, with
     const std::vector<Body> b = moved(Vec3(0.01, -0.003, 0.02), 0.0);
     recycler.begin_step();
     Manifold kept;
-    REQUIRE(recycler.recycle(0, 1, b, 0.05, kept));
+    ContactRecycler::Cursor cursor;
+    REQUIRE(recycler.recycle(0, 1, b, 0.05, kept, cursor));
+    CHECK(cursor.found == 0);
     Manifold fresh;
     REQUIRE(collide(b[0], b[1], fresh, 0.02) == 4);
     REQUIRE(kept.count == 4);
@@ -482,7 +490,7 @@ TEST_CASE("contact recycling keeps a manifold while the bodies barely move, with
       }
       CHECK(same);
     }
-    recycler.keep(kept, b, true);
+    recycler.keep(kept, b, cursor.found);
     recycler.end_step();
   }
   // The motion adds up from the pose of the clip, not from the last recycling: 0.03 m more
@@ -490,24 +498,24 @@ TEST_CASE("contact recycling keeps a manifold while the bodies barely move, with
   {
     recycler.begin_step();
     Manifold kept;
-    CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3(0.04, 0.0, 0.03), 0.0), 0.05, kept));
+    CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3(0.04, 0.0, 0.03), 0.0), 0.05, kept, fresh_cursor));
     recycler.end_step();
   }
   // Turns: 3 degrees moves the box's corners by 2 sin(1.5 deg) 0.866 = 0.045 m, kept at 0.05;
   // 12 degrees is past the turn limit at any distance.
   recycler.begin_step();
-  recycler.keep(first, bodies, false);
+  recycler.keep(first, bodies, ContactRecycler::kNone);
   recycler.end_step();
   recycler.begin_step();
   Manifold kept;
-  CHECK(recycler.recycle(0, 1, moved(Vec3::Zero(), 3.0), 0.05, kept));
+  CHECK(recycler.recycle(0, 1, moved(Vec3::Zero(), 3.0), 0.05, kept, fresh_cursor));
   recycler.begin_step();
-  CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3::Zero(), 3.0), 0.04, kept));
+  CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3::Zero(), 3.0), 0.04, kept, fresh_cursor));
   recycler.begin_step();
-  CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3::Zero(), 12.0), 100.0, kept));
+  CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3::Zero(), 12.0), 100.0, kept, fresh_cursor));
   // Another pair than the cached one is never recycled.
   recycler.begin_step();
-  CHECK_FALSE(recycler.recycle(0, 2, bodies, 0.05, kept));
+  CHECK_FALSE(recycler.recycle(0, 2, bodies, 0.05, kept, fresh_cursor));
 }
 
 TEST_CASE("a world with contact recycling and reduced manifolds steps its copy as itself",

@@ -113,6 +113,12 @@ void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
                         const BodyVelocity& v_a, const BodyVelocity& v_b,
                         const RowParams& params, std::vector<ConstraintRow>& rows);
 
+/// The rows of append_normal_rows written to out[0, m.count) instead (each row replaced whole),
+/// so that threads may build the rows of different manifolds into one vector. No errors.
+void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
+                       const BodyVelocity& v_a, const BodyVelocity& v_b,
+                       const RowParams& params, ConstraintRow* out);
+
 /// Appends two friction rows per point of m (Sec. 5.4), in point order, along t1 and t2 of
 /// tangent_basis(n): target 0, limits +-mu m |g . n| (N) where m (kg) is the combined mass of
 /// the two bodies divided over the manifold's points (the movable body's mass when the other is
@@ -124,6 +130,12 @@ void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
 void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
                           const RowParams& params, int first_normal_row,
                           std::vector<ConstraintRow>& rows, const Vec3* tangents = nullptr);
+
+/// The rows of append_friction_rows written to out[0, 2 m.count) instead (each row replaced
+/// whole; nothing when params.friction is 0). No errors.
+void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
+                         const RowParams& params, int first_normal_row, ConstraintRow* out,
+                         const Vec3* tangents = nullptr);
 
 /// A distance constraint (Sec. 5.2): point local_a of body_a and point local_b of body_b stay
 /// `length` apart (m, >= 0). local_a, local_b are in body space (m); when body_b is kWorldBody,

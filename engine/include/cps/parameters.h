@@ -151,8 +151,11 @@ struct WorldDef {
   SoftRelax soft_relax = SoftRelax::continue_solve;
   /// Threads a step runs on (count, in [1, 64]; the calling thread is one of them). The soft
   /// step, and the matrix-free solve of SolverKind::coloured_pgs, share each graph colour's rows
-  /// among them (engine/src/constraint_graph.h); everything else runs on one thread. The result is the same for every count, bit for bit.
-  /// Typical: the machine's cores for large scenes; 1 (the default) for small ones.
+  /// among them (engine/src/constraint_graph.h); under every method the narrow phase, the
+  /// matrix-free packing and right-hand side and the soft step's prepare and store are shared
+  /// too (engine/src/workers.h); the rest runs on one thread. The result is the same for every
+  /// count, bit for bit. Typical: the machine's cores for large scenes; 1 (the default) for
+  /// small ones.
   int threads = 1;
   /// Soft step only: the contact rows' stiffness (Hz, >= 0; 0 = rigid rows without push), capped
   /// at an eighth of the substep rate; contacts with a static body get twice it. Box3D's

@@ -104,6 +104,10 @@
 namespace cps {
 namespace {
 
+// Fewest bodies or manifolds a stage shares among threads (count): below it waking them
+// (microseconds, tens on a virtual machine) costs about what the work does.
+constexpr std::size_t kMinParallel = 256;
+
 // Box3D's soft coefficients of one kind of row over a substep (b3MakeSoft).
 struct Softness {
   double bias_rate = 0.0;      // 1/s
@@ -238,7 +242,7 @@ class SoftStep final : public PushMethod {
   void step(StepContext& ctx) override {
     const WorldDef& def = *ctx.def;
     const double h = def.dt / static_cast<double>(def.soft_substeps);
-    if (!workers_ || workers_->count() != def.threads) workers_ = std::make_unique<Workers>(def.threads);
+    workers_ = ctx.workers() != nullptr ? ctx.workers() : &one_thread_;
     {
       StageTimer timer(ctx, &StageTimes::prepare);
       prepare(ctx, h);
@@ -269,17 +273,19 @@ class SoftStep final : public PushMethod {
     const auto threads = static_cast<std::size_t>(workers_->count());
     detail::resize_with_headroom(solver_bodies_, n + threads);
     detail::resize_with_headroom(inertia_, n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Body& body = bodies[i];
-      SolverBody& s = solver_bodies_[i];
-      s = SolverBody{};
-      if (body.is_static()) continue;
-      s.inv_mass = body.inv_mass;
-      s.inv_I = body.inv_inertia_world();
-      s.v = body.velocity();
-      s.w = s.inv_I * body.l;
-      inertia_[i] = s.inv_I.inverse();
-    }
+    parallel_for(workers_, n, kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const Body& body = bodies[i];
+        SolverBody& s = solver_bodies_[i];
+        s = SolverBody{};
+        if (body.is_static()) continue;
+        s.inv_mass = body.inv_mass;
+        s.inv_I = body.inv_inertia_world();
+        s.v = body.velocity();
+        s.w = s.inv_I * body.l;
+        inertia_[i] = s.inv_I.inverse();
+      }
+    });
     for (std::size_t t = 0; t < threads; ++t) solver_bodies_[n + t] = SolverBody{};  // stand-ins
     // A static body and the world (kWorldBody) are -1 in the sweeps (body()); read here, a
     // static body's entry and the stand-in n are both zero.
@@ -324,89 +330,92 @@ class SoftStep final : public PushMethod {
     for (std::size_t j = 0; j < count; ++j) point_start_[j + 1] += point_start_[j];
     detail::resize_with_headroom(contacts_, points);
     detail::resize_with_headroom(manifolds_, count);
-    for (std::size_t k = 0; k < count; ++k) {
-      const Manifold& m = ctx.manifolds[k];
-      std::size_t g = first_row_[k];  // the point's index over the step: its contact row
-      const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];
-      const Body& body_b = bodies[static_cast<std::size_t>(m.body_b)];
-      const SolverBody& a = solver_bodies_[static_cast<std::size_t>(m.body_a)];
-      const SolverBody& b = solver_bodies_[static_cast<std::size_t>(m.body_b)];
-      ManifoldFriction& f = manifolds_[slot_[k]];
-      f = ManifoldFriction{};
-      f.a = moving(m.body_a);
-      f.b = moving(m.body_b);
-      f.begin = point_start_[slot_[k]];
-      f.normal = m.contacts[0].normal;
-      Vec3 center_a = Vec3::Zero();
-      Vec3 center_b = Vec3::Zero();
-      double total_weight = 0.0;
-      for (int i = 0; i < m.count; ++i, ++g) {
-        const Contact& c = m.contacts[static_cast<std::size_t>(i)];
-        ContactPoint& p = contacts_[f.begin + static_cast<std::size_t>(i)];
-        p = ContactPoint{};
-        p.a = f.a;
-        p.b = f.b;
-        p.row = static_cast<int>(g);
-        p.r_a = c.point - body_a.x;
-        p.r_b = c.point - body_b.x;
-        p.base_separation = -c.depth - c.normal.dot(p.r_b - p.r_a);
-        p.restitution = rows[g].restitution;
-        p.touches_static = body_a.is_static() || body_b.is_static();
-        p.normal = make_axis_row(c.normal, p.r_a, p.r_b, a, b, guess(g));
-        const double weight = std::clamp(2.0 + c.depth * inv_tau, 1e-10, 1.0);
-        center_a += weight * p.r_a;
-        center_b += weight * p.r_b;
-        total_weight += weight;
-      }
-      f.end = f.begin + static_cast<std::size_t>(m.count);
-      if (!friction) continue;
-      const std::size_t first = points + 2 * first_row_[k];
-      f.center_a = center_a / total_weight;
-      f.center_b = center_b / total_weight;
-      for (std::size_t i = f.begin; i < f.end; ++i) {
-        contacts_[i].lever_arm = (contacts_[i].r_a - f.center_a).norm();
-      }
-      f.first_friction_row = static_cast<int>(first);
-      f.mu = rows[first].mu;
-      f.fixed_limit = coupled ? -1.0 : rows[first].c_max * h;
-      tangent_basis(f.normal, f.t1, f.t2);
-      const Vec3 rt_a1 = f.center_a.cross(f.t1);
-      const Vec3 rt_a2 = f.center_a.cross(f.t2);
-      const Vec3 rt_b1 = f.center_b.cross(f.t1);
-      const Vec3 rt_b2 = f.center_b.cross(f.t2);
-      Eigen::Matrix2d K;
-      K(0, 0) = a.inv_mass + b.inv_mass + rt_a1.dot(a.inv_I * rt_a1) + rt_b1.dot(b.inv_I * rt_b1);
-      K(1, 1) = a.inv_mass + b.inv_mass + rt_a2.dot(a.inv_I * rt_a2) + rt_b2.dot(b.inv_I * rt_b2);
-      K(0, 1) = K(1, 0) = rt_a1.dot(a.inv_I * rt_a2) + rt_b1.dot(b.inv_I * rt_b2);
-      f.tangent_mass = K.determinant() != 0.0 ? Eigen::Matrix2d(K.inverse()) : Eigen::Matrix2d::Zero();
-      const double k_twist = f.normal.dot((a.inv_I + b.inv_I) * f.normal);
-      f.twist_mass = k_twist > 0.0 ? 1.0 / k_twist : 0.0;
-      // The warm start: the friction rows' initial lambdas (N, store() below) summed back into
-      // the force at the centre and its twist about the normal, as impulses over h. store()
-      // writes each point's force as an equal share of the centre's plus the twist's
-      // tangential force tau (n x d_i), so with the same points the twist is
-      // sum n . (d_i x (F_i - share)). Only then: from other points, or some of them, that
-      // moment is not the twist they carried, and warm starting it spun large_pyramid's bottom
-      // boxes about their normals at up to 11 rad/s within 1 s.
-      if (warm != nullptr) {
-        Vec3 P = Vec3::Zero();
-        for (std::size_t i = f.begin; i < f.end; ++i) {
-          const std::size_t r = first + 2 * (i - f.begin);
-          P += h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
+    // Each manifold writes only its own slot and points: shared among the threads.
+    parallel_for(workers_, count, kMinParallel, [&](int, std::size_t k_begin, std::size_t k_end) {
+      for (std::size_t k = k_begin; k < k_end; ++k) {
+        const Manifold& m = ctx.manifolds[k];
+        std::size_t g = first_row_[k];  // the point's index over the step: its contact row
+        const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];
+        const Body& body_b = bodies[static_cast<std::size_t>(m.body_b)];
+        const SolverBody& a = solver_bodies_[static_cast<std::size_t>(m.body_a)];
+        const SolverBody& b = solver_bodies_[static_cast<std::size_t>(m.body_b)];
+        ManifoldFriction& f = manifolds_[slot_[k]];
+        f = ManifoldFriction{};
+        f.a = moving(m.body_a);
+        f.b = moving(m.body_b);
+        f.begin = point_start_[slot_[k]];
+        f.normal = m.contacts[0].normal;
+        Vec3 center_a = Vec3::Zero();
+        Vec3 center_b = Vec3::Zero();
+        double total_weight = 0.0;
+        for (int i = 0; i < m.count; ++i, ++g) {
+          const Contact& c = m.contacts[static_cast<std::size_t>(i)];
+          ContactPoint& p = contacts_[f.begin + static_cast<std::size_t>(i)];
+          p = ContactPoint{};
+          p.a = f.a;
+          p.b = f.b;
+          p.row = static_cast<int>(g);
+          p.r_a = c.point - body_a.x;
+          p.r_b = c.point - body_b.x;
+          p.base_separation = -c.depth - c.normal.dot(p.r_b - p.r_a);
+          p.restitution = rows[g].restitution;
+          p.touches_static = body_a.is_static() || body_b.is_static();
+          p.normal = make_axis_row(c.normal, p.r_a, p.r_b, a, b, guess(g));
+          const double weight = std::clamp(2.0 + c.depth * inv_tau, 1e-10, 1.0);
+          center_a += weight * p.r_a;
+          center_b += weight * p.r_b;
+          total_weight += weight;
         }
-        f.impulse = Eigen::Vector2d(P.dot(f.t1), P.dot(f.t2));
-        if (ctx.warm_start != nullptr && ctx.warm_start->same_points(k)) {
-          const Vec3 share = P / static_cast<double>(m.count);
-          double L = 0.0;
+        f.end = f.begin + static_cast<std::size_t>(m.count);
+        if (!friction) continue;
+        const std::size_t first = points + 2 * first_row_[k];
+        f.center_a = center_a / total_weight;
+        f.center_b = center_b / total_weight;
+        for (std::size_t i = f.begin; i < f.end; ++i) {
+          contacts_[i].lever_arm = (contacts_[i].r_a - f.center_a).norm();
+        }
+        f.first_friction_row = static_cast<int>(first);
+        f.mu = rows[first].mu;
+        f.fixed_limit = coupled ? -1.0 : rows[first].c_max * h;
+        tangent_basis(f.normal, f.t1, f.t2);
+        const Vec3 rt_a1 = f.center_a.cross(f.t1);
+        const Vec3 rt_a2 = f.center_a.cross(f.t2);
+        const Vec3 rt_b1 = f.center_b.cross(f.t1);
+        const Vec3 rt_b2 = f.center_b.cross(f.t2);
+        Eigen::Matrix2d K;
+        K(0, 0) = a.inv_mass + b.inv_mass + rt_a1.dot(a.inv_I * rt_a1) + rt_b1.dot(b.inv_I * rt_b1);
+        K(1, 1) = a.inv_mass + b.inv_mass + rt_a2.dot(a.inv_I * rt_a2) + rt_b2.dot(b.inv_I * rt_b2);
+        K(0, 1) = K(1, 0) = rt_a1.dot(a.inv_I * rt_a2) + rt_b1.dot(b.inv_I * rt_b2);
+        f.tangent_mass = K.determinant() != 0.0 ? Eigen::Matrix2d(K.inverse()) : Eigen::Matrix2d::Zero();
+        const double k_twist = f.normal.dot((a.inv_I + b.inv_I) * f.normal);
+        f.twist_mass = k_twist > 0.0 ? 1.0 / k_twist : 0.0;
+        // The warm start: the friction rows' initial lambdas (N, store() below) summed back into
+        // the force at the centre and its twist about the normal, as impulses over h. store()
+        // writes each point's force as an equal share of the centre's plus the twist's
+        // tangential force tau (n x d_i), so with the same points the twist is
+        // sum n . (d_i x (F_i - share)). Only then: from other points, or some of them, that
+        // moment is not the twist they carried, and warm starting it spun large_pyramid's bottom
+        // boxes about their normals at up to 11 rad/s within 1 s.
+        if (warm != nullptr) {
+          Vec3 P = Vec3::Zero();
           for (std::size_t i = f.begin; i < f.end; ++i) {
             const std::size_t r = first + 2 * (i - f.begin);
-            const Vec3 F = h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
-            L += f.normal.dot((contacts_[i].r_a - f.center_a).cross(F - share));
+            P += h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
           }
-          f.twist_impulse = L;
+          f.impulse = Eigen::Vector2d(P.dot(f.t1), P.dot(f.t2));
+          if (ctx.warm_start != nullptr && ctx.warm_start->same_points(k)) {
+            const Vec3 share = P / static_cast<double>(m.count);
+            double L = 0.0;
+            for (std::size_t i = f.begin; i < f.end; ++i) {
+              const std::size_t r = first + 2 * (i - f.begin);
+              const Vec3 F = h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
+              L += f.normal.dot((contacts_[i].r_a - f.center_a).cross(F - share));
+            }
+            f.twist_impulse = L;
+          }
         }
       }
-    }
+    });
 
     const std::size_t first_rod = points * (friction ? 3 : 1);
     rods_.clear();
@@ -751,13 +760,15 @@ class SoftStep final : public PushMethod {
   // bodies' momenta.
   void store(StepContext& ctx, double h) {
     std::vector<Body>& bodies = *ctx.bodies;
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      Body& body = bodies[i];
-      if (body.is_static()) continue;
-      const SolverBody& s = solver_bodies_[i];
-      body.p = body.mass * s.v;
-      body.l = inertia_[i] * s.w;
-    }
+    parallel_for(workers_, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        Body& body = bodies[i];
+        if (body.is_static()) continue;
+        const SolverBody& s = solver_bodies_[i];
+        body.p = body.mass * s.v;
+        body.l = inertia_[i] * s.w;
+      }
+    });
     detail::assign_with_headroom(ctx.lambda, ctx.rows.size(), 0.0);
     const double inv_h = 1.0 / h;
     for (const ContactPoint& p : contacts_) ctx.lambda[static_cast<std::size_t>(p.row)] = p.normal.impulse * inv_h;
@@ -766,29 +777,33 @@ class SoftStep final : public PushMethod {
     // the point's offset from the centre across the normal), which sum to no force and to the
     // torque tau about the normal; each row's lambda the component along its tangent. (A twist
     // on a single point has no such forces and is dropped.)
-    for (const ManifoldFriction& f : manifolds_) {
-      if (f.first_friction_row < 0) continue;
-      const Vec3 share = (f.impulse.x() * f.t1 + f.impulse.y() * f.t2) *
-                         (inv_h / static_cast<double>(f.end - f.begin));
-      double spread = 0.0;  // m^2
-      for (std::size_t i = f.begin; i < f.end; ++i) {
-        const Vec3 d = contacts_[i].r_a - f.center_a;
-        spread += (d - f.normal.dot(d) * f.normal).squaredNorm();
+    parallel_for(workers_, manifolds_.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const ManifoldFriction& f = manifolds_[k];
+        if (f.first_friction_row < 0) continue;
+        const Vec3 share = (f.impulse.x() * f.t1 + f.impulse.y() * f.t2) *
+                           (inv_h / static_cast<double>(f.end - f.begin));
+        double spread = 0.0;  // m^2
+        for (std::size_t i = f.begin; i < f.end; ++i) {
+          const Vec3 d = contacts_[i].r_a - f.center_a;
+          spread += (d - f.normal.dot(d) * f.normal).squaredNorm();
+        }
+        const double tau = spread > 0.0 ? f.twist_impulse * inv_h / spread : 0.0;  // N / m
+        for (std::size_t i = f.begin; i < f.end; ++i) {
+          const Vec3 d = contacts_[i].r_a - f.center_a;
+          const Vec3 F = share + tau * f.normal.cross(d);
+          const std::size_t r = static_cast<std::size_t>(f.first_friction_row) + 2 * (i - f.begin);
+          ctx.lambda[r] = F.dot(ctx.rows[r].j.segment<3>(6));
+          ctx.lambda[r + 1] = F.dot(ctx.rows[r + 1].j.segment<3>(6));
+        }
       }
-      const double tau = spread > 0.0 ? f.twist_impulse * inv_h / spread : 0.0;  // N / m
-      for (std::size_t i = f.begin; i < f.end; ++i) {
-        const Vec3 d = contacts_[i].r_a - f.center_a;
-        const Vec3 F = share + tau * f.normal.cross(d);
-        const std::size_t r = static_cast<std::size_t>(f.first_friction_row) + 2 * (i - f.begin);
-        ctx.lambda[r] = F.dot(ctx.rows[r].j.segment<3>(6));
-        ctx.lambda[r + 1] = F.dot(ctx.rows[r + 1].j.segment<3>(6));
-      }
-    }
+    });
     for (const Rod& rod : rods_) ctx.lambda[static_cast<std::size_t>(rod.row)] = rod.impulse * inv_h;
     ctx.lambda_second.clear();
   }
 
-  std::unique_ptr<Workers> workers_;       // def.threads threads (workers.h)
+  Workers* workers_ = nullptr;             // the step's threads (StepContext::workers) or one_thread_
+  Workers one_thread_{1};                  // the calling thread alone
   std::size_t bodies_ = 0;                 // n: the step's bodies
   std::vector<SolverBody> solver_bodies_;  // n + threads: the bodies, then each thread's static stand-in
   // The colours (constraint_graph.h): the step's rods and manifolds by colour (their indices in

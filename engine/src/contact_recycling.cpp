@@ -84,13 +84,21 @@ bool ContactRecycler::recycle(int a, int b, const std::vector<Body>& bodies, dou
 }
 
 void ContactRecycler::keep(const Manifold& m, const std::vector<Body>& bodies, std::size_t found) {
+  next_.emplace_back();
+  keep_at(next_.size() - 1, m, bodies, found);
+}
+
+void ContactRecycler::resize_kept(std::size_t count) { next_.resize(count); }
+
+void ContactRecycler::keep_at(std::size_t at, const Manifold& m, const std::vector<Body>& bodies,
+                              std::size_t found) {
   if (found != kNone && last_[found].a == m.body_a && last_[found].b == m.body_b) {
-    next_.push_back(last_[found]);  // the poses of its caching, so that motion adds up
+    next_[at] = last_[found];  // the poses of its caching, so that motion adds up
     return;
   }
   const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];
   const Body& body_b = bodies[static_cast<std::size_t>(m.body_b)];
-  Cached& c = next_.emplace_back();
+  Cached& c = next_[at];
   c.a = m.body_a;
   c.b = m.body_b;
   c.normal = m.contacts[0].normal;

@@ -55,6 +55,13 @@ class ContactRecycler {
   /// (kNone: none); call once per manifold of the step, in the collide stage's order. No errors.
   void keep(const Manifold& m, const std::vector<Body>& bodies, std::size_t found);
 
+  /// Makes room for `count` manifolds of this step at once, each then cached by keep_at() (from
+  /// any thread, each i once) in place of keep(). No errors.
+  void resize_kept(std::size_t count);
+  /// keep() for the step's manifold `at` (its place in the collide stage's order, < the count of
+  /// resize_kept()). No errors.
+  void keep_at(std::size_t at, const Manifold& m, const std::vector<Body>& bodies, std::size_t found);
+
   /// Ends the step: this step's cache replaces the last one. No errors.
   void end_step();
 

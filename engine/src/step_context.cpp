@@ -110,7 +110,7 @@ void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
 
 void StepContext::store_warm_start() {
   StageTimer timer(*this, &StageTimes::store);
-  if (warm()) warm_start->store(manifolds, rows, distances->size(), lambda, lambda_second);
+  if (warm()) warm_start->store(manifolds, rows, distances->size(), lambda, lambda_second, workers());
 }
 
 void StepContext::integrate(const Eigen::VectorXd& f_position, const Eigen::VectorXd& f_momentum,

@@ -84,6 +84,8 @@ struct StepContext {
   struct NarrowShare {
     std::vector<Manifold> manifolds;
     std::vector<std::size_t> found;
+    std::size_t first = 0;   ///< its first manifold's place in the step's manifolds
+    std::size_t points = 0;  ///< contact points in its manifolds
   };
   std::vector<NarrowShare> narrow_shares;  ///< per chunk; not copied with the context
   std::vector<std::size_t> first_points;   ///< per manifold: its points before it (World::build_rows)

@@ -19,6 +19,20 @@ std::size_t point_count(const std::vector<Manifold>& manifolds) {
   return n;
 }
 
+// Fewest manifolds a pass over them shares among threads (count): below it waking them
+// (microseconds, tens on a virtual machine) costs about what the work does.
+constexpr std::size_t kMinParallel = 256;
+
+// Per manifold, the points of the manifolds before it, into first (no allocation once grown).
+void first_points(const std::vector<Manifold>& manifolds, std::vector<std::size_t>& first) {
+  detail::resize_with_headroom(first, manifolds.size());
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < manifolds.size(); ++k) {
+    first[k] = n;
+    n += static_cast<std::size_t>(manifolds[k].count);
+  }
+}
+
 // Whether the rows hold two friction rows per point (rows = points + 2 points + rods).
 bool rows_have_friction(std::size_t points, std::size_t rows, std::size_t rods) {
   return points > 0 && rows == 3 * points + rods;
@@ -26,57 +40,75 @@ bool rows_have_friction(std::size_t points, std::size_t rows, std::size_t rods) 
 
 }  // namespace
 
-void WarmStartCache::match(const std::vector<Manifold>& manifolds) {
+void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* workers) {
   const std::size_t points = point_count(manifolds);
   detail::assign_with_headroom(match_, points, -1);
   detail::resize_with_headroom(tangents_, points);
   detail::assign_with_headroom(same_points_, manifolds.size(), static_cast<unsigned char>(0));
-  matched_ = 0;
-  std::size_t k = 0;  // this step's point
-  std::size_t index = 0;  // this step's manifold
-  std::size_t j = 0;  // cached manifold
-  for (const Manifold& m : manifolds) {
+  first_points(manifolds, first_point_);
+  const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
+  detail::assign_with_headroom(matched_by_thread_, threads, std::size_t{0});
+  parallel_for(workers, manifolds.size(), kMinParallel, [&](int t, std::size_t begin, std::size_t end) {
+    if (begin == end) return;
+    std::size_t matched = 0;
     // Both lists are in pair order: walk the cached one along (a missing or extra pair, or any
-    // other order, only means fewer matches).
-    while (j < manifolds_.size() &&
-           pair_less(manifolds_[j].body_a, manifolds_[j].body_b, m.body_a, m.body_b)) {
-      ++j;
-    }
-    const bool same_pair = j < manifolds_.size() && manifolds_[j].body_a == m.body_a &&
-                           manifolds_[j].body_b == m.body_b;
-    unsigned used = 0;  // cached points of this pair already matched (at most 8: one bit each)
-    int matched_here = 0;
-    for (int i = 0; i < m.count; ++i, ++k) {
-      const Contact& c = m.contacts[static_cast<std::size_t>(i)];
-      Vec3 t1;
-      Vec3 t2;
-      tangent_basis(c.normal, t1, t2);  // the paper's directions for a new point
-      if (same_pair) {
-        const CachedManifold& cm = manifolds_[j];
-        for (int q = 0; q < cm.count; ++q) {
-          const CachedPoint& p = points_[static_cast<std::size_t>(cm.first + q)];
-          if ((used >> q) & 1u || p.feature != c.feature) continue;
-          used |= 1u << q;
-          match_[k] = cm.first + q;
-          ++matched_;
-          ++matched_here;
-          // The cached t1 in the new contact plane: the friction rows keep their directions.
-          const Vec3 projected = p.t1 - p.t1.dot(c.normal) * c.normal;
-          if (projected.norm() > 0.5) t1 = projected.normalized();
-          break;
-        }
+    // other order, only means fewer matches), a later share from the first cached manifold not
+    // below its first pair.
+    const auto below = [](const CachedManifold& c, const Manifold& m) {
+      return pair_less(c.body_a, c.body_b, m.body_a, m.body_b);
+    };
+    std::size_t j = begin == 0 ? 0
+                               : static_cast<std::size_t>(
+                                     std::lower_bound(manifolds_.begin(), manifolds_.end(),
+                                                      manifolds[begin], below) -
+                                     manifolds_.begin());
+    for (std::size_t index = begin; index < end; ++index) {
+      const Manifold& m = manifolds[index];
+      std::size_t k = first_point_[index];  // this step's point
+      while (j < manifolds_.size() &&
+             pair_less(manifolds_[j].body_a, manifolds_[j].body_b, m.body_a, m.body_b)) {
+        ++j;
       }
-      tangents_[k] = t1;
+      const bool same_pair = j < manifolds_.size() && manifolds_[j].body_a == m.body_a &&
+                             manifolds_[j].body_b == m.body_b;
+      unsigned used = 0;  // cached points of this pair already matched (at most 8: one bit each)
+      int matched_here = 0;
+      for (int i = 0; i < m.count; ++i, ++k) {
+        const Contact& c = m.contacts[static_cast<std::size_t>(i)];
+        Vec3 t1;
+        Vec3 t2;
+        tangent_basis(c.normal, t1, t2);  // the paper's directions for a new point
+        if (same_pair) {
+          const CachedManifold& cm = manifolds_[j];
+          for (int q = 0; q < cm.count; ++q) {
+            const CachedPoint& p = points_[static_cast<std::size_t>(cm.first + q)];
+            if ((used >> q) & 1u || p.feature != c.feature) continue;
+            used |= 1u << q;
+            match_[k] = cm.first + q;
+            ++matched;
+            ++matched_here;
+            // The cached t1 in the new contact plane: the friction rows keep their directions.
+            const Vec3 projected = p.t1 - p.t1.dot(c.normal) * c.normal;
+            if (projected.norm() > 0.5) t1 = projected.normalized();
+            break;
+          }
+        }
+        tangents_[k] = t1;
+      }
+      same_points_[index] = same_pair && matched_here == m.count && manifolds_[j].count == m.count;
     }
-    same_points_[index++] = same_pair && matched_here == m.count && manifolds_[j].count == m.count;
-  }
+    matched_by_thread_[static_cast<std::size_t>(t)] = matched;
+  });
+  matched_ = 0;
+  for (const std::size_t m : matched_by_thread_) matched_ += m;
 }
 
 void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
                                      const std::vector<ConstraintRow>& rows, std::size_t rods,
                                      double factor, FrictionModel friction,
                                      std::vector<double>& first,
-                                     std::vector<double>& second, WarmStartRule rule) const {
+                                     std::vector<double>& second, WarmStartRule rule,
+                                     Workers* workers) const {
   const bool last = rule == WarmStartRule::last;
   const std::size_t c = rows.size();
   const std::size_t points = point_count(manifolds);
@@ -88,37 +120,44 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
   } else {
     second.clear();
   }
+  // Each manifold writes only its own rows: a share starts at its first manifold's first point
+  // (match()'s first_point_; without a match() of these manifolds, one share from point 0).
+  const bool matched = first_point_.size() == manifolds.size();
   for (int solve = 0; solve < (has_second_ ? 2 : 1); ++solve) {
     std::vector<double>& out = solve == 0 ? first : second;
-    std::size_t k = 0;
-    for (const Manifold& m : manifolds) {
-      for (int i = 0; i < m.count; ++i, ++k) {
-        if (k >= match_.size() || match_[k] < 0) continue;  // a new point: 0
-        const CachedPoint& p = points_[static_cast<std::size_t>(match_[k])];
-        const double* cached = solve == 0 ? p.first : p.second;
-        const double older = p.older[solve];
-        // Contact row k: the smaller of its last two lambdas (see the class comment).
-        const double sustained = last ? cached[0] : std::max(0.0, std::min(cached[0], older));
-        out[k] = factor * sustained;
-        if (!friction_rows || !has_friction_) continue;
-        // The cached friction force, scaled as the contact's, along this step's directions (t1
-        // is the cached t1 in the new plane, so this is close to a copy), within the row's limits.
-        const double scale = last ? 1.0 : cached[0] > 0.0 ? sustained / cached[0] : 0.0;
-        const Vec3 force = scale * (cached[1] * p.t1 + cached[2] * p.t2);
-        const Vec3& t1 = tangents_[k];
-        const Vec3 t2 = m.contacts[static_cast<std::size_t>(i)].normal.cross(t1);
-        for (int r = 0; r < 2; ++r) {
-          const std::size_t row = points + 2 * k + static_cast<std::size_t>(r);
-          double lo = last ? -kInfinity : rows[row].c_min;
-          double hi = last ? kInfinity : rows[row].c_max;
-          if (coupled && !last) {
-            hi = rows[row].mu * out[k];
-            lo = -hi;
+    parallel_for(matched ? workers : nullptr, manifolds.size(), kMinParallel,
+                 [&](int, std::size_t begin, std::size_t end) {
+      std::size_t k = matched && begin < end ? first_point_[begin] : 0;
+      for (std::size_t index = begin; index < end; ++index) {
+        const Manifold& m = manifolds[index];
+        for (int i = 0; i < m.count; ++i, ++k) {
+          if (k >= match_.size() || match_[k] < 0) continue;  // a new point: 0
+          const CachedPoint& p = points_[static_cast<std::size_t>(match_[k])];
+          const double* cached = solve == 0 ? p.first : p.second;
+          const double older = p.older[solve];
+          // Contact row k: the smaller of its last two lambdas (see the class comment).
+          const double sustained = last ? cached[0] : std::max(0.0, std::min(cached[0], older));
+          out[k] = factor * sustained;
+          if (!friction_rows || !has_friction_) continue;
+          // The cached friction force, scaled as the contact's, along this step's directions (t1
+          // is the cached t1 in the new plane, so this is close to a copy), within the row's limits.
+          const double scale = last ? 1.0 : cached[0] > 0.0 ? sustained / cached[0] : 0.0;
+          const Vec3 force = scale * (cached[1] * p.t1 + cached[2] * p.t2);
+          const Vec3& t1 = tangents_[k];
+          const Vec3 t2 = m.contacts[static_cast<std::size_t>(i)].normal.cross(t1);
+          for (int r = 0; r < 2; ++r) {
+            const std::size_t row = points + 2 * k + static_cast<std::size_t>(r);
+            double lo = last ? -kInfinity : rows[row].c_min;
+            double hi = last ? kInfinity : rows[row].c_max;
+            if (coupled && !last) {
+              hi = rows[row].mu * out[k];
+              lo = -hi;
+            }
+            out[row] = std::clamp(factor * force.dot(r == 0 ? t1 : t2), lo, hi);
           }
-          out[row] = std::clamp(factor * force.dot(r == 0 ? t1 : t2), lo, hi);
         }
       }
-    }
+    });
     // Rods: kept by index, always the same rows at the end; the smaller of the last two lambdas
     // when they have the same sign, else 0.
     const std::vector<double>& cached_rods = solve == 0 ? rods_first_ : rods_second_;
@@ -135,42 +174,47 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
 
 void WarmStartCache::store(const std::vector<Manifold>& manifolds,
                            const std::vector<ConstraintRow>& rows, std::size_t rods,
-                           const std::vector<double>& first, const std::vector<double>& second) {
+                           const std::vector<double>& first, const std::vector<double>& second,
+                           Workers* workers) {
   const std::size_t c = rows.size();
   const std::size_t points = point_count(manifolds);
   has_friction_ = rows_have_friction(points, c, rods);
   has_second_ = !second.empty();
-  manifolds_.clear();
-  detail::reserve_with_headroom(manifolds_, manifolds.size());
+  first_points(manifolds, first_point_);
+  detail::resize_with_headroom(manifolds_, manifolds.size());
   detail::resize_with_headroom(next_points_, points);
-  std::size_t k = 0;
-  for (const Manifold& m : manifolds) {
-    manifolds_.push_back({m.body_a, m.body_b, static_cast<int>(k), m.count});
-    for (int i = 0; i < m.count; ++i, ++k) {
-      CachedPoint& p = next_points_[k];
-      const bool matched = k < match_.size() && match_[k] >= 0;
-      const CachedPoint* before = matched ? &points_[static_cast<std::size_t>(match_[k])] : nullptr;
-      p.older[0] = before != nullptr ? before->first[0] : 0.0;
-      p.older[1] = before != nullptr ? before->second[0] : 0.0;
-      const Contact& contact = m.contacts[static_cast<std::size_t>(i)];
-      p.feature = contact.feature;
-      for (int s = 0; s < 2; ++s) {
-        const std::vector<double>& lambda = s == 0 ? first : second;
-        double* out = s == 0 ? p.first : p.second;
-        const bool have = s == 0 || has_second_;
-        out[0] = have && k < lambda.size() ? lambda[k] : 0.0;
-        out[1] = have && has_friction_ ? lambda[points + 2 * k] : 0.0;
-        out[2] = have && has_friction_ ? lambda[points + 2 * k + 1] : 0.0;
-      }
-      if (has_friction_) {
-        // The directions of its friction rows: the linear part of body b's half of j is t.
-        p.t1 = rows[points + 2 * k].j.segment<3>(6);
-        p.t2 = rows[points + 2 * k + 1].j.segment<3>(6);
-      } else {
-        tangent_basis(contact.normal, p.t1, p.t2);
+  // Each manifold writes only its own entry and points.
+  parallel_for(workers, manifolds.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t index = begin; index < end; ++index) {
+      const Manifold& m = manifolds[index];
+      std::size_t k = first_point_[index];
+      manifolds_[index] = {m.body_a, m.body_b, static_cast<int>(k), m.count};
+      for (int i = 0; i < m.count; ++i, ++k) {
+        CachedPoint& p = next_points_[k];
+        const bool matched = k < match_.size() && match_[k] >= 0;
+        const CachedPoint* before = matched ? &points_[static_cast<std::size_t>(match_[k])] : nullptr;
+        p.older[0] = before != nullptr ? before->first[0] : 0.0;
+        p.older[1] = before != nullptr ? before->second[0] : 0.0;
+        const Contact& contact = m.contacts[static_cast<std::size_t>(i)];
+        p.feature = contact.feature;
+        for (int s = 0; s < 2; ++s) {
+          const std::vector<double>& lambda = s == 0 ? first : second;
+          double* out = s == 0 ? p.first : p.second;
+          const bool have = s == 0 || has_second_;
+          out[0] = have && k < lambda.size() ? lambda[k] : 0.0;
+          out[1] = have && has_friction_ ? lambda[points + 2 * k] : 0.0;
+          out[2] = have && has_friction_ ? lambda[points + 2 * k + 1] : 0.0;
+        }
+        if (has_friction_) {
+          // The directions of its friction rows: the linear part of body b's half of j is t.
+          p.t1 = rows[points + 2 * k].j.segment<3>(6);
+          p.t2 = rows[points + 2 * k + 1].j.segment<3>(6);
+        } else {
+          tangent_basis(contact.normal, p.t1, p.t2);
+        }
       }
     }
-  }
+  });
   points_.swap(next_points_);
   const std::size_t had_rods = rods_first_.size();
   rods_older_first_.swap(rods_first_);

@@ -10,6 +10,7 @@
 #include "cps/collision.h"
 #include "cps/constraint.h"
 #include "cps/parameters.h"
+#include "workers.h"
 
 #include <cstdint>
 #include <vector>
@@ -49,8 +50,9 @@ class WarmStartCache {
   /// the point's normal): for a matched point the cached t1 projected onto the new contact plane
   /// and normalised, so that the friction lambdas carry over (if the normal turned so far that
   /// the projection is shorter than 1/2, tangent_basis instead); for a new point tangent_basis's
-  /// t1 (the paper's choice, Sec. 5.4).
-  void match(const std::vector<Manifold>& manifolds);
+  /// t1 (the paper's choice, Sec. 5.4). Shared among `workers`' threads (nullptr: the calling
+  /// thread; the same result for every count), as initial_guesses() and store() are.
+  void match(const std::vector<Manifold>& manifolds, Workers* workers = nullptr);
 
   /// The t1 picked by match() for the points of one manifold, m.count of them, for
   /// append_friction_rows; first_point: the number of points in the manifolds before it. Valid
@@ -72,14 +74,15 @@ class WarmStartCache {
                        const std::vector<ConstraintRow>& rows, std::size_t rods, double factor,
                        FrictionModel friction, std::vector<double>& first,
                        std::vector<double>& second,
-                       WarmStartRule rule = WarmStartRule::sustained) const;
+                       WarmStartRule rule = WarmStartRule::sustained,
+                       Workers* workers = nullptr) const;
 
   /// Replaces the cache by this step's points (features, t1, t2) and lambdas: `first` (c, N)
   /// from the solve with the push, `second` (c, N, or empty) from the solve without it (Sec.
   /// 8.1). The rows are laid out as the class says with `rods` rod rows at the end.
   void store(const std::vector<Manifold>& manifolds, const std::vector<ConstraintRow>& rows,
              std::size_t rods, const std::vector<double>& first,
-             const std::vector<double>& second);
+             const std::vector<double>& second, Workers* workers = nullptr);
 
   /// Forgets everything: the next step starts every row from 0.
   void clear();
@@ -122,6 +125,9 @@ class WarmStartCache {
   std::vector<Vec3> tangents_;
   std::vector<unsigned char> same_points_;  // per manifold: same_points()
   std::size_t matched_ = 0;
+  // Per manifold of the step: the points of the manifolds before it (match() and store()).
+  std::vector<std::size_t> first_point_;
+  std::vector<std::size_t> matched_by_thread_;  // match(): points matched by each thread
 };
 
 }  // namespace cps

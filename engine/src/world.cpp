@@ -201,19 +201,20 @@ void World::collide() {
     if (def_.manifold_points == ManifoldPoints::four) reduce_manifold(m, def_.contact_margin);
     return true;
   };
-  // A touching pair's manifold, in pair order: cached for recycling, counted and bounded.
   std::size_t points = 0;
+  const auto too_many_points = [this] {
+    throw std::length_error("the narrow phase found more than " +
+                            std::to_string(kMaxContactPoints) + " contact points among " +
+                            std::to_string(bodies_.size()) +
+                            " bodies in one step: the bodies are too crowded; spread them out");
+  };
+  // A touching pair's manifold, in pair order: cached for recycling, counted and bounded.
   const auto accept = [&](const Manifold& m, std::size_t found) {
     if (recycler != nullptr) recycler->keep(m, bodies_, found);
     counters.recycled += found != ContactRecycler::kNone ? 1 : 0;
     counters.contacts += m.count;
     points += static_cast<std::size_t>(m.count);
-    if (points > kMaxContactPoints) {
-      throw std::length_error("the narrow phase found more than " +
-                              std::to_string(kMaxContactPoints) + " contact points among " +
-                              std::to_string(bodies_.size()) +
-                              " bodies in one step: the bodies are too crowded; spread them out");
-    }
+    if (points > kMaxContactPoints) too_many_points();
   };
   counters.pairs_tested += static_cast<std::int64_t>(pairs_.size());
   Workers* workers = ctx_->workers();
@@ -243,22 +244,38 @@ void World::collide() {
       share.manifolds.clear();
       share.found.clear();
       Cursor cursor = recycler != nullptr ? recycler->cursor_at(pairs_[begin].first, pairs_[begin].second) : Cursor{};
+      share.points = 0;
       for (std::size_t i = begin; i < end; ++i) {
         Manifold& m = share.manifolds.emplace_back();
         if (narrow(pairs_[i], m, cursor)) {
           share.found.push_back(cursor.found);
+          share.points += static_cast<std::size_t>(m.count);
         } else {
           share.manifolds.pop_back();
         }
       }
     });
+    // Counted and bounded in chunk order, then copied to their places (and cached for recycling)
+    // on the threads.
+    std::size_t count = 0;
     for (std::size_t k = 0; k < chunks; ++k) {
+      StepContext::NarrowShare& share = shares[k];
+      share.first = count;
+      count += share.manifolds.size();
+      points += share.points;
+      counters.contacts += static_cast<std::int64_t>(share.points);
+      for (const std::size_t found : share.found) counters.recycled += found != ContactRecycler::kNone ? 1 : 0;
+    }
+    if (points > kMaxContactPoints) too_many_points();
+    manifolds.resize(count);
+    if (recycler != nullptr) recycler->resize_kept(count);
+    parallel_chunks(workers, chunks, [&](std::size_t k) {
       const StepContext::NarrowShare& share = shares[k];
       for (std::size_t i = 0; i < share.manifolds.size(); ++i) {
-        accept(share.manifolds[i], share.found[i]);
-        manifolds.push_back(share.manifolds[i]);
+        manifolds[share.first + i] = share.manifolds[i];
+        if (recycler != nullptr) recycler->keep_at(share.first + i, share.manifolds[i], bodies_, share.found[i]);
       }
-    }
+    });
   }
   if (recycler != nullptr) recycler->end_step();
 }
@@ -295,7 +312,7 @@ void World::build_rows() {
   const bool warm = def_.warm_start > 0.0;
   if (warm) {
     if (!ctx.warm_start) ctx.warm_start = std::make_unique<WarmStartCache>();
-    ctx.warm_start->match(ctx.manifolds);
+    ctx.warm_start->match(ctx.manifolds, ctx.workers());
   } else if (ctx.warm_start) {
     ctx.warm_start->clear();
   }
@@ -332,7 +349,7 @@ void World::build_rows() {
   if (warm) {
     ctx.warm_start->initial_guesses(ctx.manifolds, rows, distances_.size(), def_.warm_start,
                                     def_.friction_model, ctx.initial, ctx.initial_second,
-                                    push_->warm_start_rule(def_));
+                                    push_->warm_start_rule(def_), workers);
   }
 }
 

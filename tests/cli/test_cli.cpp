@@ -458,6 +458,34 @@ TEST_CASE("cps bench --scene --json times each scene over a window where it is i
   fs::remove_all(dir);
 }
 
+TEST_CASE("cps bench --scene steps the world parameters it is given", "[cli][bench]") {
+  const fs::path dir = fresh_dir("bench_params");
+  // Without friction a contact point has one row, with it three (Sec. 5.4): the parameters reach
+  // the timed world. On two threads the time is the wall clock's.
+  const Result plain = cps("bench --quick --json --scene intersecting_stack", dir);
+  const Result frictionless = cps(
+      "bench --quick --json --scene intersecting_stack --friction 0 --solver coloured-pgs "
+      "--threads 2", dir);
+  REQUIRE(plain.exit_code == 0);
+  REQUIRE(frictionless.exit_code == 0);
+  const nlohmann::json p = nlohmann::json::parse(plain.out)["physics"][0];
+  const nlohmann::json f = nlohmann::json::parse(frictionless.out)["physics"][0];
+  CHECK(p["rows_per_step"].get<double>() == Approx(3.0 * p["contacts_per_step"].get<double>()));
+  CHECK(f["rows_per_step"].get<double>() == Approx(f["contacts_per_step"].get<double>()));
+  CHECK(p["threads"] == 1);
+  CHECK(p["clock"] == "thread_cpu");
+  CHECK(f["threads"] == 2);
+  CHECK(f["clock"] == "wall");
+  // The full tables run each scene at its own settings; the bench times both assemblies.
+  const Result alone = cps("bench --quick --threads 2", dir);
+  CHECK(alone.exit_code == 2);
+  CHECK(alone.err.find("--scene") != std::string::npos);
+  const Result assembly = cps("bench --quick --scene stack --assembly explicit", dir);
+  CHECK(assembly.exit_code == 2);
+  CHECK(assembly.err.find("--assembly") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("cps report never overwrites a foreign report.md, CSV or run.json", "[cli][output]") {
   const fs::path dir = fresh_dir("report_foreign");
   // A complete sweep to merge (the intersecting stack's quick one), computed and timed on one

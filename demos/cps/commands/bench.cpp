@@ -4,7 +4,7 @@
 #include "command.h"
 #include "options/options.h"
 #include "output/output.h"
-#include "report/timing.h"  // thread_cpu_seconds: the physics runs on this one thread
+#include "report/timing.h"  // thread_cpu_seconds: a one-thread world steps on this thread
 #include "scene.h"
 
 #ifdef CPS_HAVE_RENDERER
@@ -60,15 +60,18 @@ constexpr std::pair<const char*, double StageTimes::*> kStages[] = {
     {"relax", &StageTimes::relax},     {"integrate", &StageTimes::integrate},
     {"store", &StageTimes::store},     {"other", &StageTimes::other}};
 
-// The world is advanced, untimed, to `start_s`; a copy of it is then stepped `steps` times once
-// untimed (the copy's buffers grow to their working size) and `repeats` times timed, each from
-// a fresh copy of the same state, so every repeat times the same window. The median repeat's
-// thread CPU time per step counts. One more repeat, not in the median, runs with the engine's
-// stage timing on (World::set_stage_timing) for the stages' shares of a step. start_s >= 0 (s); steps >= 1; repeats >= 1. warm_start, if
-// set, replaces the scene's warm starting factor (dimensionless, [0, 1]) from the start.
-StepCost step_cost(const scenes::Scene& scene, Assembly assembly, double start_s, int steps,
-                   int repeats, std::optional<double> warm_start = std::nullopt) {
-  scenes::Run run = scenes::make_run(scene);
+// The world (the scene with `overrides`) is advanced, untimed, to `start_s`; a copy of it is
+// then stepped `steps` times once untimed (the copy's buffers grow to their working size) and
+// `repeats` times timed, each from a fresh copy of the same state, so every repeat times the same
+// window. The median repeat's time per step counts: this thread's CPU time, or the wall-clock
+// time when the world steps on more than one thread (WorldDef::threads). One more repeat, not in
+// the median, runs with the engine's stage timing on (World::set_stage_timing) for the stages'
+// shares of a step. start_s >= 0 (s); steps >= 1; repeats >= 1. warm_start, if set, replaces the
+// scene's warm starting factor (dimensionless, [0, 1]) from the start.
+StepCost step_cost(const scenes::Scene& scene, const scenes::Overrides& overrides,
+                   Assembly assembly, double start_s, int steps, int repeats,
+                   std::optional<double> warm_start = std::nullopt) {
+  scenes::Run run = scenes::make_run(scene, overrides);
   WorldDef def = run.world.def();
   def.assembly = assembly;
   if (warm_start) def.warm_start = *warm_start;
@@ -76,12 +79,17 @@ StepCost step_cost(const scenes::Scene& scene, Assembly assembly, double start_s
   while (scenes::short_of(run.world, start_s)) run.world.step();
   StepCost cost;
   std::vector<double> times;
+  const bool wall = def.threads > 1;
+  const auto now = [wall] {
+    return wall ? std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count()
+                : thread_cpu_seconds();
+  };
   for (int r = 0; r <= repeats; ++r) {
     World world = run.world;
     const StepCounters before = world.counters();
-    const double start = thread_cpu_seconds();
+    const double start = now();
     for (int k = 0; k < steps; ++k) world.step();
-    const double us = 1e6 * (thread_cpu_seconds() - start) / steps;
+    const double us = 1e6 * (now() - start) / steps;
     if (r == 0) {  // the untimed warm-up repeat; the window's work is the same in every repeat
       cost.rows = static_cast<double>(world.counters().rows - before.rows) / steps;
       cost.contacts = static_cast<double>(world.counters().contacts - before.contacts) / steps;
@@ -112,11 +120,12 @@ int window_repeats(int steps, bool quick) {
   return std::max(5, (timed_steps + steps - 1) / steps);
 }
 
-// Refuses (UsageError, check_work) a scene of the physics table whose stepping would pass
-// max_work (body-iterations): for each of the two assemblies, the steps to the window's start
-// and the window once untimed and `repeats` times timed.
-void check_bench_work(const scenes::Scene& scene, bool quick, double max_work) {
-  const scenes::Run run = make_run_or_usage_error(scene, {});
+// Refuses (UsageError, check_work) a scene of the physics table (with `overrides`) whose stepping
+// would pass max_work (body-iterations): for each of the two assemblies, the steps to the
+// window's start and the window once untimed and `repeats` times timed.
+void check_bench_work(const scenes::Scene& scene, const scenes::Overrides& overrides, bool quick,
+                      double max_work) {
+  const scenes::Run run = make_run_or_usage_error(scene, overrides);
   const WorldDef& def = run.world.def();
   const int steps = window_steps(scene, quick);
   const double per_assembly =
@@ -341,6 +350,7 @@ struct BenchOptions {
   bool json = false;       // one JSON document on stdout instead of Markdown tables
   std::vector<std::string> scenes;  // only these scenes, physics table only (empty: every table)
   double max_work = kDefaultMaxWork;  // body-iterations a --scene may step
+  scenes::Overrides overrides;      // world parameters of the --scene runs
 };
 
 // The physics table's scenes: the paper's, then scaled ones (larger ones unless quick).
@@ -357,20 +367,27 @@ std::vector<std::string> physics_scenes(bool quick) {
   return names;
 }
 
-// The physics table: each scene of `names` over its bench window (Scene::bench), explicit and
-// matrix-free.
-nlohmann::json physics_table(const std::vector<std::string>& names, bool quick, bool markdown) {
+// The physics table: each scene of `names` (with `overrides`) over its bench window
+// (Scene::bench), explicit and matrix-free.
+nlohmann::json physics_table(const std::vector<std::string>& names,
+                             const scenes::Overrides& overrides, bool quick, bool markdown) {
   // At least 5 repeats, and enough that the timed steps add up to 3 s of a 60 Hz scene (1 s
   // quick): a short window (the intersecting stack's 6 steps) is repeated more often.
   const int timed_steps = quick ? 60 : 180;
+  const ParameterValue* threads_set = overrides.find("threads");
+  const int threads = threads_set != nullptr && std::holds_alternative<int>(*threads_set)
+                          ? std::get<int>(*threads_set)
+                          : 1;
   if (markdown) {
-    std::printf("## Physics: microseconds per step (one thread; its CPU time; median of the "
+    const std::string clock = threads > 1 ? std::to_string(threads) + " threads; wall-clock time"
+                                          : std::string("one thread; its CPU time");
+    std::printf("## Physics: microseconds per step (%s; median of the "
                 "repeats of the scene's window, each from a copy of the state at its start: at "
                 "least 5 repeats and %d steps)\n\n"
                 "| scene | bodies | window (s) | repeats | contacts/step | rows/step | explicit "
                 "(us/step) | matrix-free (us/step) | speed-up |\n"
                 "|---|---|---|---|---|---|---|---|---|\n",
-                timed_steps);
+                clock.c_str(), timed_steps);
   }
   nlohmann::json rows = nlohmann::json::array();
   std::string stage_rows;  // the stage table's Markdown rows
@@ -381,8 +398,8 @@ nlohmann::json physics_table(const std::vector<std::string>& names, bool quick, 
     const double start = scene.bench.start_s;
     const int repeats = window_repeats(steps, quick);
     std::fprintf(stderr, "bench: %s\n", name.c_str());
-    const StepCost e = step_cost(scene, Assembly::explicit_matrices, start, steps, repeats);
-    const StepCost m = step_cost(scene, Assembly::matrix_free, start, steps, repeats);
+    const StepCost e = step_cost(scene, overrides, Assembly::explicit_matrices, start, steps, repeats);
+    const StepCost m = step_cost(scene, overrides, Assembly::matrix_free, start, steps, repeats);
     const std::size_t bodies = scenes::make_run(scene).world.bodies().size();
     const double end = start + steps * dt;
     rows.push_back({{"scene", name},
@@ -392,6 +409,8 @@ nlohmann::json physics_table(const std::vector<std::string>& names, bool quick, 
                     {"window_reason", scene.bench.reason},
                     {"steps", steps},
                     {"repeats", repeats},
+                    {"threads", scenes::world_def_with(scene, overrides).threads},
+                    {"clock", scenes::world_def_with(scene, overrides).threads > 1 ? "wall" : "thread_cpu"},
                     {"contacts_per_step", m.contacts},
                     {"rows_per_step", m.rows},
                     {"explicit_us_per_step", e.us},
@@ -440,9 +459,9 @@ nlohmann::json warm_start_table(const std::vector<std::string>& names, bool quic
     const int repeats = std::max(5, (timed_steps + steps - 1) / steps);
     const double start = scene.bench.start_s;
     std::fprintf(stderr, "bench: %s warm starting\n", name.c_str());
-    const StepCost cold = step_cost(scene, Assembly::matrix_free, start, steps, repeats, 0.0);
-    const StepCost match = step_cost(scene, Assembly::matrix_free, start, steps, repeats, 1e-100);
-    const StepCost warm = step_cost(scene, Assembly::matrix_free, start, steps, repeats, 0.8);
+    const StepCost cold = step_cost(scene, {}, Assembly::matrix_free, start, steps, repeats, 0.0);
+    const StepCost match = step_cost(scene, {}, Assembly::matrix_free, start, steps, repeats, 1e-100);
+    const StepCost warm = step_cost(scene, {}, Assembly::matrix_free, start, steps, repeats, 0.8);
     const double cost = match.us / cold.us - 1.0;
     rows.push_back({{"scene", name},
                     {"cold_us_per_step", cold.us},
@@ -484,7 +503,7 @@ nlohmann::json growth_table(bool quick, bool markdown) {
       const scenes::Scene& scene = *scenes::find_scene(name);
       const double bodies = static_cast<double>(scenes::make_run(scene).world.bodies().size());
       const StepCost cost =
-          step_cost(scene, Assembly::matrix_free, scene.bench.start_s, quick ? 3 : 6, k_repeats);
+          step_cost(scene, {}, Assembly::matrix_free, scene.bench.start_s, quick ? 3 : 6, k_repeats);
       by_bodies.emplace_back(bodies, cost.us);
       by_rows.emplace_back(std::max(cost.rows, 1.0), cost.us);
       points.push_back({{"scene", name},
@@ -524,11 +543,20 @@ int run_bench(const BenchOptions& o) {
     throw UsageError("--scene and --rendering exclude each other: --scene times the physics of "
                      "the named scenes, --rendering only the rendering table");
   }
+  if (!o.overrides.values.empty() && o.scenes.empty()) {
+    throw UsageError("world parameters (--" + std::string(o.overrides.values.front().first->flag) +
+                     " and the like) apply to the scenes of --scene; the full tables run each "
+                     "scene at its own settings");
+  }
+  if (o.overrides.find("assembly") != nullptr) {
+    throw UsageError("--assembly: cps bench times every scene under both assemblies (explicit "
+                     "and matrix-free columns); leave it out");
+  }
   std::vector<std::string> names;
   for (const std::string& name : o.scenes) {
     try {
       for (const scenes::Scene* scene : select_scenes(name)) {
-        check_bench_work(*scene, o.quick, o.max_work);
+        check_bench_work(*scene, o.overrides, o.quick, o.max_work);
         names.emplace_back(scene->name);
       }
     } catch (const UsageError& e) {
@@ -538,10 +566,10 @@ int run_bench(const BenchOptions& o) {
   const bool markdown = !o.json;
   nlohmann::json out = {{"engine_version", engine_version()}, {"quick", o.quick}};
   if (!names.empty()) {
-    out["physics"] = physics_table(names, o.quick, markdown);
+    out["physics"] = physics_table(names, o.overrides, o.quick, markdown);
   } else {
     if (!o.rendering) {
-      out["physics"] = physics_table(physics_scenes(o.quick), o.quick, markdown);
+      out["physics"] = physics_table(physics_scenes(o.quick), {}, o.quick, markdown);
       out["warm_start"] = warm_start_table({"stack", "funnel"}, o.quick, markdown);
       out["growth"] = growth_table(o.quick, markdown);
     }
@@ -572,6 +600,7 @@ Command add_bench(CLI::App& app) {
       ->check(kNotEmpty);
   add_seed_option(*sub, o->scenes);
   add_max_work_option(*sub, o->max_work);
+  add_world_options(*sub, o->overrides);
   return {sub, [o] { return run_bench(*o); }};
 }
 

@@ -59,10 +59,10 @@ struct BenchTraits {
 struct ReportTraits {
   /// Simulated time every run of the report's sweep lasts (s, > 0); unset: the scene's
   /// default_seconds (see Scene::report_horizon_s).
-  std::optional<double> horizon_s;
+  std::optional<double> horizon_s{};
   /// The horizon of the quick sweep (`cps report --quick`, s, > 0); unset: horizon_s. For a
   /// scene whose runs are long and whose step costs the same all along (the pendulum wave).
-  std::optional<double> quick_horizon_s;
+  std::optional<double> quick_horizon_s{};
   /// Why the horizon is what it is, in one line (report.md prints it with the horizon).
   std::string_view horizon_reason = "the scene's default duration";
   /// The CSV column of the report's headline measure: the error whose value at the paper's
@@ -202,7 +202,7 @@ struct Run {
   /// Whether and when the run diverged (divergence.h), fed through `metrics` (make_run wraps
   /// them); read it, not the metrics' report, once the run may have moved (a report can read
   /// the world a scene's metrics saw last).
-  std::shared_ptr<const DivergenceWatch> divergence;
+  std::shared_ptr<const DivergenceWatch> divergence{};
 
   /// Steps once and feeds the metrics.
   void step() {

@@ -149,19 +149,14 @@ std::string fix_for(PushMode push, bool constrained) {
            "term: a body spinning about an axis that is not a principal one changes its kinetic "
            "energy at constant angular momentum, docs/conventions.md); no --push changes it";
   }
-  switch (push) {
-    case PushMode::baumgarte:
-      return "the paper's push factor keeps its push beta d / dt in the velocities, so every "
-             "overlap and rod error it corrects comes back as motion (Sec. 5.3); try --push split "
-             "(Sec. 8.1: the push moves the positions, the momenta come from a solve without it; "
-             "\"push\": \"split\" in a scene file's \"world\")";
-    case PushMode::soft:
-      return "the soft rows are springs that store and return energy; try --push split (Sec. 8.1; "
-             "\"push\": \"split\" in a scene file's \"world\")";
-    default:
-      return "this push keeps itself out of the momenta, so the rise comes from the solve: try a "
-             "smaller --dt or more --iterations";
+  const PushTraits& traits = push_traits(push);
+  if (traits.push_in_momenta) {
+    return std::string(traits.energy_rise_cause) +
+           "; try --push split (Sec. 8.1: the push moves the positions, the momenta come from a "
+           "solve without it; \"push\": \"split\" in a scene file's \"world\")";
   }
+  return "this push keeps itself out of the momenta, so the rise comes from the solve: try a "
+         "smaller --dt or more --iterations";
 }
 
 }  // namespace

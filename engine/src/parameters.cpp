@@ -48,23 +48,49 @@ void set_member(WorldDef& d, const ParameterValue& v) {
   }
 }
 
+// One row per push method (PushTraits, parameters.h): what it reads, whether it solves A lambda = b,
+// its substeps parameter and whether its push stays in the momenta, from each file's top comment.
+constexpr PushTraits kBaumgarte{
+    .make = &make_baumgarte,
+    .push_in_momenta = true,
+    .energy_rise_cause = "the paper's push factor keeps its push beta d / dt in the velocities, so "
+                         "every overlap and rod error it corrects comes back as motion (Sec. 5.3)"};
+constexpr PushTraits kSplit{.make = &make_single_frame_push};
+constexpr PushTraits kSplitImpulse{.make = &make_split_impulse};
+constexpr PushTraits kSoft{.make = &make_soft_step,
+                           .reads = {.solver = false, .friction_model = true, .warm_start = true},
+                           .solves_system = false,
+                           .substeps = "soft_substeps",
+                           .push_in_momenta = true,
+                           .energy_rise_cause = "the soft rows are springs that store and return energy"};
+constexpr PushTraits kNgs{.make = &make_ngs};
+// At most substeps x iterations biased sweeps, plus the relax's.
+constexpr PushTraits kTgs{.make = &make_tgs, .substeps = "tgs_substeps"};
+// One sweep a substep, swept as --solver sweeps (pgs or coloured), but not through A lambda = b.
+constexpr PushTraits kXpbd{.make = &make_xpbd,
+                           .reads = {.solver = true, .friction_model = false, .warm_start = false},
+                           .solves_system = false,
+                           .substeps = "xpbd_substeps"};
+constexpr PushTraits kAvbd{.make = &make_avbd,
+                           .reads = {.solver = false, .friction_model = false, .warm_start = false},
+                           .solves_system = false};
+
 constexpr std::array kPushChoices = {
     Choice{"baumgarte", static_cast<int>(PushMode::baumgarte), "Sec. 5.3", "push factor",
-           /*in_paper=*/true, &make_baumgarte},
+           /*in_paper=*/true, &kBaumgarte},
     Choice{"split", static_cast<int>(PushMode::split), "Sec. 8.1", "single frame push factor",
-           /*in_paper=*/true, &make_single_frame_push},
+           /*in_paper=*/true, &kSplit},
     Choice{"split-impulse", static_cast<int>(PushMode::split_impulse), "Bullet", "split impulse",
-           /*in_paper=*/false, &make_split_impulse},
-    Choice{"soft", static_cast<int>(PushMode::soft), "Box3D", "soft step",
-           /*in_paper=*/false, &make_soft_step},
+           /*in_paper=*/false, &kSplitImpulse},
+    Choice{"soft", static_cast<int>(PushMode::soft), "Box3D", "soft step", /*in_paper=*/false, &kSoft},
     Choice{"ngs", static_cast<int>(PushMode::ngs), "Box2D v2.4", "non-linear Gauss-Seidel",
-           /*in_paper=*/false, &make_ngs},
+           /*in_paper=*/false, &kNgs},
     Choice{"tgs", static_cast<int>(PushMode::tgs), "PhysX 5", "temporal Gauss-Seidel",
-           /*in_paper=*/false, &make_tgs},
+           /*in_paper=*/false, &kTgs},
     Choice{"xpbd", static_cast<int>(PushMode::xpbd), "Mueller et al. 2020", "extended position based dynamics",
-           /*in_paper=*/false, &make_xpbd},
+           /*in_paper=*/false, &kXpbd},
     Choice{"avbd", static_cast<int>(PushMode::avbd), "Giles et al. 2025",
-           "augmented vertex block descent", /*in_paper=*/false, &make_avbd},
+           "augmented vertex block descent", /*in_paper=*/false, &kAvbd},
 };
 constexpr std::array kSolverChoices = {
     Choice{"pgs", static_cast<int>(SolverKind::pgs), "Sec. 7.2", "projected Gauss-Seidel"},
@@ -746,13 +772,18 @@ const Parameter& parameter(std::string_view name) {
   throw std::invalid_argument("no world parameter is called '" + std::string(name) + "'");
 }
 
-PushReads push_reads(PushMode push) {
-  switch (push) {
-    case PushMode::soft: return {.solver = false, .friction_model = true, .warm_start = true};
-    case PushMode::xpbd: return {.solver = true, .friction_model = false, .warm_start = false};
-    case PushMode::avbd: return {.solver = false, .friction_model = false, .warm_start = false};
-    default: return {};
+const PushTraits& push_traits(PushMode push) {
+  for (const Choice& c : kPushChoices) {
+    if (c.value == static_cast<int>(push)) return *c.push;
   }
+  return *kPushChoices[0].push;  // not reached: every PushMode has its row (checked by the tests)
+}
+
+PushReads push_reads(PushMode push) { return push_traits(push).reads; }
+
+int push_substeps(const WorldDef& def) {
+  const std::string_view substeps = push_traits(def.push).substeps;
+  return substeps.empty() ? 1 : std::get<int>(parameter(substeps).get(def));
 }
 
 std::string_view name_of(PushMode v) { return parameter("push").choice_name(static_cast<int>(v)); }

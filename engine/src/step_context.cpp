@@ -13,6 +13,7 @@ namespace cps {
 StepContext::StepContext(const StepContext& other)
     : manifolds(other.manifolds),
       rows(other.rows),
+      layout(other.layout),
       lambda(other.lambda),
       lambda_second(other.lambda_second),
       warm_start(other.warm_start ? std::make_unique<WarmStartCache>(*other.warm_start) : nullptr),

@@ -27,6 +27,21 @@ namespace cps {
 
 struct StepContext;
 
+/// Where each kind of row sits in StepContext::rows (World::build_rows, Sec. 5): one contact row
+/// per contact point, the manifolds' points in order; then, when the world has friction, two
+/// friction rows per point in the same order; then one row per rod. Indices are row numbers
+/// (0-based, < size()).
+struct RowLayout {
+  std::size_t points = 0;  ///< contact points, so contact rows
+  bool friction = false;   ///< whether two friction rows a point follow the contact rows
+  std::size_t rods = 0;    ///< distance rows
+  /// The first of point p's two friction rows (friction only).
+  std::size_t friction_row(std::size_t p) const { return points + 2 * p; }
+  std::size_t first_rod() const { return points * (friction ? 3 : 1); }
+  std::size_t rod_row(std::size_t r) const { return first_rod() + r; }
+  std::size_t size() const { return first_rod() + rods; }
+};
+
 /// Adds the wall-clock time from its construction to its destruction to one stage of
 /// ctx.stage_times (s), when ctx.time_stages and `active` are on (a method on several threads
 /// times on one of them); otherwise reads no clock. No errors.
@@ -61,6 +76,7 @@ struct StepContext {
 
   std::vector<Manifold> manifolds;    ///< Sec. 4: the manifolds of this step's collide stage
   std::vector<ConstraintRow> rows;    ///< Sec. 5: c rows: contacts, friction, rods
+  RowLayout layout;                   ///< where each kind of row sits in `rows`
   std::vector<double> lambda;         ///< c, N: the solve that sets the step's result
   std::vector<double> lambda_second;  ///< c, N: the second solve of Sec. 8.1 (split only)
   Eigen::VectorXd f_ext;              ///< 6n: f_ext = [m g, 0] per movable body (Sec. 6.1)

@@ -119,7 +119,7 @@ void World::step() {
   ctx.bodies = &bodies_;
   ctx.distances = &distances_;
   if (!push_ || push_mode_ != def_.push) {
-    push_ = parameter("push").find_choice(name_of(def_.push))->make_push_method();
+    push_ = push_traits(def_.push).make();
     push_mode_ = def_.push;
   }
   ctx.solves_this_step = 0;
@@ -133,7 +133,7 @@ void World::step() {
     StageTimer timer(ctx, &StageTimes::rows);
     build_rows();  // Sec. 5: rows of J, targets, limits
   }
-  if (push_->solves_system()) ctx.prepare();  // Sec. 6: A or the packed rows
+  if (push_traits(def_.push).solves_system) ctx.prepare();  // Sec. 6: A or the packed rows
   // The push method's time in the stages it times itself; the rest of it is `other`.
   StageTimes& times = ctx.stage_times;
   const double staged_before = times.total() - times.other;
@@ -283,16 +283,20 @@ void World::collide() {
 void World::build_rows() {
   StepContext& ctx = *ctx_;
   std::vector<ConstraintRow>& rows = ctx.rows;
-  RowParams params{def_.beta,        def_.dt,
-                   def_.friction,    def_.gravity,
-                   def_.restitution, def_.restitution_threshold,
-                   def_.penetration_slop};
+  RowParams params{.beta = def_.beta,
+                   .dt = def_.dt,
+                   .friction = def_.friction,
+                   .gravity = def_.gravity,
+                   .restitution = def_.restitution,
+                   .restitution_threshold = def_.restitution_threshold,
+                   .penetration_slop = def_.penetration_slop};
   push_->adjust_rows(def_, params);  // the paper's methods leave params as they are
   // The row count is known from the manifolds: make room once, with headroom (no allocation in
   // steady state).
   const std::size_t points = contact_point_count(ctx.manifolds);
   const bool friction = params.friction > 0.0;  // two friction rows a point (write_friction_rows)
-  detail::reserve_with_headroom(rows, points * (friction ? 3 : 1) + distances_.size());
+  ctx.layout = RowLayout{.points = points, .friction = friction, .rods = distances_.size()};
+  detail::reserve_with_headroom(rows, ctx.layout.size());
   // Each body's v and w (w needs I^-1 = R I_body^-1 R^T) once, for the bodies in a manifold
   // (velocity_known_ marks them); a body typically sits in several.
   velocity_known_.assign(bodies_.size(), 0);  // n bytes: no allocation once grown
@@ -332,7 +336,7 @@ void World::build_rows() {
     first_point[k] = p;
     p += static_cast<std::size_t>(ctx.manifolds[k].count);
   }
-  rows.resize(points * (friction ? 3 : 1));  // rows left from the last step are written whole
+  rows.resize(ctx.layout.first_rod());  // rows left from the last step are written whole
   parallel_for(workers, ctx.manifolds.size(), kMinParallelRows, [&](int, std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const Manifold& m = ctx.manifolds[k];
@@ -340,7 +344,7 @@ void World::build_rows() {
       write_normal_rows(m, bodies_, velocities_[static_cast<std::size_t>(m.body_a)],
                         velocities_[static_cast<std::size_t>(m.body_b)], params, rows.data() + first);
       if (!friction) continue;
-      write_friction_rows(m, bodies_, params, static_cast<int>(first), rows.data() + points + 2 * first,
+      write_friction_rows(m, bodies_, params, static_cast<int>(first), rows.data() + ctx.layout.friction_row(first),
                           warm ? ctx.warm_start->tangents(first) : nullptr);
     }
   });

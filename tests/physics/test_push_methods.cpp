@@ -175,6 +175,52 @@ TEST_CASE("a stretched rod returns toward its length under every push method", "
   }
 }
 
+TEST_CASE("every push method has its row, and its row says what its steps do",
+          "[push_methods][parameters]") {
+  // The row of each push choice (PushTraits) is what the work estimate, the energy advice, the
+  // comparisons and World::step read: checked against the table and against the steps
+  // themselves. A method whose row says it solves A lambda = b solves it every step of a pile; one
+  // whose row says it does not never does (World::step prepares no solver for it).
+  const scenes::Scene* scene = scenes::find_scene("pyramid_10");
+  REQUIRE(scene != nullptr);
+  for (const Choice& c : parameter("push").choices) {
+    CAPTURE(c.name);
+    REQUIRE(c.push != nullptr);
+    const PushTraits& traits = *c.push;
+    CHECK(&push_traits(static_cast<PushMode>(c.value)) == &traits);
+    CHECK(traits.make != nullptr);
+    CHECK(traits.push_in_momenta == !traits.energy_rise_cause.empty());
+    WorldDef def;
+    def.push = static_cast<PushMode>(c.value);
+    if (traits.substeps.empty()) {
+      CHECK(push_substeps(def) == 1);
+    } else {
+      const Parameter* substeps = find_parameter(traits.substeps);
+      REQUIRE(substeps != nullptr);
+      CHECK(substeps->type == ParameterType::integer);
+      CHECK(substeps->min >= 1.0);
+      substeps->set(def, 7);
+      CHECK(push_substeps(def) == 7);
+    }
+    scenes::Run run = scenes::make_run(*scene);
+    WorldDef stepped = run.world.def();
+    stepped.push = def.push;
+    run.world.set_def(stepped);
+    for (int k = 0; k < 5; ++k) run.world.step();
+    CHECK(run.world.counters().rows > 0);
+    if (traits.solves_system) {
+      CHECK(run.world.counters().solves >= 5);
+    } else {
+      CHECK(run.world.counters().solves == 0);
+    }
+  }
+  // Only the push parameter's choices carry a row.
+  for (const Parameter& p : world_parameters()) {
+    if (p.name == "push") continue;
+    for (const Choice& c : p.choices) CHECK(c.push == nullptr);
+  }
+}
+
 TEST_CASE("stage timing accounts for a step's time once, by stage, and changes no result",
           "[push_methods][stages]") {
   // The stages are disjoint intervals inside the steps, so their sum is bounded by the wall time

@@ -77,6 +77,16 @@ void check_energy_bound(const scenes::EnergyTracker& e) {
   CHECK(e.max_step_excess() <= energy_tolerance(e));
 }
 
+// E(t) <= E(0) + W(t) + R(t) over the run only, for a method whose rows are springs kept from step
+// to step, which may give back in one step what an earlier step stored (tolerance above).
+void check_run_energy_bound(const scenes::EnergyTracker& e) {
+  INFO("E(0) = " << e.initial() << " J, max E - E(0) = " << e.max_gain() << " J, push work W = "
+                 << e.push_work() << " J, rotation term R = " << e.rotation_drift()
+                 << " J, max(E - E(0) - W - R) = " << e.max_unaccounted() << " J");
+  CHECK_FALSE(e.nonfinite());
+  CHECK(e.max_unaccounted() <= energy_tolerance(e));
+}
+
 // Steps `run` until `seconds` (s), checking after every step that every body is finite (the fp
 // trap catches most of it earlier; this catches what slips through as a stored NaN).
 void advance_checked(scenes::Run& run, double seconds) {
@@ -677,7 +687,21 @@ TEST_CASE("a pile of bodies in one spot fails with the count instead of asking f
   CHECK(world.counters().contacts > 0);
 }
 
-// ---- 11. The push methods beyond the paper's (split_impulse.h, soft_step.h, ngs.h) ----
+// ---- 11. The push methods beyond the paper's (engine/src/push/) ----
+
+// Every push method of the table but the paper's two, which the sections above check with their
+// own push work W.
+namespace {
+bool beyond_the_paper(const Choice& push) { return !push.in_paper; }
+
+// Whether the bound is checked step by step for `push`, or over the run alone. avbd's penalty
+// rows are springs whose stiffness and force are kept from step to step (Giles et al. 2025, the
+// warm start of the penalties and multipliers), so a step can give back what earlier steps
+// stored: measured at the scenes' 25 iterations, a step's excess of 0.045 J on chain_20 and
+// 10.2 J on stack_dt_0.1 (tolerances 0.016 and 0.012 J), and on 6 of the first 20 random piles up
+// to 113 J, while E(t) - E(0) - W(t) - R(t) never went above 0 in any of those runs.
+bool bound_step_by_step(const Choice& push) { return push.name != "avbd"; }
+}  // namespace
 
 TEST_CASE("the push methods beyond the paper's keep the energy bound in the stiff scenes",
           "[stress][push_methods]") {
@@ -688,16 +712,19 @@ TEST_CASE("the push methods beyond the paper's keep the energy bound in the stif
   // would show first: the chain's whip, heavy on light, the stack at dt = 0.1 s, the ball in the
   // box, the heavy ball on the grid. xpbd moves positions in substeps and takes the velocities
   // from them; the bound holds for it as for the others (its pre-stabilisation is a push of
-  // positions alone, counted in W).
-  for (const char* method : {"split-impulse", "soft", "ngs", "tgs", "xpbd"}) {
+  // positions alone, counted in W). Every method of the push table but the paper's two (checked
+  // above); avbd over the run alone (bound_step_by_step).
+  for (const Choice& choice : parameter("push").choices) {
+    if (!beyond_the_paper(choice)) continue;
+    const std::string method(choice.name);
     for (const double warm : {0.0, 0.8}) {
       for (const char* name : {"chain_20", "mass_ratio_10", "stack_dt_0.1", "sphere_in_box",
                                "heavy_ball_grid"}) {
         INFO(method << ", warm start " << warm << ", scene " << name);
         scenes::Overrides o;
-        o.set("push", parameter("push").find_choice(method)->value);
+        o.set("push", choice.value);
         o.set("warm_start", warm);
-        if ((std::string(method) == "ngs" || std::string(method) == "tgs") && warm > 0.0 &&
+        if ((method == "ngs" || method == "tgs") && warm > 0.0 &&
             std::string(name) == "stack_dt_0.1") {
           // Measured at 25 sweeps: a step excess of 0.049 J (tolerance 0.0104 J), at 100 sweeps
           // 0.005 J, at 400 0.0006 J: the residual of a velocity solve started from a stale
@@ -705,9 +732,9 @@ TEST_CASE("the push methods beyond the paper's keep the energy bound in the stif
           // not take back. Checked where the solve converges enough for the bound to apply. tgs
           // alike (its relax is a velocity solve from the same guess): 0.32 J at 25 sweeps,
           // 0.0135 J at 100 (tolerance 0.011 J); checked at 400.
-          o.set("iterations", std::string(method) == "tgs" ? 400 : 100);
+          o.set("iterations", method == "tgs" ? 400 : 100);
         }
-        if (std::string(method) == "soft") {
+        if (method == "soft") {
           // Box3D's relax continues from the soft solve's impulses and velocities; the push its
           // sweeps do not take out stays in the momenta. Measured at 25 sweeps, step excess: chain_20
           // 1.36 J, stack_dt_0.1 0.20 J, heavy_ball_grid 0.15 J (tolerances 0.016, 0.010, 0.11 J),
@@ -715,7 +742,7 @@ TEST_CASE("the push methods beyond the paper's keep the energy bound in the stif
           // (soft_step.cpp).
           o.set("soft_relax", SoftRelax::restart);
         }
-        if (std::string(method) == "xpbd" && std::string(name) == "chain_20") {
+        if (method == "xpbd" && std::string(name) == "chain_20") {
           // One sweep a substep along the 20 links leaves stretch (2.1 mm at 20 substeps) that the
           // next substep corrects, as a velocity: measured step excess 8.8 J at 20 substeps,
           // 0.65 J at 30, 0.012 J at 40, -0.033 J at 60 (tolerance about 0.017 J). Checked at 60,
@@ -724,7 +751,11 @@ TEST_CASE("the push methods beyond the paper's keep the energy bound in the stif
         }
         const CheckedRun c = run_checked(name, std::min(5.0, scene(name).default_seconds), o);
         INFO(c.metrics.dump());
-        check_energy_bound(c.energy);
+        if (bound_step_by_step(choice)) {
+          check_energy_bound(c.energy);
+        } else {
+          check_run_energy_bound(c.energy);
+        }
       }
     }
   }
@@ -732,14 +763,15 @@ TEST_CASE("the push methods beyond the paper's keep the energy bound in the stif
 
 TEST_CASE("random piles keep the energy bound with the push methods beyond the paper's",
           "[stress][random][push_methods]") {
-  // As the random pile test above (section 9), for split-impulse, soft, ngs, tgs and xpbd, over
-  // a tenth of its seeds.
+  // As the random pile test above (section 9), for every method of the push table but the
+  // paper's two (avbd over the run alone: bound_step_by_step), over a tenth of its seeds.
   int seeds = 200;
   if (const char* env = std::getenv("CPS_RANDOM_SEEDS")) seeds = std::atoi(env);
   seeds = std::max(1, seeds / 10);
   for (int seed = 0; seed < seeds; ++seed) {
-    for (const PushMode push : {PushMode::split_impulse, PushMode::soft, PushMode::ngs,
-                                PushMode::tgs, PushMode::xpbd}) {
+    for (const Choice& choice : parameter("push").choices) {
+      if (!beyond_the_paper(choice)) continue;
+      const auto push = static_cast<PushMode>(choice.value);
       WorldDef def = scenes::stack_world_def();
       def.push = push;
       def.soft_relax = SoftRelax::restart;  // as in the test above: Box3D's relax keeps push
@@ -752,7 +784,11 @@ TEST_CASE("random piles keep the energy bound with the push methods beyond the p
         e.observe(world);
       }
       INFO("seed " << seed << " (push " << name_of(push) << ")");
-      if (!energy_bound_holds(e)) check_energy_bound(e);
+      if (!bound_step_by_step(choice)) {
+        check_run_energy_bound(e);
+      } else if (!energy_bound_holds(e)) {
+        check_energy_bound(e);
+      }
     }
   }
   SUCCEED(seeds << " seeds");

@@ -86,18 +86,9 @@ std::string count_text(double n) {
   return text;
 }
 
-double substeps_of(const WorldDef& def) {
-  switch (def.push) {
-    case PushMode::soft:
-      return static_cast<double>(def.soft_substeps);
-    case PushMode::tgs:  // at most substeps x iterations biased sweeps, plus the relax's
-      return static_cast<double>(def.tgs_substeps);
-    case PushMode::xpbd:  // one sweep per substep: an upper bound
-      return static_cast<double>(def.xpbd_substeps);
-    default:
-      return 1.0;
-  }
-}
+// The push method's substeps a step (PushTraits::substeps): the work estimate's bound is
+// substeps x iterations sweeps a step.
+double substeps_of(const WorldDef& def) { return static_cast<double>(push_substeps(def)); }
 
 }  // namespace
 
@@ -118,11 +109,9 @@ void add_max_work_option(CLI::App& cmd, double& max_work) {
 }
 
 std::string lower_run_options(const WorldDef& def, const std::string& shorter) {
+  const std::string_view substeps = push_traits(def.push).substeps;
   return "give " + shorter + ", a larger --dt, fewer --iterations" +
-         (def.push == PushMode::soft   ? std::string(" or --soft-substeps")
-          : def.push == PushMode::tgs  ? std::string(" or --tgs-substeps")
-          : def.push == PushMode::xpbd ? std::string(" or --xpbd-substeps")
-                                       : std::string()) +
+         (substeps.empty() ? std::string() : " or --" + std::string(parameter(substeps).flag)) +
          ", or raise --max-work";
 }
 

@@ -18,9 +18,10 @@
 namespace cps {
 
 class PushMethod;  // internal to the engine: engine/src/push/push_method.h
+struct WorldDef;
 
 /// How violated constraints are corrected; each is one file in engine/src/push/, made through
-/// its entry in the push parameter's table (Choice::make_push_method).
+/// its entry in the push parameter's table (PushTraits).
 enum class PushMode {
   baumgarte,  ///< the push factor stays in the velocity (Eq. 5.2.3, 5.3.1): one solve a step
   split,      ///< the single frame push factor (Sec. 8.1): positions move with f_cv, the stored
@@ -48,8 +49,36 @@ struct PushReads {
   bool warm_start = true;      ///< --warm-start; xpbd starts each substep at 0, avbd uses gamma
 };
 
-/// The settings `push` reads (above). Throws nothing.
+/// What the rest of cps needs to know of a push method, in its row of the push parameter's table
+/// (parameters.cpp): the method's file in engine/src/push/, this row, one CMake line and its own
+/// parameters' rows are all a new method adds. Source: the top comment of each method's file.
+struct PushTraits {
+  /// Makes the method (engine/src/push/, internal to the engine). Never nullptr.
+  std::unique_ptr<PushMethod> (*make)() = nullptr;
+  PushReads reads{};  ///< the settings of the solve it reads
+  /// Whether it solves A lambda = b through the step's solver (Sec. 6-7), so that World::step
+  /// assembles A (or packs the rows) before it; false for methods that sweep their own rows.
+  bool solves_system = true;
+  /// The parameter (WorldDef member name, type integer) that sets its substeps a step; empty for
+  /// one solve a step. The work estimate counts substeps x iterations.
+  std::string_view substeps{};
+  /// Whether its push stays in the stored momenta (baumgarte: beta d / dt in the velocity; soft:
+  /// the soft rows' springs), so that an energy rise can come from the push itself.
+  bool push_in_momenta = false;
+  /// Why its push can raise the energy, for the energy-rise warning; empty when
+  /// push_in_momenta is false.
+  std::string_view energy_rise_cause{};
+};
+
+/// The traits of `push` (above), from its row of the push parameter's table. Throws nothing.
+const PushTraits& push_traits(PushMode push);
+
+/// The settings `push` reads (push_traits(push).reads). Throws nothing.
 PushReads push_reads(PushMode push);
+
+/// The substeps a step of `def`'s push method takes (count, >= 1): the value of its substeps
+/// parameter, or 1. Throws nothing.
+int push_substeps(const WorldDef& def);
 
 /// The iteration used for A lambda = b.
 enum class SolverKind {
@@ -242,9 +271,9 @@ struct Choice {
   std::string_view title{};
   /// Defined in the paper (Tamis & Maggiore 2015); false for the methods it is compared with.
   bool in_paper = false;
-  /// Push choices only: makes the method (engine/src/push/, internal to the engine); nullptr for
-  /// the other parameters' choices.
-  std::unique_ptr<PushMethod> (*make_push_method)() = nullptr;
+  /// Push choices only: the method's traits and factory (PushTraits); nullptr for the other
+  /// parameters' choices.
+  const PushTraits* push = nullptr;
 };
 
 /// A parameter's value: double (real), int (integer, and choice: the enum's value), bool

@@ -156,7 +156,7 @@ class Avbd final : public PushMethod {
       if (it >= def.iterations) apply_poses(bodies);
     }
     if (total == def.iterations) apply_poses(bodies);
-    write_lambda(ctx, def, rods.size());
+    write_lambda(ctx);
   }
 
  private:
@@ -427,21 +427,19 @@ class Avbd final : public PushMethod {
     }
   }
 
-  // ctx.lambda per row (N, the paper's sign, -f): contact rows, then two friction rows per
-  // contact point when there is friction, then the rods (World::build_rows' order).
-  void write_lambda(StepContext& ctx, const WorldDef& def, std::size_t rod_count) const {
+  // ctx.lambda per row (N, the paper's sign, -f) at the rows' places (ctx.layout): each contact
+  // point's contact row and, with friction, its two friction rows; each rod's row.
+  void write_lambda(StepContext& ctx) const {
+    const RowLayout& layout = ctx.layout;
     ctx.lambda.assign(ctx.rows.size(), 0.0);
-    const std::size_t n = contacts_.size();
-    const bool friction = def.friction > 0.0;
-    if (ctx.rows.size() != n * (friction ? 3 : 1) + rod_count) return;  // another layout
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < contacts_.size(); ++i) {
       ctx.lambda[i] = -contacts_[i].lambda[0];
-      if (friction) {
-        ctx.lambda[n + 2 * i] = -contacts_[i].lambda[1];
-        ctx.lambda[n + 2 * i + 1] = -contacts_[i].lambda[2];
+      if (layout.friction) {
+        ctx.lambda[layout.friction_row(i)] = -contacts_[i].lambda[1];
+        ctx.lambda[layout.friction_row(i) + 1] = -contacts_[i].lambda[2];
       }
     }
-    for (std::size_t i = 0; i < rod_count; ++i) ctx.lambda[n * (friction ? 3 : 1) + i] = -rod_[i].lambda;
+    for (std::size_t r = 0; r < rod_.size(); ++r) ctx.lambda[layout.rod_row(r)] = -rod_[r].lambda;
   }
 
   std::vector<BodyState> state_;

@@ -2,8 +2,8 @@
 // A push method: how a step corrects the constraint error (overlaps, rod stretch) and sets the
 // stored momenta. It is the solve and integrate stages of World::step (world.h), after the rows
 // are built and prepared; each method is one file in this folder with its derivation and
-// sources on top, made through its entry in the push parameter's table (parameters.cpp,
-// Choice::make_push_method).
+// sources on top, made through its row of the push parameter's table (parameters.cpp,
+// PushTraits), which also says whether World::step prepares A lambda = b for it.
 
 #include "../step_context.h"
 
@@ -48,11 +48,6 @@ class PushMethod {
     (void)def;
     return WarmStartRule::sustained;
   }
-
-  /// Whether the method solves A lambda = b through the step context's solver (Sec. 6-7), so that
-  /// World::step assembles A (or packs the rows) before step(); methods that sweep their own rows
-  /// return false and the assembly is skipped. No errors.
-  virtual bool solves_system() const { return true; }
 
   /// The solve and integrate stages: solves with ctx's rows and prepared solver, leaves the
   /// step's lambda (and lambda_second, or clears it) in ctx, stores the warm start, and moves the

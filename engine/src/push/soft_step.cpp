@@ -232,7 +232,6 @@ AxisRow make_axis_row(const Vec3& axis, const Vec3& r_a, const Vec3& r_b, const 
 
 class SoftStep final : public PushMethod {
  public:
-  bool solves_system() const override { return false; }
   // Box3D's warm start (the last step's impulses), or for the restart variant the sustained
   // rule of the other methods (warm_start.h).
   WarmStartRule warm_start_rule(const WorldDef& def) const override {
@@ -368,7 +367,7 @@ class SoftStep final : public PushMethod {
         }
         f.end = f.begin + static_cast<std::size_t>(m.count);
         if (!friction) continue;
-        const std::size_t first = points + 2 * first_row_[k];
+        const std::size_t first = ctx.layout.friction_row(first_row_[k]);
         f.center_a = center_a / total_weight;
         f.center_b = center_b / total_weight;
         for (std::size_t i = f.begin; i < f.end; ++i) {
@@ -417,7 +416,7 @@ class SoftStep final : public PushMethod {
       }
     });
 
-    const std::size_t first_rod = points * (friction ? 3 : 1);
+    const std::size_t first_rod = ctx.layout.first_rod();
     rods_.clear();
     detail::reserve_with_headroom(rods_, distances.size());
     for (const std::size_t r : rod_order_) {

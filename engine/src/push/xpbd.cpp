@@ -145,7 +145,7 @@ class Xpbd final : public PushMethod {
       solve_positions(bodies, *ctx.distances, def, h);
       update_velocities(bodies, h);
       solve_velocities(bodies, def, h);
-      accumulate_forces(ctx.rows, ctx.lambda, h, def.dt);
+      accumulate_forces(ctx.rows, ctx.layout, ctx.lambda, h, def.dt);
     }
     ctx.store_warm_start();
   }
@@ -428,27 +428,22 @@ class Xpbd final : public PushMethod {
     flush(bodies, true);
   }
 
-  // Adds this substep's share of each row's mean force over the step (N) to `lambda` (c, in
-  // the order of the rows: contact rows as the points, then two friction rows per point when
-  // friction > 0, then the rods): positional impulses / h and velocity impulses, over dt.
-  void accumulate_forces(const std::vector<ConstraintRow>& rows, std::vector<double>& lambda,
-                         double h, double dt) const {
-    const std::size_t contacts = points_.size();
-    const std::size_t rods = rod_lambda_.size();
-    if (rows.size() < contacts + rods) return;  // not the rows of these points (no error)
-    const bool friction_rows = rows.size() == 3 * contacts + rods;
-    for (std::size_t i = 0; i < contacts; ++i) {
+  // Adds this substep's share of each row's mean force over the step (N) to `lambda` (c) at the
+  // rows' places (`layout`: each point's contact row and, with friction, its two friction rows;
+  // each rod's row): positional impulses / h and velocity impulses, over dt.
+  void accumulate_forces(const std::vector<ConstraintRow>& rows, const RowLayout& layout,
+                         std::vector<double>& lambda, double h, double dt) const {
+    for (std::size_t i = 0; i < points_.size(); ++i) {
       const Point& p = points_[i];
       lambda[i] += (p.lambda_n / h + p.normal.dot(p.velocity_impulse)) / dt;
-      if (!friction_rows) continue;
+      if (!layout.friction) continue;
       const Vec3 tangential = p.friction / h + p.velocity_impulse;
       for (std::size_t t = 0; t < 2; ++t) {
-        const std::size_t row = contacts + 2 * i + t;
+        const std::size_t row = layout.friction_row(i) + t;
         lambda[row] += tangential.dot(rows[row].j.segment<3>(6)) / dt;
       }
     }
-    const std::size_t first_rod = rows.size() - rods;
-    for (std::size_t r = 0; r < rods; ++r) lambda[first_rod + r] += rod_lambda_[r] / h / dt;
+    for (std::size_t r = 0; r < rod_lambda_.size(); ++r) lambda[layout.rod_row(r)] += rod_lambda_[r] / h / dt;
   }
 
   std::vector<Point> points_;

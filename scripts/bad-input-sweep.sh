@@ -67,6 +67,7 @@ declare -A KIND=(
   ['export:scene']=scene_one ['export:--out']=out_glb ['*:--max-work']=max_work
   ['export:--fclib']=out_hdf5 ['export:--at']=steps
   ['report:--repeats']=repeats ['report:--jobs']='param:integer:1:256:0:threads'
+  ['report:--shard']=shard
   # The sweep puts a positional's bad value in the first place, so reference's values cover frames.
   ['diff:reference']=png_in ['diff:frames']=skip ['diff:--out']=out_folder
   ['diff:--threshold']='param:real:0:255:0:levels' ['diff:--tolerance']='param:real:0:100:0:%'
@@ -110,6 +111,7 @@ BASE['report:--run']='report --out out'
 BASE['simulate:--at']='simulate stack --seconds 0.1 --solver-error e.csv'
 BASE['simulate:--sweeps']='simulate stack --seconds 0.1 --solver-error e.csv'
 BASE['report:--merge']='report --out out'
+BASE['report:--shard']='report intersecting_stack --quick --out out'
 # --fclib excludes --out and --fps; intersecting_stack has contacts from its first step.
 BASE['export:--fclib']='export intersecting_stack --seconds 0.1'
 BASE['export:--at']='export intersecting_stack --seconds 0.1 --fclib out/s.hdf5'
@@ -212,6 +214,9 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
       printf '%s\n' "" file file/s.json adir /dev/null . ;;
     seed)  # a decimal integer in [0, 2^64 - 1] (and only for the random scene)
       printf '%s\n' "" x -1 1.5 1e3 0x10 " 1" "1 " 18446744073709551616 99999999999999999999999 ;;
+    shard)  # I/N: whole numbers, 1 <= I <= N <= 100000, or 'slurm' in a Slurm array task
+      printf '%s\n' "" 1 / 1/ /3 0/3 4/3 -1/3 1/0 1/-3 1/100001 1/3/ 1//3 a/3 1/b +1/3 " 1/3" \
+        "1/3 " 1.5/3 1e0/3 0x1/3 3/3.0 4294967297/4294967298 nan/3 SLURM ;;
     merge)  # folders holding report CSVs
       printf '%s\n' "" nosuch file file/sub adir /dev/null ;;
     scene_one | scene_many | scene_figure | scene_report | scene_bench)
@@ -272,6 +277,10 @@ EXTRA=(
   "--energy-every|simulate stack --seconds 1e5 --dt 0.01 --energy e.csv --max-work 1e18"
   "--run/--merge|report --merge $MERGE_SRC --run $RUN_ID --out out"
   "--run/--list-runs|report --list-runs --run $RUN_ID --out out"
+  "--shard/--list-runs|report intersecting_stack --list-runs --shard 1/2 --out out"
+  "--shard/--run|report intersecting_stack --run $RUN_ID --shard 1/2 --out out"
+  "--shard/--merge|report --merge $MERGE_SRC --shard 1/2 --out out"
+  "--shard|report push --shard 1/2 --out out"
   "push/--run|report push --run $RUN_ID --out out"
   "push/--merge|report push --merge $MERGE_SRC --out out"
   "push/--list-runs|report push --list-runs --out out"

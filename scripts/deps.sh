@@ -17,8 +17,9 @@ cps_packages=(
   # Figures of `cps figure` (PNG, PDF, SVG with the labels as text): cairo, and the font it
   # typesets the labels in, DejaVu Sans.
   libcairo2-dev fonts-dejavu-core
-  # Tests only: pdftotext reads the text of the figures' and the report's PDFs.
-  poppler-utils
+  # Tests only: pdftotext reads the text of the figures' and the report's PDFs; GNU parallel
+  # runs a spread sweep as docs/commands.md shows it.
+  poppler-utils parallel
   # glTF 2.0 binaries of `cps export` (header only; built and read back by the tests).
   libtinygltf-dev
   # The exact reference of a step (`cps simulate --solver-error`, demos/analysis): Siconos

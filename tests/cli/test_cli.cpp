@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <map>
 #include <sstream>
 #include <string>
@@ -674,6 +675,83 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
     CHECK(r.err.find("unknown push 'sideways'") != std::string::npos);
     CHECK(!fs::exists(dir / "o"));
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cps report --shard: the shards of a sweep take every run once and merge into the "
+          "sweep's errors for 1 and 7 shards in any order",
+          "[cli][report]") {
+  // A 0.2 s scene file of one box on a plane: the quick sweep's runs take milliseconds.
+  const fs::path dir = fresh_dir("report-shard");
+  {
+    std::ofstream drop(dir / "drop.json");
+    drop << R"({"seconds": 0.2, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0},)"
+            R"( {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1, "position_m": [0, 0.6, 0]}]})";
+  }
+  const Result listed = cps("report drop.json --quick --list-runs --out l", dir);
+  REQUIRE(listed.exit_code == 0);
+  const auto planned = static_cast<std::size_t>(std::count(listed.out.begin(), listed.out.end(), '\n') - 1);
+  REQUIRE(planned > 7u);
+  // The run CSVs in `folder` (run.json aside).
+  const auto run_files = [&](const fs::path& folder) {
+    std::set<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir / folder)) {
+      if (entry.path().extension() == ".csv") names.insert(entry.path().filename().string());
+    }
+    return names;
+  };
+  // Shards 3 of 3, then 1, then 2, into one folder: each adds runs no other shard took, and
+  // together they take the plan.
+  std::size_t taken = 0;
+  for (const int shard : {3, 1, 2}) {
+    const Result r = cps("report drop.json --quick --shard " + std::to_string(shard) + "/3 --out s3", dir);
+    REQUIRE(r.exit_code == 0);
+    const std::size_t now = run_files("s3").size();
+    const std::size_t expected = (planned - static_cast<std::size_t>(shard - 1) + 2) / 3;
+    CHECK(now - taken == expected);
+    taken = now;
+  }
+  CHECK(taken == planned);
+  // One shard of one, and 7 shards in reverse order, merged: the same runs with the same errors
+  // (every cell but the timing's, which measures this machine at that moment).
+  REQUIRE(cps("report drop.json --quick --shard 1/1 --out s1", dir).exit_code == 0);
+  for (int shard = 7; shard >= 1; --shard) {
+    REQUIRE(cps("report drop.json --quick --shard " + std::to_string(shard) + "/7 --out s7", dir).exit_code == 0);
+  }
+  CHECK(run_files("s1") == run_files("s3"));
+  CHECK(run_files("s7") == run_files("s3"));
+  REQUIRE(cps("report --merge s1 --out m1", dir).exit_code == 0);
+  REQUIRE(cps("report --merge s7 --out m7", dir).exit_code == 0);
+  const cli_test::CsvRows one = cli_test::read_report_csv(dir / "m1/drop.csv");
+  const cli_test::CsvRows seven = cli_test::read_report_csv(dir / "m7/drop.csv");
+  REQUIRE(one.columns == seven.columns);
+  REQUIRE(one.rows.size() == planned);
+  REQUIRE(seven.rows.size() == planned);
+  const std::set<std::string> timing = {"cpu_s_per_sim_s", "cpu_s_per_sim_s_q1", "cpu_s_per_sim_s_q3",
+                                        "cpu_s_per_sim_s_min", "us_per_step", "runs_per_repeat",
+                                        "timing_threads"};
+  std::size_t compared = 0;
+  for (std::size_t k = 0; k < planned; ++k) {
+    for (const std::string& column : one.columns) {
+      if (timing.count(column)) continue;
+      INFO("row " << k << ", column " << column);
+      CHECK(one.rows[k].at(column) == seven.rows[k].at(column));
+      ++compared;
+    }
+  }
+  CHECK(compared > planned * 20);
+  // A shard's place from a Slurm job array's variables: task 5 of an array 4, 6, 8 is shard 2/3.
+  const Result slurm = run_cps("report drop.json --quick --shard slurm --out sl", dir,
+                           "SLURM_ARRAY_TASK_ID=6 SLURM_ARRAY_TASK_MIN=4 SLURM_ARRAY_TASK_STEP=2 "
+                           "SLURM_ARRAY_TASK_COUNT=3");
+  REQUIRE(slurm.exit_code == 0);
+  CHECK(slurm.out.find("shard 2/3") != std::string::npos);
+  CHECK(run_files("sl").size() == (planned - 1 + 2) / 3);
+  const Result outside = run_cps("report drop.json --quick --shard slurm --out so", dir,
+                             "env -u SLURM_ARRAY_TASK_ID");
+  CHECK(outside.exit_code == 2);
+  CHECK(outside.err.find("SLURM_ARRAY_TASK_ID is not set") != std::string::npos);
+  CHECK(!fs::exists(dir / "so"));
   fs::remove_all(dir);
 }
 

@@ -18,8 +18,11 @@
 
 #include <charconv>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
+#include <optional>
+#include <string_view>
 
 namespace cps::cli {
 namespace {
@@ -32,6 +35,7 @@ struct ReportOptions {
   bool list = false;
   std::vector<std::string> merge;
   std::string run;
+  std::string shard;  // "I/N" or "slurm"; empty: the whole sweep
   bool force = false;
   double max_work = kDefaultMaxWork;  // body-iterations a run
   int repeats = 0;                    // timed repeats a run; 0: default_repeats(quick)
@@ -86,6 +90,60 @@ void check_runs_work(const std::vector<RunSpec>& runs, double max_work, int repe
   }
 }
 
+// A whole number in [lo, hi] from all of `text`, or nullopt.
+std::optional<int> whole_number(std::string_view text, int lo, int hi) {
+  int n = 0;
+  const char* last = text.data() + text.size();
+  const auto [end, ec] = std::from_chars(text.data(), last, n);
+  if (text.empty() || ec != std::errc{} || end != last || n < lo || n > hi) return std::nullopt;
+  return n;
+}
+
+// `--shard I/N` (I in [1, N], N in [1, kMaxShards]), or `--shard slurm`: the array task's place
+// among the array's tasks, from SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_MIN, SLURM_ARRAY_TASK_STEP
+// (1 when unset) and SLURM_ARRAY_TASK_COUNT. Throws UsageError naming the bad value.
+constexpr int kMaxShards = 100000;
+Shard parse_shard(const std::string& text) {
+  if (text == "slurm") {
+    const auto read = [](const char* name, bool required, int fallback) {
+      const char* value = std::getenv(name);
+      if (value == nullptr) {
+        if (!required) return fallback;
+        throw UsageError(std::string("--shard slurm: ") + name + " is not set (run it as a task of "
+                         "a Slurm job array: sbatch --array=...), or give --shard I/N");
+      }
+      const std::optional<int> n = whole_number(value, 0, kMaxShards * 100);
+      if (!n) {
+        throw UsageError(std::string("--shard slurm: ") + name + "='" + value +
+                         "' is not a whole number in [0, " + std::to_string(kMaxShards * 100) + "]");
+      }
+      return *n;
+    };
+    const int id = read("SLURM_ARRAY_TASK_ID", true, 0);
+    const int min = read("SLURM_ARRAY_TASK_MIN", true, 0);
+    const int step = read("SLURM_ARRAY_TASK_STEP", false, 1);
+    const int count = read("SLURM_ARRAY_TASK_COUNT", true, 0);
+    if (step < 1 || count < 1 || count > kMaxShards || id < min || (id - min) % step != 0 ||
+        (id - min) / step >= count) {
+      throw UsageError("--shard slurm: task " + std::to_string(id) + " of an array from " +
+                       std::to_string(min) + " in steps of " + std::to_string(step) + " with " +
+                       std::to_string(count) + " tasks is not one of its tasks (tasks in [1, " +
+                       std::to_string(kMaxShards) + "])");
+    }
+    return {(id - min) / step, count};
+  }
+  const std::size_t slash = text.find('/');
+  const std::optional<int> count =
+      slash == std::string::npos ? std::nullopt : whole_number(std::string_view(text).substr(slash + 1), 1, kMaxShards);
+  const std::optional<int> index =
+      count ? whole_number(std::string_view(text).substr(0, slash), 1, *count) : std::nullopt;
+  if (!index) {
+    throw UsageError("--shard '" + text + "': give I/N, this shard I of N shards (whole numbers, "
+                     "1 <= I <= N <= " + std::to_string(kMaxShards) + "), or 'slurm'");
+  }
+  return {*index - 1, *count};
+}
+
 // The absolute path of this executable, for commands that must run anywhere.
 std::string self_path() {
   char path[4096];
@@ -109,6 +167,7 @@ std::vector<const scenes::Scene*> report_scenes(const std::string& name) {
 int run_push(const ReportOptions& o, const nlohmann::json& info) {
   const char* sweep_only = !o.run.empty() ? "--run" : !o.merge.empty() ? "--merge"
                            : o.list        ? "--list-runs"
+                           : !o.shard.empty() ? "--shard"
                            : o.max_work != kDefaultMaxWork ? "--max-work"
                            : o.repeats != 0                ? "--repeats"
                            : o.jobs != 0                   ? "--jobs" : nullptr;
@@ -151,6 +210,10 @@ int run_report(ReportOptions o, int argc, char** argv) {
   const std::vector<const scenes::Scene*> scenes = report_scenes(o.scene);
   const std::vector<RunSpec> runs = plan_runs(scenes, o.quick);
   check_runs_work(runs, o.max_work, o.repeats);
+  if (!o.shard.empty()) {
+    const Shard shard = parse_shard(o.shard);
+    return run_shard(to, shard_runs(runs, shard), shard);
+  }
   if (o.list) {
     // Each run's command carries a --max-work given here (and --repeats: run_commands).
     const std::string budget =
@@ -206,6 +269,13 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                   "execute one run by its id (see --list-runs); the scene argument and --quick "
                   "name the sweep it belongs to, recorded in its CSV for --merge")
       ->check(kNotEmpty);
+  CLI::Option* shard = sub->add_option("--shard", o->shard,
+                  "I/N: run only this shard's part of the sweep, every N-th run of its plan from "
+                  "the I-th (1 <= I <= N), each run's CSV written into --out as it ends; 'slurm': "
+                  "I and N of this task of a Slurm job array (SLURM_ARRAY_TASK_ID, _MIN, _STEP, "
+                  "_COUNT); merge the shards' folders with --merge")
+      ->type_name("I/N")
+      ->check(kNotEmpty);
   add_max_work_option(*sub, o->max_work);
   sub->add_option("--repeats", o->repeats,
                   "timed repeats of each run, in [" + std::to_string(kMinRepeats) + ", " +
@@ -227,8 +297,9 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                       "of the report running beside it")
       ->type_name("N")
       ->check(count_in_range(1, kMaxJobs, "threads", "threads"));
-  run->excludes(merge)->excludes(list);
-  merge->excludes(list);
+  run->excludes(merge)->excludes(list)->excludes(shard);
+  merge->excludes(list)->excludes(shard);
+  list->excludes(shard);
   sub->add_flag("--force", o->force,
                 "let the report replace files in --out that have the names of its own outputs "
                 "but that no earlier cps run wrote there (other files are never touched)");

@@ -205,6 +205,31 @@ int run_one(const SweepOutput& to, const RunSpec& spec) {
   return 0;
 }
 
+std::vector<RunSpec> shard_runs(const std::vector<RunSpec>& runs, Shard shard) {
+  std::vector<RunSpec> taken;
+  for (std::size_t i = static_cast<std::size_t>(shard.index); i < runs.size();
+       i += static_cast<std::size_t>(shard.count)) {
+    taken.push_back(runs[i]);
+  }
+  return taken;
+}
+
+int run_shard(const SweepOutput& to, const std::vector<RunSpec>& runs, Shard shard) {
+  Progress progress("report " + to.sweep + " shard " + std::to_string(shard.index + 1) + "/" +
+                        std::to_string(shard.count),
+                    static_cast<long long>(runs.size()), "runs");
+  long long done = 0;
+  for (const RunSpec& spec : runs) {
+    run_one(to, spec);
+    progress.update(++done);
+  }
+  progress.finish();
+  std::printf("shard %d/%d: %zu runs in %s; when every shard has finished: cps report --merge %s "
+              "--out REPORT_FOLDER\n",
+              shard.index + 1, shard.count, runs.size(), to.out.c_str(), to.out.c_str());
+  return 0;
+}
+
 std::vector<std::string> run_commands(const std::string& exe, const SweepOutput& to,
                                       const std::vector<RunSpec>& runs) {
   std::vector<std::string> lines;

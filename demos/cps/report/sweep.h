@@ -43,6 +43,22 @@ int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& sc
 /// with the sweep it belongs to. Throws as run_sweep does. Returns the exit code, 0.
 int run_one(const SweepOutput& to, const RunSpec& spec);
 
+/// One shard of a sweep spread over a scheduler (`--shard I/N`): `index` in [0, count), count >= 1.
+struct Shard {
+  int index = 0;
+  int count = 1;
+};
+
+/// The runs of `runs` (a plan, plan_runs) that `shard` takes: those whose place in the plan is
+/// shard.index modulo shard.count, in plan order, so the shards of one count take every run once.
+/// Throws nothing.
+std::vector<RunSpec> shard_runs(const std::vector<RunSpec>& runs, Shard shard);
+
+/// Runs `runs` (one shard's) one after another as run_one does, each CSV written into `to.out`
+/// as soon as its run ends, so a shard stopped half way keeps the runs it finished. Throws as
+/// run_one does. Prints one line on stdout with the count and the merge command. Returns 0.
+int run_shard(const SweepOutput& to, const std::vector<RunSpec>& runs, Shard shard);
+
 /// The commands of `--list-runs`: per run of `runs`, `'EXE' report 'SWEEP' --run ID --out
 /// 'OUT/runs'` (with --quick for a quick sweep, and --repeats N where to.repeats is not
 /// default_repeats(to.quick)), then a comment line with the merge command.

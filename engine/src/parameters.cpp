@@ -66,7 +66,7 @@ constexpr PushTraits kSoft{.make = &make_soft_step,
 constexpr PushTraits kNgs{.make = &make_ngs};
 // At most substeps x iterations biased sweeps, plus the relax's.
 constexpr PushTraits kTgs{.make = &make_tgs, .substeps = "tgs_substeps"};
-// One sweep a substep, swept as --solver sweeps (pgs or coloured), but not through A lambda = b.
+// One sweep a substep, by Gauss-Seidel or Jacobi as --solver says, but not through A lambda = b.
 constexpr PushTraits kXpbd{.make = &make_xpbd,
                            .reads = {.solver = true, .friction_model = false, .warm_start = false},
                            .solves_system = false,

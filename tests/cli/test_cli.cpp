@@ -756,6 +756,66 @@ TEST_CASE("cps report --shard: the shards of a sweep take every run once and mer
   fs::remove_all(dir);
 }
 
+TEST_CASE("cps report --list-runs quotes every word for sh: names with quotes, spaces, $ and "
+          "backticks run where they name, and a control character is refused",
+          "[cli][report]") {
+  const fs::path dir = fresh_dir("report-quoting");
+  // A scene file whose name holds a space and a quote, and output folders a shell would misread.
+  const std::string scene = "my drop's.json";
+  {
+    std::ofstream drop(dir / scene);
+    drop << R"({"seconds": 0.2, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0},)"
+            R"( {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1, "position_m": [0, 0.6, 0]}]})";
+  }
+  for (const std::string out : {"x'; touch PWNED; echo '", "O'Brien runs", "$HOME and `touch TICK`",
+                                "a \"b\" \\c"}) {
+    INFO("--out " << out);
+    // The names travel through files, so that the test's own command line needs no quoting.
+    { std::ofstream(dir / "out.txt") << out; }
+    { std::ofstream(dir / "scene.txt") << scene; }
+    const Result listed = cps("report \"$(cat scene.txt)\" --quick --list-runs --out \"$(cat out.txt)\"", dir);
+    REQUIRE(listed.exit_code == 0);
+    std::vector<std::string> lines;
+    std::stringstream text(listed.out);
+    for (std::string line; std::getline(text, line);) lines.push_back(line);
+    REQUIRE(lines.size() > 3u);
+    // Two listed runs, run by sh: their CSVs land in OUT/runs under the names cps gives them.
+    for (std::size_t k = 0; k < 2; ++k) {
+      const std::string command = "cd '" + dir.string() + "' && sh -c \"$(sed -n " +
+                                  std::to_string(k + 1) + "p stdout.list)\" > /dev/null 2>&1";
+      { std::ofstream(dir / "stdout.list") << listed.out; }
+      CHECK(std::system(command.c_str()) == 0);
+    }
+    std::size_t csvs = 0;
+    if (fs::is_directory(dir / out / "runs")) {
+      for (const auto& e : fs::directory_iterator(dir / out / "runs")) csvs += e.path().extension() == ".csv";
+    }
+    CHECK(csvs == 2u);
+    CHECK(!fs::exists(dir / "PWNED"));
+    CHECK(!fs::exists(dir / "TICK"));
+    // The merge line, its comment mark taken off and cps's path replaced by printf: sh reads
+    // exactly the words report --merge OUT/runs --out OUT.
+    const std::string& merge = lines.back();
+    const std::string mark = "# when all have finished: ";
+    REQUIRE(merge.rfind(mark, 0) == 0);
+    const std::size_t words = merge.find(" report --merge ");
+    REQUIRE(words != std::string::npos);
+    { std::ofstream(dir / "merge.sh") << "printf '[%s]\\n'" << merge.substr(words) << "\n"; }
+    const std::string read_back = "cd '" + dir.string() + "' && sh merge.sh > merge.out";
+    REQUIRE(std::system(read_back.c_str()) == 0);
+    CHECK(slurp(dir / "merge.out") ==
+          "[report]\n[--merge]\n[" + out + "/runs]\n[--out]\n[" + out + "]\n");
+    fs::remove_all(dir / out);
+  }
+  // A newline cannot stay inside a listing of one command a line: refused, naming it.
+  { std::ofstream(dir / "out.txt") << "two\nlines"; }
+  const Result newline = cps("report \"$(cat scene.txt)\" --quick --list-runs --out \"$(cat out.txt)\"", dir);
+  CHECK(newline.exit_code == 2);
+  CHECK(newline.err.find("--out holds the control character 0x0a") != std::string::npos);
+  CHECK(newline.out.empty());
+  fs::remove_all(dir);
+}
+
 TEST_CASE("cps report --repeats sets the timed repeats, their quartiles and what they ran on",
           "[cli][report]") {
   const fs::path dir = fresh_dir("report_repeats");

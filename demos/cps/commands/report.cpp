@@ -23,6 +23,7 @@
 #include <memory>
 #include <optional>
 #include <string_view>
+#include <utility>
 
 namespace cps::cli {
 namespace {
@@ -215,6 +216,19 @@ int run_report(ReportOptions o, int argc, char** argv) {
     return run_shard(to, shard_runs(runs, shard), shard);
   }
   if (o.list) {
+    // One command a line: a newline or another control character in a quoted word would split it.
+    for (const auto& [what, text] : {std::pair<std::string, std::string>{"--out", o.out},
+                                     {"the scene argument", o.scene},
+                                     {"this executable's path", self_path()}}) {
+      for (const char c : text) {
+        if (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f) continue;
+        char code[8];
+        std::snprintf(code, sizeof code, "0x%02x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+        throw UsageError("--list-runs: " + what + " holds the control character " + code +
+                         ", and the listed commands are one a line; give it without control "
+                         "characters (newlines, tabs, escapes)");
+      }
+    }
     // Each run's command carries a --max-work given here (and --repeats: run_commands).
     const std::string budget =
         o.max_work != kDefaultMaxWork ? " --max-work " + shortest_decimal(o.max_work) : "";

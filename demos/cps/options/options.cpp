@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -206,6 +207,23 @@ std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
                    "? ('cps list' shows the paper's and stress scenes, the example scene files, "
                    "random_SEED and the scaled families; or give the path of a scene file ending "
                    "in .json)");
+}
+
+std::string shell_quote(std::string_view text) {
+  const auto safe = [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+           std::string_view("@%+=:,./_-").find(c) != std::string_view::npos;
+  };
+  if (!text.empty() && std::all_of(text.begin(), text.end(), safe)) return std::string(text);
+  std::string quoted = "'";
+  for (const char c : text) {
+    if (c == '\'') {
+      quoted += "'\\''";
+    } else {
+      quoted += c;
+    }
+  }
+  return quoted + "'";
 }
 
 std::string with_seed(const std::string& scene, std::uint64_t seed) {

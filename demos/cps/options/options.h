@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace cps::cli {
@@ -94,6 +95,14 @@ void add_seed_option(CLI::App& cmd, std::vector<std::string>& scenes);
 std::string with_seed(const std::string& scene, std::uint64_t seed);
 
 // Variant, comparable_options and compare_variants (--compare): compare.h.
+
+/// `text` as one word of a POSIX shell command (sh, dash, bash), for every command line cps
+/// prints for a shell: as it is when non-empty and made only of letters, digits and @%+=:,./_-
+/// (which no shell reads specially there); otherwise in single quotes, each ' inside written as
+/// '\'' (close, an escaped quote, open again), every other byte, newlines included, standing for
+/// itself. Source: POSIX.1-2017, Shell Command Language, 2.2.3 Single-Quotes (the unquoted set as
+/// Python's shlex.quote). Throws nothing.
+std::string shell_quote(std::string_view text);
 
 /// Builds a run and turns a bad parameter (std::invalid_argument) into a UsageError.
 scenes::Run make_run_or_usage_error(const scenes::Scene& scene, const scenes::Overrides& o);

@@ -226,7 +226,8 @@ int run_shard(const SweepOutput& to, const std::vector<RunSpec>& runs, Shard sha
   progress.finish();
   std::printf("shard %d/%d: %zu runs in %s; when every shard has finished: cps report --merge %s "
               "--out REPORT_FOLDER\n",
-              shard.index + 1, shard.count, runs.size(), to.out.c_str(), to.out.c_str());
+              shard.index + 1, shard.count, runs.size(), to.out.c_str(),
+              shell_quote(to.out.string()).c_str());
   return 0;
 }
 
@@ -235,12 +236,13 @@ std::vector<std::string> run_commands(const std::string& exe, const SweepOutput&
   std::vector<std::string> lines;
   const std::string out = to.out.string();
   for (const RunSpec& r : runs) {
-    lines.push_back("'" + exe + "' report '" + to.sweep + "' --run " + r.id() + " --out '" + out +
-                    "/runs'" + (to.quick ? " --quick" : "") +
+    lines.push_back(shell_quote(exe) + " report " + shell_quote(to.sweep) + " --run " +
+                    shell_quote(r.id()) + " --out " + shell_quote(out + "/runs") +
+                    (to.quick ? " --quick" : "") +
                     (to.repeats != default_repeats(to.quick) ? " --repeats " + std::to_string(to.repeats) : ""));
   }
-  lines.push_back("# when all have finished: '" + exe + "' report --merge '" + out +
-                  "/runs' --out '" + out + "'");
+  lines.push_back("# when all have finished: " + shell_quote(exe) + " report --merge " +
+                  shell_quote(out + "/runs") + " --out " + shell_quote(out));
   return lines;
 }
 

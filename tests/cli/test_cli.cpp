@@ -185,6 +185,13 @@ std::map<double, int> check_warm_table(const std::string& md, const std::string&
   return fewest;
 }
 
+// Writes a scene file of one 1 kg box resting on a plane for 0.2 s at `path`: a report's quick
+// sweep over it takes milliseconds a run.
+void write_drop_scene(const fs::path& path) {
+  std::ofstream(path) << R"({"seconds": 0.2, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0},)"
+                         R"( {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1, "position_m": [0, 0.6, 0]}]})";
+}
+
 }  // namespace
 
 TEST_CASE("bad arguments exit with 2, name the problem and write nothing", "[cli]") {
@@ -681,13 +688,8 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
 TEST_CASE("cps report --shard: the shards of a sweep take every run once and merge into the "
           "sweep's errors for 1 and 7 shards in any order",
           "[cli][report]") {
-  // A 0.2 s scene file of one box on a plane: the quick sweep's runs take milliseconds.
   const fs::path dir = fresh_dir("report-shard");
-  {
-    std::ofstream drop(dir / "drop.json");
-    drop << R"({"seconds": 0.2, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0},)"
-            R"( {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1, "position_m": [0, 0.6, 0]}]})";
-  }
+  write_drop_scene(dir / "drop.json");
   const Result listed = cps("report drop.json --quick --list-runs --out l", dir);
   REQUIRE(listed.exit_code == 0);
   const auto planned = static_cast<std::size_t>(std::count(listed.out.begin(), listed.out.end(), '\n') - 1);
@@ -762,11 +764,7 @@ TEST_CASE("cps report --list-runs quotes every word for sh: names with quotes, s
   const fs::path dir = fresh_dir("report-quoting");
   // A scene file whose name holds a space and a quote, and output folders a shell would misread.
   const std::string scene = "my drop's.json";
-  {
-    std::ofstream drop(dir / scene);
-    drop << R"({"seconds": 0.2, "bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0},)"
-            R"( {"shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1, "position_m": [0, 0.6, 0]}]})";
-  }
+  write_drop_scene(dir / scene);
   for (const std::string out : {"x'; touch PWNED; echo '", "O'Brien runs", "$HOME and `touch TICK`",
                                 "a \"b\" \\c"}) {
     INFO("--out " << out);

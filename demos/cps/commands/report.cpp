@@ -103,7 +103,7 @@ std::optional<int> whole_number(std::string_view text, int lo, int hi) {
 // `--shard I/N` (I in [1, N], N in [1, kMaxShards]), or `--shard slurm`: the array task's place
 // among the array's tasks, from SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_MIN, SLURM_ARRAY_TASK_STEP
 // (1 when unset) and SLURM_ARRAY_TASK_COUNT. Throws UsageError naming the bad value.
-constexpr int kMaxShards = 100000;
+constexpr int kMaxShards = 100000;  // shards a sweep may be split into (count)
 Shard parse_shard(const std::string& text) {
   if (text == "slurm") {
     const auto read = [](const char* name, bool required, int fallback) {

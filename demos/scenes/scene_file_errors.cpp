@@ -17,6 +17,8 @@
 #include <cctype>
 #include <map>
 #include <memory>
+#include <unordered_map>
+#include <unordered_set>
 
 namespace cps::scenes::detail {
 namespace {
@@ -232,9 +234,9 @@ std::string line_column(std::string_view text, std::size_t at) {
 // keys an object already has.
 struct ParseFrame {
   bool object = false;
-  std::size_t index = 0;             // array: the element being read
-  std::string key;                   // object: the member being read
-  std::vector<std::string> keys;     // object: the keys read so far
+  std::size_t index = 0;                     // array: the element being read
+  std::string key;                           // object: the member being read
+  std::unordered_set<std::string> keys;      // object: the keys read so far
 };
 
 // Text for a message, at most 120 characters: the start and the end of a longer one.
@@ -263,12 +265,123 @@ std::size_t key_position(std::string_view text, const std::string& key, std::siz
   return std::string_view::npos;
 }
 
+// The largest number of items the schema allows the top-level array `key` ("bodies", "rods").
+std::size_t schema_max_items(const char* key) {
+  return schema_json().at("properties").at(key).at("maxItems").get<std::size_t>();
+}
+
+// The checking pass of parse_json_text, as nlohmann's SAX interface: it builds nothing, keeps
+// one frame per open object or array, and throws SceneFileError at the first thing refused, so
+// the cost is linear in the text and a refusal comes as soon as the text shows it.
+class CheckingSax {
+ public:
+  using number_integer_t = json::number_integer_t;
+  using number_unsigned_t = json::number_unsigned_t;
+  using number_float_t = json::number_float_t;
+  using string_t = json::string_t;
+  using binary_t = json::binary_t;
+
+  CheckingSax(std::string_view text, const std::string& origin) : text_(text), origin_(origin) {}
+
+  bool null() { return value(); }
+  bool boolean(bool) { return value(); }
+  bool number_integer(number_integer_t) { return value(); }
+  bool number_unsigned(number_unsigned_t) { return value(); }
+  bool number_float(number_float_t, const string_t&) { return value(); }
+  bool string(string_t&) { return value(); }
+  bool binary(binary_t&) { return value(); }
+  bool start_object(std::size_t) { return open(true); }
+  bool start_array(std::size_t) { return open(false); }
+  bool end_object() { return close(); }
+  bool end_array() { return close(); }
+
+  bool key(string_t& key) {
+    ParseFrame& f = frames_.back();
+    f.key = key;
+    const std::size_t seen = key_count_[key]++;
+    if (!f.keys.insert(key).second) {
+      const std::size_t at = key_position(text_, key, seen);
+      throw SceneFileError(origin_ + ":" + (at == std::string_view::npos ? "" : line_column(text_, at) + ":") +
+                           " " + pointer_at(frames_) + ": the key \"" + excerpt(key) +
+                           "\" a second time in one object; give each key once");
+    }
+    return true;
+  }
+
+  // position: the bytes read when the parser stopped, counted from 1.
+  // last_token: the token read last (a number that overflowed ends at position).
+  bool parse_error(std::size_t position, const std::string& last_token,
+                   const nlohmann::detail::exception& e) {
+    const std::size_t at = position == 0 ? 0 : position - 1;
+    std::string why = e.what();
+    if (dynamic_cast<const json::out_of_range*>(&e) != nullptr) {
+      const std::size_t start = position >= last_token.size() ? position - last_token.size() : 0;
+      // "number overflow parsing '1e400'": the number as written.
+      const std::size_t open = why.find('\'');
+      const std::size_t close = why.rfind('\'');
+      const std::string number =
+          open != std::string::npos && close > open ? why.substr(open + 1, close - open - 1) : "";
+      throw SceneFileError(origin_ + ":" + line_column(text_, start) + ": " + pointer_at(frames_) +
+                           ": the number " + (number.empty() ? "" : excerpt(number) + " ") +
+                           "is out of the range of a double (at most about 1.8e308 in size)");
+    }
+    const std::size_t cut = why.find("syntax error");
+    if (cut != std::string::npos) why = why.substr(cut);
+    throw SceneFileError(origin_ + ":" + line_column(text_, at) +
+                         ": not valid JSON (comments are allowed): " + why);
+  }
+
+ private:
+  bool open(bool object) {
+    if (frames_.size() >= kMaxSceneFileDepth) {
+      throw SceneFileError(origin_ + ": " + pointer_at(frames_) + ": nested deeper than " +
+                           std::to_string(kMaxSceneFileDepth) +
+                           " objects and arrays; a scene file needs 4");
+    }
+    frames_.push_back({object, 0, {}, {}});
+    return true;
+  }
+
+  bool close() {
+    frames_.pop_back();
+    return value();
+  }
+
+  // A value ended: the next element of an enclosing array, counted against the schema's
+  // maxItems for the top-level "bodies" and "rods".
+  bool value() {
+    if (frames_.empty() || frames_.back().object) return true;
+    ParseFrame& f = frames_.back();
+    ++f.index;
+    if (frames_.size() == 2 && frames_.front().object) {
+      const std::string& key = frames_.front().key;
+      if (key == "bodies" || key == "rods") {
+        static const std::size_t max_bodies = schema_max_items("bodies");
+        static const std::size_t max_rods = schema_max_items("rods");
+        const std::size_t most = key == "bodies" ? max_bodies : max_rods;
+        if (f.index > most) {
+          throw SceneFileError(origin_ + ": /" + key + ": more than " + std::to_string(most) + " " +
+                               key + " (the most a scene file may hold); refused at /" + key + "/" +
+                               std::to_string(most) + ", before the rest was read");
+        }
+      }
+    }
+    return true;
+  }
+
+  std::string_view text_;
+  const std::string& origin_;
+  std::vector<ParseFrame> frames_;
+  std::unordered_map<std::string, std::size_t> key_count_;  // keys seen so far, for their position
+};
+
 }  // namespace
 
-// Parses the JSON text of a scene file: comments allowed; refused, with the file, line:column
-// and pointer: nesting deeper than kMaxSceneFileDepth, a key twice in one object, a number out
-// of the range of a double, a NUL byte (the parser would stop there and take what follows for
-// the end), anything after the document, and any syntax error.
+// Parses the JSON text of a scene file in two linear passes: the checking pass (CheckingSax)
+// refuses, with the file, line:column and pointer: nesting deeper than kMaxSceneFileDepth, a key
+// twice in one object, more "bodies" or "rods" than the schema allows, a number out of the range
+// of a double, a NUL byte (the parser would stop there and take what follows for the end),
+// anything after the document, and any syntax error; then the document is built.
 json parse_json_text(std::string_view text, const std::string& origin) {
   const std::size_t nul = text.find('\0');
   if (nul != std::string_view::npos) {
@@ -276,66 +389,11 @@ json parse_json_text(std::string_view text, const std::string& origin) {
                          ": a NUL byte: a scene file is JSON text, and nothing may follow the "
                          "document");
   }
-  std::vector<ParseFrame> frames;
-  std::map<std::string, std::size_t> key_count;  // keys seen so far, for their position
-  const json::parser_callback_t track = [&](int, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start:
-      case json::parse_event_t::array_start:
-        if (frames.size() >= kMaxSceneFileDepth) {
-          throw SceneFileError(origin + ": " + pointer_at(frames) + ": nested deeper than " +
-                               std::to_string(kMaxSceneFileDepth) +
-                               " objects and arrays; a scene file needs 4");
-        }
-        frames.push_back({event == json::parse_event_t::object_start, 0, {}, {}});
-        break;
-      case json::parse_event_t::key: {
-        ParseFrame& f = frames.back();
-        f.key = parsed.get<std::string>();
-        const std::size_t seen = key_count[f.key]++;
-        if (std::find(f.keys.begin(), f.keys.end(), f.key) != f.keys.end()) {
-          const std::size_t at = key_position(text, f.key, seen);
-          throw SceneFileError(origin + ":" +
-                               (at == std::string_view::npos ? "" : line_column(text, at) + ":") +
-                               " " + pointer_at(frames) + ": the key \"" + excerpt(f.key) +
-                               "\" a second time in one object; give each key once");
-        }
-        f.keys.push_back(f.key);
-        break;
-      }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        frames.pop_back();
-        if (!frames.empty() && !frames.back().object) ++frames.back().index;
-        break;
-      case json::parse_event_t::value:
-        if (!frames.empty() && !frames.back().object) ++frames.back().index;
-        break;
-    }
-    return true;
-  };
-  try {
-    return json::parse(text, track, true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& e) {
-    // e.byte: the byte where parsing stopped, counted from 1.
-    std::string why = e.what();
-    const std::size_t cut = why.find("syntax error");
-    if (cut != std::string::npos) why = why.substr(cut);
-    throw SceneFileError(origin + ":" + line_column(text, e.byte == 0 ? 0 : e.byte - 1) +
-                         ": not valid JSON (comments are allowed): " + why);
-  } catch (const json::out_of_range& e) {
-    // "number overflow parsing '1e400'": the number as written, and where it first appears.
-    const std::string why = e.what();
-    const std::size_t open = why.find('\'');
-    const std::size_t close = why.rfind('\'');
-    const std::string number =
-        open != std::string::npos && close > open ? why.substr(open + 1, close - open - 1) : "";
-    const std::size_t at = number.empty() ? std::string_view::npos : text.find(number);
-    throw SceneFileError(origin + ":" +
-                         (at == std::string_view::npos ? "" : line_column(text, at) + ":") + " " +
-                         pointer_at(frames) + ": the number " + (number.empty() ? "" : number + " ") +
-                         "is out of the range of a double (at most about 1.8e308 in size)");
-  }
+  CheckingSax check(text, origin);
+  json::sax_parse(text, &check, json::input_format_t::json, /*strict=*/true, /*ignore_comments=*/true);
+  // nlohmann's parser with a callback is quadratic in an array's objects; without one it is
+  // linear, and the text is known good.
+  return json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
 }
 
 }  // namespace cps::scenes::detail

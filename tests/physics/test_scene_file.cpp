@@ -289,6 +289,24 @@ TEST_CASE("scene file text past what JSON allows is refused with the line, colum
     const std::string e = error_of("{\n  \"world\": {\"beta\": 0.1,\n    \"beta\": 0.3}\n}");
     CHECK(e.find("test.json:3:5: /world/beta: the key \"beta\" a second time") == 0);
   }
+  SECTION("more bodies or rods than the schema allows: refused while reading, at the first extra") {
+    // 400,000 empty bodies (1.2 MB), then text that is not JSON: the cap is met at
+    // /bodies/100000, before the parser reaches the bad text or builds a document.
+    for (const char* key : {"bodies", "rods"}) {
+      std::string text = std::string("{\"") + key + "\": [{}";
+      for (int i = 1; i < 400000; ++i) text += ",{}";
+      text += ", not json";
+      const std::string e = error_of(text);
+      INFO(e);
+      CHECK(e.find(std::string("test.json: /") + key + ": more than 100000 " + key) == 0);
+      CHECK(e.find(std::string("refused at /") + key + "/100000") != std::string::npos);
+    }
+    // A key of another name holds any number of items until the schema refuses the key.
+    std::string text = "{\"bodies\": [], \"extra\": [{}";
+    for (int i = 1; i < 200000; ++i) text += ",{}";
+    text += "]}";
+    CHECK(error_of(text).find("extra") != std::string::npos);
+  }
   SECTION("the same key in two objects is allowed") {
     CHECK_NOTHROW(parse_scene_file(kValid, "test.json"));
   }

@@ -212,3 +212,37 @@ TEST_CASE("cps simulate --energy refuses bad values and writes nothing", "[cli][
     CHECK(slurp(dir / "lab.csv") == "mine\n");
   }
 }
+
+TEST_CASE("cps simulate bounds --trace, and replaces another scene's --trace, --energy or "
+          "--solver-error file only with --force",
+          "[cli][energy][output]") {
+  const fs::path dir = fresh_dir("simulate_files");
+  // 1e5 s at 1/60 s is 6e6 steps of the stack's 6 bodies: more rows than a trace may have,
+  // refused before any step with a --seconds that fits.
+  Result r = run_cps("simulate stack --seconds 1e5 --trace t.csv", dir);
+  INFO(r.err);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("rows a trace may have; give --seconds") != std::string::npos);
+  CHECK(!fs::exists(dir / "t.csv"));
+  CHECK(!fs::exists(dir / "run.json"));
+  const std::string files = " --seconds 0.1 --trace t.csv --energy e.csv --solver-error s.csv";
+  REQUIRE(run_cps("simulate stack" + files, dir).exit_code == 0);
+  const std::string stack_trace = slurp(dir / "t.csv");
+  // The same scene again replaces its own files; another scene is refused, naming both, and
+  // leaves every file as it was, each option alone too.
+  CHECK(run_cps("simulate stack" + files, dir).exit_code == 0);
+  for (const char* option : {" --trace t.csv", " --energy e.csv", " --solver-error s.csv"}) {
+    r = run_cps(std::string("simulate intersecting_stack --seconds 0.1") + option, dir);
+    INFO(option << ": " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("scene intersecting_stack") != std::string::npos);
+    CHECK(r.err.find("scene stack") != std::string::npos);
+    CHECK(r.err.find("--force") != std::string::npos);
+  }
+  r = run_cps("simulate intersecting_stack" + files, dir);
+  CHECK(r.exit_code == 2);
+  CHECK(slurp(dir / "t.csv") == stack_trace);
+  CHECK(run_cps("simulate intersecting_stack --force" + files, dir).exit_code == 0);
+  CHECK(slurp(dir / "t.csv") != stack_trace);
+  fs::remove_all(dir);
+}

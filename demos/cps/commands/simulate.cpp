@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,16 +34,18 @@ long long energy_rows(long long steps, long long every) {
   return steps / every + 1 + (steps % every != 0 ? 1 : 0);
 }
 
-SimulateFiles::SimulateFiles(std::vector<SimulateTarget> targets, bool force)
+SimulateFiles::SimulateFiles(std::vector<SimulateTarget> targets, const std::string& scene, bool force)
     : targets_(std::move(targets)) {
   namespace fs = std::filesystem;
   const auto request = [&](const fs::path& folder, std::vector<std::string> files,
                            const std::string& option) {
+    std::map<std::string, std::string> scenes;
+    for (const std::string& f : files) scenes[f] = scene;
     return plan_output({.folder = folder,
                         .files = std::move(files),
                         .command = "simulate",
                         .use = FolderUse::shared,
-                        .scenes = {},
+                        .scenes = std::move(scenes),
                         .option = option,
                         .force = force});
   };
@@ -278,15 +281,38 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
                      std::to_string(kMaxEnergyRows) + " an energy file may have; give --energy-every " +
                      std::to_string(fits) + " or more, or fewer --seconds");
   }
-  // Every file is checked before any is written.
+  const long long bodies = static_cast<long long>(r.world.bodies().size());
+  if (!o.trace.empty() && static_cast<double>(steps + 1) * static_cast<double>(bodies) > kMaxTraceRows) {
+    const long long fits = std::max(0LL, kMaxTraceRows / std::max(1LL, bodies) - 1);
+    throw UsageError("--trace " + o.trace + ": " + std::to_string(steps + 1) + " steps (step 0 and " +
+                     std::to_string(steps) + " more) of " + std::to_string(bodies) +
+                     " bodies would write more than the " + std::to_string(kMaxTraceRows) +
+                     " rows a trace may have; give --seconds " +
+                     shortest_decimal(static_cast<double>(fits) * r.world.def().dt) + " or less (" +
+                     std::to_string(fits) + " steps), or --energy FILE for one row a step");
+  }
+  // Every file is checked before any is written: the trace's and energy's folders are planned,
+  // then the solver error's is planned and begun, then theirs are begun.
+  const std::string source = scene_source(scene->name);
   std::vector<SimulateTarget> targets;
   if (!o.trace.empty()) targets.push_back({o.trace, "--trace"});
   if (!o.energy.empty()) targets.push_back({o.energy, "--energy"});
   std::optional<SimulateFiles> files;
   std::optional<TraceWriter> trace;
   std::optional<EnergyWriter> energy_csv;
-  if (!targets.empty()) {
-    files.emplace(targets, o.force);
+  if (!targets.empty()) files.emplace(targets, source, o.force);
+  std::optional<SolverErrorWriter> errors;
+  if (solver_error) {
+    errors.emplace(std::move(*solver_error), source, o.force,
+                   run_info("simulate", argc, argv,
+                            {{"scene", scene->name},
+                             {"seconds", seconds},
+                             {"solver_error", o.solver_error},
+                             {"overrides", overrides_json(o.overrides)},
+                             {"parameters", parameters_json(r.world.def())}}));
+    errors->observe(r.world);
+  }
+  if (files) {
     nlohmann::json info = {{"scene", scene->name},
                            {"seconds", seconds},
                            {"overrides", overrides_json(o.overrides)},
@@ -300,17 +326,6 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
     std::size_t i = 0;
     if (!o.trace.empty()) trace.emplace(files->file(i++));
     if (!o.energy.empty()) energy_csv.emplace(files->file(i++), every);
-  }
-  std::optional<SolverErrorWriter> errors;
-  if (solver_error) {
-    errors.emplace(std::move(*solver_error), o.force,
-                   run_info("simulate", argc, argv,
-                            {{"scene", scene->name},
-                             {"seconds", seconds},
-                             {"solver_error", o.solver_error},
-                             {"overrides", overrides_json(o.overrides)},
-                             {"parameters", parameters_json(r.world.def())}}));
-    errors->observe(r.world);
   }
   // Steps on stderr, only once the run has taken 2 s (short runs and --json stay clean).
   Progress progress("simulate " + o.scene, std::llround(seconds / r.world.def().dt), "steps", 2.0);

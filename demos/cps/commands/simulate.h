@@ -26,6 +26,9 @@ inline constexpr std::string_view kEnergyHeader =
 /// The most rows an energy CSV may have (header excluded): 1e6 rows of about 100 bytes, some
 /// 100 MB. A run that would write more is refused before any step, naming --energy-every.
 inline constexpr long long kMaxEnergyRows = 1'000'000;
+/// Rows a --trace file may have (one per body per step, step 0 included): 1e7 rows of about
+/// 105 bytes, some 1 GB. A run that would write more is refused before any step.
+inline constexpr long long kMaxTraceRows = 10'000'000;
 
 /// The rows an energy CSV of a run of `steps` steps gets with one row every `every` steps
 /// (>= 1): steps 0, every, 2 every, ..., and the last step if it is not one of them.
@@ -47,9 +50,10 @@ class SimulateFiles {
  public:
   /// Checks every target (plan_output with its option: UsageError if it exists and no earlier
   /// cps run wrote it, unless `force`; if it is a folder; if its folder cannot be created or
-  /// written into) and that no two targets are one file (UsageError naming both options).
+  /// written into; if an earlier run wrote it for another scene than `scene`, a scene_source,
+  /// unless `force`) and that no two targets are one file (UsageError naming both options).
   /// Writes nothing.
-  SimulateFiles(std::vector<SimulateTarget> targets, bool force);
+  SimulateFiles(std::vector<SimulateTarget> targets, const std::string& scene, bool force);
   SimulateFiles(const SimulateFiles&) = delete;
   SimulateFiles& operator=(const SimulateFiles&) = delete;
 

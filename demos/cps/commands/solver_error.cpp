@@ -75,14 +75,16 @@ std::filesystem::path solver_error_rows_path(const std::filesystem::path& path) 
   return path.parent_path() / (path.stem().string() + "-rows.csv");
 }
 
-SolverErrorWriter::SolverErrorWriter(SolverErrorPlan plan, bool force, nlohmann::json info)
+SolverErrorWriter::SolverErrorWriter(SolverErrorPlan plan, const std::string& scene, bool force,
+                                     nlohmann::json info)
     : plan_(std::move(plan)), info_(std::move(info)) {
+  const std::string file = plan_.path.filename().string();
+  const std::string rows_file = solver_error_rows_path(plan_.path).filename().string();
   output_ = plan_output({.folder = plan_.path.parent_path(),
-                         .files = {plan_.path.filename().string(),
-                                   solver_error_rows_path(plan_.path).filename().string()},
+                         .files = {file, rows_file},
                          .command = "simulate",
                          .use = FolderUse::shared,
-                         .scenes = {},
+                         .scenes = {{file, scene}, {rows_file, scene}},
                          .option = "--solver-error",
                          .force = force});
   begin_output(output_, info_);

@@ -63,10 +63,10 @@ std::filesystem::path solver_error_rows_path(const std::filesystem::path& path);
 class SolverErrorWriter {
  public:
   /// Checks the path and the rows file beside it (plan_output with option "--solver-error":
-  /// UsageError if one exists and no earlier cps run wrote it, unless `force`; a folder of that
-  /// name; a folder that cannot be written), creates the folder and records the run in its
-  /// run.json (begin_output with `info`).
-  SolverErrorWriter(SolverErrorPlan plan, bool force, nlohmann::json info);
+  /// UsageError if one exists and no earlier cps run wrote it, or wrote it for another scene than
+  /// `scene` (a scene_source), unless `force`; a folder of that name; a folder that cannot be
+  /// written), creates the folder and records the run in its run.json (begin_output with `info`).
+  SolverErrorWriter(SolverErrorPlan plan, const std::string& scene, bool force, nlohmann::json info);
   SolverErrorWriter(const SolverErrorWriter&) = delete;
   SolverErrorWriter& operator=(const SolverErrorWriter&) = delete;
 

@@ -11,7 +11,8 @@
 #
 # Each command line (nproc of them at a time, or SWEEP_JOBS; SWEEP_TIMEOUT, SWEEP_VERBOSE=1 to
 # list every verdict) runs in a fresh temporary folder (its cwd, with a few fixture files:
-# `file`, `file.png` and `file.hdf5` regular files, `adir`, `adir.json` and `dir.png` folders, scene files
+# `file`, `file.png` and `file.hdf5` regular files, `adir`, `adir.json` and `dir.png` folders,
+# `fifo.png` (a FIFO), `loop.png` (a link to itself) and `bomb.png` (a size bomb), scene files
 # `bad.json` (a box without half_extents_m) and `notjson.json`, valid ones `a/x.json` and
 # `b/x.json` of one stem, and `prior/`, a/x.json's render and figure made in another folder)
 # under `timeout 20` and a
@@ -179,7 +180,7 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         beta==0.1,0.2 iterations=1,0 iterations=1,1.5 dt=0,1/60 dt=1/0,1/60 \
         "beta=0.1;0.2" iterations=1,2,3,4,5,6,7,8,9 ;;
     png_in)  # not a PNG file, or a file beside a folder (the base's other input is a PNG)
-      printf '%s\n' "" nosuch.png file file.png dir.png adir bad.json ;;
+      printf '%s\n' "" nosuch.png file file.png dir.png adir bad.json fifo.png loop.png bomb.png ;;
     out_folder)  # cannot be a folder: an existing file, a path under a file, a device
       printf '%s\n' "" file file/sub /dev/null ;;
     out_png)  # not a PNG path that can be written
@@ -271,6 +272,7 @@ EXTRA=(
   "--overlay|figure paper --overlay"
   "steps/--times/--dt|figure stack --times 0,1e5 --dt 1e-6 --size 16x16 --out out/f.png"
   "--trace/adir|simulate stack --seconds 0.1 --trace adir --force"
+  "--trace/--seconds|simulate stack --seconds 1e5 --trace t.csv"
   "--energy/adir|simulate stack --seconds 0.1 --energy adir --force"
   "--energy/--trace|simulate stack --seconds 0.1 --energy t.csv --trace ./t.csv"
   "--energy-every/--energy|simulate stack --seconds 0.1 --energy-every 2"
@@ -295,6 +297,8 @@ EXTRA=(
   "--fclib/--fps|export intersecting_stack --seconds 0.1 --fclib out/s.hdf5 --fps 10"
   "--out/--fclib|export intersecting_stack --seconds 0.1"
   "--fclib/file.hdf5|export intersecting_stack --seconds 0.1 --fclib file.hdf5"
+  "--out/prior|diff prior/x prior/x --out prior/x"
+  "--out/prior|diff prior/x/frame_000000.png prior/x/frame_000000.png --out prior/x --force"
   "--at/1001|export intersecting_stack --seconds 20 --fclib out/s.hdf5 --at $(seq_csv 1001)"
   # Scene-file paths: another file of the same stem into a folder that holds a/x.json's render
   # (both named), and a command's own input as its output (even with --force).
@@ -406,6 +410,9 @@ choose_cap() {
 
 # Runs "$@" as cps's arguments in a fresh folder; sets RC, OUT, ERR, WROTE (what was written).
 CASE_DIR=$root/case
+BOMB_PNG='\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x01\x86\xa0\x00\x01\x86\xa0'
+BOMB_PNG+='\x08\x02\x00\x00\x00\x27\x30\x9c\x9f\x00\x00\x00\x08\x49\x44\x41\x54\x78\x9c\x03\x00\x00\x00'
+BOMB_PNG+='\x00\x01\x48\x06\x89\xd2\x00\x00\x00\x00\x49\x45\x4e\x44\xae\x42\x60\x82'
 run_cps() {
   local d=$CASE_DIR
   rm -rf "$d"
@@ -419,6 +426,11 @@ run_cps() {
   printf 'not written by cps\n' > "$d/cwd/file"
   printf 'not a png, not written by cps\n' > "$d/cwd/file.png"
   printf 'not an FCLIB file, not written by cps\n' > "$d/cwd/file.hdf5"
+  # PNG inputs cps must not open or must refuse: a FIFO, a link loop, a 65-byte PNG declaring
+  # 100000 x 100000 pixels.
+  mkfifo "$d/cwd/fifo.png"
+  ln -s loop.png "$d/cwd/loop.png"
+  printf "$BOMB_PNG" > "$d/cwd/bomb.png"
   local before
   before=$(snapshot "$d")
   (cd "$d/cwd" && TMPDIR="$d/tmp" exec timeout -k 5 "$TIMEOUT" "${CAP[@]}" "$CPS" "$@" \

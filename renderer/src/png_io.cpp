@@ -252,6 +252,15 @@ void append_bytes(void* context, void* data, int size) {
   file.insert(file.end(), bytes, bytes + size);
 }
 
+// The most bytes of filtered rows, (3 width + 1) height, one PNG of cps may hold: 1 GiB.
+// stb_image_write counts them in int; read_png takes no larger picture than encode_png writes.
+constexpr std::uint64_t k_max_row_bytes = std::uint64_t{1} << 30;
+
+// (3 width + 1) height in 64 bits: no wrap for any two 32-bit sides.
+std::uint64_t filtered_row_bytes(std::uint64_t width, std::uint64_t height) {
+  return (3u * width + 1u) * height;
+}
+
 }  // namespace
 
 // encode_png: image of width x height > 0 with 3 * width * height bytes (RGB8, rows top to
@@ -268,9 +277,7 @@ std::span<const std::uint8_t> encode_png(const Image& image) {
   }
   // stb_image_write counts bytes in int: the filtered rows, (3 width + 1) height bytes, and the
   // file, about as large for noise, must stay below INT_MAX with room for the chunks.
-  const auto row_bytes = (3u * static_cast<std::size_t>(image.width) + 1u) *
-                         static_cast<std::size_t>(image.height);
-  constexpr std::size_t k_max_row_bytes = std::size_t{1} << 30;  // 1 GiB
+  const std::uint64_t row_bytes = filtered_row_bytes(image.width, image.height);
   if (row_bytes > k_max_row_bytes) {
     throw std::invalid_argument("encode_png: image " + std::to_string(image.width) + "x" +
                                 std::to_string(image.height) + " too large (" +
@@ -405,12 +412,30 @@ Image read_png(const std::filesystem::path& path) {
     png_image_free(&png);
     throw std::runtime_error("read_png: cannot read " + path.string() + ": " + why);
   };
+  // Only a regular file (after links): a FIFO or a device named .png would block or never end.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (ec) throw std::runtime_error("read_png: cannot read " + path.string() + ": " + ec.message());
+  if (!std::filesystem::is_regular_file(status)) {
+    throw std::runtime_error("read_png: cannot read " + path.string() + ": not a regular file");
+  }
   if (png_image_begin_read_from_file(&png, path.c_str()) == 0) return fail();
+  // The declared size, checked in 64 bits before any pixel is allocated.
+  if (filtered_row_bytes(png.width, png.height) > k_max_row_bytes) {
+    const std::string size = std::to_string(png.width) + "x" + std::to_string(png.height);
+    png_image_free(&png);
+    throw std::runtime_error("read_png: cannot read " + path.string() + ": it declares " + size +
+                             " pixels, more than the " + std::to_string(k_max_row_bytes) +
+                             " bytes of rows ((3 width + 1) height) a PNG of cps may hold");
+  }
+  // 16-bit samples without gAMA or sRGB are sRGB, as 8-bit ones are (PNG spec 11.3.3.2 leaves the
+  // choice to the reader; libpng's simplified API would take them as linear light).
+  png.flags |= PNG_IMAGE_FLAG_16BIT_sRGB;
   png.format = PNG_FORMAT_RGB;
   Image image;
   image.width = static_cast<int>(png.width);
   image.height = static_cast<int>(png.height);
-  image.pixels.resize(PNG_IMAGE_SIZE(png));
+  image.pixels.resize(static_cast<std::size_t>(png.width) * png.height * 3u);
   if (png_image_finish_read(&png, nullptr, image.pixels.data(), 0, nullptr) == 0) return fail();
   return image;
 }

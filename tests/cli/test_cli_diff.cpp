@@ -8,11 +8,14 @@
 
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -35,6 +38,53 @@ long long red_pixels(const cps::render::Image& image) {
     if (image.pixels[p] == 255 && image.pixels[p + 1] == 0 && image.pixels[p + 2] == 0) ++n;
   }
   return n;
+}
+
+void put_be32(std::vector<unsigned char>& out, std::uint32_t v) {
+  for (int shift = 24; shift >= 0; shift -= 8) out.push_back(static_cast<unsigned char>(v >> shift));
+}
+
+// One PNG chunk (PNG spec 5.3): length, type, data, CRC-32 of type and data.
+void put_chunk(std::vector<unsigned char>& out, const char* type, const std::vector<unsigned char>& data) {
+  put_be32(out, static_cast<std::uint32_t>(data.size()));
+  std::vector<unsigned char> typed(type, type + 4);
+  typed.insert(typed.end(), data.begin(), data.end());
+  out.insert(out.end(), typed.begin(), typed.end());
+  put_be32(out, static_cast<std::uint32_t>(crc32(0L, typed.data(), static_cast<uInt>(typed.size()))));
+}
+
+// A truecolour PNG of `width` x `height` pixels declared, `bit_depth` 8 or 16, every sample
+// `sample` (in the depth's range), without gAMA or sRGB. `rows` rows are stored (fewer than
+// declared makes a file that claims more than it holds).
+std::vector<unsigned char> png_file(std::uint32_t width, std::uint32_t height, int bit_depth,
+                                    unsigned sample, std::uint32_t rows) {
+  std::vector<unsigned char> file = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  std::vector<unsigned char> ihdr;
+  put_be32(ihdr, width);
+  put_be32(ihdr, height);
+  // bit depth, colour type 2 (truecolour), compression, filter and interlace methods 0
+  ihdr.insert(ihdr.end(), {static_cast<unsigned char>(bit_depth), 2, 0, 0, 0});
+  put_chunk(file, "IHDR", ihdr);
+  std::vector<unsigned char> raw;
+  for (std::uint32_t y = 0; y < rows; ++y) {
+    raw.push_back(0);  // filter type none
+    for (std::uint32_t i = 0; i < width * 3; ++i) {
+      if (bit_depth == 16) raw.push_back(static_cast<unsigned char>(sample >> 8));
+      raw.push_back(static_cast<unsigned char>(sample & 0xff));
+    }
+  }
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::vector<unsigned char> idat(size);
+  REQUIRE(compress(idat.data(), &size, raw.data(), static_cast<uLong>(raw.size())) == Z_OK);
+  idat.resize(size);
+  put_chunk(file, "IDAT", idat);
+  put_chunk(file, "IEND", {});
+  return file;
+}
+
+void write_bytes(const fs::path& path, const std::vector<unsigned char>& bytes) {
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                              static_cast<std::streamsize>(bytes.size()));
 }
 
 }  // namespace
@@ -188,4 +238,49 @@ TEST_CASE("cps render --backend egl without an EGL driver says which step failed
   CHECK(err.find("libegl-mesa0") != std::string::npos);      // what to install
   CHECK(err.find("--backend osmesa") != std::string::npos);  // what to do instead
   CHECK_FALSE(rendered);
+}
+
+TEST_CASE("cps diff reads 16-bit PNGs as sRGB, opens only regular files and keeps exit 1 for differing frames",
+          "[cli][diff]") {
+  const fs::path dir = fresh_dir("hostile");
+  // The same grey, 8-bit and 16-bit (x 257), neither with gAMA or sRGB: one picture (PNG spec
+  // 11.3.3.2), so no level differs. Read as linear light, 100/255 would become about 175.
+  write_bytes(dir / "grey8.png", png_file(32, 24, 8, 100, 24));
+  write_bytes(dir / "grey16.png", png_file(32, 24, 16, 100 * 257, 24));
+  Result r = run_cps("diff grey8.png grey16.png --threshold 0", dir);
+  INFO(r.out << r.err);
+  CHECK(r.exit_code == 0);
+  CHECK(r.out.find("max 0 levels") != std::string::npos);
+  const cps::render::Image grey = cps::render::read_png(dir / "grey16.png");
+  CHECK(grey.pixels.at(0) == 100);
+  // A file of a few hundred bytes declaring 100000 x 100000 pixels (30 GB of RGB) is refused
+  // before its pixels are allocated: under a 512 MiB address-space limit it still exits 2.
+  write_bytes(dir / "bomb.png", png_file(100000, 100000, 8, 0, 0));
+  CHECK(fs::file_size(dir / "bomb.png") < 1000);
+  r = run_cps("diff bomb.png grey8.png", dir, "ulimit -v 524288;");
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("declares 100000x100000 pixels") != std::string::npos);
+  // A FIFO named .png is never opened (opening it would block), a link loop is named, and an
+  // --out among the compared folders is refused: all exit 2, never 1 ("frames differ").
+  REQUIRE(::mkfifo((dir / "fifo.png").c_str(), 0600) == 0);
+  fs::create_symlink("loop.png", dir / "loop.png");
+  fs::create_directories(dir / "a");
+  fs::create_directories(dir / "b");
+  fs::copy_file(dir / "grey8.png", dir / "a/frame.png");
+  write_bytes(dir / "b/frame.png", png_file(32, 24, 8, 200, 24));
+  for (const char* bad : {"diff fifo.png grey8.png", "diff grey8.png loop.png", "diff a b --out b",
+                          "diff a/frame.png b/frame.png --out a", "diff a b --out ./a/"}) {
+    INFO(bad);
+    r = run_cps(bad, dir);
+    CHECK(r.exit_code == 2);
+    CHECK_FALSE(r.err.empty());
+  }
+  CHECK(run_cps("diff a b --out d", dir).exit_code == 1);
+  CHECK(fs::exists(dir / "d/frame-diff.png"));
+  // A diff picture that cannot be written (d is a file) is an error, exit 3, not "frames differ".
+  std::ofstream(dir / "e") << "a file";
+  r = run_cps("diff a b --out e/sub", dir);
+  CHECK(r.exit_code != 0);
+  CHECK(r.exit_code != 1);
+  fs::remove_all(dir);
 }

@@ -1,5 +1,6 @@
 // `cps diff A B`: two PNG files, or two frame folders, compared frame by frame with a tolerance
-// (pictures/image_diff.h); a diff picture for each frame past it; exit 0 within, 1 past.
+// (pictures/image_diff.h); a diff picture for each frame past it; exit 0 within, 1 past, 2 for
+// bad input, 3 for any other failure.
 #include "command.h"
 #include "options/options.h"
 #include "output/output.h"
@@ -28,6 +29,10 @@ constexpr double kDefaultThresholdLevels = 8.0;
 /// A frame passes while at most this percentage of its pixels differ. Typical 0.1 %.
 constexpr double kDefaultTolerancePercent = 0.1;
 
+/// The exit code of `cps diff` for a failure that is neither a usage error (2) nor frames that
+/// differ (1): a diff picture that cannot be written, memory exhausted.
+constexpr int kDiffErrorExit = 3;
+
 struct DiffOptions {
   std::string a;
   std::string b;
@@ -48,7 +53,11 @@ std::vector<std::string> png_names(const fs::path& folder) {
   std::vector<std::string> names;
   std::error_code ec;
   for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
-    if (e.is_regular_file() && e.path().extension() == ".png") names.push_back(e.path().filename().string());
+    if (e.path().extension() != ".png") continue;
+    std::error_code status_ec;
+    const bool regular = e.is_regular_file(status_ec);
+    if (status_ec) throw UsageError(e.path().string() + ": cannot be read: " + status_ec.message());
+    if (regular) names.push_back(e.path().filename().string());
     if (static_cast<double>(names.size()) > kMaxFrames) {
       throw UsageError(folder.string() + ": more than " +
                        std::to_string(static_cast<long long>(kMaxFrames)) +
@@ -60,24 +69,52 @@ std::vector<std::string> png_names(const fs::path& folder) {
   return names;
 }
 
+// True for a folder, false for a regular file (links followed). Throws UsageError for a missing
+// path, a link loop or another unreadable status, and for anything else (a FIFO, a device), which
+// cps diff never opens: reading it could block for ever.
+bool is_folder_to_compare(const fs::path& p) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(p, ec);
+  if (status.type() == fs::file_type::not_found) {
+    throw UsageError(p.string() + ": no such file or folder (give two PNG files or two frame "
+                     "folders)");
+  }
+  if (ec) throw UsageError(p.string() + ": cannot be read: " + ec.message());
+  if (fs::is_directory(status)) return true;
+  if (fs::is_regular_file(status)) return false;
+  throw UsageError(p.string() + ": neither a regular file nor a folder (cps diff compares PNG "
+                   "files or frame folders)");
+}
+
+// Refuses an --out that is one of the compared folders, or the folder of a compared file: the
+// diff pictures would become frames of the next comparison there.
+void refuse_out_among_inputs(const DiffOptions& o, bool folders) {
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(fs::path(o.out), ec);
+  if (ec) return;  // plan_output reports an --out it cannot use
+  for (const std::string& input : {o.a, o.b}) {
+    const fs::path in = folders ? fs::path(input) : fs::path(input).parent_path();
+    const fs::path folder = fs::weakly_canonical(in.empty() ? fs::path(".") : in, ec);
+    if (!ec && folder == out) {
+      throw UsageError("--out " + o.out + " is " + (folders ? "the compared folder " : "the folder of ") +
+                       input + ": give another folder for the diff pictures, so they never become "
+                       "frames of the next comparison");
+    }
+  }
+}
+
 // The frames to compare: one pair for two files, the union of the PNG names for two folders.
 // Throws UsageError for a missing path, a file beside a folder, or folders without PNG files.
 std::vector<FramePair> frame_pairs(const DiffOptions& o) {
   const fs::path a(o.a);
   const fs::path b(o.b);
-  for (const fs::path& p : {a, b}) {
-    std::error_code ec;
-    if (!fs::exists(p, ec)) {
-      throw UsageError(p.string() + ": no such file or folder (give two PNG files or two frame "
-                       "folders)");
-    }
-  }
-  const bool a_dir = fs::is_directory(a);
-  const bool b_dir = fs::is_directory(b);
+  const bool a_dir = is_folder_to_compare(a);
+  const bool b_dir = is_folder_to_compare(b);
   if (a_dir != b_dir) {
     throw UsageError((a_dir ? a : b).string() + " is a folder and " + (a_dir ? b : a).string() +
                      " is not: give two PNG files or two frame folders");
   }
+  refuse_out_among_inputs(o, a_dir);
   if (!a_dir) return {{a.filename().string(), a, b}};
   const std::vector<std::string> in_a = png_names(a);
   const std::vector<std::string> in_b = png_names(b);
@@ -206,7 +243,18 @@ Command add_diff(CLI::App& app, int argc, char** argv) {
       ->default_str("out/diff");
   sub->add_flag("--force", o->force,
                 "replace diff pictures that no cps run wrote (the output rule, docs/commands.md)");
-  return {sub, [o, argc, argv] { return run_diff(*o, argc, argv); }};
+  // Exit 1 means "frames differ" alone: any other failure (a file that cannot be written, memory)
+  // exits 3 with its message; usage errors exit 2 in main.
+  return {sub, [o, argc, argv] {
+            try {
+              return run_diff(*o, argc, argv);
+            } catch (const UsageError&) {
+              throw;
+            } catch (const std::exception& e) {
+              std::fprintf(stderr, "cps: error: %s\n", e.what());
+              return kDiffErrorExit;
+            }
+          }};
 }
 
 }  // namespace cps::cli

@@ -156,8 +156,11 @@ class PngWriter {
 };
 
 /// Reads a PNG back as RGB8 (for tests and tools) through libpng, which checks every chunk's CRC
-/// and the zlib checksum; alpha, if any, is composited onto black. Throws std::runtime_error
-/// naming the path and the reason on failure.
+/// and the zlib checksum; alpha, if any, is composited onto black; 16-bit samples without gAMA
+/// or sRGB are taken as sRGB, as 8-bit ones are. Throws std::runtime_error naming the path and
+/// the reason on failure: not a regular file (a FIFO, a folder, a link loop), a declared size past
+/// what encode_png writes ((3 width + 1) height > 2^30 bytes, checked before any pixel is
+/// allocated), or a file libpng refuses.
 Image read_png(const std::filesystem::path& path);
 
 }  // namespace cps::render

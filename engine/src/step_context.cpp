@@ -77,6 +77,10 @@ void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<d
 void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
                                   std::vector<double>& out,
                                   const std::vector<double>* start) const {
+  const bool observed =
+      observer && (!observe_filter || observe_filter(static_cast<std::int64_t>(counters.steps), solves_this_step,
+                                                     static_cast<Eigen::Index>(out.size())));
+  if (!observed && !override_solve) return;
   StepSystem system;
   system.step = counters.steps;
   system.solve = solves_this_step;
@@ -98,7 +102,7 @@ void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
   system.lambda = Eigen::Map<const Eigen::VectorXd>(out.data(), c);
   system.initial = start != nullptr ? Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(start->data(), c))
                                     : Eigen::VectorXd::Zero(c);
-  if (observer) observer(system);
+  if (observed) observer(system);
   if (!override_solve) return;
   Eigen::VectorXd replaced = system.lambda;
   override_solve(system, replaced);

@@ -110,6 +110,8 @@ struct StepContext {
   /// World::set_solve_observer's callback, or empty (the usual case: one branch a solve). Not
   /// copied with the context: a copy of a world starts unobserved.
   SolveObserver observer;
+  /// World::set_solve_observer's choice of solves, or empty (every solve is observed).
+  SolveFilter observe_filter;
   /// World::set_solve_override's callback, or empty (the usual case). Not copied either.
   SolveOverride override_solve;
   int solves_this_step = 0;  ///< solves made in the current step (StepSystem::solve)

@@ -105,7 +105,10 @@ int World::add_distance(const DistanceConstraint& d) {
   return static_cast<int>(distances_.size()) - 1;
 }
 
-void World::set_solve_observer(SolveObserver observer) { ctx_->observer = std::move(observer); }
+void World::set_solve_observer(SolveObserver observer, SolveFilter wants) {
+  ctx_->observer = std::move(observer);
+  ctx_->observe_filter = std::move(wants);
+}
 
 void World::set_solve_override(SolveOverride override) { ctx_->override_solve = std::move(override); }
 

@@ -246,3 +246,29 @@ TEST_CASE("cps simulate bounds --trace, and replaces another scene's --trace, --
   CHECK(slurp(dir / "t.csv") != stack_trace);
   fs::remove_all(dir);
 }
+
+TEST_CASE("cps simulate --solver-error refuses a system past the exact solve's rows, and re-solves "
+          "past --max-work, before any is solved and with nothing written",
+          "[cli][energy][output]") {
+  const fs::path dir = fresh_dir("solver_error_bounds");
+  // pyramid_100's contacts give some 2100 rows a step: a dense LCP that Lemke's pivots would
+  // take minutes for, refused when the run reaches the step.
+  Result r = run_cps("simulate pyramid_100 --seconds 0.1 --solver-error s.csv", dir);
+  INFO(r.err);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("rows, more than the 1000 an exact solve takes") != std::string::npos);
+  CHECK(fs::is_empty(dir));
+  // A million sweeps of the intersecting stack's rows (some 50), three methods: past a budget of
+  // 1e6 that the run itself (a few bodies, 6 steps) leaves nearly whole.
+  r = run_cps("simulate intersecting_stack --seconds 0.1 --solver-error s.csv --sweeps 1000000 "
+              "--max-work 1e6", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("--max-work") != std::string::npos);
+  CHECK(fs::is_empty(dir));
+  // Within both, the same request writes its files.
+  CHECK(run_cps("simulate intersecting_stack --seconds 0.1 --solver-error s.csv --sweeps 100 "
+                "--max-work 1e6", dir)
+            .exit_code == 0);
+  CHECK(fs::exists(dir / "s.csv"));
+  fs::remove_all(dir);
+}

@@ -111,6 +111,30 @@ TEST_CASE("a captured step is the system the engine solved, and observing it cha
   CHECK(solves > 0);
   CHECK(solves == observed.world.counters().solves);
   CHECK(scenes::state_hash(plain.world) == scenes::state_hash(observed.world));
+  // A filter asked before each solve is written out: told the step, the solve and the rows the
+  // observer then sees, and a false keeps the observer from it.
+  scenes::Run filtered = scenes::make_run(*scenes::find_scene("stack"));
+  int asked = 0;
+  std::vector<std::int64_t> seen;
+  Eigen::Index asked_rows = -1;
+  filtered.world.set_solve_observer(
+      [&](const StepSystem& s) {
+        seen.push_back(s.step);
+        CHECK(s.rows() == asked_rows);
+      },
+      [&](std::int64_t step, int solve, Eigen::Index rows) {
+        ++asked;
+        CHECK(solve == 0);
+        CHECK(step == static_cast<std::int64_t>(filtered.world.counters().steps));
+        asked_rows = rows;
+        return step % 10 == 0;
+      });
+  for (int k = 0; k < 120; ++k) filtered.step();
+  CHECK(asked == solves);
+  REQUIRE_FALSE(seen.empty());
+  CHECK(std::all_of(seen.begin(), seen.end(), [](std::int64_t step) { return step % 10 == 0; }));
+  CHECK(seen.size() < static_cast<std::size_t>(asked));
+  CHECK(scenes::state_hash(filtered.world) == scenes::state_hash(plain.world));
 }
 
 TEST_CASE("the exact solution of the resting stack and funnel satisfies every criterion to "

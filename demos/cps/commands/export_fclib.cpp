@@ -159,9 +159,10 @@ int run_fclib_export(const FclibExportOptions& o, int argc, char** argv) {
 
   // The first solve of each chosen step, up to the last of them.
   std::map<std::int64_t, StepSystem> captured;
-  run.world.set_solve_observer([&](const StepSystem& s) {
-    if (s.solve == 0 && names.count(s.step) != 0) captured.emplace(s.step, s);
-  });
+  run.world.set_solve_observer([&](const StepSystem& s) { captured.emplace(s.step, s); },
+                               [&](std::int64_t step, int solve, Eigen::Index) {
+                                 return solve == 0 && names.count(step) != 0;
+                               });
   const std::int64_t last = steps.back();
   Progress progress("export " + o.scene, static_cast<long long>(last + 1), "steps", 2.0);
   while (run.world.counters().steps <= last) {

@@ -310,7 +310,7 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
                              {"solver_error", o.solver_error},
                              {"overrides", overrides_json(o.overrides)},
                              {"parameters", parameters_json(r.world.def())}}));
-    errors->observe(r.world);
+    errors->observe(r.world, o.max_work - run_work(r.world.bodies().size(), r.world.def(), seconds));
   }
   if (files) {
     nlohmann::json info = {{"scene", scene->name},

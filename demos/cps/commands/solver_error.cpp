@@ -87,16 +87,38 @@ SolverErrorWriter::SolverErrorWriter(SolverErrorPlan plan, const std::string& sc
                          .scenes = {{file, scene}, {rows_file, scene}},
                          .option = "--solver-error",
                          .force = force});
-  begin_output(output_, info_);
 }
 
-void SolverErrorWriter::observe(World& world) {
-  world.set_solve_observer([this](const StepSystem& s) {
-    if (std::binary_search(plan_.steps.begin(), plan_.steps.end(), s.step)) systems_.push_back(s);
-  });
+void SolverErrorWriter::observe(World& world, double work_left) {
+  long long sweeps = 0;
+  for (const int k : plan_.sweeps) sweeps += k;
+  // PGS, Jacobi and coloured PGS (the last for a coloured run only: counted always).
+  constexpr double kSweepingMethods = 3.0;
+  world.set_solve_observer(
+      [this](const StepSystem& s) { systems_.push_back(s); },
+      [this, sweeps, work_left](std::int64_t step, int solve, Eigen::Index rows) {
+        if (!std::binary_search(plan_.steps.begin(), plan_.steps.end(), step)) return false;
+        const std::string which = "--solver-error: step " + std::to_string(step) + ", solve " +
+                                  std::to_string(solve) + " has " + std::to_string(rows) + " rows";
+        if (rows > kMaxExactRows) {
+          throw UsageError(which + ", more than the " + std::to_string(kMaxExactRows) +
+                           " an exact solve takes (a dense LCP solved by Lemke's method); give a "
+                           "smaller scene, or --at a step with fewer contacts");
+        }
+        sweep_work_ += kSweepingMethods * static_cast<double>(sweeps) * static_cast<double>(rows);
+        if (sweep_work_ > work_left) {
+          throw UsageError(which + ": its re-solves (rows x " + std::to_string(sweeps) +
+                           " sweeps of --sweeps x 3 methods) bring them to " + count_text(sweep_work_) +
+                           " row-sweeps, more than the " + count_text(std::max(0.0, work_left)) +
+                           " that --max-work leaves after the run; give smaller --sweeps, fewer --at "
+                           "steps, or a larger --max-work");
+        }
+        return true;
+      });
 }
 
 long SolverErrorWriter::finish() {
+  begin_output(output_, info_);
   std::string text = solver_error_header() + "\n";
   std::string rows_text = "step,solve," + system_rows_header("") + "\n";
   long rows = 0;

@@ -26,6 +26,13 @@ inline constexpr std::string_view kDefaultSweeps = "1,2,5,10,25,100,1000";
 /// The most sweeps --sweeps accepts (count): 10^6 sweeps of a 150-row system take about 2 s.
 inline constexpr int kMaxSolverErrorSweeps = 1'000'000;
 
+/// The most rows a captured system may have for --solver-error (count; pyramid_50 has 975): its
+/// exact solve is a dense LCP of up to about twice as many variables (exact_lcp.h), whose Lemke
+/// pivots take time and memory that grow as the cube and the square of that (docs/commands.md
+/// gives the times). A larger system is refused (exit 2) when the run reaches it, before it is
+/// written out or handed to Siconos.
+inline constexpr Eigen::Index kMaxExactRows = 1000;
+
 /// What --solver-error asks for: the file, the steps (indices as World::counters().steps before
 /// the step: 0 is the first step; sorted, unique) and the sweep counts (sorted, unique).
 struct SolverErrorPlan {
@@ -65,17 +72,22 @@ class SolverErrorWriter {
   /// Checks the path and the rows file beside it (plan_output with option "--solver-error":
   /// UsageError if one exists and no earlier cps run wrote it, or wrote it for another scene than
   /// `scene` (a scene_source), unless `force`; a folder of that name; a folder that cannot be
-  /// written), creates the folder and records the run in its run.json (begin_output with `info`).
+  /// written). Writes nothing: finish() creates the folder and the files.
   SolverErrorWriter(SolverErrorPlan plan, const std::string& scene, bool force, nlohmann::json info);
   SolverErrorWriter(const SolverErrorWriter&) = delete;
   SolverErrorWriter& operator=(const SolverErrorWriter&) = delete;
 
-  /// Sets world's solve observer to keep the systems of the planned steps. The writer must
-  /// outlive the steps.
-  void observe(World& world);
+  /// Sets world's solve observer to keep the systems of the planned steps (only theirs are
+  /// written out). The writer must outlive the steps. A planned system is refused, by a
+  /// UsageError thrown out of World::step before it is written out, when it has more than
+  /// kMaxExactRows rows, or when its re-solves (rows x the sum of the --sweeps counts, for each
+  /// sweeping method) bring the re-solves' work past `work_left` (row-sweeps, counted as the
+  /// run's body-iterations: what --max-work leaves after the run itself).
+  void observe(World& world, double work_left);
   /// Solves each captured system exactly and writes one row per step, solve, method (exact,
   /// engine, pgs, jacobi, coloured-pgs for a run under it) and sweep count, and the solves' rows
-  /// (solver_error_rows_path), then lists both files in run.json. Returns the rows
+  /// (solver_error_rows_path): creates the folder, records the run in its run.json
+  /// (begin_output with the constructor's `info`), writes both files and lists them there. Returns the rows
   /// written. A planned step with no solve (no contact or rod) is named on stderr. Throws
   /// std::runtime_error when an exact solve fails (naming the step) or the file cannot be
   /// written.
@@ -86,6 +98,7 @@ class SolverErrorWriter {
   OutputPlan output_;
   nlohmann::json info_;
   std::vector<StepSystem> systems_;
+  double sweep_work_ = 0.0;  // row-sweeps of the re-solves of the systems kept so far
 };
 
 }  // namespace cps::cli

@@ -74,9 +74,6 @@ void check_steps(const std::string& what, double seconds, double dt) {
   }
 }
 
-namespace {
-
-// A count as text: whole below 1e7 ("6000000"), else 3 significant digits ("3.6e+14").
 std::string count_text(double n) {
   char text[40];
   if (n < 1e7) {
@@ -86,6 +83,8 @@ std::string count_text(double n) {
   }
   return text;
 }
+
+namespace {
 
 // The push method's substeps a step (PushTraits::substeps): the work estimate's bound is
 // substeps x iterations sweeps a step.

@@ -29,6 +29,10 @@ inline constexpr double kMaxFrames = 1.0e5;   ///< frames in one render folder
 /// are smaller; this bounds the drawing work.
 inline constexpr double kMaxPixelBytes = 68719476736.0;
 
+/// A count (n >= 0) as text for messages: whole below 1e7 ("6000000"), else 3 significant digits
+/// ("3.6e+14"). No errors.
+std::string count_text(double n);
+
 /// Default work budget of one run (body-iterations, see run_work), the default of --max-work.
 /// Typical runs: 9e4 (the stack), 1.5e9 (pendulum_wave_20000); docs/commands.md says why 1e11.
 inline constexpr double kDefaultMaxWork = 1.0e11;

@@ -59,6 +59,13 @@ struct StepSystem {
 /// Called after each solve of a step with the system it solved; see World::set_solve_observer.
 using SolveObserver = std::function<void(const StepSystem&)>;
 
+/// Asked after each solve, before its system is written out (A alone is c x c doubles): `step`
+/// (World::counters().steps before the step), `solve` (StepSystem::solve) and `rows` (c); true
+/// hands the system to the observer, false skips it at the cost of the call. It may throw, to
+/// refuse a system too large for what the caller would do with it: the exception leaves
+/// World::step, and the world may then only be destroyed or assigned.
+using SolveFilter = std::function<bool(std::int64_t step, int solve, Eigen::Index rows)>;
+
 /// Called after each solve of a step, after the observer, with the system it solved (its
 /// lambda the engine's) and `lambda` holding a copy of the engine's lambda (c, N): what the
 /// function leaves in `lambda` is what the step goes on with, in place of the engine's. For

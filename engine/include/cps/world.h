@@ -152,8 +152,10 @@ class World {
   /// paper's push factor, two with the single frame push factor (Sec. 8.1), more with the
   /// substeps of the soft step. The observer runs inside World::step and must not touch the
   /// world. A copy of the world is not observed. Unobserved, a step does nothing more than test
-  /// that the function is empty. No errors.
-  void set_solve_observer(SolveObserver observer);
+  /// that the function is empty. `wants`, if not empty, chooses the solves observed before their
+  /// system is written out (cps/step_system.h, SolveFilter; an exception it throws leaves step).
+  /// No errors of its own.
+  void set_solve_observer(SolveObserver observer, SolveFilter wants = {});
   /// Hands each solve of the following steps to `override` after the engine's own sweeps (and
   /// after the observer): the lambda it leaves is the one the step uses (its forces, the warm
   /// start; the residual of measure_residual with the explicit assembly, while the matrix-free

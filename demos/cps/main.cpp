@@ -135,9 +135,11 @@ int run(int argc, char** argv) {
       if (*command.sub) return command.run();
     }
   } catch (const cli::UsageError& e) {
+    cli::abandon_outputs();
     std::cerr << "cps: " << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
+    cli::abandon_outputs();
     std::cerr << "cps: error: " << e.what() << "\n";
     return 1;
   }

@@ -5,6 +5,7 @@
 #include "push_methods.h"
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <fstream>
@@ -265,6 +266,22 @@ TEST_CASE("cps simulate --solver-error refuses a system past the exact solve's r
   CHECK(r.exit_code == 2);
   CHECK(r.err.find("--max-work") != std::string::npos);
   CHECK(fs::is_empty(dir));
+  // A run that fails after its trace was begun leaves run.json listing only files that exist:
+  // none in a new folder (so no run.json), the earlier trace beside it.
+  r = run_cps("simulate pyramid_100 --seconds 0.1 --trace t.csv --solver-error s.csv", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(fs::is_empty(dir));
+  REQUIRE(run_cps("simulate stack --seconds 0.1 --trace t.csv", dir).exit_code == 0);
+  r = run_cps("simulate pyramid_100 --seconds 0.1 --trace t2.csv --solver-error s.csv", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(!fs::exists(dir / "t2.csv"));
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(dir / "run.json"));
+  INFO(manifest.dump(1));
+  CHECK(manifest["files"] == nlohmann::json::array({"t.csv"}));
+  CHECK(manifest["complete"] == true);
+  CHECK(manifest["unfinished_runs"].empty());
+  fs::remove(dir / "run.json");
+  fs::remove(dir / "t.csv");
   // Within both, the same request writes its files.
   CHECK(run_cps("simulate intersecting_stack --seconds 0.1 --solver-error s.csv --sweeps 100 "
                 "--max-work 1e6", dir)

@@ -251,6 +251,7 @@ Command add_diff(CLI::App& app, int argc, char** argv) {
             } catch (const UsageError&) {
               throw;
             } catch (const std::exception& e) {
+              abandon_outputs();
               std::fprintf(stderr, "cps: error: %s\n", e.what());
               return kDiffErrorExit;
             }

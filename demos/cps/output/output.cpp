@@ -591,6 +591,57 @@ OutputPlan plan_output(const OutputRequest& r) {
   refuse_foreign(r, manifest, findings);
 }
 
+namespace {
+
+// The folders this process began (begin_output) and has not ended, with the info of their
+// run.json, for abandon_outputs.
+struct Begun {
+  fs::path folder;
+  nlohmann::json info;
+};
+std::mutex begun_mutex;
+std::vector<Begun> begun;
+
+void note_begun(const fs::path& folder, const nlohmann::json& info) {
+  const std::lock_guard lock(begun_mutex);
+  begun.push_back({folder, info});
+}
+
+void note_ended(const fs::path& folder) {
+  const std::lock_guard lock(begun_mutex);
+  const auto it = std::find_if(begun.begin(), begun.end(), [&](const Begun& b) { return b.folder == folder; });
+  if (it != begun.end()) begun.erase(it);
+}
+
+}  // namespace
+
+void abandon_outputs() noexcept {
+  std::vector<Begun> folders;
+  {
+    const std::lock_guard lock(begun_mutex);
+    folders.swap(begun);
+  }
+  for (const Begun& b : folders) {
+    try {
+      const FolderLock lock(b.folder);
+      const Manifest manifest = read_manifest(b.folder);
+      if (!manifest.ours) continue;
+      std::vector<RunId> unfinished;
+      for (const RunId& r : manifest.unfinished) {
+        if (r.token != run_token()) unfinished.push_back(r);
+      }
+      const std::vector<std::string> files = still_listed(b.folder, manifest.files, unfinished);
+      if (files.empty() && unfinished.empty()) {
+        // Nothing of cps's is there: a manifest would list nothing.
+        ::unlink((b.folder / k_manifest_name).c_str());
+        continue;
+      }
+      write_manifest(b.folder, b.info, unfinished.empty(), files, manifest.written, unfinished);
+    } catch (...) {  // best effort: the next run there treats this one as interrupted
+    }
+  }
+}
+
 void begin_output(const OutputPlan& plan, const nlohmann::json& info) {
   const fs::path folder = plan.folder.empty() ? fs::path(".") : plan.folder;
   std::error_code ec;
@@ -632,6 +683,7 @@ void begin_output(const OutputPlan& plan, const nlohmann::json& info) {
     records[name] = {plan.command, scene == plan.scenes.end() ? std::string() : scene->second, ""};
   }
   write_manifest(folder, info, false, files, records, unfinished);
+  note_begun(folder, info);
 }
 
 void end_output(const OutputPlan& plan, const nlohmann::json& info) {
@@ -664,6 +716,7 @@ void end_output(const OutputPlan& plan, const nlohmann::json& info) {
                      content_hash(folder / name)};
   }
   write_manifest(folder, info, unfinished.empty(), files, records, unfinished);
+  note_ended(folder);
 }
 
 void write_json_atomic(const fs::path& path, const nlohmann::json& j) {

@@ -129,6 +129,14 @@ void begin_output(const OutputPlan& plan, const nlohmann::json& info);
 /// are hashed now). Throws std::runtime_error naming the path on failure.
 void end_output(const OutputPlan& plan, const nlohmann::json& info);
 
+/// For a command that fails after begin_output: in each folder this process began and did not
+/// end, takes this run off run.json's "unfinished_runs" and lists only the files that exist (or
+/// that another run still writing will write), so run.json never names a file the failed run
+/// did not write; a run.json that would then list nothing is removed. The failed run's
+/// temporaries are removed by their AtomicFile. Best effort, no errors (a folder it cannot fix is
+/// left as an interrupted run's, for the next run there).
+void abandon_outputs() noexcept;
+
 /// Writes `j` (indented, with a final newline) to `path` atomically (write_text_atomic). Throws
 /// std::runtime_error "cannot write PATH: REASON" on failure; the old file, if any, stays.
 void write_json_atomic(const std::filesystem::path& path, const nlohmann::json& j);

@@ -9,7 +9,14 @@ extern "C" {
 #include <fclib.h>
 }
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 #include <climits>
+#include <csignal>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -162,6 +169,26 @@ std::string fclib_mapping_text() {
          "not cps's box problem.";
 }
 
+namespace {
+
+// The reason in HDF5's diagnostics (its error stack, as fclib's child printed it): the system's
+// message of the failed call ("No space left on device") where HDF5 gives one, else the last
+// "minor:" line; "" when there is neither.
+std::string hdf5_reason(const std::string& said) {
+  const std::string key = "error message = '";
+  const std::size_t at = said.rfind(key);
+  if (at != std::string::npos) {
+    const std::size_t end = said.find('\'', at + key.size());
+    if (end != std::string::npos) return ": " + said.substr(at + key.size(), std::min<std::size_t>(end - at - key.size(), 200));
+  }
+  const std::size_t minor = said.rfind("minor: ");
+  if (minor == std::string::npos) return "";
+  const std::size_t end = said.find('\n', minor);
+  return ": HDF5 says " + said.substr(minor + 7, std::min<std::size_t>(end == std::string::npos ? said.size() - minor - 7 : end - minor - 7, 200));
+}
+
+}  // namespace
+
 void write_fclib_local(const FclibLocal& p, const FclibText& text, const std::filesystem::path& path) {
   const Eigen::Index m = p.W.rows();
   const Eigen::Index rods = static_cast<Eigen::Index>(p.rod_rows.size());
@@ -199,9 +226,46 @@ void write_fclib_local(const FclibLocal& p, const FclibText& text, const std::fi
     problem.R = &R;
     problem.s = copy.s.data();
   }
-  if (fclib.write_local(&problem, path.c_str()) != 1) {
-    throw std::runtime_error("cannot write " + path.string() + ": fclib_write_local failed");
+  // fclib ends the process (exit) when an HDF5 call fails, as on a full disk: the write runs in a
+  // child process, whose end and stderr (HDF5's diagnostics) this process reads.
+  int pipe_fds[2];
+  if (::pipe(pipe_fds) != 0) {
+    throw std::runtime_error("cannot write " + path.string() + ": pipe: " + std::strerror(errno));
   }
+  const pid_t child = ::fork();
+  if (child < 0) {
+    const int error = errno;
+    ::close(pipe_fds[0]);
+    ::close(pipe_fds[1]);
+    throw std::runtime_error("cannot write " + path.string() + ": fork: " + std::strerror(error));
+  }
+  if (child == 0) {
+    ::close(pipe_fds[0]);
+    ::dup2(pipe_fds[1], STDERR_FILENO);
+    ::dup2(pipe_fds[1], STDOUT_FILENO);
+    ::_exit(fclib.write_local(&problem, path.c_str()) == 1 ? 0 : 1);
+  }
+  ::close(pipe_fds[1]);
+  std::string said;  // the first 4 KiB the child printed
+  char chunk[4096];
+  for (;;) {
+    const ssize_t n = ::read(pipe_fds[0], chunk, sizeof chunk);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    if (said.size() < sizeof chunk) said.append(chunk, static_cast<std::size_t>(n));
+  }
+  ::close(pipe_fds[0]);
+  int status = 0;
+  while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
+  std::string why = WIFSIGNALED(status) ? "fclib_write_local was ended by signal " +
+                                              std::to_string(WTERMSIG(status)) + " (" +
+                                              strsignal(WTERMSIG(status)) + ")"
+                                        : "fclib_write_local failed (exit " +
+                                              std::to_string(WEXITSTATUS(status)) + ")";
+  why += hdf5_reason(said);
+  throw std::runtime_error("cannot write " + path.string() + ": " + why);
 }
 
 }  // namespace cps::analysis

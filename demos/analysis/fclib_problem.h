@@ -81,8 +81,10 @@ std::string load_fclib();
 /// /fclib_local; W, V, R in compressed columns). `path` must not exist (fclib would add to an
 /// HDF5 file already there). Opens FCLIB first (load_fclib). Throws std::invalid_argument when
 /// p's sizes disagree or exceed FCLIB's int indices, std::runtime_error when FCLIB cannot be
-/// opened (load_fclib) or naming the path when fclib reports a failure. FCLIB
-/// ends the process (exit 1) on a failed HDF5 call within a write.
+/// opened (load_fclib), or naming the path and the reason when the write fails. FCLIB ends its
+/// process (exit) on a failed HDF5 call, so the write runs in a child process (fork(2)): its
+/// failure, exit or signal, becomes the exception, with the first line it printed; the caller
+/// removes what the child left at `path`.
 void write_fclib_local(const FclibLocal& p, const FclibText& text, const std::filesystem::path& path);
 
 }  // namespace cps::analysis

@@ -201,8 +201,12 @@ int run_fclib_export(const FclibExportOptions& o, int argc, char** argv) {
     AtomicFile file(target);
     file.hand_over();
     std::filesystem::remove(file.temporary());
-    analysis::write_fclib_local(problem, problem_text(scene_name, captured.at(step), problem, parameters),
-                                file.temporary());
+    try {
+      analysis::write_fclib_local(problem, problem_text(scene_name, captured.at(step), problem, parameters),
+                                  file.temporary());
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error("--fclib " + target.string() + ": nothing written (" + e.what() + ")");
+    }
     const std::uintmax_t bytes = file.commit();
     std::cerr << "export " << scene_name << ": step " << step << ", " << problem.contacts()
               << " contacts and " << problem.rod_rows.size() << " rods (W " << problem.W.rows()

@@ -290,6 +290,7 @@ EXTRA=(
   "push/--list-runs|report push --list-runs --out out"
   "push/--seed|report push --seed 3 --out out"
   "twice|report --merge $MERGE_SRC $MERGE_SRC --out out"
+  "--merge/--out|report --merge $MERGE_SRC --out $MERGE_SRC/report"
   "again in|report --merge $MERGE_SRC $MERGE_DUP --out out"
   "us_per_step: 'nan'|report --merge $MERGE_NAN --out out"
   "--rendering/--quick|bench --rendering=false --quick=junk"

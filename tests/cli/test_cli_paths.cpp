@@ -202,3 +202,23 @@ TEST_CASE("report runs of two scene files of one name into one --out are refused
   CHECK(r.err.find("input of this command") != std::string::npos);
   CHECK(slurp(dir / "q/x.csv") == table);
 }
+
+TEST_CASE("an output folder through a dangling symbolic link is refused with exit 2, naming the link",
+          "[cli][output][paths]") {
+  const fs::path dir = fresh_dir("dangling");
+  fs::create_symlink("nowhere", dir / "out");
+  for (const char* line : {"simulate stack --seconds 0.1 --trace out/t.csv",
+                           "simulate stack --seconds 0.1 --energy out/sub/e.csv",
+                           "scene stack --out out/s.json"}) {
+    INFO(line);
+    const Result r = run_cps(line, dir);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("out is a symbolic link to nowhere, which does not exist") != std::string::npos);
+  }
+  CHECK(!fs::exists(dir / "nowhere"));
+  // Once its target exists, the link is a folder like any other.
+  fs::create_directories(dir / "nowhere");
+  CHECK(run_cps("simulate stack --seconds 0.1 --trace out/t.csv", dir).exit_code == 0);
+  CHECK(fs::exists(dir / "nowhere/t.csv"));
+  fs::remove_all(dir);
+}

@@ -313,6 +313,18 @@ TEST_CASE("report --merge refuses a run twice, naming the id and both files, and
     CHECK(r.err.find("run stack.pgs.split.fixed.it4.ss1 is in runs/stack.pgs.split.fixed.it4.ss1.csv "
                      "line 2 and again in again/copy.csv line 2") != std::string::npos);
   }
+  SECTION("an --out that is a merged folder or below one: its report would be read as runs") {
+    const std::string before = slurp(dir / "runs/stack.pgs.split.fixed.it4.ss1.csv");
+    for (const char* out : {"runs", "./runs/", "runs/report", "runs/../runs/x/y"}) {
+      INFO(out);
+      const Result r = run_cps(std::string("report --merge runs --out ") + out, dir);
+      CHECK(r.exit_code == 2);
+      CHECK(r.err.find("the --merge folder runs") != std::string::npos);
+    }
+    CHECK_FALSE(fs::exists(dir / "runs/report"));
+    CHECK_FALSE(fs::exists(dir / "runs/report.md"));
+    CHECK(slurp(dir / "runs/stack.pgs.split.fixed.it4.ss1.csv") == before);
+  }
   SECTION("the same run twice in one file") {
     const std::string csv = slurp(dir / "runs/stack.pgs.split.fixed.it4.ss1.csv");
     fs::create_directories(dir / "twice");

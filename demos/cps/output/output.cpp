@@ -306,6 +306,15 @@ void check_folder(const fs::path& folder, std::string_view option) {
       throw UsageError("output folder " + display(folder) + ": " + p.string() + ": " +
                        std::strerror(errno) + choose);
     }
+    struct stat link {};
+    if (::lstat(p.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
+      std::error_code ec;
+      const fs::path to = fs::read_symlink(p, ec);
+      throw UsageError("output folder " + display(folder) + ": " + p.string() +
+                       " is a symbolic link to " + (ec ? std::string("a path") : to.string()) +
+                       ", which does not exist (cps creates no folder through a dangling link); "
+                       "create its target, or choose another " + std::string(option));
+    }
     missing = true;
     fs::path parent = p.parent_path();
     if (parent.empty()) parent = ".";

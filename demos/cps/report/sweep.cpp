@@ -273,6 +273,25 @@ std::vector<std::string> missing_runs(const std::vector<RunResult>& runs, std::s
 
 int merge_report(const SweepOutput& to, const std::vector<fs::path>& dirs) {
   const std::vector<RunResult> runs = read_results(dirs);
+  // The merged report's CSVs would be read as runs by the next merge of that folder.
+  const auto resolved = [](const fs::path& p, std::error_code& ec) {
+    fs::path r = fs::weakly_canonical(fs::absolute(p), ec).lexically_normal();
+    return r.has_filename() ? r : r.parent_path();  // "a/b/" as "a/b"
+  };
+  std::error_code ec;
+  const fs::path out = resolved(to.out, ec);
+  for (const fs::path& dir : dirs) {
+    std::error_code dir_ec;
+    const fs::path from = resolved(dir, dir_ec);
+    if (ec || dir_ec) continue;
+    const auto [end, at] = std::mismatch(from.begin(), from.end(), out.begin(), out.end());
+    if (end == from.end()) {
+      throw UsageError("--out " + to.out.string() + " is " + (at == out.end() ? "" : "inside ") +
+                       "the --merge folder " + dir.string() + ": the next merge of it would read "
+                       "the merged report's CSVs as runs; choose an --out outside every --merge "
+                       "folder");
+    }
+  }
   if (runs.empty()) throw UsageError("--merge: no report CSV found below the given folders");
   std::size_t planned = 0;
   const std::vector<std::string> missing = missing_runs(runs, planned);

@@ -291,6 +291,8 @@ EXTRA=(
   "push/--seed|report push --seed 3 --out out"
   "twice|report --merge $MERGE_SRC $MERGE_SRC --out out"
   "--merge/--out|report --merge $MERGE_SRC --out $MERGE_SRC/report"
+  "names/bidi.json/U+202E|render names/bidi.json --seconds 0.1 --fps 10 --size 16x16 --out out"
+  "names/run.json/run|scene names/run.json --out out/s.json"
   "again in|report --merge $MERGE_SRC $MERGE_DUP --out out"
   "us_per_step: 'nan'|report --merge $MERGE_NAN --out out"
   "--rendering/--quick|bench --rendering=false --quick=junk"
@@ -434,6 +436,10 @@ run_cps() {
   mkfifo "$d/cwd/fifo.png"
   ln -s loop.png "$d/cwd/loop.png"
   printf "$BOMB_PNG" > "$d/cwd/bomb.png"
+  # Scene files whose outputs would be named with a bidi control or as cps's own run.json.
+  mkdir -p "$d/cwd/names"
+  printf '{"bodies": [], "name": "ab\\u202ecd"}\n' > "$d/cwd/names/bidi.json"
+  printf '{"bodies": []}\n' > "$d/cwd/names/run.json"
   local before
   before=$(snapshot "$d")
   (cd "$d/cwd" && TMPDIR="$d/tmp" exec timeout -k 5 "$TIMEOUT" "${CAP[@]}" "$CPS" "$@" \

@@ -82,8 +82,21 @@ Scene scene_of(const SceneFile& file, std::string_view name);
 /// bytes of letters, digits, '_', '-', '.' or non-ASCII UTF-8 that does not begin with '.' or
 /// '-' ("cradle"); else the stem of `path` (the file name without ".json", spaces and unicode
 /// kept) when that is a usable file name (not empty, no control character, not beginning with
-/// '.', at most 200 bytes); else "scene". Never the path as typed. No errors.
+/// '.', at most 200 bytes); else "scene". Never the path as typed. Throws SceneFileError when the
+/// name chosen is one of cps's own outputs (kReservedOutputNames), or when the "name" or the stem
+/// holds a character no file name of cps may hold (unsafe_name_character).
 std::string scene_file_output_name(const SceneFile& file, const std::filesystem::path& path);
+
+/// Output names a scene may not have: cps's own files beside its outputs ("run" would make
+/// `scene`'s run.json, "report" and "mass_ratio" the report's report.md and mass_ratio.csv,
+/// "plots" the report's plots folder).
+inline constexpr std::string_view kReservedOutputNames[] = {"run", "report", "mass_ratio", "plots"};
+
+/// The first character of UTF-8 text `s` that a name of cps's outputs may not hold, as "U+XXXX"
+/// with what it is ("a control character", "a bidirectional control", "a line or paragraph
+/// separator"), or "invalid UTF-8 at byte N"; "" when there is none. Such characters make a name
+/// print as another (U+202E turns the text after it around) or break a line. No errors.
+std::string unsafe_name_character(std::string_view s);
 
 /// The scene file at `path` (a name ending in ".json"), loaded once and kept for the program's
 /// life; the Scene is named `path` as given. Throws SceneFileError for a file that cannot be read

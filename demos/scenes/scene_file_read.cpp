@@ -330,10 +330,56 @@ bool usable_stem(std::string_view n) {
 
 }  // namespace
 
+std::string unsafe_name_character(std::string_view s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto b = static_cast<unsigned char>(s[i]);
+    std::size_t length = b < 0x80 ? 1 : (b >> 5) == 0x6 ? 2 : (b >> 4) == 0xe ? 3 : (b >> 3) == 0x1e ? 4 : 0;
+    if (length == 0 || i + length > s.size()) return "invalid UTF-8 at byte " + std::to_string(i);
+    char32_t c = length == 1 ? b : length == 2 ? (b & 0x1f) : length == 3 ? (b & 0x0f) : (b & 0x07);
+    for (std::size_t k = 1; k < length; ++k) {
+      const auto next = static_cast<unsigned char>(s[i + k]);
+      if ((next >> 6) != 0x2) return "invalid UTF-8 at byte " + std::to_string(i + k);
+      c = (c << 6) | (next & 0x3f);
+    }
+    const char* what = c < 0x20 || (c >= 0x7f && c <= 0x9f) ? "a control character"
+                       : c == 0x061c || c == 0x200e || c == 0x200f || (c >= 0x202a && c <= 0x202e) ||
+                               (c >= 0x2066 && c <= 0x2069)
+                           ? "a bidirectional control"
+                       : c == 0x2028 || c == 0x2029 ? "a line or paragraph separator"
+                                                    : nullptr;
+    if (what != nullptr) {
+      char code[16];
+      std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(c));
+      return std::string(code) + " (" + what + ")";
+    }
+    i += length;
+  }
+  return "";
+}
+
 std::string scene_file_output_name(const SceneFile& file, const std::filesystem::path& path) {
-  if (title_name(file.name)) return file.name;
+  const std::string in_name = unsafe_name_character(file.name);
+  if (!in_name.empty()) {
+    throw SceneFileError(file.origin + ": /name: holds " + in_name + ", which no scene name may " +
+                         "hold: a name must print as itself on one line");
+  }
   const std::string stem = path.stem().string();
-  return usable_stem(stem) ? stem : std::string("scene");
+  const std::string name = title_name(file.name) ? file.name : usable_stem(stem) ? stem : std::string("scene");
+  if (name == stem) {
+    const std::string in_stem = unsafe_name_character(stem);
+    if (!in_stem.empty()) {
+      throw SceneFileError(file.origin + ": the file's name holds " + in_stem + ", which no name of " +
+                           "cps's outputs may hold; rename the file, or give the scene a \"name\"");
+    }
+  }
+  for (const std::string_view reserved : kReservedOutputNames) {
+    if (name == reserved) {
+      throw SceneFileError(file.origin + ": the scene's outputs would be named \"" + name +
+                           "\", which is one of cps's own files (run, report, mass_ratio, plots); " +
+                           (name == file.name ? "give another \"name\"" : "rename the file or give it a \"name\""));
+    }
+  }
+  return name;
 }
 
 Scene scene_of(const SceneFile& file, std::string_view name) {

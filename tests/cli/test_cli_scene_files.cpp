@@ -64,6 +64,16 @@ TEST_CASE("a bad scene file exits 2 naming the file and the pointer, and writes 
         R"({"bodies": [{"shape": "sphere", "radius_m": 1, "mass_kg": 1, "positon_m": [0, 2, 0]}]})");
   write(dir / "notjson.json", "bodies: none\n");
   fs::create_directories(dir / "folder.json");
+  // Names that would print as another (U+202E, a right-to-left override, turns the text after
+  // it around), break a line (U+2028), or name cps's own files.
+  const std::string plane = R"({"bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0}])";
+  write(dir / "bidi.json", plane + ", \"name\": \"ab\u202ecd\"}");
+  write(dir / "named_run.json", plane + ", \"name\": \"run\"}");
+  fs::create_directories(dir / "names");
+  write(dir / "names/report.json", plane + "}");
+  write(dir / "names/mass_ratio.json", plane + "}");
+  write(dir / "names/x\u2028y.json", plane + "}");
+  write(dir / "names/x\u2028y_named.json", plane + ", \"name\": \"fine\"}");
   struct Case {
     std::string args;
     std::string says;
@@ -80,6 +90,11 @@ TEST_CASE("a bad scene file exits 2 naming the file and the pointer, and writes 
       {"simulate random_2 --seed 3", "already names its seed"},
       {"simulate random --seed x", "give a decimal integer"},
       {"simulate nosuch", "the example scene files"},
+      {"simulate bidi.json", "bidi.json: /name: holds U+202E (a bidirectional control)"},
+      {"simulate named_run.json", "would be named \"run\", which is one of cps's own files"},
+      {"report names/report.json --out out", "would be named \"report\""},
+      {"report names/mass_ratio.json --out out", "would be named \"mass_ratio\""},
+      {"scene 'names/x\u2028y.json'", "holds U+2028 (a line or paragraph separator)"},
 #ifdef CPS_HAVE_RENDERER
       {"render typo.json --out out", "/bodies/0/positon_m"},
       {"figure typo.json --times 0 --out out", "/bodies/0/positon_m"},
@@ -92,6 +107,8 @@ TEST_CASE("a bad scene file exits 2 naming the file and the pointer, and writes 
     CHECK(r.err.find(c.says) != std::string::npos);
     CHECK(!fs::exists(dir / "out"));
   }
+  // A file whose name cannot be used names its outputs by a usable "name".
+  CHECK(run_cps("simulate 'names/x\u2028y_named.json' --seconds 0.1", dir).exit_code == 0);
 }
 
 TEST_CASE("the seed option makes the random scene random_N, and cps list shows examples and families",

@@ -337,6 +337,25 @@ TEST_CASE("report --merge refuses a run twice, naming the id and both files, and
   fs::remove_all(dir);
 }
 
+TEST_CASE("report --merge refuses two scenes with one output name, naming both, and writes nothing",
+          "[cli][report]") {
+  const fs::path dir = fresh_dir("one_name");
+  two_runs(dir);
+  // A scene file written from the stack keeps "name": "stack": its report files are the stack's.
+  REQUIRE(run_cps("scene stack --out heavy.json", dir).exit_code == 0);
+  REQUIRE(run_cps("report heavy.json --run heavy.json.pgs.split.fixed.it4.ss1 --out heavy", dir).exit_code == 0);
+  const Result r = run_cps("report --merge runs heavy --out out", dir);
+  INFO(r.err);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("scenes stack and heavy.json are two scenes with one output name, stack") !=
+        std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "out"));
+  // Each alone merges.
+  CHECK(run_cps("report --merge heavy --out out", dir).exit_code <= 1);
+  CHECK(fs::exists(dir / "out/stack.csv"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("report --merge refuses a cell that is not finite, naming file, line, column and value",
           "[cli][report]") {
   const fs::path dir = fresh_dir("non_finite");

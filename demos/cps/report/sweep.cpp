@@ -7,6 +7,7 @@
 #include "report/report.h"
 #include "report/run.h"
 #include "report/tasks.h"
+#include "scene_file.h"
 
 #include <algorithm>
 #include <chrono>
@@ -34,6 +35,31 @@ std::map<std::string, std::string> scenes_of_files(const std::vector<std::string
   return out;
 }
 
+// Refuses (UsageError) scenes whose report files would share a name: two scenes (as typed: a
+// built-in name, or a scene file's path) with one output name (file_stem), such as a scene file
+// whose "name" is "stack" beside the built-in stack, or a scene whose output name is one of the
+// report's own files.
+const std::vector<std::string>& distinct_outputs(const std::vector<std::string>& scenes) {
+  std::map<std::string, std::string> by_output;
+  for (const std::string& scene : scenes) {
+    const std::string stem = file_stem(scene);
+    for (const std::string_view reserved : scenes::kReservedOutputNames) {
+      if (stem == reserved) {
+        throw UsageError("scene " + scene + ": its report files would be named " + stem +
+                         ", as the report's own; rename it (its file, or its \"name\")");
+      }
+    }
+    const auto [it, inserted] = by_output.emplace(stem, scene);
+    if (!inserted && it->second != scene) {
+      throw UsageError("scenes " + it->second + " and " + scene + " are two scenes with one output "
+                       "name, " + stem + ": their rows would share " + stem + ".csv and its "
+                       "plots; nothing was written. Rename one (its file, or its \"name\"), or "
+                       "report them into two --out folders");
+    }
+  }
+  return scenes;
+}
+
 // The report's two folders (OUT and OUT/plots, both shared: see output.h), checked for the
 // report of `scenes` before any work; write() then begins them, calls `body` and ends them, so
 // that each folder's run.json lists what was written. With `record_scenes`, each scene's files
@@ -47,7 +73,7 @@ struct ReportOutput {
   ReportOutput(const fs::path& out, const std::vector<std::string>& scenes, bool force,
                nlohmann::json run, bool record_scenes)
       : main(plan_output({.folder = out,
-                          .files = report_files(scenes),
+                          .files = report_files(distinct_outputs(scenes)),
                           .command = "report",
                           .use = FolderUse::shared,
                           .scenes = record_scenes ? scenes_of_files(scenes, report_files)

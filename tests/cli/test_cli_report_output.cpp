@@ -3,15 +3,18 @@
 // one on a full disk fails with ENOSPC), a gnuplot that fails, the temporaries of a killed run,
 // and the merge's refusals of duplicate runs, non-finite cells and too much data.
 #include "cli_support.h"
+#include "report/csv.h"
 #include "report/reference_report.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -43,6 +46,29 @@ void two_runs(const fs::path& dir) {
   for (const char* id : {"stack.pgs.split.fixed.it4.ss1", "stack.jacobi.split.fixed.it4.ss1"}) {
     REQUIRE(run_cps(std::string("report stack --run ") + id + " --out runs", dir).exit_code == 0);
   }
+}
+
+// run_cps in a child process of its own, with the largest resident memory (MiB, rounded up to
+// 255 at most) that any process it waited for had: cps's peak, apart from this test's others.
+std::pair<Result, int> run_cps_peak(const std::string& args, const fs::path& dir) {
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    const Result r = run_cps(args, dir);
+    std::ofstream(dir / "peak_result.txt") << r.exit_code << "\n" << r.err;
+    rusage usage{};
+    ::getrusage(RUSAGE_CHILDREN, &usage);
+    ::_exit(static_cast<int>(std::min<long>(255, (usage.ru_maxrss + 1023) / 1024)));
+  }
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  REQUIRE(WIFEXITED(status));
+  std::ifstream in(dir / "peak_result.txt");
+  Result r;
+  in >> r.exit_code;
+  r.err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  fs::remove(dir / "peak_result.txt");
+  return {r, WEXITSTATUS(status)};
 }
 
 // The names of the files in `folder` (not below it) that end with `suffix`.
@@ -337,6 +363,40 @@ TEST_CASE("report --merge refuses a run twice, naming the id and both files, and
   fs::remove_all(dir);
 }
 
+TEST_CASE("report CSVs are RFC 4180: cells with commas, quotes and line breaks are quoted and read "
+          "back, CRLF is read, an unclosed quote is named",
+          "[cli][report]") {
+  const fs::path dir = fresh_dir("rfc4180");
+  cps::cli::CsvTable table;
+  table.columns = {"scene", "note", "n"};
+  table.rows = {{"a,b.json", "say \"hi\"", "1"}, {"two\nlines.json", "", "2"}, {"plain", "x", ""}};
+  const std::string text = cps::cli::csv_text(table);
+  CHECK(text == "scene,note,n\n\"a,b.json\",\"say \"\"hi\"\"\",1\n\"two\nlines.json\",,2\nplain,x,\n");
+  write_text(dir / "lf.csv", text);
+  std::string crlf;
+  for (const char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  // The line break inside the quoted cell stays as written: CRLF outside quotes ends a record.
+  write_text(dir / "crlf.csv", crlf);
+  for (const char* name : {"lf.csv", "crlf.csv"}) {
+    INFO(name);
+    const cps::cli::CsvTable back = cps::cli::read_csv(dir / name);
+    CHECK(back.columns == table.columns);
+    REQUIRE(back.rows.size() == 3);
+    CHECK(back.rows[0] == table.rows[0]);
+    CHECK(back.rows[1][0].find("lines.json") != std::string::npos);
+    CHECK(back.rows[2] == table.rows[2]);
+    CHECK(back.lines == std::vector<std::size_t>{2, 3, 5});  // the second row spans lines 3 and 4
+  }
+  write_text(dir / "open.csv", "scene,n\nplain,1\n\"never closed,2\n");
+  try {
+    (void)cps::cli::read_csv(dir / "open.csv");
+    FAIL("an unclosed quote was read");
+  } catch (const std::runtime_error& e) {
+    CHECK(std::string(e.what()).find("open.csv line 3: a quoted cell is not closed") != std::string::npos);
+  }
+  fs::remove_all(dir);
+}
+
 TEST_CASE("report --merge refuses two scenes with one output name, naming both, and writes nothing",
           "[cli][report]") {
   const fs::path dir = fresh_dir("one_name");
@@ -417,6 +477,20 @@ TEST_CASE("report --merge bounds its memory by its cells, not by a count of rows
     CHECK(r.err.find("would take at least 2") != std::string::npos);  // 25x or 26x MiB
     CHECK_FALSE(fs::exists(dir / "out"));
   }
+  // A reference section's table (its header not starting with 'scene') of one 100 MB line: told
+  // apart by its first bytes, never read to its end: the peak resident memory stays far below it.
+  fs::create_directories(dir / "one_line");
+  {
+    std::ofstream big(dir / "one_line/stack_energy.csv", std::ios::binary);
+    const std::string block(1 << 20, 'x');
+    for (int k = 0; k < 100; ++k) big << block;
+  }
+  const auto [one_line, peak_mib] = run_cps_peak("report --merge one_line --out out", dir);
+  INFO(one_line.err);
+  CHECK(one_line.exit_code == 2);
+  CHECK(one_line.err.find("no report CSV found") != std::string::npos);
+  CHECK(peak_mib < 50);  // the line alone is 100 MiB
+  fs::remove_all(dir / "one_line");
   // 100 rows of 1,000 columns: read (and refused for its settings, not its size).
   std::string fits = "scene,solver";
   for (int c = 0; c < 1000; ++c) fits += ",x" + std::to_string(c);

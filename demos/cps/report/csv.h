@@ -1,7 +1,8 @@
 #pragma once
-// The report's CSV files, written and read by one piece of code: a header line of column names,
-// then one line per row, cells separated by commas. Cells never hold a comma or a line break
-// (names, numbers, space-separated lists), so nothing is quoted.
+// The report's CSV files, written and read by one piece of code, as RFC 4180 has them: a header
+// record of column names, then one record per row, cells separated by commas; a cell holding a
+// comma, a double quote or a line break (a scene file's path may) is written in double quotes
+// with its quotes doubled. Records end at LF when written; LF or CRLF when read.
 
 #include <cstddef>
 #include <filesystem>
@@ -27,10 +28,10 @@ struct CsvTable {
   const std::string& cell(std::size_t row, std::string_view column) const;
 };
 
-/// Reads `file`: its first line is the header, each further non-empty line a row, split at
-/// commas (missing cells at the end of a line are ""; cells past the header's count dropped),
-/// with its line number in `lines`.
-/// Throws std::runtime_error "cannot read FILE" if it cannot be opened.
+/// Reads `file` (RFC 4180: quoted cells, LF or CRLF): its first record is the header, each
+/// further non-empty record a row (missing cells at its end are ""; cells past the header's count
+/// dropped), with the line it begins on in `lines`. Throws std::runtime_error "cannot read FILE"
+/// if it cannot be read, and naming the file and line for a quoted cell that is never closed.
 CsvTable read_csv(const std::filesystem::path& file);
 
 /// The rows of a table as maps, column name -> cell ("" where empty): every column in every row.

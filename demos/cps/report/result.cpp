@@ -373,10 +373,12 @@ bool is_reference_section_csv(const fs::path& file) {
   if (!ends_with("_solver_error.csv") && !ends_with("_references.csv") && !ends_with("_energy.csv")) {
     return false;
   }
-  std::ifstream in(file);
-  std::string header;
-  std::getline(in, header);
-  return header.rfind("scene", 0) != 0;
+  // Only the header's first 5 bytes: a file of any size (a single line of gigabytes) is never
+  // read further here; the merge's size bound reads the rest in blocks.
+  std::ifstream in(file, std::ios::binary);
+  char start[5] = {};
+  in.read(start, sizeof start);
+  return std::string_view(start, static_cast<std::size_t>(in.gcount())) != "scene";
 }
 
 }  // namespace

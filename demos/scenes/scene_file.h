@@ -88,9 +88,11 @@ Scene scene_of(const SceneFile& file, std::string_view name);
 std::string scene_file_output_name(const SceneFile& file, const std::filesystem::path& path);
 
 /// Output names a scene may not have: cps's own files beside its outputs ("run" would make
-/// `scene`'s run.json, "report" and "mass_ratio" the report's report.md and mass_ratio.csv,
-/// "plots" the report's plots folder).
-inline constexpr std::string_view kReservedOutputNames[] = {"run", "report", "mass_ratio", "plots"};
+/// `scene`'s run.json, "run.json" render's frames folder OUT/run.json beside OUT's own run.json,
+/// "report" and "mass_ratio" the report's report.md and mass_ratio.csv, "plots" the report's
+/// plots folder).
+inline constexpr std::string_view kReservedOutputNames[] = {"run", "run.json", "report", "mass_ratio",
+                                                            "plots"};
 
 /// The first character of UTF-8 text `s` that a name of cps's outputs may not hold, as "U+XXXX"
 /// with what it is ("a control character", "a bidirectional control", "a line or paragraph

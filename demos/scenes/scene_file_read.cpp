@@ -375,7 +375,7 @@ std::string scene_file_output_name(const SceneFile& file, const std::filesystem:
   for (const std::string_view reserved : kReservedOutputNames) {
     if (name == reserved) {
       throw SceneFileError(file.origin + ": the scene's outputs would be named \"" + name +
-                           "\", which is one of cps's own files (run, report, mass_ratio, plots); " +
+                           "\", which is one of cps's own files (run, run.json, report, mass_ratio, plots); " +
                            (name == file.name ? "give another \"name\"" : "rename the file or give it a \"name\""));
     }
   }

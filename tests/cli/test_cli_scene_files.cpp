@@ -69,6 +69,7 @@ TEST_CASE("a bad scene file exits 2 naming the file and the pointer, and writes 
   const std::string plane = R"({"bodies": [{"shape": "plane", "normal": [0, 1, 0], "offset_m": 0}])";
   write(dir / "bidi.json", plane + ", \"name\": \"ab\u202ecd\"}");
   write(dir / "named_run.json", plane + ", \"name\": \"run\"}");
+  write(dir / "named_run_json.json", plane + ", \"name\": \"run.json\"}");
   fs::create_directories(dir / "names");
   write(dir / "names/report.json", plane + "}");
   write(dir / "names/mass_ratio.json", plane + "}");
@@ -92,6 +93,7 @@ TEST_CASE("a bad scene file exits 2 naming the file and the pointer, and writes 
       {"simulate nosuch", "the example scene files"},
       {"simulate bidi.json", "bidi.json: /name: holds U+202E (a bidirectional control)"},
       {"simulate named_run.json", "would be named \"run\", which is one of cps's own files"},
+      {"simulate named_run_json.json", "would be named \"run.json\""},
       {"report names/report.json --out out", "would be named \"report\""},
       {"report names/mass_ratio.json --out out", "would be named \"mass_ratio\""},
       {"scene 'names/x\u2028y.json'", "holds U+2028 (a line or paragraph separator)"},

@@ -163,7 +163,7 @@ TEST_CASE("a file cps wrote and the user edited is foreign, and a command never 
     r = run_cps(std::string("simulate o/s.json --seconds 0.1 --trace o/s.json") + force, dir);
     INFO(r.err);
     CHECK(r.exit_code == 2);
-    CHECK(r.err.find("is the --merge folder q") != std::string::npos);
+    CHECK(r.err.find("input of this command") != std::string::npos);
     CHECK(slurp(dir / "o/s.json") == text);
   }
   // --force replaces the edited file with cps's own again.

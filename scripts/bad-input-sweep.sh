@@ -273,6 +273,7 @@ EXTRA=(
   "steps/--times/--dt|figure stack --times 0,1e5 --dt 1e-6 --size 16x16 --out out/f.png"
   "--trace/adir|simulate stack --seconds 0.1 --trace adir --force"
   "--trace/--seconds|simulate stack --seconds 1e5 --trace t.csv"
+  "--trace/--max-work|simulate stack --seconds 10 --trace t.csv --max-work 92000"
   "--solver-error/1000|simulate pyramid_100 --seconds 0.1 --solver-error s.csv"
   "--solver-error/--max-work|simulate intersecting_stack --seconds 0.1 --solver-error s.csv --sweeps 1000000 --max-work 1e6"
   "--energy/adir|simulate stack --seconds 0.1 --energy adir --force"

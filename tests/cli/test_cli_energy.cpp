@@ -226,6 +226,12 @@ TEST_CASE("cps simulate bounds --trace, and replaces another scene's --trace, --
   CHECK(r.err.find("rows a trace may have; give --seconds") != std::string::npos);
   CHECK(!fs::exists(dir / "t.csv"));
   CHECK(!fs::exists(dir / "run.json"));
+  // The trace's rows count in --max-work with the run: the run's 6 x 600 x 25 = 90000
+  // body-iterations fit a budget of 92000, with the trace's 601 x 6 = 3606 rows they do not.
+  r = run_cps("simulate stack --seconds 10 --trace t.csv --max-work 92000", dir);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("the trace's 3606 rows") != std::string::npos);
+  CHECK(fs::is_empty(dir));
   const std::string files = " --seconds 0.1 --trace t.csv --energy e.csv --solver-error s.csv";
   REQUIRE(run_cps("simulate stack" + files, dir).exit_code == 0);
   const std::string stack_trace = slurp(dir / "t.csv");

@@ -291,8 +291,17 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
                      shortest_decimal(static_cast<double>(fits) * r.world.def().dt) + " or less (" +
                      std::to_string(fits) + " steps), or --energy FILE for one row a step");
   }
-  // Every file is checked before any is written: the trace's and energy's folders are planned,
-  // then the solver error's is planned and begun, then theirs are begun.
+  // The budget covers the trace too: a row is one body's state written, one body-iteration.
+  const double trace_work = o.trace.empty() ? 0.0 : static_cast<double>(steps + 1) * static_cast<double>(bodies);
+  const double work = run_work(r.world.bodies().size(), r.world.def(), seconds);
+  if (work + trace_work > o.max_work) {
+    throw UsageError("--trace " + o.trace + ": the run's " + count_text(work) + " body-iterations and the trace's " +
+                     count_text(trace_work) + " rows (one body-iteration each) pass the budget of " +
+                     count_text(o.max_work) + " body-iterations a run may take (--max-work); give a "
+                     "larger --max-work, or fewer --seconds");
+  }
+  // Every file is checked before any is written: the trace's and energy's folders and the solver
+  // error's are planned; the first two are begun before the run, the last when it is written.
   const std::string source = scene_source(scene->name);
   std::vector<SimulateTarget> targets;
   if (!o.trace.empty()) targets.push_back({o.trace, "--trace"});
@@ -310,7 +319,7 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
                              {"solver_error", o.solver_error},
                              {"overrides", overrides_json(o.overrides)},
                              {"parameters", parameters_json(r.world.def())}}));
-    errors->observe(r.world, o.max_work - run_work(r.world.bodies().size(), r.world.def(), seconds));
+    errors->observe(r.world, o.max_work - work - trace_work);
   }
   if (files) {
     nlohmann::json info = {{"scene", scene->name},

@@ -54,7 +54,8 @@ constexpr PushTraits kBaumgarte{
     .make = &make_baumgarte,
     .push_in_momenta = true,
     .energy_rise_cause = "the paper's push factor keeps its push beta d / dt in the velocities, so "
-                         "every overlap and rod error it corrects comes back as motion (Sec. 5.3)"};
+                         "every overlap and rod error it corrects comes back as motion (Sec. 5.3)",
+    .push_in_rows = true};
 constexpr PushTraits kSplit{.make = &make_single_frame_push};
 constexpr PushTraits kSplitImpulse{.make = &make_split_impulse};
 constexpr PushTraits kSoft{.make = &make_soft_step,

@@ -38,7 +38,7 @@ void EnergyTracker::observe(const World& world) {
   const Vec3& g = world.def().gravity;
   if (previous_.size() == bodies.size() && world.counters().steps > 0) {
     double work = 0.0;
-    if (world.def().push == PushMode::baumgarte) {
+    if (push_traits(world.def().push).push_in_rows) {
       // dt sum_r max(0, lambda_r t_r) over the rows of the step just taken.
       const auto& rows = world.rows();
       const std::vector<double>& lambda = world.lambda();

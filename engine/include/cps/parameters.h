@@ -68,6 +68,10 @@ struct PushTraits {
   /// Why its push can raise the energy, for the energy-rise warning; empty when
   /// push_in_momenta is false.
   std::string_view energy_rise_cause{};
+  /// Whether its push is a velocity in the rows' right-hand side (Sec. 5.3: beta d / dt), so that
+  /// the push's work over a step is dt sum_r max(0, lambda_r push_r) (N, m/s); false: the push
+  /// is measured as the displacement beyond the velocity, x2 - x1 - v2 dt (m).
+  bool push_in_rows = false;
 };
 
 /// The traits of `push` (above), from its row of the push parameter's table. Throws nothing.

@@ -9,6 +9,7 @@
 #include "warm_start.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <sstream>
@@ -18,6 +19,9 @@
 
 namespace cps {
 namespace {
+
+// World::steps_in_process.
+std::atomic<std::int64_t> steps_begun{0};
 
 // Fewest bodies or manifolds the row stage shares among threads (count): below it waking them
 // (microseconds, tens on a virtual machine) costs about what the work does.
@@ -116,7 +120,10 @@ std::size_t World::persisting_contacts() const {
   return ctx_->warm_start && def_.warm_start > 0.0 ? ctx_->warm_start->matched_points() : 0;
 }
 
+std::int64_t World::steps_in_process() { return steps_begun.load(std::memory_order_relaxed); }
+
 void World::step() {
+  steps_begun.fetch_add(1, std::memory_order_relaxed);
   StepContext& ctx = *ctx_;
   ctx.def = &def_;
   ctx.bodies = &bodies_;

@@ -195,7 +195,8 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     hash)  # 16 hex digits (0x prefix allowed)
       printf '%s\n' "" xyz 0123456789abcde 0123456789abcdef0 0123456789abcdeg 0x0123456789abcde \
         -123456789abcdef " 0123456789abcdef" "0123456789abcdef " 0x 0xx0123456789abcdef nan ;;
-    run_id)  # scene.solver.push.friction.itN.ssM, then optionally .wsF (warm start F in [0, 1])
+    run_id)  # scene.solver.push.friction.itN.ssM, then optionally .wsF (warm start F in [0, 1]);
+             # or a study: SCENE.solver_error|references|energy, mass_ratio.R.SOLVER.PUSH
       local good=intersecting_stack.pgs.baumgarte.fixed
       printf '%s\n' "" garbage intersecting_stack "$good.it25" "$good.it25.ss1.extra" \
         nosuch.pgs.baumgarte.fixed.it1.ss1 intersecting_stack.sor.baumgarte.fixed.it1.ss1 \
@@ -206,7 +207,10 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
         "$good.it1.ss1.5" ..... "$good.IT1.SS1" \
         "$good.it1.ss1.ws2" "$good.it1.ss1.ws-0.1" "$good.it1.ss1.wsnan" "$good.it1.ss1.wsinf" \
         "$good.it1.ss1.ws1e-1" "$good.it1.ss1.ws0x1" "$good.it1.ss1.ws" "$good.it1.ss1.ws0.5.5" \
-        "$good.it1.ss1.ws 0.5" "$good.it1.ss1.WS0.5" "$good.it1.ws0.5" "$good.it1.ss1.ws1.0001" ;;
+        "$good.it1.ss1.ws 0.5" "$good.it1.ss1.WS0.5" "$good.it1.ws0.5" "$good.it1.ss1.ws1.0001" \
+        mass_ratio. mass_ratio.7.pgs.baumgarte mass_ratio.10.pgs mass_ratio.10.jacobi.avbd \
+        mass_ratio.10.pgs.baumgarte.x mass_ratio.1e1.pgs.baumgarte pendulum_wave.references \
+        nosuch.energy .energy intersecting_stack.Energy intersecting_stack.energy.x ;;
     out_glb)  # not a .glb path that can be written as a new file
       printf '%s\n' "" file file/s.glb adir .glb s.png s.GLB /dev/null . ;;
     out_hdf5)  # not a .hdf5 path that can be written as a new file (file.hdf5: a foreign one)

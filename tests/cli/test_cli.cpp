@@ -71,6 +71,14 @@ const int kQuickCold = (5 + 1) * (2 * paper_push_methods() + (push_methods() - p
 const int kQuickWarm = 2 * 4;
 const int kQuickRuns = kQuickCold + kQuickWarm;
 
+// The rows of the mass ratio table, a study each in every sweep's plan: ratios 10, 100, 1000 x
+// every push method x the solvers it reads.
+int mass_ratio_studies() {
+  int variants = 0;
+  for (const cli_test::Reads& r : cli_test::push_method_reads()) variants += r.solver ? 2 : 1;
+  return 3 * variants;
+}
+
 // The warm start factor of a report CSV row; 0 where the column is empty.
 double warm_of(const std::map<std::string, std::string>& row) {
   const double w = value(row, "warm_start");
@@ -514,7 +522,8 @@ TEST_CASE("cps report never overwrites a foreign report.md, CSV or run.json", "[
     for (std::size_t i = 0; i < one.rows.size(); ++i) {
       for (const auto& [column, cell] : one.rows[i]) {
         const bool timed = column.rfind("cpu_s_per_sim_s", 0) == 0 || column == "us_per_step" ||
-                           column == "runs_per_repeat" || column == "timing_threads";
+                           column == "runs_per_repeat" || column == "timing_threads" ||
+                           column == "exact_cpu_s";
         if (timed) continue;
         INFO("row " << i << ", " << column);
         CHECK(three.rows[i].at(column) == cell);
@@ -525,6 +534,27 @@ TEST_CASE("cps report never overwrites a foreign report.md, CSV or run.json", "[
       CHECK(three.rows[0].at("timing_threads") == "3");
     }
   }
+  // Written from the studies' CSVs, the report is the same when merged from them, and the merge
+  // steps no world (run.json counts the engine's steps); the sweep stepped every run and study.
+  REQUIRE(cps("report --merge src --out merged", dir).exit_code == 0);
+  const auto steps = [&](const char* folder) {
+    return nlohmann::json::parse(slurp(dir / folder / "run.json"))["engine_steps"].get<std::int64_t>();
+  };
+  CHECK(steps("merged") == 0);
+  CHECK(steps("src") > 100000);
+  for (const char* file : {"mass_ratio.csv", "intersecting_stack_solver_error.csv",
+                           "intersecting_stack_references.csv", "intersecting_stack_energy.csv",
+                           "intersecting_stack.csv", "plots/intersecting_stack_energy.dat",
+                           "plots/intersecting_stack_solver_error.dat"}) {
+    INFO(file);
+    CHECK(slurp(dir / "merged" / file) == slurp(dir / "src" / file));
+  }
+  // report.md alike but for the load sentence, which only a timed sweep has.
+  std::string timed_md = slurp(dir / "src/report.md");
+  const std::size_t load = timed_md.find(" Load averages");
+  REQUIRE(load != std::string::npos);
+  timed_md.erase(load, timed_md.find('\n', load) - load);
+  CHECK(slurp(dir / "merged/report.md") == timed_md);
   // Its warm starting table agrees with its CSV (the scene's measure: the largest body speed
   // at the end; the paper's run flings the boxes apart fastest, so few iterations reach it).
   check_warm_table(slurp(dir / "src/report.md"), "intersecting_stack",
@@ -623,19 +653,20 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
     CHECK(value(timed, "cpu_s_per_sim_s_q1") <= value(timed, "cpu_s_per_sim_s"));
     CHECK(value(timed, "cpu_s_per_sim_s") <= value(timed, "cpu_s_per_sim_s_q3"));
     const Result merged = cps("report --merge runs --out merged", dir);
-    // 2 of the quick stack sweep's runs: the others are named (a few, then a count).
+    // 2 of the quick stack sweep's runs: the others are named (a few, then a count), the studies
+    // first (the stack's three, and a row of the mass ratio table per push and solver it reads).
+    const int planned = kQuickRuns + 3 + mass_ratio_studies();
     CHECK(merged.exit_code == 1);
-    CHECK(merged.err.find(std::to_string(kQuickRuns - 2) + " of the " + std::to_string(kQuickRuns) +
+    CHECK(merged.err.find(std::to_string(planned - 2) + " of the " + std::to_string(planned) +
                           " planned runs are missing") != std::string::npos);
-    CHECK(merged.err.find("stack.pgs.baumgarte.fixed.it1.ss1") != std::string::npos);
-    CHECK(merged.err.find("and " + std::to_string(kQuickRuns - 2 - 5) + " more") != std::string::npos);
+    CHECK(merged.err.find("stack.solver_error, stack.references, stack.energy") != std::string::npos);
+    CHECK(merged.err.find("and " + std::to_string(planned - 2 - 5) + " more") != std::string::npos);
     CHECK(merged.err.find("INCOMPLETE") != std::string::npos);
     const std::string md = slurp(dir / "merged/report.md");
     CHECK(md.find("INCOMPLETE") < md.find("## Headline"));
-    // The missing warm-started runs are named too (report.md names the first 20 in plan order:
-    // the Baumgarte runs, cold then warm).
-    CHECK(md.find("`stack.pgs.baumgarte.fixed.it1.ss1.ws0.8`") != std::string::npos);
-    CHECK(md.find("`stack.pgs.baumgarte.fixed.it25.ss1.ws1`") != std::string::npos);
+    // report.md names the first 20 in plan order.
+    CHECK(md.find("`stack.energy`") != std::string::npos);
+    CHECK(md.find("`mass_ratio.10.pgs.baumgarte`") != std::string::npos);
     const std::string csv = slurp(dir / "merged/stack.csv");
     const std::vector<std::string> columns = cli_test::read_report_csv(dir / "merged/stack.csv").columns;
     for (const char* column : {"cpu_s_per_sim_s", "cpu_s_per_sim_s_q1", "cpu_s_per_sim_s_q3",
@@ -653,7 +684,9 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
   SECTION("--list-runs prints one command per run; all of them merge into a complete report") {
     const Result r = cps("report mass_ratio_10 --quick --list-runs --out o", dir);
     REQUIRE(r.exit_code == 0);
-    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == kQuickRuns + 1);  // and the merge line
+    // The error runs, the mass ratio table's rows (a stress scene has no scene studies) and the
+    // merge line.
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == kQuickRuns + mass_ratio_studies() + 1);
     CHECK(r.out.find("--run mass_ratio_10.pgs.baumgarte.fixed.it25.ss1 ") != std::string::npos);
     CHECK(r.out.find("--run mass_ratio_10.pgs.baumgarte.fixed.it16.ss1.ws0.8 ") != std::string::npos);
     CHECK(r.out.find("--merge") != std::string::npos);
@@ -665,7 +698,7 @@ TEST_CASE("cps report writes CSVs with units and plots and report.md and runs sp
       CHECK(std::system(command.c_str()) == 0);
       ++ran;
     }
-    CHECK(ran == kQuickRuns);
+    CHECK(ran == kQuickRuns + mass_ratio_studies());
     // A warm run's file is named by its id, which reads back to the run: warm_start 0.8.
     const auto warm = read_table(dir / "o/runs/mass_ratio_10.pgs.baumgarte.fixed.it16.ss1.ws0.8.csv");
     REQUIRE(warm.size() == 1u);
@@ -694,6 +727,12 @@ TEST_CASE("cps report --shard: the shards of a sweep take every run once and mer
   REQUIRE(listed.exit_code == 0);
   const auto planned = static_cast<std::size_t>(std::count(listed.out.begin(), listed.out.end(), '\n') - 1);
   REQUIRE(planned > 7u);
+  // Of which studies (the mass ratio table's rows: a scene file has no scene studies); the rest
+  // are the error runs, a row each of drop.csv.
+  std::size_t studies = 0;
+  for (std::size_t at = 0; (at = listed.out.find(" --run mass_ratio.", at)) != std::string::npos; ++at) ++studies;
+  REQUIRE(studies > 0u);
+  const std::size_t error_runs = planned - studies;
   // The run CSVs in `folder` (run.json aside).
   const auto run_files = [&](const fs::path& folder) {
     std::set<std::string> names;
@@ -727,13 +766,15 @@ TEST_CASE("cps report --shard: the shards of a sweep take every run once and mer
   const cli_test::CsvRows one = cli_test::read_report_csv(dir / "m1/drop.csv");
   const cli_test::CsvRows seven = cli_test::read_report_csv(dir / "m7/drop.csv");
   REQUIRE(one.columns == seven.columns);
-  REQUIRE(one.rows.size() == planned);
-  REQUIRE(seven.rows.size() == planned);
+  REQUIRE(one.rows.size() == error_runs);
+  REQUIRE(seven.rows.size() == error_runs);
+  CHECK(slurp(dir / "m1/mass_ratio.csv") == slurp(dir / "m7/mass_ratio.csv"));
+  CHECK(read_table(dir / "m1/mass_ratio.csv").size() == studies);
   const std::set<std::string> timing = {"cpu_s_per_sim_s", "cpu_s_per_sim_s_q1", "cpu_s_per_sim_s_q3",
                                         "cpu_s_per_sim_s_min", "us_per_step", "runs_per_repeat",
                                         "timing_threads"};
   std::size_t compared = 0;
-  for (std::size_t k = 0; k < planned; ++k) {
+  for (std::size_t k = 0; k < error_runs; ++k) {
     for (const std::string& column : one.columns) {
       if (timing.count(column)) continue;
       INFO("row " << k << ", column " << column);
@@ -741,7 +782,7 @@ TEST_CASE("cps report --shard: the shards of a sweep take every run once and mer
       ++compared;
     }
   }
-  CHECK(compared > planned * 20);
+  CHECK(compared > error_runs * 20);
   // A shard's place from a Slurm job array's variables: task 6 of an array 4, 6, 8, ... of 7
   // tasks is shard 2/7.
   const Result slurm = run_cps("report drop.json --quick --shard slurm --out sl", dir,
@@ -870,8 +911,13 @@ TEST_CASE("cps report --repeats sets the timed repeats, their quartiles and what
 TEST_CASE("cps report plans warm-started PGS runs beside the cold sweep and their ids read back",
           "[cli][report]") {
   const fs::path dir = fresh_dir("warm_plan");
-  // The ids of a sweep's runs, from --list-runs.
-  const auto ids_of = [&](const std::string& args) {
+  // A study's id: a paper scene's three, or a row of the mass ratio table.
+  const auto is_study = [](const std::string& id) {
+    return id.rfind("mass_ratio.", 0) == 0 || id.ends_with(".solver_error") ||
+           id.ends_with(".references") || id.ends_with(".energy");
+  };
+  // The ids of a sweep's plan, from --list-runs: its error runs, or with `studies` its studies.
+  const auto ids_of = [&](const std::string& args, bool studies = false) {
     const Result r = cps("report " + args + " --list-runs --out o", dir);
     REQUIRE(r.exit_code == 0);
     std::vector<std::string> ids;
@@ -879,10 +925,24 @@ TEST_CASE("cps report plans warm-started PGS runs beside the cold sweep and thei
     for (std::string line; std::getline(lines, line);) {
       const std::size_t at = line.find("--run ");
       if (at == std::string::npos) continue;
-      ids.push_back(line.substr(at + 6, line.find(' ', at + 6) - at - 6));
+      const std::string id = line.substr(at + 6, line.find(' ', at + 6) - at - 6);
+      if (is_study(id) == studies) ids.push_back(id);
     }
     return ids;
   };
+  SECTION("the studies come first: the scene's three, then a row of the mass ratio table each") {
+    const Result r = cps("report funnel --quick --list-runs --out o", dir);
+    REQUIRE(r.exit_code == 0);
+    const std::vector<std::string> studies = ids_of("funnel --quick", true);
+    REQUIRE(studies.size() == static_cast<std::size_t>(3 + mass_ratio_studies()));
+    CHECK(studies[0] == "funnel.solver_error");
+    CHECK(studies[1] == "funnel.references");
+    CHECK(studies[2] == "funnel.energy");
+    CHECK(studies[3] == "mass_ratio.10.pgs.baumgarte");
+    CHECK(r.out.find(studies.back()) < r.out.find(ids_of("funnel --quick").front()));
+    // A scene file has no scene studies; the mass ratio rows are in every plan.
+    CHECK(ids_of("stress --quick", true).size() == static_cast<std::size_t>(mass_ratio_studies()));
+  }
   // The factor of an id (after ".ws"; 0 without) and whether it is PGS at 1 substep.
   const auto factor = [](const std::string& id) {
     const std::size_t ws = id.rfind(".ws");
@@ -976,13 +1036,26 @@ TEST_CASE("cps report plans warm-started PGS runs beside the cold sweep and thei
 
 TEST_CASE("cps report's mass ratio table says whether each stack held", "[cli][report]") {
   const fs::path dir = fresh_dir("held");
+  // The table's rows are studies of every sweep's plan: each run alone by its id, as listed.
+  const Result listed = cps("report stack --list-runs --out l", dir);
+  REQUIRE(listed.exit_code == 0);
+  std::istringstream lines(listed.out);
+  int studies = 0;
+  for (std::string line; std::getline(lines, line);) {
+    const std::size_t at = line.find(" --run mass_ratio.");
+    if (at == std::string::npos) continue;
+    const std::string id = line.substr(at + 7, line.find(' ', at + 7) - at - 7);
+    REQUIRE(cps("report --run " + id + " --out runs", dir).exit_code == 0);
+    ++studies;
+  }
   REQUIRE(cps("report --run stack.pgs.split.fixed.it4.ss1 --out runs", dir).exit_code == 0);
-  cps("report --merge runs --out r", dir);  // incomplete (exit 1), but with the mass ratio table
+  // Incomplete (exit 1: the stack's other runs are missing), but with the whole table.
+  const Result merged = cps("report --merge runs --out r", dir);
+  CHECK(merged.exit_code == 1);
+  CHECK(merged.err.find("mass_ratio.") == std::string::npos);
   const auto rows = read_table(dir / "r/mass_ratio.csv");
-  // ratios 10, 100, 1000 x every push method of the table x the solvers it reads
-  int variants = 0;
-  for (const cli_test::Reads& r : cli_test::push_method_reads()) variants += r.solver ? 2 : 1;
-  REQUIRE(rows.size() == static_cast<std::size_t>(3 * variants));
+  CHECK(rows.size() == static_cast<std::size_t>(studies));
+  REQUIRE(rows.size() == static_cast<std::size_t>(mass_ratio_studies()));
   // Cubes of edge 1 m: stacked, the heavy one's centre is at 1.5 m; squeezed out, at 0.5 m.
   const double h = 0.5;
   for (const auto& row : rows) {

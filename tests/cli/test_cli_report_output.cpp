@@ -42,8 +42,10 @@ void write_text(const fs::path& p, const std::string& text) {
 }
 
 // Two runs of the stack's sweep (their CSVs in dir/runs): a merge of them draws three diagrams.
+// Two runs of the stack's sweep and its three studies (their sections' pictures), into DIR/runs.
 void two_runs(const fs::path& dir) {
-  for (const char* id : {"stack.pgs.split.fixed.it4.ss1", "stack.jacobi.split.fixed.it4.ss1"}) {
+  for (const char* id : {"stack.pgs.split.fixed.it4.ss1", "stack.jacobi.split.fixed.it4.ss1",
+                         "stack.solver_error", "stack.references", "stack.energy"}) {
     REQUIRE(run_cps(std::string("report stack --run ") + id + " --out runs", dir).exit_code == 0);
   }
 }
@@ -500,5 +502,62 @@ TEST_CASE("report --merge bounds its memory by its cells, not by a count of rows
   const Result r = run_cps("report --merge fits --out out", dir);
   CHECK(r.exit_code == 2);
   CHECK(r.err.find("a row without push") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("report --merge reads the studies' CSVs as strictly as the runs': a study given twice, "
+          "an unknown study or a bad cell is refused, naming it, and nothing is written",
+          "[cli][report]") {
+  const fs::path dir = fresh_dir("study_input");
+  // One run (the columns a run needs) beside each study table, so that the merge gets to them.
+  const std::string run = "scene,solver,push,friction_model,iterations,substeps,diverged\n"
+                          "stack,pgs,baumgarte,fixed,1,1,0\n";
+  REQUIRE(run_cps("report --run mass_ratio.10.pgs.baumgarte --out study", dir).exit_code == 0);
+  const std::string good = slurp(dir / "study/mass_ratio_10_pgs_baumgarte.csv");
+  REQUIRE(good.rfind("study,", 0) == 0);
+  const auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string text = good;
+    const std::size_t at = text.find(from, text.find('\n'));
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+  };
+  const auto cell_of = [&](std::size_t column) {  // the data row's cell
+    std::istringstream row(good.substr(good.find('\n') + 1));
+    std::string cell;
+    for (std::size_t c = 0; c <= column; ++c) std::getline(row, cell, ',');
+    return cell;
+  };
+  // Columns: study, solver, push, iterations, mass_ratio, seconds, held, heavy_height_m, ...
+  const std::string held = cell_of(6);
+  const std::string height = cell_of(7);
+  struct Case {
+    const char* name;
+    std::vector<std::string> files;  // the study tables, each in a folder of its own
+    std::vector<std::string> words;  // what the message names
+  };
+  const std::vector<Case> cases = {
+      {"twice", {good, good}, {"mass_ratio.10.pgs.baumgarte", "merged once"}},
+      {"unknown", {replaced("mass_ratio.10.pgs.baumgarte", "mass_ratio.7.pgs.baumgarte")},
+       {"mass_ratio.7.pgs.baumgarte", "column study"}},
+      {"held", {replaced("," + held + "," + height + ",", ",2," + height + ",")}, {"column held", "'2'"}},
+      {"height", {replaced("," + height + ",", ",nan,")}, {"column heavy_height_m", "'nan'"}},
+  };
+  for (const Case& c : cases) {
+    INFO(c.name);
+    std::string folders;
+    for (std::size_t k = 0; k < c.files.size(); ++k) {
+      const std::string folder = std::string(c.name) + "/" + std::to_string(k);
+      fs::create_directories(dir / folder);
+      write_text(dir / folder / "run.csv", run);
+      write_text(dir / folder / "mass_ratio_10_pgs_baumgarte.csv", c.files[k]);
+      folders += " " + folder;
+      if (k > 0) fs::remove(dir / folder / "run.csv");  // the run once
+    }
+    const Result r = run_cps("report --merge" + folders + " --out out", dir);
+    INFO(r.err);
+    CHECK(r.exit_code == 2);
+    for (const std::string& w : c.words) CHECK(r.err.find(w) != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "out"));
+  }
   fs::remove_all(dir);
 }

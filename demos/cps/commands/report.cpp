@@ -202,15 +202,19 @@ int run_report(ReportOptions o, int argc, char** argv) {
                        o.repeats, o.max_work, o.jobs != 0 ? o.jobs : default_jobs()};
   if (!o.merge.empty()) return merge_report(to, {o.merge.begin(), o.merge.end()});
   if (!o.run.empty()) {
+    report_scenes(o.scene);  // the sweep it belongs to must be one
+    if (std::optional<StudySpec> study = StudySpec::parse(o.run)) {
+      study->quick = o.quick;
+      return run_one(to, *study);
+    }
     RunSpec spec = RunSpec::parse(o.run);
     spec.quick = o.quick;
-    report_scenes(o.scene);  // the sweep it belongs to must be one
     check_runs_work({spec}, o.max_work, o.repeats);
     return run_one(to, spec);
   }
   const std::vector<const scenes::Scene*> scenes = report_scenes(o.scene);
-  const std::vector<RunSpec> runs = plan_runs(scenes, o.quick);
-  check_runs_work(runs, o.max_work, o.repeats);
+  check_runs_work(plan_runs(scenes, o.quick), o.max_work, o.repeats);
+  const std::vector<PlanItem> runs = plan_items(scenes, o.quick);
   if (!o.shard.empty()) {
     const Shard shard = parse_shard(o.shard);
     return run_shard(to, shard_runs(runs, shard), shard);
@@ -280,7 +284,8 @@ Command add_report(CLI::App& app, int argc, char** argv) {
                   std::to_string(kMergeMemoryLimit >> 20) + " MiB of memory")
       ->check(kNotEmpty);
   CLI::Option* run = sub->add_option("--run", o->run,
-                  "execute one run by its id (see --list-runs); the scene argument and --quick "
+                  "execute one run of the plan, an error run or a study, by its id (see --list-runs); "
+                  "the scene argument and --quick "
                   "name the sweep it belongs to, recorded in its CSV for --merge")
       ->check(kNotEmpty);
   CLI::Option* shard = sub->add_option("--shard", o->shard,

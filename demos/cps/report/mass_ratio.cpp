@@ -57,6 +57,12 @@ std::vector<PairRow> mass_ratio_rows() {
   return rows;
 }
 
+std::string pair_id(const PairRow& row) {
+  std::string id = "mass_ratio.";
+  id.append(number(row.mass_ratio)).append(".").append(name_of(row.solver));
+  return id.append(".").append(name_of(row.push));
+}
+
 void run_pair_row(PairRow& r) {
   r.outcome = run_pair(r.mass_ratio, r.solver, r.push, kPairTableIterations, kPairSeconds);
   r.iterations_holding.clear();
@@ -66,20 +72,17 @@ void run_pair_row(PairRow& r) {
   }
 }
 
-std::vector<PairRow> mass_ratio_study() {
-  std::vector<PairRow> rows = mass_ratio_rows();
-  for (PairRow& r : rows) run_pair_row(r);
-  return rows;
-}
-
 CsvTable mass_ratio_table(const std::vector<PairRow>& rows) {
   CsvTable table;
-  table.columns = {"solver", "push", "iterations", "mass_ratio", "seconds", "held",
+  table.columns = {"study", "solver", "push", "iterations", "mass_ratio", "seconds", "held",
                    "heavy_height_m", "light_offset_m", "overlap_m", "iterations_holding"};
   for (const PairRow& r : rows) {
     std::string holding;
-    for (const int n : r.iterations_holding) holding += (holding.empty() ? "" : " ") + std::to_string(n);
-    table.rows.push_back({std::string(name_of(r.solver)), std::string(name_of(r.push)),
+    for (const int n : r.iterations_holding) {
+      if (!holding.empty()) holding += ' ';
+      holding += std::to_string(n);
+    }
+    table.rows.push_back({pair_id(r), std::string(name_of(r.solver)), std::string(name_of(r.push)),
                           std::to_string(kPairTableIterations), number(r.mass_ratio),
                           number(kPairSeconds), r.outcome.held ? "1" : "0",
                           number(r.outcome.heavy_height_m), number(r.outcome.light_offset_m),

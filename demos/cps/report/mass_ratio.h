@@ -7,6 +7,7 @@
 #include "stress/mass_ratio.h"
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace cps::cli {
@@ -68,14 +69,15 @@ struct PairRow {
 /// push_reads), in that order.
 std::vector<PairRow> mass_ratio_rows();
 
+/// The study id of a row (studies.h): "mass_ratio.R.SOLVER.PUSH", R as number() writes it
+/// ("mass_ratio.1000.jacobi.split"). No errors.
+std::string pair_id(const PairRow& row);
+
 /// Runs one row of mass_ratio_rows: its outcome at kPairTableIterations and the iteration
 /// counts 1, 2, 4, ..., 256 that hold (run_pair, kPairSeconds each). Rows are independent.
 void run_pair_row(PairRow& row);
 
-/// mass_ratio_rows, each run (run_pair_row) in order on this thread.
-std::vector<PairRow> mass_ratio_study();
-
-/// The table as mass_ratio.csv: columns solver, push, iterations, mass_ratio, seconds (s), held
+/// The table as mass_ratio.csv: columns study (pair_id), solver, push, iterations, mass_ratio, seconds (s), held
 /// (1 or 0), heavy_height_m, light_offset_m, overlap_m (m; "" where the run blew up) and
 /// iterations_holding (space-separated counts).
 CsvTable mass_ratio_table(const std::vector<PairRow>& rows);

@@ -40,7 +40,8 @@ UsageError bad_id(const std::string& id, const std::string& why) {
   };
   return UsageError("run id '" + id + "': " + why + "; expected scene." + names("solver") + "." +
                     names("push") + "." + names("friction_model") +
-                    ".itN.ssM, optionally followed by .wsF, a warm start factor F in [0, 1]");
+                    ".itN.ssM, optionally followed by .wsF, a warm start factor F in [0, 1]; or "
+                    "a study's id ('cps report SCENE --list-runs' lists every id of a sweep)");
 }
 
 // Splits the warm start factor off an id: ".wsF" right after the ".ssM" part (F may hold a dot).

@@ -5,6 +5,7 @@
 #include "report/plan.h"
 #include "report/references.h"
 #include "report/run.h"
+#include "report/studies.h"
 #include "output/atomic_file.h"
 
 #include <algorithm>
@@ -34,12 +35,6 @@ std::string dat(double v, double floor) {
   char text[32];
   std::snprintf(text, sizeof text, "%.9g", std::max(v, floor));
   return text;
-}
-
-// A CSV cell: number() with 6 digits, "inf" for an overflowed value, "" for NaN.
-std::string cell(double v) {
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  return number(v);
 }
 
 // The gnuplot head of a picture of panels side by side with a title and a key row under them
@@ -112,18 +107,7 @@ std::string solver_error_section(const fs::path& dir, const std::string& scene,
   const int no_solve = studies.no_solve;
   const std::vector<SolverErrorPoint>& points = studies.solver_error;
 
-  CsvTable csv;
-  csv.columns = {"step", "t_s", "solve", "rows", "method", "sweeps", "lambda_error_relative",
-                 "velocity_error_mps", "natural_map_N", "refused"};
-  for (const SolverErrorPoint& p : points) {
-    std::string why = p.refused;
-    std::replace(why.begin(), why.end(), ',', ';');
-    std::replace(why.begin(), why.end(), '\n', ' ');
-    csv.rows.push_back({std::to_string(p.step), number(p.t_s), std::to_string(p.solve),
-                        std::to_string(p.rows), p.method, std::to_string(p.sweeps),
-                        cell(p.relative), cell(p.velocity_mps), cell(p.residual_N), why});
-  }
-  write_csv(dir / (stem + ".csv"), csv);
+  write_csv(dir / (stem + ".csv"), solver_error_table(scene, studies));
 
   // Per line: times, relative errors, velocity errors; counts of diverged sweeps (non-finite).
   const std::vector<Line> lines = solver_lines();
@@ -220,22 +204,19 @@ std::string solver_error_section(const fs::path& dir, const std::string& scene,
 std::string references_section(const fs::path& dir, const std::string& scene,
                                const SceneStudies& studies, const std::string& title_note) {
   const scenes::Scene* s = scenes::find_scene(scene);
-  const ReferenceAgreement* a = studies.agreement;
-  if (s == nullptr || a == nullptr) return "";
+  if (s == nullptr || !studies.agreement) return "";
+  const ReferenceAgreement* a = &*studies.agreement;
   const std::string stem = file_stem(scene) + "_references";
-  CsvTable csv;
-  csv.columns = {"t_s", "distance_m", "tolerance_m"};
   std::ostringstream data;
   for (std::size_t i = 0; i < a->t_s.size(); ++i) {
-    csv.rows.push_back({number(a->t_s[i]), number(a->distance_m[i]), number(a->tolerance_m)});
     data << a->t_s[i] << " " << dat(a->distance_m[i], kDistanceFloor) << "\n";
   }
-  write_csv(dir / (stem + ".csv"), csv);
+  write_csv(dir / (stem + ".csv"), references_table(scene, studies));
   const fs::path dat_file = dir / "plots" / (stem + ".dat");
   write_text_atomic(dat_file, data.str() + "NaN NaN\n");
 
   const double t_scene = std::min(s->report_trajectory_time_s(), s->report_horizon_s());
-  const double t_used = trajectory_time_of(*s);
+  const double t_used = trajectory_time_with(*s, a);
   double top = a->tolerance_m;
   for (const double d : a->distance_m) top = std::max(top, std::isfinite(d) ? d : top);
   std::ostringstream gp;
@@ -303,20 +284,16 @@ std::string energy_section(const fs::path& dir, const std::string& scene,
                            const SceneStudies& studies, const std::string& title_note) {
   const std::string stem = file_stem(scene) + "_energy";
   const std::vector<EnergyTrace>& traces = studies.energy;
-  CsvTable csv;
-  csv.columns = {"push", "t_s", "kinetic_J", "potential_J", "total_J", "penetration_m",
-                 "rod_error_m"};
+  if (traces.empty()) return "";
   std::ostringstream data;
   for (const EnergyTrace& e : traces) {
     for (std::size_t i = 0; i < e.t_s.size(); ++i) {
-      csv.rows.push_back({e.push, number(e.t_s[i]), cell(e.kinetic_J[i]), cell(e.potential_J[i]),
-                          cell(e.total_J[i]), cell(e.penetration_m[i]), cell(e.rod_error_m[i])});
       data << e.t_s[i] << " " << dat(e.total_J[i], -1e300) << " "
            << dat(std::max(e.penetration_m[i], e.rod_error_m[i]), kConstraintFloor) << "\n";
     }
     data << "NaN NaN NaN\n\n\n";
   }
-  write_csv(dir / (stem + ".csv"), csv);
+  write_csv(dir / (stem + ".csv"), energy_table(scene, studies));
   const fs::path dat_file = dir / "plots" / (stem + ".dat");
   write_text_atomic(dat_file, data.str());
 
@@ -405,29 +382,10 @@ std::map<std::string, std::map<int, double>> solver_error_medians(const SceneStu
   return out;
 }
 
-std::vector<std::function<void()>> scene_study_tasks(const std::string& scene, bool quick,
-                                                      SceneStudies& into) {
-  if (!has_reference_sections(scene)) return {};
-  into.samples = quick ? kSolverErrorSamplesQuick : kSolverErrorSamples;
-  RunSpec paper{scene};
-  paper.quick = quick;
-  return {
-      [paper, &into] { into.solver_error = sample_solver_error(paper, into.samples, into.no_solve); },
-      [paper, &into] { into.agreement = scene_agreement(paper.scene_def()); },
-      [paper, &into] { into.energy = energy_traces(paper.scene, kEnergyPoints, paper.quick); },
-  };
-}
-
-SceneStudies scene_studies(const std::string& scene, bool quick) {
-  SceneStudies s;
-  for (const std::function<void()>& task : scene_study_tasks(scene, quick, s)) task();
-  return s;
-}
-
 std::string write_reference_sections(const fs::path& dir, const std::string& scene,
                                      const SceneStudies& studies, const std::string& title_note) {
-  if (!has_reference_sections(scene) || studies.samples == 0) return "";
-  return solver_error_section(dir, scene, studies, title_note) +
+  if (!has_reference_sections(scene)) return "";
+  return (studies.samples > 0 ? solver_error_section(dir, scene, studies, title_note) : "") +
          references_section(dir, scene, studies, title_note) +
          energy_section(dir, scene, studies, title_note);
 }

@@ -7,8 +7,8 @@
 #include "report/references.h"
 
 #include <filesystem>
-#include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,30 +20,20 @@ inline constexpr const char* kReferenceParts[] = {"solver_error", "references", 
 /// Whether `scene` (a scene name) gets the reference sections: one of the paper's scenes.
 bool has_reference_sections(const std::string& scene);
 
-/// What a paper scene's sections show, computed apart from writing them (scene_studies).
+/// What a paper scene's sections show, computed apart from writing them (studies.h: each part
+/// is a study of the report's plan, read back from its CSV). A part not present is not drawn.
 struct SceneStudies {
-  int samples = 0;  ///< steps sampled for the solver error (count); 0: no sections
+  bool quick = false;  ///< the quick sweep's studies (fewer samples, the quick horizon)
+  int samples = 0;  ///< steps sampled for the solver error (count); 0: that part not present
   std::vector<SolverErrorPoint> solver_error;  ///< sample_solver_error at the paper's settings
   int no_solve = 0;  ///< sampled steps without a solve (count)
-  /// scene_agreement: nullptr for a scene judged by its own reference solution.
-  const ReferenceAgreement* agreement = nullptr;
+  /// scene_agreement; none for a scene judged by its own reference solution, or not present.
+  std::optional<ReferenceAgreement> agreement;
   std::vector<EnergyTrace> energy;  ///< energy_traces, kEnergyPoints recorded steps at most
 };
 
 /// The most recorded steps of an energy trace (count).
 inline constexpr int kEnergyPoints = 1500;
-
-/// The tasks that fill `into` for a paper scene (none for another scene: has_reference_sections),
-/// independent of each other, to be run once each in any order or at once (run_tasks): the
-/// solver error of kSolverErrorSamplesQuick sampled steps when `quick`, else
-/// kSolverErrorSamples (sample_solver_error at the paper's settings); the references'
-/// agreement (scene_agreement); the energy traces (energy_traces). `into` must outlive them. A
-/// task throws UsageError for a scene this build does not know.
-std::vector<std::function<void()>> scene_study_tasks(const std::string& scene, bool quick,
-                                                      SceneStudies& into);
-
-/// scene_study_tasks of `scene`, run in order on this thread.
-SceneStudies scene_studies(const std::string& scene, bool quick);
 
 /// The median relative force error of each line of the solver error (method "pgs" or "jacobi" ->
 /// sweeps -> median over the sampled solves of |lambda - lambda*| / |lambda*|, dimensionless;
@@ -54,8 +44,9 @@ std::map<std::string, std::map<int, double>> solver_error_medians(const SceneStu
 
 /// Writes a paper scene's sections from its `studies` into DIR: SCENE_solver_error.csv,
 /// SCENE_references.csv (not for a scene judged by its own reference solution) and
-/// SCENE_energy.csv, each with its diagram as .png, .svg and .pdf and their data and scripts in
-/// DIR/plots (SCENE_<part>.dat, .gp). Steps no world. `title_note` is appended to the diagrams'
+/// SCENE_energy.csv (studies.h's tables), each with its diagram as .png, .svg and .pdf and their
+/// data and scripts in DIR/plots (SCENE_<part>.dat, .gp); a part not present in `studies` is
+/// left out. Steps no world. `title_note` is appended to the diagrams'
 /// titles. Returns the markdown of the sections, "" for a scene that has none
 /// (has_reference_sections). Throws std::runtime_error if a file cannot be written or gnuplot
 /// fails.

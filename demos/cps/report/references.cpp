@@ -189,8 +189,11 @@ const ReferenceAgreement* scene_agreement(const scenes::Scene& scene) {
 }
 
 double trajectory_time_of(const scenes::Scene& scene) {
+  return trajectory_time_with(scene, scene_agreement(scene));
+}
+
+double trajectory_time_with(const scenes::Scene& scene, const ReferenceAgreement* a) {
   const double t = std::min(scene.report_trajectory_time_s(), scene.report_horizon_s());
-  const ReferenceAgreement* a = scene_agreement(scene);
   if (a == nullptr || !(a->horizon_s < t)) return t;
   const double frame = 1.0 / 60.0;
   return std::max(1.0, std::floor(a->horizon_s / frame + 1e-9)) * frame;

@@ -120,6 +120,9 @@ const ReferenceAgreement* scene_agreement(const scenes::Scene& scene);
 /// report_trajectory_time_s (within its horizon), or, when its references part before it
 /// (scene_agreement), their horizon rounded down to a whole 1/60 s frame, at least one frame.
 double trajectory_time_of(const scenes::Scene& scene);
+/// trajectory_time_of with the references' agreement given (nullptr: none), as a report written
+/// from the studies' CSVs has it. Steps no world. No errors.
+double trajectory_time_with(const scenes::Scene& scene, const ReferenceAgreement* agreement);
 
 /// One push method's energy over time at the paper's settings otherwise (PGS, 25 iterations,
 /// 1 substep, fixed friction, cold): per recorded step (step 0, every `every`-th and the last)

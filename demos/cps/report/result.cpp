@@ -362,28 +362,35 @@ void add_size(MergeSize& size, const fs::path& file, std::size_t file_count) {
 
 namespace {
 
-// True for a table of the report's reference sections (reference_report.h): its name ends in
-// _solver_error.csv, _references.csv or _energy.csv and its header does not start with 'scene'
-// (a run table of a scene so named still does, and is read).
-bool is_reference_section_csv(const fs::path& file) {
+// The first 5 bytes of a file's header ("scene" for a run table, "study" for a study table):
+// a file of any size (a single line of gigabytes) is never read further here; the merge's size
+// bound reads the rest in blocks.
+std::string header_start(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  char start[5] = {};
+  in.read(start, sizeof start);
+  return std::string(start, static_cast<std::size_t>(in.gcount()));
+}
+
+// True for a table that holds neither runs nor studies and is left alone: an older build's
+// mass_ratio.csv or reference section (SCENE_solver_error.csv, SCENE_references.csv,
+// SCENE_energy.csv) whose header starts with neither 'scene' nor 'study'.
+bool is_older_table(const fs::path& file) {
   const std::string name = file.filename().string();
   const auto ends_with = [&](const std::string& tail) {
     return name.size() > tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
   };
-  if (!ends_with("_solver_error.csv") && !ends_with("_references.csv") && !ends_with("_energy.csv")) {
+  if (name != "mass_ratio.csv" && !ends_with("_solver_error.csv") && !ends_with("_references.csv") &&
+      !ends_with("_energy.csv")) {
     return false;
   }
-  // Only the header's first 5 bytes: a file of any size (a single line of gigabytes) is never
-  // read further here; the merge's size bound reads the rest in blocks.
-  std::ifstream in(file, std::ios::binary);
-  char start[5] = {};
-  in.read(start, sizeof start);
-  return std::string_view(start, static_cast<std::size_t>(in.gcount())) != "scene";
+  const std::string start = header_start(file);
+  return start != "scene" && start != "study";
 }
 
 }  // namespace
 
-std::vector<RunResult> read_results(const std::vector<fs::path>& dirs) {
+ReportCsvs read_results(const std::vector<fs::path>& dirs) {
   // Every CSV once, with the folder it was found below.
   std::vector<std::pair<fs::path, fs::path>> sources;  // file, given folder
   std::map<fs::path, fs::path> seen;                    // canonical file -> given folder
@@ -394,11 +401,8 @@ std::vector<RunResult> read_results(const std::vector<fs::path>& dirs) {
     }
     std::vector<fs::path> files;
     for (const auto& entry : fs::recursive_directory_iterator(dir)) {
-      // mass_ratio.csv (the report's mass ratio table) and the reference sections' tables
-      // (SCENE_solver_error.csv, SCENE_references.csv, SCENE_energy.csv, whose header does not
-      // start with 'scene') hold no runs.
       if (entry.is_regular_file() && entry.path().extension() == ".csv" &&
-          entry.path().filename() != "mass_ratio.csv" && !is_reference_section_csv(entry.path())) {
+          !is_older_table(entry.path())) {
         files.push_back(entry.path());
       }
     }
@@ -417,10 +421,15 @@ std::vector<RunResult> read_results(const std::vector<fs::path>& dirs) {
   MergeSize size;
   for (std::size_t k = 0; k < sources.size(); ++k) add_size(size, sources[k].first, k + 1);
 
-  std::vector<RunResult> results;
+  ReportCsvs csvs;
+  std::vector<RunResult>& results = csvs.runs;
   std::map<std::string, std::pair<std::string, std::size_t>> first;  // run id -> file, line
   for (const auto& [file, dir] : sources) {
-    const CsvTable table = read_csv(file);
+    CsvTable table = read_csv(file);
+    if (!table.columns.empty() && table.columns.front() == "study") {
+      csvs.studies.emplace_back(file.string(), std::move(table));
+      continue;
+    }
     std::vector<RunResult> rows = results_of(table, file.string());
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const std::size_t line = k < table.lines.size() ? table.lines[k] : k + 2;
@@ -435,7 +444,7 @@ std::vector<RunResult> read_results(const std::vector<fs::path>& dirs) {
       results.push_back(std::move(rows[k]));
     }
   }
-  return results;
+  return csvs;
 }
 
 }  // namespace cps::cli

@@ -138,8 +138,17 @@ inline constexpr std::uintmax_t kMergeBytesPerCell = 256;
 /// four times the largest sweep's CSVs (stress: 7,200 runs of about 40 columns).
 inline constexpr std::uintmax_t kMergeMemoryLimit = std::uintmax_t{256} << 20;
 
+/// What the CSVs below a merge's folders hold: the runs, and the study tables (header starting
+/// with "study": studies.h) with the file each was read from.
+struct ReportCsvs {
+  std::vector<RunResult> runs;
+  std::vector<std::pair<std::string, CsvTable>> studies;
+};
+
 /// Reads every *.csv below the given folders (as written by write_report or `--run`), in path
-/// order, except mass_ratio.csv, which holds no runs. Before parsing any, counts their bytes,
+/// order, except an older build's mass_ratio.csv and reference sections, which hold neither
+/// runs nor studies: the runs (results_of), and the study tables as they are, to be read by
+/// add_study_table. Before parsing any, counts their bytes,
 /// rows and cells (rows x header columns) and throws UsageError naming those counts, the
 /// estimate (bytes + cells x kMergeBytesPerCell) and the limit if the estimate passes
 /// kMergeMemoryLimit. Throws UsageError naming a folder that does not exist; a file found below
@@ -147,6 +156,6 @@ inline constexpr std::uintmax_t kMergeMemoryLimit = std::uintmax_t{256} << 20;
 /// not finite ("nan", "inf"), not a number where one is due, or not 0 or 1 in diverged, quick
 /// or under_reference_error (naming the file, line, column and cell); and a run id found twice
 /// (naming the id and both files and lines).
-std::vector<RunResult> read_results(const std::vector<std::filesystem::path>& dirs);
+ReportCsvs read_results(const std::vector<std::filesystem::path>& dirs);
 
 }  // namespace cps::cli

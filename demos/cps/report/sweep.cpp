@@ -93,6 +93,7 @@ struct ReportOutput {
     begin_output(main, info);
     begin_output(plots, info);
     body();
+    info["engine_steps"] = World::steps_in_process();
     end_output(plots, info);
     end_output(main, info);
   }
@@ -114,22 +115,11 @@ std::vector<std::string> scenes_of(const std::vector<RunResult>& runs) {
   return scenes;
 }
 
-// The tasks that compute, independently of each other, the studies of `scenes` into `studies`
-// (the quick sweep's where quick(scene); scene_study_tasks) and the mass ratio table into `pairs`
-// (its rows made here, each run by its own task). Both must outlive the tasks.
-template <class Quick>
-std::vector<std::function<void()>> study_tasks(const std::vector<std::string>& scenes, Quick quick,
-                                               std::map<std::string, SceneStudies>& studies,
-                                               std::vector<PairRow>& pairs) {
-  std::vector<std::function<void()>> tasks;
-  for (const std::string& scene : scenes) {
-    for (std::function<void()>& t : scene_study_tasks(scene, quick(scene), studies[scene])) {
-      tasks.push_back(std::move(t));
-    }
-  }
-  pairs = mass_ratio_rows();
-  for (PairRow& p : pairs) tasks.push_back([&p] { run_pair_row(p); });
-  return tasks;
+// The studies of `tables` (of `studies`, one each), read back as the report draws them.
+ReportStudies read_studies(const std::vector<StudySpec>& studies, const std::vector<CsvTable>& tables) {
+  ReportStudies read;
+  for (std::size_t i = 0; i < studies.size(); ++i) add_study_table(tables[i], studies[i].file_name(), read);
+  return read;
 }
 
 }  // namespace
@@ -138,12 +128,14 @@ int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& sc
   const std::vector<RunSpec> runs = plan_runs(scenes, to.quick);
   ReportOutput output(to.out, scene_names(scenes), to.force, to.info, /*record_scenes=*/true);
 
-  // What is computed before anything is written: the scenes' studies, the mass ratio rows and
-  // the error runs, on to.jobs threads, the long studies first.
-  std::map<std::string, SceneStudies> studies;
-  std::vector<PairRow> pairs;
-  std::vector<std::function<void()>> tasks =
-      study_tasks(scene_names(scenes), [&](const std::string&) { return to.quick; }, studies, pairs);
+  // What is computed before anything is written: the studies and the error runs, on to.jobs
+  // threads, the long studies first.
+  const std::vector<StudySpec> studies = plan_studies(scenes, to.quick);
+  std::vector<CsvTable> study_tables(studies.size());
+  std::vector<std::function<void()>> tasks;
+  for (std::size_t i = 0; i < studies.size(); ++i) {
+    tasks.push_back([&study_tables, &studies, i] { study_tables[i] = run_study(studies[i]); });
+  }
   const std::size_t first_run = tasks.size();
   std::vector<MeasuredRun> measured(runs.size());
   std::vector<bool> run_done(runs.size(), false);
@@ -210,29 +202,60 @@ int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& sc
     record_timing(m.timing, static_cast<int>(std::min<std::size_t>(to.jobs, measured.size())), m.result);
     results.push_back(in_sweep(to, std::move(m.result)));
   }
-  output.write([&] { write_report(to.out, results, studies, pairs, {}, results.size(), load); });
+  // The report is written from the studies as their CSVs read back, as a merge reads them.
+  const ReportStudies read = read_studies(studies, study_tables);
+  output.write([&] {
+    write_report(to.out, results, read.scenes, read.pairs, {}, results.size() + studies.size(), load);
+  });
   progress.finish();
   std::printf("%zu runs: %s/report.md\n", results.size(), to.out.c_str());
   return 0;
 }
 
-int run_one(const SweepOutput& to, const RunSpec& spec) {
-  const std::string file = run_file_name(spec);
+std::string item_id(const PlanItem& item) {
+  return std::visit([](const auto& spec) { return spec.id(); }, item);
+}
+
+std::vector<PlanItem> plan_items(const std::vector<const scenes::Scene*>& scenes, bool quick) {
+  std::vector<PlanItem> items;
+  for (const StudySpec& s : plan_studies(scenes, quick)) items.emplace_back(s);
+  for (const RunSpec& r : plan_runs(scenes, quick)) items.emplace_back(r);
+  return items;
+}
+
+int run_one(const SweepOutput& to, const PlanItem& item) {
+  const StudySpec* study = std::get_if<StudySpec>(&item);
+  const std::string file = study ? study->file_name() : run_file_name(std::get<RunSpec>(item));
+  const std::string scene = study ? study->scene : std::get<RunSpec>(item).scene;
   const OutputPlan plan = plan_output({.folder = to.out,
                                        .files = {file},
                                        .command = "report",
                                        .use = FolderUse::shared,
-                                       .scenes = {{file, scene_source(spec.scene)}},
+                                       .scenes = scene.empty()
+                                                     ? std::map<std::string, std::string>{}
+                                                     : std::map<std::string, std::string>{
+                                                           {file, scene_source(scene)}},
                                        .force = to.force});
-  const RunResult result = in_sweep(to, execute_run(spec, to.repeats, to.max_work));
-  begin_output(plan, to.info);
-  write_results(to.out / file, {result});
-  end_output(plan, to.info);
+  nlohmann::json info = to.info;
+  if (study) {
+    StudySpec spec = *study;
+    spec.quick = to.quick;
+    const CsvTable table = run_study(spec);
+    info["engine_steps"] = World::steps_in_process();
+    begin_output(plan, info);
+    write_csv(to.out / file, table);
+  } else {
+    const RunResult result = in_sweep(to, execute_run(std::get<RunSpec>(item), to.repeats, to.max_work));
+    info["engine_steps"] = World::steps_in_process();
+    begin_output(plan, info);
+    write_results(to.out / file, {result});
+  }
+  end_output(plan, info);
   return 0;
 }
 
-std::vector<RunSpec> shard_runs(const std::vector<RunSpec>& runs, Shard shard) {
-  std::vector<RunSpec> taken;
+std::vector<PlanItem> shard_runs(const std::vector<PlanItem>& runs, Shard shard) {
+  std::vector<PlanItem> taken;
   for (std::size_t i = static_cast<std::size_t>(shard.index); i < runs.size();
        i += static_cast<std::size_t>(shard.count)) {
     taken.push_back(runs[i]);
@@ -240,13 +263,13 @@ std::vector<RunSpec> shard_runs(const std::vector<RunSpec>& runs, Shard shard) {
   return taken;
 }
 
-int run_shard(const SweepOutput& to, const std::vector<RunSpec>& runs, Shard shard) {
+int run_shard(const SweepOutput& to, const std::vector<PlanItem>& runs, Shard shard) {
   Progress progress("report " + to.sweep + " shard " + std::to_string(shard.index + 1) + "/" +
                         std::to_string(shard.count),
                     static_cast<long long>(runs.size()), "runs");
   long long done = 0;
-  for (const RunSpec& spec : runs) {
-    run_one(to, spec);
+  for (const PlanItem& item : runs) {
+    run_one(to, item);
     progress.update(++done);
   }
   progress.finish();
@@ -258,12 +281,12 @@ int run_shard(const SweepOutput& to, const std::vector<RunSpec>& runs, Shard sha
 }
 
 std::vector<std::string> run_commands(const std::string& exe, const SweepOutput& to,
-                                      const std::vector<RunSpec>& runs) {
+                                      const std::vector<PlanItem>& runs) {
   std::vector<std::string> lines;
   const std::string out = to.out.string();
-  for (const RunSpec& r : runs) {
+  for (const PlanItem& r : runs) {
     lines.push_back(shell_quote(exe) + " report " + shell_quote(to.sweep) + " --run " +
-                    shell_quote(r.id()) + " --out " + shell_quote(out + "/runs") +
+                    shell_quote(item_id(r)) + " --out " + shell_quote(out + "/runs") +
                     (to.quick ? " --quick" : "") +
                     (to.repeats != default_repeats(to.quick) ? " --repeats " + std::to_string(to.repeats) : ""));
   }
@@ -272,9 +295,10 @@ std::vector<std::string> run_commands(const std::string& exe, const SweepOutput&
   return lines;
 }
 
-std::vector<std::string> missing_runs(const std::vector<RunResult>& runs, std::size_t& planned) {
+std::vector<std::string> missing_runs(const std::vector<RunResult>& runs,
+                                      const std::set<std::string>& study_ids, std::size_t& planned) {
   std::set<std::pair<std::string, bool>> sweeps;
-  std::set<std::string> present;
+  std::set<std::string> present = study_ids;
   for (const RunResult& r : runs) {
     sweeps.emplace(r.sweep.value_or(r.scene), r.quick.value_or(false));
     present.insert(r.id());
@@ -288,8 +312,8 @@ std::vector<std::string> missing_runs(const std::vector<RunResult>& runs, std::s
     } catch (const std::exception&) {
       // A sweep this build does not know (a CSV of another build): its plan is unknown.
     }
-    for (const RunSpec& spec : plan_runs(scenes, quick)) {
-      const std::string id = spec.id();
+    for (const PlanItem& item : plan_items(scenes, quick)) {
+      const std::string id = item_id(item);
       if (seen.insert(id).second && !present.count(id)) missing.push_back(id);
     }
   }
@@ -298,7 +322,8 @@ std::vector<std::string> missing_runs(const std::vector<RunResult>& runs, std::s
 }
 
 int merge_report(const SweepOutput& to, const std::vector<fs::path>& dirs) {
-  const std::vector<RunResult> runs = read_results(dirs);
+  const ReportCsvs csvs = read_results(dirs);
+  const std::vector<RunResult>& runs = csvs.runs;
   // The merged report's CSVs would be read as runs by the next merge of that folder.
   const auto resolved = [](const fs::path& p, std::error_code& ec) {
     fs::path r = fs::weakly_canonical(fs::absolute(p), ec).lexically_normal();
@@ -319,27 +344,16 @@ int merge_report(const SweepOutput& to, const std::vector<fs::path>& dirs) {
     }
   }
   if (runs.empty()) throw UsageError("--merge: no report CSV found below the given folders");
+  ReportStudies studies;
+  for (const auto& [source, table] : csvs.studies) add_study_table(table, source, studies);
   std::size_t planned = 0;
-  const std::vector<std::string> missing = missing_runs(runs, planned);
-  const std::vector<std::string> scenes = scenes_of(runs);
-  ReportOutput output(to.out, scenes, to.force, to.info, /*record_scenes=*/false);
-  // The studies of the scenes (quick where a run of the scene is) and the mass ratio rows, on
-  // to.jobs threads.
-  std::map<std::string, SceneStudies> studies;
-  std::vector<PairRow> pairs;
-  const std::vector<std::function<void()>> tasks =
-      study_tasks(scenes, [&](const std::string& scene) {
-        return std::any_of(runs.begin(), runs.end(), [&](const RunResult& r) {
-          return r.scene == scene && r.quick.value_or(false);
-        });
-      }, studies, pairs);
-  {
-    Progress progress("report --merge", static_cast<long long>(tasks.size()), "tasks", 2.0);
-    long long done = 0;
-    run_tasks(tasks, to.jobs, [&](std::size_t) { progress.update(++done); });
-    progress.finish();
+  const std::vector<std::string> missing = missing_runs(runs, studies.ids, planned);
+  std::vector<std::string> scenes = scenes_of(runs);
+  for (const auto& [scene, s] : studies.scenes) {
+    if (std::find(scenes.begin(), scenes.end(), scene) == scenes.end()) scenes.push_back(scene);
   }
-  output.write([&] { write_report(to.out, runs, studies, pairs, missing, planned); });
+  ReportOutput output(to.out, scenes, to.force, to.info, /*record_scenes=*/false);
+  output.write([&] { write_report(to.out, runs, studies.scenes, studies.pairs, missing, planned); });
   if (missing.empty()) {
     std::printf("merged %zu runs into %s/report.md\n", runs.size(), to.out.c_str());
     return 0;

@@ -4,6 +4,7 @@
 
 #include "report/plan.h"
 #include "report/result.h"
+#include "report/studies.h"
 #include "report/timing.h"
 #include "options/options.h"
 
@@ -11,7 +12,9 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <set>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace cps::cli {
@@ -28,8 +31,18 @@ struct SweepOutput {
   int jobs = 1;  ///< threads that compute the runs and studies (>= 1; --jobs); timing uses one
 };
 
-/// Computes the scenes' studies (scene_study_tasks), the mass ratio rows and the error runs of
-/// plan_runs(scenes, quick) on to.jobs threads; then times the runs on this thread alone
+/// One run of a sweep's plan: a study (studies.h) or an error run (plan.h).
+using PlanItem = std::variant<StudySpec, RunSpec>;
+
+/// Its id (StudySpec::id, RunSpec::id). No errors.
+std::string item_id(const PlanItem& item);
+
+/// The plan of the sweep of `scenes`: its studies (plan_studies), then its error runs
+/// (plan_runs), each with `quick`. No errors.
+std::vector<PlanItem> plan_items(const std::vector<const scenes::Scene*>& scenes, bool quick);
+
+/// Computes the studies (run_study) and the error runs of plan_items(scenes, quick) on to.jobs
+/// threads; then times the runs on this thread alone
 /// (to.repeats timed repeats of each, interleaved across the sweep: time_runs); then writes the
 /// report (write_report), which steps no world, into `to.out` and
 /// `to.out`/plots, both shared folders (output.h). One progress line on stderr covers every
@@ -39,9 +52,11 @@ struct SweepOutput {
 /// OUT/report.md" on stdout. Returns the exit code, 0.
 int run_sweep(const SweepOutput& to, const std::vector<const scenes::Scene*>& scenes);
 
-/// Runs `spec` alone (execute_run, to.repeats timed repeats) and writes its CSV (one row, run_file_name) into `to.out`, a shared folder,
-/// with the sweep it belongs to. Throws as run_sweep does. Returns the exit code, 0.
-int run_one(const SweepOutput& to, const RunSpec& spec);
+/// Runs `item` alone and writes its CSV into `to.out`, a shared folder: a study's table
+/// (run_study, StudySpec::file_name), or an error run's one row (execute_run, to.repeats timed
+/// repeats, run_file_name) with the sweep it belongs to. Throws as run_sweep does. Returns the
+/// exit code, 0.
+int run_one(const SweepOutput& to, const PlanItem& item);
 
 /// One shard of a sweep spread over a scheduler (`--shard I/N`): `index` in [0, count), count >= 1.
 struct Shard {
@@ -49,31 +64,33 @@ struct Shard {
   int count = 1;
 };
 
-/// The runs of `runs` (a plan, plan_runs) that `shard` takes: those whose place in the plan is
+/// The runs of `runs` (a plan, plan_items) that `shard` takes: those whose place in the plan is
 /// shard.index modulo shard.count, in plan order, so the shards of one count take every run once.
 /// Throws nothing.
-std::vector<RunSpec> shard_runs(const std::vector<RunSpec>& runs, Shard shard);
+std::vector<PlanItem> shard_runs(const std::vector<PlanItem>& runs, Shard shard);
 
 /// Runs `runs` (one shard's) one after another as run_one does, each CSV written into `to.out`
 /// as soon as its run ends, so a shard stopped half way keeps the runs it finished. Throws as
 /// run_one does. Prints one line on stdout with the count and the merge command. Returns 0.
-int run_shard(const SweepOutput& to, const std::vector<RunSpec>& runs, Shard shard);
+int run_shard(const SweepOutput& to, const std::vector<PlanItem>& runs, Shard shard);
 
 /// The commands of `--list-runs`: per run of `runs`, `'EXE' report 'SWEEP' --run ID --out
 /// 'OUT/runs'` (with --quick for a quick sweep, and --repeats N where to.repeats is not
 /// default_repeats(to.quick)), then a comment line with the merge command.
 std::vector<std::string> run_commands(const std::string& exe, const SweepOutput& to,
-                                      const std::vector<RunSpec>& runs);
+                                      const std::vector<PlanItem>& runs);
 
-/// The ids (RunSpec::id) of the runs that the sweeps named in `runs` plan (plan_runs of the
-/// run's sweep, a scene selector as select_scenes takes, and its quick flag) and that no run
-/// holds, in plan order. A run without a sweep (an older build's CSV) belongs to the full sweep
+/// The ids (item_id) of the runs that the sweeps named in `runs` plan (plan_items of the
+/// run's sweep, a scene selector as select_scenes takes, and its quick flag) and that neither a
+/// run nor a study of `study_ids` holds, in plan order. A run without a sweep (an older build's CSV) belongs to the full sweep
 /// of its own scene; a sweep this build cannot select plans nothing. `planned` is set to the
 /// number of distinct planned runs.
-std::vector<std::string> missing_runs(const std::vector<RunResult>& runs, std::size_t& planned);
+std::vector<std::string> missing_runs(const std::vector<RunResult>& runs,
+                                      const std::set<std::string>& study_ids, std::size_t& planned);
 
-/// Reads the CSVs below `dirs` (read_results), computes the scenes' studies and the mass ratio
-/// rows (on to.jobs threads) and writes one report of them into `to.out` (as run_sweep; `to.sweep` and `to.quick` are not used). Throws
+/// Reads the CSVs below `dirs` (read_results: the runs and the studies) and writes one report
+/// of them into `to.out` (as run_sweep; `to.sweep` and `to.quick` are not used). Steps no world:
+/// a study missing from the CSVs is named as a missing run. Throws
 /// UsageError if no report CSV is found or a file is not one, and as run_sweep does. If planned
 /// runs are missing (missing_runs), the report is marked INCOMPLETE, stderr names the first 5
 /// and the return is 1; else stdout says "merged N runs into OUT/report.md" and the return is 0.

@@ -4,20 +4,41 @@
 # each:
 #   SCENE PUSH SOLVER ASSEMBLY HASH
 # Usage: scripts/state-hashes.sh [CPS]               print the table (CPS: default build/demos/cps)
-#        scripts/state-hashes.sh --check FILE [CPS]  rerun every line of FILE with --expect-hash;
-#                                                    exit 1 listing the lines whose state differs
+#        scripts/state-hashes.sh --check FILE [CPS] [K/N]
+#                                 rerun every line of FILE (with K/N: its lines K, K + N, ...)
+#                                 with --expect-hash; exit 1 listing the lines whose state
+#                                 differs; exit 77 (skipped) on a machine whose floating-point
+#                                 features differ from those the table's "# machine:" line names
 # A refactoring that must not change the physics keeps every hash (docs/state_hashes.txt holds
 # the table of the last change that was meant to keep them). Hashes are of IEEE-754 bytes: a
 # different compiler, flags or libm (glibc picks sin/cos variants by CPU) may change them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# What the hashes depend on besides the build: the architecture and the CPU features by which
+# glibc picks its libm variants.
+machine() {
+  echo "$(uname -m) $(grep -o -w -E 'fma|avx2' /proc/cpuinfo 2> /dev/null | sort -u | tr '\n' ' ' | sed 's/ $//')"
+}
 if [ "${1:-}" = "--check" ]; then
   table=${2:?--check needs the table file}
   cps=${3:-build/demos/cps}
+  part=${4:-1/1}
+  k=${part%/*} n=${part#*/}
+  [[ "$k" =~ ^[1-9][0-9]*$ && "$n" =~ ^[1-9][0-9]*$ && "$k" -le "$n" ]] ||
+    { echo "state-hashes.sh: part '$part' is not K/N with 1 <= K <= N" >&2; exit 2; }
+  made_on=$(sed -n 's/^# machine: //p' "$table")
+  if [ -n "$made_on" ] && [ "$made_on" != "$(machine)" ]; then
+    echo "state hashes skipped: the table was made on '$made_on', this machine is '$(machine)'"
+    echo "(hashes of IEEE-754 bytes follow the libm variant glibc picks by CPU features)"
+    exit 77
+  fi
   failed=0
   checked=0
+  line=0
   while read -r scene push solver assembly hash; do
     case "$scene" in ''|'#'*) continue ;; esac
+    line=$((line + 1))
+    [ $(((line - 1) % n)) -eq $((k - 1)) ] || continue
     checked=$((checked + 1))
     if ! "$cps" simulate "$scene" --push "$push" --solver "$solver" --assembly "$assembly" \
         --expect-hash "$hash" > /dev/null 2> /tmp/cps-state-hash.$$; then
@@ -36,6 +57,7 @@ cps=${1:-build/demos/cps}
 # scenes stack_20 and pyramid_210, which the table leaves out too.
 scenes=$("$cps" list | awk '/^Scaled/{exit} /^  /{print $1}' | grep -v '_long$')
 echo "# scene push solver assembly state_hash   ($("$cps" simulate stack --seconds 0.02 --json | sed -n 's/.*"engine_version": "\(.*\)".*/\1/p'))"
+echo "# machine: $(machine)"
 # The push methods as the binary's --help lists them: "--push {baumgarte, split, ...}".
 pushes=$("$cps" simulate --help | sed -n 's/^ *--push {\([^}]*\)}.*/\1/p' | tr -d ',')
 [ -n "$pushes" ] || { echo "state-hashes.sh: no --push methods in '$cps simulate --help'" >&2; exit 1; }

@@ -73,6 +73,39 @@ std::string unknown_option_message(CLI::App& app, int argc, char** argv,
   return fallback + "\nRun 'cps --help' or 'cps COMMAND --help' for usage.";
 }
 
+// A clearer message for an option given without its value ("1 required TEXT missing") or with a
+// value it cannot take ("Could not convert"): the option, what it wants (its description), and
+// for a switch how to give it. `fallback`: CLI11's message, when the option cannot be found.
+std::string value_message(CLI::App& app, int argc, char** argv, const CLI::ParseError& e,
+                          const std::string& fallback) {
+  const CLI::App* sub = nullptr;
+  for (const CLI::App* s : app.get_subcommands({})) {
+    if (argc > 1 && s->get_name() == argv[1]) sub = s;
+  }
+  const std::string what = e.what();
+  const bool missing = dynamic_cast<const CLI::ArgumentMismatch*>(&e) != nullptr;
+  // "--solver-error: 1 required TEXT missing"; "Could not convert: --rods = maybe".
+  std::string name = missing ? what.substr(0, what.find(':'))
+                             : what.substr(what.find(": ") + 2, what.find(" = ") - what.find(": ") - 2);
+  const CLI::Option* option = sub && name.rfind("--", 0) == 0 ? sub->get_option_no_throw(name) : nullptr;
+  if (option == nullptr) return fallback;
+  const std::string description = option->get_description();
+  if (missing && option->get_expected_max() == 0) {  // a switch given twice
+    std::string names;
+    for (const std::string& n : option->get_lnames()) names += (names.empty() ? "--" : " or --") + n;
+    return names + " given more than once: give one of them, once";
+  }
+  if (missing) {
+    return name + " needs a value (" + option->get_type_name() + "): " + description;
+  }
+  const std::string value = what.substr(what.find(" = ") + 3);
+  if (option->get_expected_max() == 0) {
+    return name + " is a switch: give " + name + " alone (or " + name + "=true, " + name +
+           "=false), not '" + value + "'";
+  }
+  return name + ": '" + value + "' is not a value it takes: " + description;
+}
+
 int run(int argc, char** argv) {
   CLI::App app{"cps: the constraint based physics solver of Tamis & Maggiore (2015)"};
   app.require_subcommand(1);
@@ -124,6 +157,12 @@ int run(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ExtrasError& e) {
     std::cerr << "cps: " << unknown_option_message(app, argc, argv, e.what()) << "\n";
+    return 2;
+  } catch (const CLI::ArgumentMismatch& e) {
+    std::cerr << "cps: " << value_message(app, argc, argv, e, e.what()) << "\n";
+    return 2;
+  } catch (const CLI::ConversionError& e) {
+    std::cerr << "cps: " << value_message(app, argc, argv, e, e.what()) << "\n";
     return 2;
   } catch (const CLI::ParseError& e) {
     std::cerr << "cps: " << e.what() << "\nRun 'cps --help' or 'cps COMMAND --help' for usage.\n";

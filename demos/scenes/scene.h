@@ -149,9 +149,8 @@ const Scene* find_scene(std::string_view name);
 /// typed. No errors.
 std::string_view output_name(const Scene& scene);
 
-/// The candidate nearest to `word` by edit distance (Levenshtein; the first on a tie), for "did
-/// you mean" in messages; "" when there are no candidates. No errors.
-std::string nearest_name(std::string_view word, const std::vector<std::string>& candidates);
+/// The candidate nearest to `word` by edit distance (cps::nearest_name, parameters.h).
+using ::cps::nearest_name;
 
 /// The random scene with this seed, named random_SEED (see find_scene); kept for the program's
 /// life.

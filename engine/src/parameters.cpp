@@ -594,6 +594,34 @@ std::optional<double> parse_decimal(std::string_view text, bool allow_fraction) 
   return *a / *b;
 }
 
+std::string nearest_name(std::string_view word, const std::vector<std::string>& candidates) {
+  // Levenshtein distance, one row at a time.
+  const auto distance = [](std::string_view a, std::string_view b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      std::size_t diagonal = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const std::size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diagonal = up;
+      }
+    }
+    return row[b.size()];
+  };
+  std::string best;
+  std::size_t best_distance = std::string::npos;
+  for (const std::string& c : candidates) {
+    const std::size_t d = distance(word, c);
+    if (d < best_distance) {
+      best = c;
+      best_distance = d;
+    }
+  }
+  return best;
+}
+
 std::string Parameter::allowed() const {
   switch (type) {
     case ParameterType::real: {
@@ -713,7 +741,12 @@ ParameterValue Parameter::parse(std::string_view text) const {
     }
     case ParameterType::choice: {
       const Choice* c = find_choice(text);
-      if (c == nullptr) throw refuse("'" + std::string(text) + "' is not " + allowed());
+      if (c == nullptr) {
+        std::vector<std::string> names;
+        for (const Choice& choice : choices) names.emplace_back(choice.name);
+        throw refuse("'" + std::string(text) + "' is not " + allowed() + "; did you mean '" +
+                     nearest_name(text, names) + "'?");
+      }
       v = c->value;
       break;
     }

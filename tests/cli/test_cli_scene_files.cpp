@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 using cli_test::Result;
@@ -251,3 +252,42 @@ TEST_CASE("a scene file without a camera keeps its moving bodies in every frame"
   CHECK(lost_as_built >= 2);
 }
 #endif
+
+TEST_CASE("messages that help: the scene file beside a name, a missing or wrong value, a switch "
+          "given twice, and did-you-mean for choices and --compare names",
+          "[cli][scene_file][messages]") {
+  const fs::path dir = cli_test::fresh_dir("cps-test-messages");
+  fs::copy_file(std::string(CPS_TEST_DATA) + "/cradle.json", dir / "cradle.json");
+  struct Case {
+    std::string args;
+    std::vector<std::string> words;  // what the message says
+  };
+  std::vector<Case> cases = {
+      {"simulate cradle --seconds 0.1", {"did you mean the scene file 'cradle.json' in this folder?"}},
+      {"simulate stack --seconds 0.1 --solver-error", {"--solver-error needs a value", "CSV"}},
+      {"simulate stack --seconds", {"--seconds needs a value", "simulated time (s)"}},
+      {"simulate stack --push baumgrate", {"'baumgrate' is not one of", "did you mean 'baumgarte'?"}},
+      {"simulate stack --solver jacobbi", {"did you mean 'jacobi'?"}},
+  };
+#ifdef CPS_HAVE_RENDERER
+  cases.push_back({"render stack --rods=maybe --seconds 0.1 --out o",
+                   {"--rods is a switch", "not 'maybe'"}});
+  cases.push_back({"render stack --label --no-label --seconds 0.1 --out o",
+                   {"--label or --no-label given more than once"}});
+  cases.push_back({"render stack --compare pussh=baumgarte,split --seconds 0.1 --out o",
+                   {"'pussh' is not a parameter --compare takes; did you mean 'push'?"}});
+  cases.push_back({"render stack --compare push=baumgarte,splt --seconds 0.1 --out o",
+                   {"did you mean 'split'?"}});
+#endif
+  for (const Case& c : cases) {
+    INFO(c.args);
+    const Result r = run_cps(c.args, dir);
+    INFO(r.err);
+    CHECK(r.exit_code == 2);
+    for (const std::string& w : c.words) CHECK(r.err.find(w) != std::string::npos);
+    CHECK(r.err.find("Could not convert") == std::string::npos);
+    CHECK(r.err.find("required TEXT missing") == std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "o"));
+  }
+  fs::remove_all(dir);
+}

@@ -61,7 +61,8 @@ Comparison parse_comparison(const std::string& spec, const scenes::Overrides& ba
   const std::string name = spec.substr(0, eq);
   const Parameter* p = find_parameter(name);
   if (p == nullptr || !comparable(*p) || p->flag != name) {
-    throw UsageError(what + "'" + name + "' is not a parameter --compare takes; give " +
+    throw UsageError(what + "'" + name + "' is not a parameter --compare takes; did you mean '" +
+                     nearest_name(name, comparable_options()) + "'? Give " +
                      "PARAM=V1,V2,... with PARAM one of: " + join(comparable_options()) +
                      " (a choice alone, e.g. --compare push, compares all its values)");
   }

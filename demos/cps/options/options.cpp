@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <filesystem>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -193,6 +194,12 @@ std::vector<const scenes::Scene*> select_scenes(const std::string& name) {
   for (const std::string_view e : scenes::example_scene_names()) known.emplace_back(e);
   for (const std::string_view help : scenes::scaled_families()) {
     known.emplace_back(help.substr(0, help.find(' ')));
+  }
+  // A scene file of that name beside it ("cradle" for ./cradle.json) is what was meant.
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(name + ".json", ec)) {
+    throw UsageError("unknown scene '" + name + "'; did you mean the scene file '" + name +
+                     ".json' in this folder? (a scene file is given by its path, ending in .json)");
   }
   const std::string nearest = scenes::nearest_name(name, known);
   std::string suggestion = "'" + nearest + "'";

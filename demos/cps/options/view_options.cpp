@@ -55,11 +55,14 @@ void add_view_options(CLI::App& cmd, View& view, bool& label, bool label_default
   cmd.add_flag("--contacts", overlays.contacts,
                "draw the last step's contact points (red spheres) and normals (red segments, about "
                "one body size long (m), from body a towards body b); default: off");
+  // Each switch once: "--label --no-label" is refused, not decided by the last.
   cmd.add_flag("--rods,!--no-rods", overlays.rods,
-               "draw distance constraints as rods; default: on (--no-rods hides them)");
+               "draw distance constraints as rods; default: on (--no-rods hides them)")
+      ->multi_option_policy(CLI::MultiOptionPolicy::Throw);
   cmd.add_flag("--label,!--no-label", label,
                std::string("write scene, variant and time (s) on each picture; default: ") +
-                   (label_default ? "on (--no-label leaves the pictures bare)" : "off (variants of --compare are always labelled)"));
+                   (label_default ? "on (--no-label leaves the pictures bare)" : "off (variants of --compare are always labelled)"))
+      ->multi_option_policy(CLI::MultiOptionPolicy::Throw);
   cmd.add_option("--camera", view.camera,
                  "view: preset (the scene's own; fit for a scene file without a camera), auto "
                  "(framed on the bodies as built), fit "

@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 #include <variant>
+#include <vector>
 
 namespace cps {
 
@@ -73,6 +74,10 @@ struct PushTraits {
   /// is measured as the displacement beyond the velocity, x2 - x1 - v2 dt (m).
   bool push_in_rows = false;
 };
+
+/// The candidate nearest to `word` by edit distance (Levenshtein; the first on a tie), for "did
+/// you mean" in messages; "" when there are no candidates. No errors.
+std::string nearest_name(std::string_view word, const std::vector<std::string>& candidates);
 
 /// The traits of `push` (above), from its row of the push parameter's table. Throws nothing.
 const PushTraits& push_traits(PushMode push);

@@ -53,6 +53,7 @@ start_s=$SECONDS
 declare -A KIND=(
   ['*:--help']=skip ['top:--version']=skip
   ['*:--json']=flag ['*:--force']=flag ['*:--quick']=flag ['*:--list-runs']=flag
+  ['*:--quiet']=flag ['*:--warnings-as-errors']=flag
   ['*:--rendering']=flag ['*:--contacts']=flag ['*:--rods']=flag ['*:--label']=flag
   ['*:--overlay']=flag ['*:--compare']=compare
   ['*:--seconds']=seconds ['*:--fps']=fps ['*:--orbit']=orbit ['*:--speed']=speed

@@ -2,6 +2,7 @@
 // render them to PNG frames and figures. Each command lives in its own file (see command.h);
 // this file assembles them and turns errors into exit codes.
 #include "command.h"
+#include "options/diagnostics.h"
 #include "options/options.h"
 #include "output/output.h"
 #include "scene.h"
@@ -171,7 +172,7 @@ int run(int argc, char** argv) {
 
   try {
     for (const cli::Command& command : commands) {
-      if (*command.sub) return command.run();
+      if (*command.sub) return cli::exit_code_after_warnings(command.run());
     }
   } catch (const cli::UsageError& e) {
     cli::abandon_outputs();

@@ -204,18 +204,33 @@ std::string energy_rise_warning(std::string_view what, const WorldDef& def, cons
   return out + "; " + fix;
 }
 
-void print_run_warnings(std::string_view scene, std::string_view label, const Run& run,
-                        const EnergyRiseTracker& tracker) {
+std::vector<RunWarning> run_warnings(std::string_view scene, std::string_view label, const Run& run,
+                                     const EnergyRiseTracker& tracker) {
   const std::string_view first_line = label.substr(0, label.find('\n'));
   std::string what(scene);
   if (!first_line.empty()) what += " (" + std::string(first_line) + ")";
-  const std::optional<Divergence> diverged =
-      run.divergence ? run.divergence->found() : std::optional<Divergence>();
-  for (const std::string& warning :
-       {diverged ? divergence_warning(what, *diverged) : std::string(),
-        energy_rise_warning(what, run.world.def(), tracker.result())}) {
-    if (!warning.empty()) std::fprintf(stderr, "cps: warning: %s\n", warning.c_str());
+  std::vector<RunWarning> out;
+  if (const std::optional<Divergence> d = run.divergence ? run.divergence->found() : std::nullopt) {
+    char at[64];
+    std::snprintf(at, sizeof at, "%.4g", d->at_s);
+    out.push_back({"divergence", divergence_warning(what, *d),
+                   what + ": the run diverged at t = " + at + " s", "docs/commands.md#simulate"});
   }
+  const EnergyRise rise = tracker.result();
+  if (std::string text = energy_rise_warning(what, run.world.def(), rise); !text.empty()) {
+    char brief[160];
+    if (rise.fraction() > kEnergyRiseWarnFraction && std::isfinite(rise.fraction())) {
+      std::snprintf(brief, sizeof brief, ": the energy rose %.0f %% above its start with nothing "
+                    "driving the scene", 100.0 * rise.fraction());
+    } else if (rise.fraction() > kEnergyRiseWarnFraction) {
+      std::snprintf(brief, sizeof brief, ": the energy rose from nothing with nothing driving the scene");
+    } else {
+      std::snprintf(brief, sizeof brief, ": a body was thrown faster than the scene allows");
+    }
+    out.push_back({"energy_rise", std::move(text), what + brief,
+                   "docs/findings.md#energy-that-rises-with-nothing-driving-it"});
+  }
+  return out;
 }
 
 }  // namespace cps::scenes

@@ -145,12 +145,19 @@ std::shared_ptr<const EnergyRiseTracker> watch_energy_rise(Run& run);
 /// naming the push method in use and the fix to try for it (docs/findings.md). No errors.
 std::string energy_rise_warning(std::string_view what, const WorldDef& def, const EnergyRise& rise);
 
-/// Prints the run's warnings as "cps: warning: ..." lines on stderr: its divergence
-/// (divergence_warning of run.divergence) and its energy rise (energy_rise_warning of the
-/// tracker), naming it `scene`, or "scene (label)" with the first line of a --compare variant's
-/// non-empty `label` ("push = baumgarte"). Writes nothing else: no file and no exit code depends
-/// on it.
-void print_run_warnings(std::string_view scene, std::string_view label, const Run& run,
-                        const EnergyRiseTracker& tracker);
+/// A warning of a run, for the command to print (whole, or its brief once per kind).
+struct RunWarning {
+  std::string kind;   ///< "divergence" or "energy_rise"
+  std::string text;   ///< the whole warning (divergence_warning, energy_rise_warning), one line
+  std::string brief;  ///< its first clause: what happened to which run, one short line
+  std::string docs;   ///< the docs page and anchor that explain it
+};
+
+/// The run's warnings: its divergence (divergence_warning of run.divergence) and its energy rise
+/// (energy_rise_warning of the tracker), naming it `scene`, or "scene (label)" with the first
+/// line of a --compare variant's non-empty `label` ("push = baumgarte"); none when it neither
+/// diverged nor gained energy. No errors.
+std::vector<RunWarning> run_warnings(std::string_view scene, std::string_view label, const Run& run,
+                                     const EnergyRiseTracker& tracker);
 
 }  // namespace cps::scenes

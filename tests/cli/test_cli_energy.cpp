@@ -295,3 +295,48 @@ TEST_CASE("cps simulate --solver-error refuses a system past the exact solve's r
   CHECK(fs::exists(dir / "s.csv"));
   fs::remove_all(dir);
 }
+
+TEST_CASE("simulate --quiet prints each kind of warning once as one line with its docs page, and "
+          "--warnings-as-errors exits 3 when a warning fired, 0 when none did",
+          "[cli][energy][warnings]") {
+  const fs::path dir = fresh_dir("cps-test-quiet");
+  // The cradle of rods under the paper's push gains energy (docs/findings.md): one warning.
+  const std::string run = std::string("simulate ") + CPS_TEST_DATA + "/cradle.json --seconds 10 ";
+  const auto lines = [](const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) out.push_back(line);
+    return out;
+  };
+  const Result loud = run_cps(run + "--push baumgarte", dir);
+  REQUIRE(loud.exit_code == 0);
+  const std::vector<std::string> loud_lines = lines(loud.err);
+  REQUIRE(loud_lines.size() == 1u);
+  CHECK(loud_lines[0].rfind("cps: warning: ", 0) == 0);
+  CHECK(loud_lines[0].size() > 300);  // the whole story: when, how much, the fix to try
+  const Result quiet = run_cps(run + "--push baumgarte --quiet", dir);
+  REQUIRE(quiet.exit_code == 0);
+  const std::vector<std::string> quiet_lines = lines(quiet.err);
+  REQUIRE(quiet_lines.size() == 1u);
+  CHECK(quiet_lines[0].rfind("cps: warning: ", 0) == 0);
+  CHECK(quiet_lines[0].size() < 200);
+  // The page it names, and its anchor: a heading of that page.
+  const std::string link = "docs/findings.md#energy-that-rises-with-nothing-driving-it";
+  CHECK(quiet_lines[0].find("(see " + link + ")") != std::string::npos);
+  CHECK(slurp(std::string(CPS_TEST_DATA) + "/../../docs/findings.md")
+            .find("\n## Energy that rises with nothing driving it\n") != std::string::npos);
+  // --warnings-as-errors: exit 3 after the warning, and says why; the run's summary is printed.
+  const Result strict = run_cps(run + "--push baumgarte --quiet --warnings-as-errors", dir);
+  CHECK(strict.exit_code == 3);
+  CHECK(strict.err.find("--warnings-as-errors") != std::string::npos);
+  CHECK(strict.out.find("600 steps") != std::string::npos);
+  // Without a warning it changes nothing: the single frame push keeps the cradle's energy.
+  const Result kept = run_cps(run + "--push split --warnings-as-errors", dir);
+  CHECK(kept.exit_code == 0);
+  CHECK(kept.err.find("warning") == std::string::npos);
+  // Notes go too: --trace's line ("trace: N rows ...") only without --quiet.
+  const std::string traced = "simulate stack --seconds 0.1 --trace t.csv";
+  CHECK(run_cps(traced, dir).err.find("trace: ") != std::string::npos);
+  CHECK(run_cps(traced + " --quiet", dir).err.empty());
+  fs::remove_all(dir);
+}

@@ -11,6 +11,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -114,6 +115,34 @@ std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
 }  // namespace
 
 #ifdef CPS_HAVE_RENDERER
+TEST_CASE("render and figure --quiet: no progress or context line, each kind of warning once",
+          "[cli][figure][warnings]") {
+  const fs::path dir = fresh_dir("quiet");
+  // Two variants of the paper's push on the cradle of rods, both gaining energy: two warnings.
+  const std::string cradle = std::string(CPS_TEST_DATA) + "/cradle.json";
+  const std::string compare = " --compare beta=0.2,0.8 --size 160x120 ";
+  const auto warnings = [](const std::string& err) {
+    std::size_t n = 0;
+    for (std::size_t at = 0; (at = err.find("cps: warning: ", at)) != std::string::npos; ++at) ++n;
+    return n;
+  };
+  const Result loud = cps_run("render " + cradle + compare + "--seconds 4 --fps 4 --out r1", dir);
+  REQUIRE(loud.exit_code == 0);
+  CHECK(warnings(loud.err) == 2);
+  CHECK(loud.err.find("render: ") != std::string::npos);  // the GL context
+  CHECK(loud.err.find(" frames") != std::string::npos);   // the progress
+  const Result quiet = cps_run("render " + cradle + compare + "--seconds 4 --fps 4 --out r2 --quiet", dir);
+  REQUIRE(quiet.exit_code == 0);
+  CHECK(warnings(quiet.err) == 1);
+  CHECK(std::count(quiet.err.begin(), quiet.err.end(), '\n') == 1);
+  CHECK(cps_run("render " + cradle + compare + "--seconds 4 --fps 4 --out r3 --quiet "
+                "--warnings-as-errors", dir).exit_code == 3);
+  const Result figure = cps_run("figure " + cradle + compare + "--times 0,4 --out f.png --quiet", dir);
+  REQUIRE(figure.exit_code == 0);
+  CHECK(warnings(figure.err) == 1);
+  CHECK(std::count(figure.err.begin(), figure.err.end(), '\n') == 1);
+}
+
 TEST_CASE("cps figure writes one PNG of times x variants panels with a sidecar", "[cli][figure]") {
   const fs::path dir = fresh_dir("size");
   const Result r = cps_run("figure intersecting_stack --times 0,0.25,0.5 --compare push=baumgarte,split --size 48x32 "

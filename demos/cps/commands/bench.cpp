@@ -2,6 +2,7 @@
 // step goes by stage, the cost of warm starting, the cost growth with body count, and
 // milliseconds per rendered frame.
 #include "command.h"
+#include "options/diagnostics.h"
 #include "options/options.h"
 #include "output/output.h"
 #include "report/timing.h"  // thread_cpu_seconds: a one-thread world steps on this thread
@@ -196,7 +197,7 @@ nlohmann::json render_table(bool quick, bool markdown) {
   job.folder = folder;
   const int frames = static_cast<int>(frame_count(job));  // a few dozen
   for (const scenes::Scene& scene : scenes::paper_scenes()) {
-    std::fprintf(stderr, "bench: rendering %s\n", std::string(scene.name).c_str());
+    notes() << "bench: rendering " << scene.name << "\n";
     {  // Warm-up (untimed).
       scenes::Run run = scenes::make_run(scene);
       renderer.draw(draw_list(run.world, resolve_style(scene, run.world, View{}, k_aspect)));
@@ -397,7 +398,7 @@ nlohmann::json physics_table(const std::vector<std::string>& names,
     const double dt = scene.world_def().dt;
     const double start = scene.bench.start_s;
     const int repeats = window_repeats(steps, quick);
-    std::fprintf(stderr, "bench: %s\n", name.c_str());
+    notes() << "bench: " << name << "\n";
     const StepCost e = step_cost(scene, overrides, Assembly::explicit_matrices, start, steps, repeats);
     const StepCost m = step_cost(scene, overrides, Assembly::matrix_free, start, steps, repeats);
     const std::size_t bodies = scenes::make_run(scene).world.bodies().size();
@@ -458,7 +459,7 @@ nlohmann::json warm_start_table(const std::vector<std::string>& names, bool quic
     const int steps = window_steps(scene, quick);
     const int repeats = std::max(5, (timed_steps + steps - 1) / steps);
     const double start = scene.bench.start_s;
-    std::fprintf(stderr, "bench: %s warm starting\n", name.c_str());
+    notes() << "bench: " << name << " warm starting\n";
     const StepCost cold = step_cost(scene, {}, Assembly::matrix_free, start, steps, repeats, 0.0);
     const StepCost match = step_cost(scene, {}, Assembly::matrix_free, start, steps, repeats, 1e-100);
     const StepCost warm = step_cost(scene, {}, Assembly::matrix_free, start, steps, repeats, 0.8);
@@ -499,7 +500,7 @@ nlohmann::json growth_table(bool quick, bool markdown) {
     std::string cells;
     for (const int n : sizes) {
       const std::string name = std::string(family) + "_" + std::to_string(n);
-      std::fprintf(stderr, "bench: %s\n", name.c_str());
+      notes() << "bench: " << name << "\n";
       const scenes::Scene& scene = *scenes::find_scene(name);
       const double bodies = static_cast<double>(scenes::make_run(scene).world.bodies().size());
       const StepCost cost =
@@ -601,6 +602,7 @@ Command add_bench(CLI::App& app) {
   add_seed_option(*sub, o->scenes);
   add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
+  add_diagnostic_flags(*sub);
   return {sub, [o] { return run_bench(*o); }};
 }
 

@@ -6,6 +6,7 @@
 // `cps export SCENE --fclib FILE.hdf5 --at STEPS`: chosen steps' solves as FCLIB problems
 // (export_fclib.h).
 #include "command.h"
+#include "options/diagnostics.h"
 #include "commands/export_fclib.h"
 #include "pictures/draw.h"
 #include "options/options.h"
@@ -564,7 +565,7 @@ int execute_export(const ExportOptions& o, ExportPlan& plan) {
   begin_output(plan.output, plan.info);
   write_file_atomic(plan.path, std::span(reinterpret_cast<const std::uint8_t*>(data.data()), data.size()));
   end_output(plan.output, plan.info);
-  std::cerr << "export " << scene.name << ": " << world.bodies().size() << " bodies, "
+  notes() << "export " << scene.name << ": " << world.bodies().size() << " bodies, "
             << world.distances().size() << " rods, " << plan.samples << " samples at " << o.fps
             << " fps (" << data.size() << " bytes) in " << o.out << "\n";
   return 0;
@@ -642,6 +643,7 @@ Command add_export(CLI::App& app, int argc, char** argv) {
                 "it); any other file is never touched");
   add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
+  add_diagnostic_flags(*sub);
   return {sub, [o, argc, argv] { return run_export(*o, argc, argv); }};
 }
 

@@ -1,5 +1,6 @@
 // `cps export --fclib` (see export_fclib.h).
 #include "commands/export_fclib.h"
+#include "options/diagnostics.h"
 
 #include "commands/solver_error.h"
 #include "commands/system_rows.h"
@@ -208,14 +209,14 @@ int run_fclib_export(const FclibExportOptions& o, int argc, char** argv) {
       throw std::runtime_error("--fclib " + target.string() + ": nothing written (" + e.what() + ")");
     }
     const std::uintmax_t bytes = file.commit();
-    std::cerr << "export " << scene_name << ": step " << step << ", " << problem.contacts()
+    notes() << "export " << scene_name << ": step " << step << ", " << problem.contacts()
               << " contacts and " << problem.rod_rows.size() << " rods (W " << problem.W.rows()
               << " x " << problem.W.cols() << ", " << problem.W.nonZeros() << " entries), "
               << bytes << " bytes in " << target.string() << "\n";
     std::string exact_note;
     const std::filesystem::path rows = path.parent_path() / rows_name(names[step]);
     write_text_atomic(rows, rows_csv(captured.at(step), problem, exact_note));
-    std::cerr << "export " << scene_name << ": step " << step << ", its rows, bounds and lambda in "
+    notes() << "export " << scene_name << ": step " << step << ", its rows, bounds and lambda in "
               << rows.string()
               << (exact_note.empty() ? std::string() : " (no exact lambda: " + exact_note + ")")
               << "\n";

@@ -6,6 +6,7 @@
 #include "pictures/overlay.h"
 #include "options/view_options.h"
 #include "energy_rise.h"
+#include "options/diagnostics.h"
 
 #include "cps/render/image_ops.h"
 
@@ -166,7 +167,10 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
     }
   }
   for (std::size_t r = 0; r < runs.size(); ++r) {
-    scenes::print_run_warnings(scene.name, spec.variants[r].label, runs[r], *energy[r]);
+    for (const scenes::RunWarning& w :
+         scenes::run_warnings(scene.name, spec.variants[r].label, runs[r], *energy[r])) {
+      warn(w.kind, w.text, w.brief, w.docs);
+    }
   }
   const bool lettered = out.panels.size() > 1;
   for (std::size_t k = 0; k < out.panels.size(); ++k) {
@@ -545,6 +549,7 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
   add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
   add_view_options(*sub, o->view, o->label, /*label_default=*/true);
+  add_diagnostic_flags(*sub);
   return {sub, [o, argc, argv] { return run_figure(*o, argc, argv); }};
 }
 

@@ -8,6 +8,7 @@
 #include "pictures/video.h"
 #include "options/view_options.h"
 #include "energy_rise.h"
+#include "options/diagnostics.h"
 
 #include "cps/render/image_ops.h"
 
@@ -272,10 +273,10 @@ std::optional<fs::path> look_for_ffmpeg(const RenderOptions& o) {
   if (o.video.empty()) return std::nullopt;
   std::optional<fs::path> ffmpeg = find_on_path("ffmpeg");
   if (!ffmpeg) {
-    std::fprintf(stderr,
-                 "cps: warning: --video %s: ffmpeg is not on PATH; the frames will be "
-                 "rendered and kept, but no video made (install it: apt-get install ffmpeg)\n",
-                 o.video.c_str());
+    warn("ffmpeg",
+         "--video " + o.video + ": ffmpeg is not on PATH; the frames will be rendered and kept, "
+         "but no video made (install it: apt-get install ffmpeg)",
+         "--video " + o.video + ": ffmpeg is not on PATH, no video made", "docs/commands.md#render");
   }
   return ffmpeg;
 }
@@ -438,7 +439,7 @@ nlohmann::json spacing_notes(const SceneRender& job) {
   for (const scenes::Run& run : job.runs) {
     const std::string note = frame_spacing_note(job.spec, run.world.def().dt);
     if (note.empty()) continue;
-    std::fprintf(stderr, "cps: note: %s: %s\n", job.scene->name.data(), note.c_str());
+    cli::note("cps: note: " + std::string(job.scene->name) + ": " + note);
     notes.push_back(note);
   }
   return notes;
@@ -494,7 +495,7 @@ void fit_renderer(std::optional<render::Renderer>& renderer, const SceneRender& 
   }
   renderer.reset();
   renderer.emplace(job.scene_px.first, job.scene_px.second, *render::parse_backend(backend));
-  std::fprintf(stderr, "render: %s\n", renderer->context_description().c_str());
+  cli::note("render: " + renderer->context_description());
 }
 
 // Steps and draws a scene's frames into its folder (begin_output, render_frames, end_output)
@@ -512,7 +513,10 @@ long long write_frames(const RenderOptions& o, const RenderPlan& plan, SceneRend
   const long long frames = render_frames(job.style, panels, job.spec, renderer, writer, &progress);
   end_output(job.output, info);
   for (std::size_t v = 0; v < job.runs.size(); ++v) {
-    scenes::print_run_warnings(job.scene->name, plan.variants[v].label, job.runs[v], *job.energy[v]);
+    for (const scenes::RunWarning& w :
+         scenes::run_warnings(job.scene->name, plan.variants[v].label, job.runs[v], *job.energy[v])) {
+      warn(w.kind, w.text, w.brief, w.docs);
+    }
   }
   std::printf("%s: %lld frames in %s\n", job.spec.folder.filename().c_str(), frames, job.spec.folder.c_str());
   return frames;
@@ -628,6 +632,7 @@ Command add_render(CLI::App& app, int argc, char** argv) {
                   "OUT/SCENE.gif")
       ->check(CLI::IsMember({"mp4", "gif"}));
   add_view_options(*sub, o->view, o->label, /*label_default=*/false);
+  add_diagnostic_flags(*sub);
   return {sub, [o, argc, argv] { return run_render(*o, argc, argv); }};
 }
 

@@ -2,6 +2,7 @@
 // options are read here; the work is the report library's (report/): sweep.h carries out the
 // sweeps, push_report.h the push methods.
 #include "command.h"
+#include "options/diagnostics.h"
 
 #include "options/options.h"
 #include "output/output.h"
@@ -322,6 +323,7 @@ Command add_report(CLI::App& app, int argc, char** argv) {
   sub->add_flag("--force", o->force,
                 "let the report replace files in --out that have the names of its own outputs "
                 "but that no earlier cps run wrote there (other files are never touched)");
+  add_diagnostic_flags(*sub);
   return {sub, [o, argc, argv] { return run_report(*o, argc, argv); }};
 }
 

@@ -1,6 +1,7 @@
 // `cps scene NAME`: any scene (paper, stress, scaled, random, example or file) written as a scene
 // file (demos/scenes/scene_file.h), to stdout or to --out under the output rule (output.h).
 #include "command.h"
+#include "options/diagnostics.h"
 #include "options/options.h"
 #include "output/output.h"
 #include "scene_file.h"
@@ -51,7 +52,7 @@ int run_scene(const SceneOptions& o, int argc, char** argv) {
   begin_output(plan, info);
   write_json_atomic(path, file);
   end_output(plan, info);
-  std::cerr << "scene " << scene->name << ": " << run.world.bodies().size() << " bodies, "
+  notes() << "scene " << scene->name << ": " << run.world.bodies().size() << " bodies, "
             << run.world.distances().size() << " rods in " << o.out << "\n";
   return 0;
 }

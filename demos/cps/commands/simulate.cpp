@@ -7,6 +7,7 @@
 #include "output/output.h"
 #include "options/progress.h"
 #include "energy_rise.h"
+#include "options/diagnostics.h"
 #include "state_hash.h"
 
 #include <CLI/CLI.hpp>
@@ -343,21 +344,23 @@ int run_simulate(const SimulateOptions& o, int argc, char** argv) {
   const nlohmann::json summary = simulate(*scene, r, seconds, trace ? &*trace : nullptr,
                                           energy_csv ? &*energy_csv : nullptr);
   progress.finish();
-  scenes::print_run_warnings(scene->name, "", r, *energy);
+  for (const scenes::RunWarning& w : scenes::run_warnings(scene->name, "", r, *energy)) {
+    warn(w.kind, w.text, w.brief, w.docs);
+  }
   if (files) files->finish();
   if (trace) {
-    std::cerr << "trace: " << trace->rows() << " rows (" << r.world.bodies().size()
-              << " bodies per step) in " << o.trace << "\n";
+    note("trace: " + std::to_string(trace->rows()) + " rows (" +
+         std::to_string(r.world.bodies().size()) + " bodies per step) in " + o.trace);
   }
   if (energy_csv) {
-    std::cerr << "energy: " << energy_csv->rows() << " rows (one every " << every
-              << (every == 1 ? " step" : " steps") << ", and the last) in " << o.energy << "\n";
+    note("energy: " + std::to_string(energy_csv->rows()) + " rows (one every " +
+         std::to_string(every) + (every == 1 ? " step" : " steps") + ", and the last) in " + o.energy);
   }
   if (errors) {
     const long rows = errors->finish();
-    std::cerr << "solver-error: " << rows << " rows in " << o.solver_error
-              << "; the solves' rows, bounds and exact lambda in "
-              << solver_error_rows_path(o.solver_error).string() << "\n";
+    note("solver-error: " + std::to_string(rows) + " rows in " + o.solver_error +
+         "; the solves' rows, bounds and exact lambda in " +
+         solver_error_rows_path(o.solver_error).string());
   }
   if (o.json) {
     std::cout << summary.dump(2) << "\n";
@@ -450,6 +453,7 @@ Command add_simulate(CLI::App& app, int argc, char** argv) {
       ->check(kNotEmpty);
   add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);
+  add_diagnostic_flags(*sub);
   return {sub, [o, argc, argv] { return run_simulate(*o, argc, argv); }};
 }
 

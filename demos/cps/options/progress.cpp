@@ -1,5 +1,7 @@
 #include "options/progress.h"
 
+#include "options/diagnostics.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -86,6 +88,7 @@ void Progress::finish() {
 }
 
 void Progress::print(bool final_line) {
+  if (quiet()) return;
   const double elapsed = seconds(Clock::now() - start_);
   const double rate = elapsed > 0.0 ? static_cast<double>(done_) / elapsed : 0.0;
   const double left = seconds_left_ >= 0.0 || std::isnan(seconds_left_)

@@ -16,7 +16,8 @@ namespace cps::cli {
 ///   render funnel: 150/301 frames (50 %), 28.1 frames/s, about 5 s left
 ///
 /// quiet_s (s, >= 0; typical 0, or 2 for tasks that are often short): nothing is printed until
-/// the task has run this long, so short runs stay silent. Rates and times are wall clock.
+/// the task has run this long, so short runs stay silent. Under --quiet (diagnostics.h) nothing
+/// is printed at all. Rates and times are wall clock.
 class Progress {
  public:
   /// label: what runs ("render funnel"); total: units to do (>= 1); unit: their name, plural

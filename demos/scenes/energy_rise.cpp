@@ -93,7 +93,10 @@ void EnergyRiseTracker::observe(const World& world) {
     if (rise_.max_J - peaks_.back().second >= 1e-3 * size_J_) peaks_.emplace_back(world.time(), rise_.max_J);
   }
   if (!rise_.thrown) {
-    const double bounce = 1.0 + world.def().restitution;
+    // The largest restitution a contact can have: the world's, or a body's own (pair_restitution).
+    double eps = world.def().restitution;
+    for (const Body& b : world.bodies()) eps = pair_restitution(eps, b.restitution, eps);
+    const double bounce = 1.0 + eps;
     for (std::size_t i = 0; i < n; ++i) {
       if (mass_[i] == 0.0) continue;
       const double limit = std::sqrt(1.0 + kEnergyRiseWarnFraction) * bounce *

@@ -103,7 +103,8 @@ struct EnergyRise {
 ///   sqrt(1 + kEnergyRiseWarnFraction) (1 + eps) (v0 + sqrt(2 |g| max(0, H - h_i)))
 /// with v0 the fastest start speed of any movable body, H the highest point of any movable body
 /// at the start (centre plus bounding radius, along -g), h_i the lowest height body i's centre
-/// has reached and eps the world's restitution: the speed of a fall from the scene's top plus
+/// has reached and eps the largest restitution of a contact (the world's, or a body's own,
+/// pair_restitution): the speed of a fall from the scene's top plus
 /// the fastest start, doubled at most by a bounce (a contact that does not bounce gives a body at
 /// most the speed of what hits it), with the total's margin on its kinetic energy. A lever (a
 /// heavy body landing on the long arm of a see-saw) can pass it without a gain; no built-in

@@ -131,8 +131,14 @@ Body make_body(const BodyDef& def) {
   if (def.shape.kind == ShapeKind::box) Shape::box(def.shape.half_extents);  // validates
   if (def.shape.kind == ShapeKind::sphere) Shape::sphere(def.shape.radius);    // validates
 
+  if (!std::isnan(def.restitution) && !in_range(def.restitution, 0.0, 1.0)) {
+    throw std::invalid_argument("body restitution " + num(def.restitution) +
+                                " is not allowed: it must be in [0, 1] (or NaN for the world's)");
+  }
+
   Body b;
   b.shape = def.shape;
+  b.restitution = def.restitution;
   b.x = def.position;
   b.o = def.orientation.normalized();
   if (!def.is_static) {

@@ -67,6 +67,7 @@ void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
                        const RowParams& params, ConstraintRow* out) {
   const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
   const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
+  const double eps = pair_restitution(params.restitution, a.restitution, b.restitution);
   for (int i = 0; i < m.count; ++i) {
     const Contact& c = m.contacts[static_cast<std::size_t>(i)];
     ConstraintRow& contact = out[i];
@@ -89,9 +90,9 @@ void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
     }
     // Eq. 8.2.1: v_r = -eps j . v1, for points approaching faster than the threshold that touch,
     // or will close their gap within this step.
-    if (params.restitution > 0.0 && approach < -params.restitution_threshold &&
+    if (eps > 0.0 && approach < -params.restitution_threshold &&
         approach * params.dt <= std::min(c.depth, 0.0)) {
-      contact.bias = -params.restitution * approach;
+      contact.bias = -eps * approach;
       contact.restitution = contact.bias;
     }
     // Split impulse (push/split_impulse.cpp): a shallow contact's push stays in the velocity solve.

@@ -3,6 +3,9 @@
 
 #include "cps/math.h"
 
+#include <algorithm>
+#include <limits>
+
 namespace cps {
 
 /// The ranges a body may be built in, chosen so that a step stays finite: with dt <= 1 s and
@@ -49,9 +52,21 @@ struct Shape {
   static Shape plane(const Vec3& n, double offset);
 };
 
+/// The coefficient of restitution eps (dimensionless, in [0, 1]) of a contact between bodies a
+/// and b (Eq. 8.2.1 takes one eps): the larger of the two bodies' own, a body without its own
+/// (NaN) taking `world` (WorldDef::restitution). The larger, as Box2D v3 mixes restitution, so
+/// that a bouncy ball bounces on a dead floor; two bodies without their own give `world` exactly.
+/// No errors.
+inline double pair_restitution(double world, double a, double b) {
+  return std::max(a == a ? a : world, b == b ? b : world);  // x == x: not NaN
+}
+
 /// What a body is made from. mass (kg): finite and > 0 for a movable body; ignored when
 /// is_static. position (m), orientation (unit quaternion, body to world; |o| within 1e-9 of 1),
 /// velocity (m/s) and angular_velocity (rad/s) are the initial state, all in world space.
+/// restitution: the body's own coefficient of restitution eps (dimensionless, in [0, 1]; typical
+/// 0.5 for a ball), or NaN, the default, for the world's (WorldDef::restitution); see
+/// pair_restitution.
 struct BodyDef {
   Shape shape;
   bool is_static = false;
@@ -60,6 +75,7 @@ struct BodyDef {
   Quat orientation = Quat::Identity();
   Vec3 velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();
+  double restitution = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// A rigid body as the paper keeps it (Sec. 3.1): position x (m), orientation o (unit
@@ -75,6 +91,8 @@ struct Body {
   double mass = 0.0;      ///< kg; 0 for a static body
   double inv_mass = 0.0;  ///< 1/kg
   Mat3 inv_inertia_body = Mat3::Zero();
+  /// Its own coefficient of restitution (BodyDef::restitution): in [0, 1], or NaN for the world's.
+  double restitution = std::numeric_limits<double>::quiet_NaN();
 
   bool is_static() const { return inv_mass == 0.0; }
   /// Rotation matrix R of o (3 x 3, body to world).

@@ -417,7 +417,9 @@ class Xpbd final : public PushMethod {
       }
       const Vec3 u_before = (state_[ib].v + state_[ib].w.cross(rb)) - (state_[ia].v + state_[ia].w.cross(ra));
       const double vn_before = p.normal.dot(u_before);
-      const double eps = -vn_before > def.restitution_threshold ? def.restitution : 0.0;
+      const double eps = -vn_before > def.restitution_threshold
+                             ? pair_restitution(def.restitution, a.restitution, b.restitution)
+                             : 0.0;
       const double target = std::max(-eps * vn_before, 0.0);
       const double wn = inverse_mass(&a, ra, p.normal) + inverse_mass(&b, rb, p.normal);
       if (wn > 0.0) impulse += (target - vn) / wn * p.normal;

@@ -184,8 +184,8 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
       printf '%s\n' "" nosuch.png file file.png dir.png adir bad.json fifo.png loop.png bomb.png ;;
     out_folder)  # cannot be a folder: an existing file, a path under a file, a device
       printf '%s\n' "" file file/sub /dev/null ;;
-    out_png)  # not a PNG path that can be written
-      printf '%s\n' "" file.png file/f.png dir.png f.txt file /dev/null ;;
+    out_png)  # not a PNG path, nor a folder, that can be written (an existing folder takes the figure)
+      printf '%s\n' "" file.png file/f.png f.txt file /dev/null ;;
     steps)  # comma-separated step indices of the run: [0, 5] for the base's 6 steps
       printf '%s\n' "" , x -1 6 1,,2 1, ,1 1.5 0x1 1e3 +1 " 1" "1 " "1;2" nan 4294967297 \
         99999999999999999999 ;;
@@ -267,7 +267,6 @@ EXTRA=(
   "--out/file|figure paper --size 16x16 --out file"
   "--out/file|figure paper --size 16x16 --out file/sub"
   "--out/null|figure paper --size 16x16 --out /dev/null"
-  "--out/dir.png|figure stack --times 0,0.1 --size 16x16 --out dir.png --force"
   "--times/--size/16384|figure stack --times 0,1,2 --size 8192x16 --out out/f.png"
   "--compare|figure stack --compare push --push split --times 0 --size 16x16 --out out/f.png"
   "--compare/--beta|render stack --compare beta=0.1,0.2 --beta 0.3 --seconds 0.1 --fps 10 --size 64x16 --out out"

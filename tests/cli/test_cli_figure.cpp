@@ -143,6 +143,31 @@ TEST_CASE("render and figure --quiet: no progress or context line, each kind of 
   CHECK(std::count(figure.err.begin(), figure.err.end(), '\n') == 1);
 }
 
+TEST_CASE("figure --out takes a folder as render does (a trailing slash or an existing folder or "
+          "a name without an extension gets the figure under its own name) and a file name is the file",
+          "[cli][figure][output]") {
+  const fs::path dir = fresh_dir("out_folder");
+  fs::create_directories(dir / "existing");
+  const std::string figure = "figure stack --times 0 --size 40x24 --no-label --out ";
+  for (const std::string out : {"existing", "slash/", "plain"}) {
+    INFO(out);
+    const Result r = cps_run(figure + out, dir);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(png_size(dir / out / "stack.png") == std::make_pair(40, 24));
+    CHECK(fs::exists(dir / out / "stack.png.json"));
+  }
+  // With --format, the folder's figure takes its extension; a file name is the file itself.
+  REQUIRE(cps_run(figure + "vector --format svg", dir).exit_code == 0);
+  CHECK(fs::exists(dir / "vector/stack.svg"));
+  REQUIRE(cps_run(figure + "named.png", dir).exit_code == 0);
+  CHECK(png_size(dir / "named.png") == std::make_pair(40, 24));
+  // A file name with another format's extension is still refused, naming it.
+  const Result wrong = cps_run(figure + "f.txt", dir);
+  CHECK(wrong.exit_code == 2);
+  CHECK(wrong.err.find("f.txt") != std::string::npos);
+}
+
 TEST_CASE("cps figure writes one PNG of times x variants panels with a sidecar", "[cli][figure]") {
   const fs::path dir = fresh_dir("size");
   const Result r = cps_run("figure intersecting_stack --times 0,0.25,0.5 --compare push=baumgarte,split --size 48x32 "

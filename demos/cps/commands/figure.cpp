@@ -363,24 +363,30 @@ std::vector<PlannedFigure> plan_paper_figures(const FigureOptions& o, const Pixe
   return figures;
 }
 
-// The file of a scene's figure: --out, or out/figures/NAME[-compare-...][-overlay].EXT (NAME:
-// the scene's output_name, never a scene file's path as typed). Sets
-// spec.format: --format, else the format --out's extension names (.pdf, .svg), else png. Throws
-// UsageError if --out's extension is not the format's.
+// The file of a scene's figure. --out names the file, or the folder the figure goes into under
+// its own name, NAME[-compare-...][-overlay].EXT (NAME: the scene's output_name, never a scene
+// file's path as typed), as render's --out is a folder: a folder when it ends in '/', is one
+// already or has no extension. Without --out: out/figures. Sets spec.format: --format, else the
+// format a file's extension names (.pdf, .svg), else png. Throws UsageError if a file's extension
+// is not the format's.
 fs::path figure_file(const FigureOptions& o, std::optional<FigureFormat> format, FigureSpec& spec) {
-  if (!format && !o.out.empty()) {
+  const fs::path out(o.out);
+  std::error_code ec;
+  const bool folder = o.out.empty() || o.out.back() == '/' || fs::is_directory(out, ec) ||
+                      !out.has_extension();
+  if (!format && !folder) {
     // No --format: the format --out's extension names.
-    const std::string ext = fs::path(o.out).extension().string();
+    const std::string ext = out.extension().string();
     if (ext == ".pdf") format = FigureFormat::pdf;
     if (ext == ".svg") format = FigureFormat::svg;
   }
   spec.format = format.value_or(FigureFormat::png);
   const std::string ext(figure_extension(spec.format));
   const fs::path file =
-      o.out.empty()
-          ? fs::path("out/figures") / (std::string(scenes::output_name(*spec.scene)) +
-                                       comparison_suffix(spec.comparison, o.overlay) + ext)
-          : fs::path(o.out);
+      folder ? (o.out.empty() ? fs::path("out/figures") : out) /
+                   (std::string(scenes::output_name(*spec.scene)) +
+                    comparison_suffix(spec.comparison, o.overlay) + ext)
+             : out;
   if (file.extension() != ext) {
     throw UsageError("--out " + file.string() + ": the figure is a " + ext.substr(1) +
                      " file (--format " + ext.substr(1) + "); give a name ending in " + ext +
@@ -526,8 +532,9 @@ Command add_figure(CLI::App& app, int argc, char** argv) {
   sub->add_option("--size", o->size, "size of ONE panel, WxH in pixels, each in [16, 8192]")
       ->capture_default_str();
   sub->add_option("--out", o->out,
-                  "output file (default out/figures/SCENE[-compare-PARAM[-VALUES]][-overlay].png, "
-                  ".pdf or .svg as --format says); for "
+                  "output file, or a folder (ending in '/', an existing folder or a name without "
+                  "an extension) that gets SCENE[-compare-PARAM[-VALUES]][-overlay].png (.pdf or "
+                  ".svg as --format says); default out/figures/; for "
                   "'paper', "
                   "the folder (default out/figures); a FILE.json sidecar records the run, and the "
                   "folder's run.json lists the files cps wrote there")

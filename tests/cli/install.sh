@@ -15,14 +15,18 @@ fail() { echo "install: $1" >&2; exit 1; }
 mkdir "$dir/elsewhere"
 cd "$dir/elsewhere"
 [ -x "$dir/prefix/bin/cps" ] || fail "no PREFIX/bin/cps"
-PATH="$dir/prefix/bin:$PATH" cps list | grep -q '^  stack' || fail "cps list from PATH shows no stack"
-PATH="$dir/prefix/bin:$PATH" cps simulate dominoes --seconds 0.1 --json | grep -q '"state_hash"' ||
+# Whole outputs first: grep -q stopping early would end cps by SIGPIPE, a failure under pipefail.
+listed=$(PATH="$dir/prefix/bin:$PATH" cps list) || fail "cps list from PATH failed"
+grep -q '^  stack' <<< "$listed" || fail "cps list from PATH shows no stack"
+ran=$(PATH="$dir/prefix/bin:$PATH" cps simulate dominoes --seconds 0.1 --json) ||
   fail "cps simulate of an example scene failed from PATH"
+grep -q '"state_hash"' <<< "$ran" || fail "cps simulate --json of an example scene printed no state_hash"
 share=$dir/prefix/share/cps
 [ -f "$share/schemas/scene.schema.json" ] || fail "no PREFIX/share/cps/schemas/scene.schema.json"
-ls "$share"/scenes/*.json > /dev/null 2>&1 || fail "no example scene files in PREFIX/share/cps/scenes"
+scenes=("$share"/scenes/*.json)
+[ -f "${scenes[0]}" ] || fail "no example scene files in PREFIX/share/cps/scenes"
 [ -f "$share/baselines/stack/frame_000002.png" ] || fail "no baselines in PREFIX/share/cps/baselines"
 # An installed example scene file runs by its path.
-PATH="$dir/prefix/bin:$PATH" cps simulate "$(ls "$share"/scenes/*.json | head -1)" --seconds 0.1 > /dev/null ||
+PATH="$dir/prefix/bin:$PATH" cps simulate "${scenes[0]}" --seconds 0.1 > /dev/null ||
   fail "an installed example scene file does not run"
-echo "install: cps runs from $dir/prefix/bin; schema, $(ls "$share"/scenes/*.json | wc -l) example scenes and the baselines in share/cps"
+echo "install: cps runs from $dir/prefix/bin; schema, ${#scenes[@]} example scenes and the baselines in share/cps"

@@ -86,8 +86,12 @@ std::string value_message(CLI::App& app, int argc, char** argv, const CLI::Parse
   const std::string what = e.what();
   const bool missing = dynamic_cast<const CLI::ArgumentMismatch*>(&e) != nullptr;
   // "--solver-error: 1 required TEXT missing"; "Could not convert: --rods = maybe".
-  std::string name = missing ? what.substr(0, what.find(':'))
-                             : what.substr(what.find(": ") + 2, what.find(" = ") - what.find(": ") - 2);
+  const std::size_t colon = what.find(": ");
+  const std::size_t equals = what.find(" = ");
+  if (colon == std::string::npos || (!missing && (equals == std::string::npos || equals < colon))) {
+    return fallback;
+  }
+  const std::string name = missing ? what.substr(0, colon) : what.substr(colon + 2, equals - colon - 2);
   const CLI::Option* option = sub && name.rfind("--", 0) == 0 ? sub->get_option_no_throw(name) : nullptr;
   if (option == nullptr) return fallback;
   const std::string description = option->get_description();
@@ -99,7 +103,7 @@ std::string value_message(CLI::App& app, int argc, char** argv, const CLI::Parse
   if (missing) {
     return name + " needs a value (" + option->get_type_name() + "): " + description;
   }
-  const std::string value = what.substr(what.find(" = ") + 3);
+  const std::string value = what.substr(equals + 3);
   if (option->get_expected_max() == 0) {
     return name + " is a switch: give " + name + " alone (or " + name + "=true, " + name +
            "=false), not '" + value + "'";

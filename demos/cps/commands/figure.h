@@ -79,7 +79,7 @@ std::string subfigure_letter(std::size_t k);
 /// the panel, so the size is exact). Throws UsageError for a bad parameter or camera name,
 /// std::runtime_error from the renderer. `renderer` must be spec.panel_width x spec.panel_height.
 /// A run whose energy rose with nothing driving it gets a warning on stderr
-/// (scenes::print_run_warnings, over [0, last time]).
+/// (scenes::run_warnings, over [0, last time]; printed by warn, options/diagnostics.h).
 ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer);
 
 /// The sidecar of `png`, which records how it was made (figure_json): png with ".json" appended.

@@ -257,24 +257,20 @@ CsvTable run_study(const StudySpec& spec) {
   }
 }
 
-bool is_study_table(const CsvTable& table) {
-  return !table.columns.empty() && table.columns.front() == "study";
-}
-
 void add_study_table(const CsvTable& table, const std::string& source, ReportStudies& into) {
-  std::string current;  // the id of the rows being read
+  std::string current;  // the id of the rows being read, parsed once into spec
+  std::optional<StudySpec> spec;
   for (std::size_t i = 0; i < table.rows.size(); ++i) {
     const Row r{table, i, source};
     const std::string& id = r["study"];
     const bool first = id != current;
-    std::optional<StudySpec> spec;
-    try {
-      spec = StudySpec::parse(id);
-    } catch (const UsageError& e) {
-      throw r.bad("study", std::string("names no study of this build (") + e.what() + ")");
-    }
-    if (!spec) throw r.bad("study", "is not a study id");
     if (first) {
+      try {
+        spec = StudySpec::parse(id);
+      } catch (const UsageError& e) {
+        throw r.bad("study", std::string("names no study of this build (") + e.what() + ")");
+      }
+      if (!spec) throw r.bad("study", "is not a study id");
       if (!into.ids.insert(id).second) {
         throw r.bad("study", "is a study already read from another file or line; each study "
                              "may be merged once: remove one of them");

@@ -60,9 +60,6 @@ struct ReportStudies {
   std::set<std::string> ids;                   ///< the study ids present
 };
 
-/// Whether `table` holds studies: its first column is "study".
-bool is_study_table(const CsvTable& table);
-
 /// Adds the studies of `table` (a study CSV: run_study's, or the report's own SCENE_<part>.csv and
 /// mass_ratio.csv) to `into`; `source` names its file in messages. Throws UsageError naming
 /// the source, line, column and cell for a study id this build does not know, a count or a

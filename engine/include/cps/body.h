@@ -4,6 +4,7 @@
 #include "cps/math.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace cps {
@@ -58,7 +59,7 @@ struct Shape {
 /// that a bouncy ball bounces on a dead floor; two bodies without their own give `world` exactly.
 /// No errors.
 inline double pair_restitution(double world, double a, double b) {
-  return std::max(a == a ? a : world, b == b ? b : world);  // x == x: not NaN
+  return std::max(std::isnan(a) ? world : a, std::isnan(b) ? world : b);
 }
 
 /// What a body is made from. mass (kg): finite and > 0 for a movable body; ignored when

@@ -102,6 +102,10 @@ struct Scene {
   /// behind (the funnel).
   double plane_opacity = 1.0;
   std::optional<CameraPreset> camera;
+  /// The --camera name its pictures take when none is given ("preset": the camera preset as it
+  /// stands; "fit:frame" for a scene whose bodies fly far from where they start, so that its
+  /// picture holds them close at rest and draws back while they fly). See cps::cli::scene_view.
+  std::string_view default_camera = "preset";
   /// The window `cps bench` times.
   BenchTraits bench;
   /// How `cps report` runs and judges the scene.

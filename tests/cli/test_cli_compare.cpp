@@ -95,10 +95,51 @@ int pixels_of_hue(const cps::render::Image& image, double hue, double tol, int y
   return n;
 }
 
+// The rows (first, last) of `cell` that hold a saturated pixel (its largest channel at least 60
+// above its smallest: a palette-coloured body; the sky, the grey ground and its shadows, and
+// the black text never are), or (-1, -2) when none does.
+std::pair<int, int> saturated_rows(const cps::render::Image& image, const Rect& cell) {
+  int first = -1;
+  int last = -2;
+  for (int y = cell.y; y < cell.y + cell.height; ++y) {
+    for (int x = cell.x; x < cell.x + cell.width; ++x) {
+      const std::uint8_t* p = &image.pixels[3 * (static_cast<std::size_t>(y) * image.width + x)];
+      if (std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]}) >= 60) {
+        if (first < 0) first = y;
+        last = y;
+        break;
+      }
+    }
+  }
+  return {first, last};
+}
+
 constexpr double kBlueHue = 205.0;    // overlay_colour(0), #1f77b4
 constexpr double kOrangeHue = 28.0;   // overlay_colour(1), #ff7f0e
 
 }  // namespace
+
+TEST_CASE("the intersecting stack's column fills a quarter of each panel of a 2-way comparison",
+          "[cli][compare][views]") {
+  // The scene's default framing (fit:frame) at 640x360 with captions: at t = 0 the column of
+  // five cubes is at least 90 px tall (a quarter of the 360 px panel) in both panels; the fixed
+  // view that holds the Baumgarte run's 55 m flight draws it about 45 px tall.
+  const fs::path dir = fresh_dir("cps_compare_column");
+  const Result r = run("render intersecting_stack --compare push=baumgarte,split --label "
+                       "--seconds 1 --fps 1 --size 640x360 --out out",
+                       dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const fs::path folder = dir / "out" / "intersecting_stack-compare-push-baumgarte_split";
+  const cps::render::Image first = cps::render::read_png(folder / "frame_000000.png");
+  const std::vector<Rect> at = panels_of(nlohmann::json::parse(slurp(folder / "run.json")));
+  REQUIRE(at.size() == 2);
+  for (const Rect& cell : at) {
+    const auto [top, bottom] = saturated_rows(first, cell);
+    INFO("column from row " << top << " to " << bottom);
+    CHECK(bottom - top + 1 >= 90);
+  }
+}
 
 TEST_CASE("cps render --compare with three values of beta lays out 3 labelled panels that differ",
           "[cli][compare]") {

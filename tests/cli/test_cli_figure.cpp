@@ -482,6 +482,16 @@ TEST_CASE("cps render takes the overlay and camera flags", "[cli][figure]") {
   CHECK(!fs::exists(dir / "t"));
   const std::string quick = "render stack --seconds 0.1 --fps 10 --size 32x32 --out o ";
   CHECK(cps_run(quick + "--camera sideways", dir).exit_code == 2);
+  // A camera name near an allowed one is named; a tracked body that does not exist is refused
+  // with the range of indices before anything is drawn.
+  const Result near = cps_run(quick + "--camera fit:panels", dir);
+  CHECK(near.exit_code == 2);
+  CHECK(near.err.find("did you mean 'fit:panel'") != std::string::npos);
+  const Result no_body = cps_run(quick + "--camera track:12", dir);
+  CHECK(no_body.exit_code == 2);
+  CHECK(no_body.err.find("track:12") != std::string::npos);
+  CHECK(no_body.err.find("from 0 to") != std::string::npos);
+  CHECK(cps_run(quick + "--camera track:", dir).exit_code == 2);
   const Result nan = cps_run(quick + "--orbit nan", dir);
   CHECK(nan.exit_code == 2);
   CHECK(nan.err.find("--orbit") != std::string::npos);
@@ -635,7 +645,7 @@ TEST_CASE("every command's --help states the units of its options", "[cli][help]
   for (const std::string c : {"render", "figure"}) {
     cases.push_back({c,
                      {"(s)", "pixels", "degrees per", "--contacts", "--no-rods", "--label",
-                      "--camera TEXT:{preset,auto,fit,front,side,top}=preset", "--orbit", "=0",
+                      "--camera TEXT:{preset,auto,fit,fit:panel,fit:frame,front,side,top,track:BODY}=preset", "--orbit", "=0",
                       "--eye", "--target", "--fov"}});
   }
   cases[cases.size() - 2].says.push_back("never removed or changed");  // render --force

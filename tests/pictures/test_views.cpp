@@ -3,14 +3,19 @@
 // --target and --fov replace the camera's, and every scene's default view shows its bodies.
 #include "pictures/draw.h"
 #include "options/options.h"
+#include "scene_file.h"
 
 #include "cps/render/renderer.h"
 
 #include <catch2/catch.hpp>
+#include <unistd.h>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
 #include <array>
+#include <filesystem>
+#include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +67,60 @@ DrawStyle style_for(const scenes::Scene& scene, const std::vector<const World*>&
   return cli::resolve_style(scene, worlds, view, kAspect, seconds);
 }
 
+// NDC (x, y) of point p seen with `camera` at aspect kAspect; nullopt behind the eye.
+std::optional<glm::vec2> ndc(const render::Camera& camera, const Vec3& p) {
+  const glm::mat4 proj = glm::perspective(glm::radians(camera.fov_y_deg), kAspect, camera.near_m,
+                                          camera.far_m);
+  const glm::mat4 view = glm::lookAt(camera.eye, camera.target, camera.up);
+  const glm::vec4 clip = proj * view * glm::vec4(p.x(), p.y(), p.z(), 1.0f);
+  if (!(clip.w > 0.0f)) return std::nullopt;
+  return glm::vec2(clip.x / clip.w, clip.y / clip.w);
+}
+
+// The NDC box (lo, hi) of the corners of every box body of `world`: the tower of tower_roll.
+std::pair<glm::vec2, glm::vec2> boxes_ndc(const World& world, const render::Camera& camera) {
+  glm::vec2 lo(1e9f);
+  glm::vec2 hi(-1e9f);
+  for (const Body& b : world.bodies()) {
+    if (b.is_static() || b.shape.kind != ShapeKind::box) continue;
+    const Vec3 e = b.rotation().cwiseAbs() * b.shape.half_extents;
+    for (int i = 0; i < 8; ++i) {
+      const Vec3 c = b.x + Vec3((i & 1) ? e.x() : -e.x(), (i & 2) ? e.y() : -e.y(),
+                                (i & 4) ? e.z() : -e.z());
+      const std::optional<glm::vec2> q = ndc(camera, c);
+      if (!q) return {glm::vec2(-1e9f), glm::vec2(1e9f)};
+      lo = glm::min(lo, *q);
+      hi = glm::max(hi, *q);
+    }
+  }
+  return {lo, hi};
+}
+
+// A scene file: a tower of ten 1 m boxes and, beside it, a ball of 0.3 m rolling away at 10 m/s
+// (40 m in the 4 s of the file), so one body leaves while the rest stands.
+const scenes::Scene& tower_roll() {
+  static const scenes::Scene* scene = [] {
+    std::string bodies = R"({"shape": "plane", "static": true, "normal": [0, 1, 0], "offset_m": 0})";
+    for (int i = 0; i < 10; ++i) {
+      bodies += ",\n{\"name\": \"box" + std::to_string(i) +
+                R"(", "shape": "box", "half_extents_m": [0.5, 0.5, 0.5], "mass_kg": 1, "position_m": [0, )" +
+                std::to_string(0.5 + i) + ", 0]}";
+    }
+    bodies += R"(,
+{"name": "ball", "shape": "sphere", "radius_m": 0.3, "mass_kg": 1, "position_m": [-4, 0.3, 2],
+ "velocity_mps": [10, 0, 0]})";
+    const std::filesystem::path path =
+        std::filesystem::temp_directory_path() / ("cps_view_tests_" + std::to_string(::getpid())) / "tower_roll.json";
+    std::filesystem::create_directories(path.parent_path());
+    std::ofstream(path) << R"({"name": "tower_roll", "seconds": 4, "bodies": [)" << bodies << "]}";
+    const scenes::Scene* loaded = scenes::load_scene_file(path.string());
+    std::filesystem::remove_all(path.parent_path());
+    return loaded;
+  }();
+  REQUIRE(scene != nullptr);
+  return *scene;
+}
+
 }  // namespace
 
 TEST_CASE("camera fit keeps every cube of the intersecting stack in every frame", "[views]") {
@@ -99,6 +158,179 @@ TEST_CASE("camera fit frames every run of a comparison", "[views]") {
   // Framed on the split run alone (the cubes barely move), the Baumgarte run leaves the picture.
   const DrawStyle split_only = style_for(scene, {&b.world}, view, seconds);
   CHECK(widest_over_run(scenes::make_run(scene), split_only.camera, seconds) > 1.0);
+}
+
+namespace {
+
+// The framing before the rule of action_bounds, for comparison: the bounding sphere of every
+// body over the run (run_bounds), seen along `fit`'s direction at the fit's distance rule.
+render::Camera all_bodies_camera(const render::Camera& fit, std::span<const World* const> worlds,
+                                 double seconds) {
+  const cli::Bounds all = cli::run_bounds(worlds, seconds);
+  render::Camera camera = fit;
+  const glm::vec3 lo(all.lo.x(), all.lo.y(), all.lo.z());
+  const glm::vec3 hi(all.hi.x(), all.hi.y(), all.hi.z());
+  const float half_v = glm::radians(0.5f * fit.fov_y_deg);
+  const float half_h = std::atan(std::tan(half_v) * kAspect);
+  const float distance = 1.1f * 0.5f * glm::length(hi - lo) / std::sin(std::min(half_v, half_h));
+  camera.target = 0.5f * (lo + hi);
+  camera.eye = camera.target + distance * glm::normalize(fit.eye - fit.target);
+  camera.near_m = distance / 50.0f;
+  camera.far_m = distance * 50.0f;
+  return camera;
+}
+
+}  // namespace
+
+TEST_CASE("camera fit frames the bodies that stay in the action, not a ball rolling away",
+          "[views]") {
+  const scenes::Scene& scene = tower_roll();
+  const double seconds = 4.0;
+  scenes::Run run = scenes::make_run(scene);
+  const World* worlds[] = {&run.world};
+  View view;
+  view.camera = "fit";
+  const DrawStyle fit = cli::resolve_style(scene, worlds, view, kAspect, seconds);
+  const render::Camera all = all_bodies_camera(fit.camera, worlds, seconds);
+  // The tower's height as a share of the picture's (NDC spans 2), over every step: inside the
+  // picture and at least 45 % of its height with the rule; framed on every body (the ball 40 m
+  // away at the end) it would be under 30 %, so the check tells the rules apart.
+  double least_fit = 1.0;
+  double most_all = 0.0;
+  double widest = 0.0;
+  while (true) {
+    const auto [lo, hi] = boxes_ndc(run.world, fit.camera);
+    least_fit = std::min(least_fit, 0.5 * (hi.y - lo.y));
+    widest = std::max({widest, static_cast<double>(-lo.x), static_cast<double>(hi.x),
+                       static_cast<double>(-lo.y), static_cast<double>(hi.y)});
+    const auto [alo, ahi] = boxes_ndc(run.world, all);
+    most_all = std::max(most_all, 0.5 * (ahi.y - alo.y));
+    if (!scenes::short_of(run.world, seconds)) break;
+    run.step();
+  }
+  INFO("tower height share: fit at least " << least_fit << ", all bodies at most " << most_all);
+  CHECK(widest < 1.0);
+  CHECK(least_fit >= 0.45);
+  CHECK(most_all < 0.30);
+  // The ball, 40 m away at the end, has left the fitted picture.
+  const std::optional<glm::vec2> ball = ndc(fit.camera, run.world.bodies().back().x);
+  REQUIRE(ball);
+  CHECK(std::abs(ball->x) > 1.0f);
+}
+
+TEST_CASE("action_bounds keeps every body as built and drops one far from the rest", "[views]") {
+  const scenes::Scene& scene = tower_roll();
+  scenes::Run run = scenes::make_run(scene);
+  // As built, the median of the centres is (0, 4.5, 0); the boxes lie 0 to 5 m from it, the
+  // ball 6.1 m: within 2.5 x the median distance (3 m), so every body is kept ...
+  const cli::Bounds built = cli::world_bounds(run.world);
+  const cli::Bounds start = cli::action_bounds(run.world, 0.0);
+  CHECK(start.lo.x() == Approx(built.lo.x()));
+  CHECK(start.hi.y() == Approx(built.hi.y()));
+  // ... and after 2 s, the ball more than 10 m away is dropped (the tower alone: x within its
+  // half width), unless the floor reaches it.
+  run.advance_to(2.0);
+  REQUIRE(run.world.bodies().back().x.x() > 10.0);
+  const cli::Bounds later = cli::action_bounds(run.world, 0.0);
+  CHECK(later.hi.x() < 1.0);
+  CHECK(later.hi.y() > 9.5);
+  const cli::Bounds floored = cli::action_bounds(run.world, 30.0);
+  CHECK(floored.hi.x() == Approx(cli::world_bounds(run.world).hi.x()));
+}
+
+TEST_CASE("fit:panel frames each run on its own and fit:frame each time", "[views]") {
+  const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
+  const double seconds = 2.0;
+  scenes::Overrides split;
+  split.set("push", PushMode::split);
+  const scenes::Run a = scenes::make_run(scene);
+  const scenes::Run b = scenes::make_run(scene, split);
+  const std::vector<const World*> worlds = {&a.world, &b.world};
+  for (const char* name : {"fit:panel", "fit:frame"}) {
+    INFO(name);
+    View view;
+    view.camera = name;
+    const DrawStyle style = style_for(scene, worlds, view, seconds);
+    REQUIRE(style.paths.size() == 2);
+    // Every body of each run in its own picture at every step.
+    for (std::size_t r = 0; r < 2; ++r) {
+      scenes::Run run = scenes::make_run(scene, r == 0 ? scenes::Overrides{} : split);
+      double widest = widest_ndc(run.world, cli::camera_at(style, r, run.world.time()));
+      while (scenes::short_of(run.world, seconds)) {
+        run.step();
+        widest = std::max(widest, widest_ndc(run.world, cli::camera_at(style, r, run.world.time())));
+      }
+      CHECK(widest < 1.0);
+    }
+    // The split run barely moves: its camera stands at most half as far as the thrown
+    // Baumgarte run's at the end.
+    const float far = glm::length(cli::camera_at(style, 0, seconds).eye - cli::camera_at(style, 0, seconds).target);
+    const float near = glm::length(cli::camera_at(style, 1, seconds).eye - cli::camera_at(style, 1, seconds).target);
+    CHECK(near < 0.5f * far);
+    // In one picture (--overlay) one camera frames both runs.
+    view.one_picture = true;
+    CHECK(style_for(scene, worlds, view, seconds).paths.size() == (std::string(name) == "fit:frame" ? 1u : 0u));
+  }
+  // fit:frame zooms out as the cubes fly up: its first camera is nearer than its last.
+  View frame;
+  frame.camera = "fit:frame";
+  const DrawStyle style = style_for(scene, {&a.world}, frame, seconds);
+  const auto distance = [&](double t) {
+    const render::Camera c = cli::camera_at(style, 0, t);
+    return glm::length(c.eye - c.target);
+  };
+  CHECK(distance(0.0) < 0.5f * distance(seconds));
+}
+
+TEST_CASE("track:BODY keeps the body at the picture's centre", "[views]") {
+  const scenes::Scene& scene = tower_roll();
+  const double seconds = 4.0;
+  scenes::Run run = scenes::make_run(scene);
+  std::vector<const World*> worlds = {&run.world};
+  View view;
+  view.camera = "track:ball";
+  const DrawStyle style = style_for(scene, worlds, view, seconds);
+  REQUIRE(style.paths.size() == 1);
+  const render::Camera start = cli::camera_at(style, 0, 0.0);
+  // The ball rolls 25 m; the camera's target follows its centre averaged over 0.5 s, which for
+  // a steady roll is the centre itself, and off by at most 10 m/s x 0.125 s = 1.25 m in the
+  // first and last 0.25 s, where the window is cut short. The distance stays.
+  double worst = 0.0;
+  while (true) {
+    const render::Camera c = cli::camera_at(style, 0, run.world.time());
+    const Vec3 x = run.world.bodies().back().x;
+    worst = std::max(worst, static_cast<double>(glm::length(c.target - glm::vec3(x.x(), x.y(), x.z()))));
+    CHECK(glm::length(c.eye - c.target) == Approx(glm::length(start.eye - start.target)).epsilon(1e-5));
+    const std::optional<glm::vec2> q = ndc(c, x);
+    REQUIRE(q);
+    CHECK(std::abs(q->x) < 0.25f);
+    CHECK(std::abs(q->y) < 0.25f);
+    if (!scenes::short_of(run.world, seconds)) break;
+    run.step();
+  }
+  CHECK(worst <= 1.3);
+  CHECK(run.world.bodies().back().x.x() > 20.0);
+  // By index: body 11 is the ball too (the plane is body 0).
+  const scenes::Run fresh = scenes::make_run(scene);
+  worlds = {&fresh.world};
+  const DrawStyle style_fresh = style_for(scene, worlds, view, seconds);
+  CHECK(cli::camera_at(style_fresh, 0, 2.0).target == cli::camera_at(style, 0, 2.0).target);
+  view.camera = "track:11";
+  const DrawStyle by_index = style_for(scene, worlds, view, seconds);
+  CHECK(cli::camera_at(by_index, 0, 2.0).target == cli::camera_at(style, 0, 2.0).target);
+  // A name that is no body's is refused with the nearest name; an index past the end too.
+  view.camera = "track:bal";
+  try {
+    style_for(scene, worlds, view, seconds);
+    FAIL("track:bal was accepted");
+  } catch (const cli::UsageError& e) {
+    CHECK(std::string(e.what()).find("did you mean 'ball'") != std::string::npos);
+  }
+  view.camera = "track:12";
+  CHECK_THROWS_AS(style_for(scene, worlds, view, seconds), cli::UsageError);
+  CHECK(cli::check_camera_name("track:") != "");
+  CHECK(cli::check_camera_name("fit:frames").find("fit:frame") != std::string::npos);
+  CHECK(cli::check_camera_name("fit:frame") == "");
 }
 
 TEST_CASE("run_bounds holds every body at every step and leaves the worlds unchanged", "[views]") {

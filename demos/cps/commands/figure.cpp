@@ -127,8 +127,9 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
   const float aspect = static_cast<float>(renderer.width()) / static_cast<float>(renderer.height());
   std::vector<const World*> worlds;
   for (const scenes::Run& run : runs) worlds.push_back(&run.world);
-  const DrawStyle style =
-      resolve_style(scene, worlds, scene_view(scene, spec.view), aspect, spec.times.back());
+  View view = scene_view(scene, spec.view);
+  view.one_picture = spec.overlay;
+  const DrawStyle style = resolve_style(scene, worlds, view, aspect, spec.times.back());
 
   ComposedFigure out;
   FigurePage& page = out.page;
@@ -157,7 +158,7 @@ ComposedFigure render_figure(const FigureSpec& spec, render::Renderer& renderer)
     for (std::size_t r = 0; r < runs.size(); ++r) {
       for (std::size_t c = 0; c < spec.times.size(); ++c) {
         runs[r].advance_to(spec.times[c]);
-        render::Image panel = renderer.draw(draw_list(runs[r].world, style));
+        render::Image panel = renderer.draw(draw_list(runs[r].world, style, r));
         draw_border(panel);
         out.panels.push_back(std::move(panel));
         std::string text = time_caption(runs[r].world.time(), time_spacing(spec.times));

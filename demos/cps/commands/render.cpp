@@ -155,7 +155,7 @@ long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, cons
       pictures[0] = renderer.draw(overlay_draw_list(worlds, style));
     } else {
       for (std::size_t p = 0; p < panels.size(); ++p) {
-        pictures[p] = renderer.draw(draw_list(panels[p].run->world, style));
+        pictures[p] = renderer.draw(draw_list(panels[p].run->world, style, p));
       }
     }
     if (!captions) {
@@ -356,7 +356,9 @@ void plan_scene(const RenderOptions& o, const RenderPlan& plan, SceneRender& job
   place_panels(o, o.overlay ? 1 : plan.variants.size(), job);
   std::vector<const World*> worlds;
   for (const scenes::Run& run : job.runs) worlds.push_back(&run.world);
-  job.style = resolve_style(*job.scene, worlds, scene_view(*job.scene, o.view),
+  View view = scene_view(*job.scene, o.view);
+  view.one_picture = o.overlay;
+  job.style = resolve_style(*job.scene, worlds, view,
                             static_cast<float>(job.scene_px.first) / static_cast<float>(job.scene_px.second),
                             job.spec.seconds);
   const long long frames = frame_count(job.spec);

@@ -26,6 +26,17 @@ PixelSize parse_size(const std::string& text) {
   return s;
 }
 
+namespace {
+
+// "{preset,auto,...,track:BODY}": --camera's values in --help.
+std::string camera_choices() {
+  std::string text;
+  for (std::string_view n : camera_names()) text += (text.empty() ? "{" : ",") + std::string(n);
+  return text + "}";
+}
+
+}  // namespace
+
 std::string check_point(const std::string& text, Vec3* point) {
   Vec3 v;
   std::size_t start = 0;
@@ -66,12 +77,15 @@ void add_view_options(CLI::App& cmd, View& view, bool& label, bool label_default
   cmd.add_option("--camera", view.camera,
                  "view: preset (the scene's own; fit for a scene file without a camera), auto "
                  "(framed on the bodies as built), fit "
-                 "(framed on every body over the whole run: a headless pre-run of the same "
-                 "length, all --compare variants, seen from the preset's direction), front, side "
-                 "or top (the preset's target from the same distance)")
+                 "(framed on the bodies in the action over the whole run: a headless pre-run of "
+                 "the same length, all --compare variants, seen from the preset's direction; a "
+                 "body far from the others is left out), fit:panel (each variant framed on its "
+                 "own), fit:frame (each variant and time framed on its own, smoothed over 0.5 s), "
+                 "track:BODY (the preset's view following a body, by its name in a scene file or "
+                 "its index), front, side or top (the preset's target from the same distance)")
       ->capture_default_str()
-      ->check(CLI::IsMember(std::vector<std::string>(camera_names().begin(),
-                                                     camera_names().end())));
+      ->check(CLI::Validator(
+          [](std::string& input) { return check_camera_name(input); }, camera_choices()));
   const CLI::Validator point(
       [](std::string& input) { return check_point(input, nullptr); }, "X,Y,Z");
   cmd.add_option_function<std::string>(

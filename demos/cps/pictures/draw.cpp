@@ -91,11 +91,36 @@ std::string vec_text(const glm::vec3& v) {
 
 }  // namespace
 
-render::DrawList draw_list(const World& world, const DrawStyle& style) {
+render::Camera camera_at(const DrawStyle& style, std::size_t run, double t) {
+  render::Camera camera = style.camera;
+  if (style.paths.empty()) return camera;
+  const CameraPath& path = style.paths[std::min(run, style.paths.size() - 1)];
+  if (path.time_s.empty()) return camera;
+  // The last keyframe at or before t, and the share of the way to the next.
+  const auto next = std::upper_bound(path.time_s.begin(), path.time_s.end(), t);
+  const std::size_t k1 = static_cast<std::size_t>(next - path.time_s.begin());
+  const std::size_t k0 = k1 == 0 ? 0 : k1 - 1;
+  const std::size_t k = std::min(k1, path.time_s.size() - 1);
+  float w = 0.0f;
+  if (k != k0 && path.time_s[k] > path.time_s[k0]) {
+    w = static_cast<float>((t - path.time_s[k0]) / (path.time_s[k] - path.time_s[k0]));
+  }
+  const glm::vec3 target = glm::mix(path.target_m[k0], path.target_m[k], w);
+  const float distance = glm::mix(path.distance_m[k0], path.distance_m[k], w);
+  const glm::vec3 dir = glm::normalize(camera.eye - camera.target);
+  camera.target = target;
+  camera.eye = target + distance * dir;
+  camera.near_m = distance / 50.0f;
+  camera.far_m = distance * 50.0f;
+  return camera;
+}
+
+render::DrawList draw_list(const World& world, const DrawStyle& style, std::size_t run) {
   render::DrawList list;
+  const render::Camera camera = camera_at(style, run, world.time());
   list.camera = style.overlays.orbit_deg_per_s == 0.0
-                    ? style.camera
-                    : orbit(style.camera, style.overlays.orbit_deg_per_s * world.time());
+                    ? camera
+                    : orbit(camera, style.overlays.orbit_deg_per_s * world.time());
   const auto& bodies = world.bodies();
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
@@ -148,19 +173,26 @@ void Bounds::add(const Bounds& other) {
   if (other.any) add(other.lo, other.hi);
 }
 
+namespace {
+
+// Grows `out` to hold body b if it is a box or a sphere.
+void add_extent(const Body& b, Bounds& out) {
+  if (b.shape.kind == ShapeKind::box) {
+    // World half extents of the oriented box: e_i = sum_j |R_ij| h_j (Ericson 4.2.6).
+    const Vec3 e = b.rotation().cwiseAbs() * b.shape.half_extents;
+    out.add(b.x - e, b.x + e);
+  } else if (b.shape.kind == ShapeKind::sphere) {
+    const Vec3 e = Vec3::Constant(b.shape.radius);
+    out.add(b.x - e, b.x + e);
+  }
+}
+
+}  // namespace
+
 Bounds world_bounds(const World& world) {
   Bounds out;
   const auto& bodies = world.bodies();
-  for (const Body& b : bodies) {
-    if (b.shape.kind == ShapeKind::box) {
-      // World half extents of the oriented box: e_i = sum_j |R_ij| h_j (Ericson 4.2.6).
-      const Vec3 e = b.rotation().cwiseAbs() * b.shape.half_extents;
-      out.add(b.x - e, b.x + e);
-    } else if (b.shape.kind == ShapeKind::sphere) {
-      const Vec3 e = Vec3::Constant(b.shape.radius);
-      out.add(b.x - e, b.x + e);
-    }
-  }
+  for (const Body& b : bodies) add_extent(b, out);
   for (const DistanceConstraint& d : world.distances()) {
     Vec3 p_a;
     Vec3 p_b;
@@ -179,6 +211,78 @@ Bounds run_bounds(std::span<const World* const> worlds, double seconds) {
     while (scenes::short_of(copy, seconds)) {
       copy.step();
       out.add(world_bounds(copy));
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// The movable boxes' and spheres' centres of `world` (m), non-finite ones skipped.
+std::vector<Vec3> body_centres(const World& world) {
+  std::vector<Vec3> centres;
+  for (const Body& b : world.bodies()) {
+    const bool solid = b.shape.kind == ShapeKind::box || b.shape.kind == ShapeKind::sphere;
+    if (solid && !b.is_static() && b.x.allFinite()) centres.push_back(b.x);
+  }
+  return centres;
+}
+
+// The median of v (the upper one for an even count); v is reordered. v is not empty.
+double median(std::vector<double>& v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// The per-axis median of `points` (not empty).
+Vec3 median_point(const std::vector<Vec3>& points) {
+  Vec3 m;
+  std::vector<double> axis(points.size());
+  for (int a = 0; a < 3; ++a) {
+    for (std::size_t i = 0; i < points.size(); ++i) axis[i] = points[i][a];
+    m[a] = median(axis);
+  }
+  return m;
+}
+
+// The farthest a movable body's centre or a distance constraint's end lies from the median of
+// the centres (m): action_bounds' floor for a world as built, so that all of it is kept.
+double action_floor(const World& world) {
+  const std::vector<Vec3> centres = body_centres(world);
+  if (centres.empty()) return 0.0;
+  const Vec3 m = median_point(centres);
+  double floor_m = 0.0;
+  for (const Vec3& c : centres) floor_m = std::max(floor_m, (c - m).norm());
+  for (const DistanceConstraint& d : world.distances()) {
+    Vec3 p_a;
+    Vec3 p_b;
+    distance_endpoints(d, world.bodies(), p_a, p_b);
+    if (p_a.allFinite()) floor_m = std::max(floor_m, (p_a - m).norm());
+    if (p_b.allFinite()) floor_m = std::max(floor_m, (p_b - m).norm());
+  }
+  return floor_m;
+}
+
+}  // namespace
+
+Bounds action_bounds(const World& world, double floor_m) {
+  const std::vector<Vec3> centres = body_centres(world);
+  if (centres.empty()) return world_bounds(world);
+  const Vec3 m = median_point(centres);
+  std::vector<double> d(centres.size());
+  for (std::size_t i = 0; i < centres.size(); ++i) d[i] = (centres[i] - m).norm();
+  const double radius = std::max(2.5 * median(d), floor_m);
+  Bounds out;
+  for (const Body& b : world.bodies()) {
+    if (!b.is_static() && b.x.allFinite() && (b.x - m).norm() <= radius) add_extent(b, out);
+  }
+  for (const DistanceConstraint& dc : world.distances()) {
+    Vec3 p_a;
+    Vec3 p_b;
+    distance_endpoints(dc, world.bodies(), p_a, p_b);
+    for (const Vec3& p : {p_a, p_b}) {
+      if ((p - m).norm() <= radius) out.add(p, p);
     }
   }
   return out;
@@ -221,8 +325,20 @@ render::Camera camera_from_preset(const scenes::CameraPreset& preset) {
   return camera;
 }
 
-constexpr std::array<std::string_view, 6> kCameraNames = {"preset", "auto", "fit",
-                                                          "front", "side", "top"};
+constexpr std::array<std::string_view, 9> kCameraNames = {
+    "preset", "auto", "fit", "fit:panel", "fit:frame", "front", "side", "top", "track:BODY"};
+
+// What is wrong with --camera `name`: the allowed names and the nearest of them.
+std::string camera_name_error(std::string_view name) {
+  std::string known;
+  std::vector<std::string> candidates;
+  for (std::string_view n : kCameraNames) {
+    known += (known.empty() ? "" : ", ") + std::string(n);
+    candidates.emplace_back(n);
+  }
+  return "--camera " + std::string(name) + ": allowed are " + known + " (BODY a body's name or " +
+         "index); did you mean '" + nearest_name(name, candidates) + "'?";
+}
 
 // The camera preset called `name` (see camera_names()) given the scene's preset `own` (none:
 // the scene has none); nullopt means "frame the world automatically" (frame_world). `world` is
@@ -231,7 +347,9 @@ constexpr std::array<std::string_view, 6> kCameraNames = {"preset", "auto", "fit
 std::optional<scenes::CameraPreset> camera_preset(const std::optional<scenes::CameraPreset>& own,
                                                   const World& world, std::string_view name,
                                                   float aspect) {
-  if (name == "preset" || name == "fit") return own;
+  if (name == "preset" || name == "fit" || name.starts_with("fit:") || name.starts_with("track:")) {
+    return own;
+  }
   if (name == "auto") return std::nullopt;
   scenes::CameraPreset base;
   if (own) {
@@ -252,9 +370,7 @@ std::optional<scenes::CameraPreset> camera_preset(const std::optional<scenes::Ca
     // Straight down would make the up vector (0, 1, 0) degenerate: tilt a little towards +z.
     view.eye = base.target + Vec3(0.0, distance, 0.05 * distance);
   } else {
-    std::string known;
-    for (std::string_view n : kCameraNames) known += (known.empty() ? "" : ", ") + std::string(n);
-    throw UsageError("--camera " + std::string(name) + ": allowed are " + known);
+    throw UsageError(camera_name_error(name));
   }
   return view;
 }
@@ -270,8 +386,12 @@ nlohmann::json camera_json(const render::Camera& c) {
 std::span<const std::string_view> camera_names() { return kCameraNames; }
 
 View scene_view(const scenes::Scene& scene, View view) {
-  if (view.camera == "preset" && !view.preset && !scene.camera && scenes::is_file_scene(scene)) {
-    view.camera = "fit";
+  if (view.camera == "preset" && !view.preset) {
+    if (!scene.camera && scenes::is_file_scene(scene)) {
+      view.camera = "fit";
+    } else {
+      view.camera = scene.default_camera;
+    }
   }
   return view;
 }
@@ -282,34 +402,220 @@ DrawStyle resolve_style(const scenes::Scene& scene, const World& as_built, const
   return resolve_style(scene, worlds, view, aspect, 0.0);
 }
 
+namespace {
+
+// What a headless pre-run of one world saw, one entry per step (and one as built).
+struct RunSamples {
+  std::vector<double> time_s;
+  std::vector<Bounds> action;  // action_bounds, with the floor of the world as built
+  std::vector<Vec3> tracked;   // the tracked body's centre (m), if one is tracked
+  Bounds all;                  // world_bounds over the whole run
+};
+
+RunSamples sample_run(const World& as_built, double seconds, std::optional<std::size_t> tracked) {
+  World copy = as_built;
+  const double floor_m = action_floor(copy);
+  RunSamples s;
+  const auto take = [&] {
+    s.time_s.push_back(copy.time());
+    s.action.push_back(action_bounds(copy, floor_m));
+    if (tracked) s.tracked.push_back(copy.bodies()[*tracked].x);
+    s.all.add(world_bounds(copy));
+  };
+  take();
+  while (scenes::short_of(copy, seconds)) {
+    copy.step();
+    take();
+  }
+  return s;
+}
+
+// The eye-target distance (m) at which a sphere of `radius` (m) fits a picture of vertical field
+// of view fov_y_deg and aspect (width / height) with a 10 % margin.
+float fit_distance(float radius, float fov_y_deg, float aspect) {
+  const float half_v = glm::radians(0.5f * fov_y_deg);
+  const float half_h = std::atan(std::tan(half_v) * aspect);
+  return 1.1f * std::max(radius, 1e-3f) / std::sin(std::min(half_v, half_h));
+}
+
+// The bounding sphere of `b` (centre and radius, m).
+std::pair<glm::vec3, float> sphere_of(const Bounds& b) {
+  const glm::vec3 lo = to_glm(b.lo);
+  const glm::vec3 hi = to_glm(b.hi);
+  return {0.5f * (lo + hi), 0.5f * glm::length(hi - lo)};
+}
+
+// For each k, the first and last index of the samples within kCameraSmoothing_s / 2 of time k.
+std::vector<std::pair<std::size_t, std::size_t>> windows(const std::vector<double>& t) {
+  std::vector<std::pair<std::size_t, std::size_t>> out(t.size());
+  const double half = 0.5 * kCameraSmoothing_s;
+  std::size_t lo = 0;
+  std::size_t hi = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    while (t[lo] < t[k] - half) ++lo;
+    while (hi + 1 < t.size() && t[hi + 1] <= t[k] + half) ++hi;
+    out[k] = {lo, hi};
+  }
+  return out;
+}
+
+// fit:frame: at each time the sphere that holds every sample's bounding sphere within the window
+// around its smoothed centre (the mean of their centres), fitted to the picture. Times whose
+// bounds are empty hold the sphere before them (a unit sphere at the origin at the start).
+CameraPath frame_path(const std::vector<double>& t, const std::vector<Bounds>& bounds,
+                      float fov_y_deg, float aspect) {
+  std::vector<std::pair<glm::vec3, float>> spheres;
+  std::pair<glm::vec3, float> last{glm::vec3(0.0f), 1.0f};
+  for (const Bounds& b : bounds) {
+    if (b.any) last = sphere_of(b);
+    spheres.push_back(last);
+  }
+  CameraPath path;
+  for (std::size_t k = 0; const auto& [lo, hi] : windows(t)) {
+    glm::vec3 centre(0.0f);
+    for (std::size_t j = lo; j <= hi; ++j) centre += spheres[j].first;
+    centre /= static_cast<float>(hi - lo + 1);
+    float radius = 0.0f;
+    for (std::size_t j = lo; j <= hi; ++j) {
+      radius = std::max(radius, spheres[j].second + glm::length(spheres[j].first - centre));
+    }
+    path.time_s.push_back(t[k]);
+    path.target_m.push_back(centre);
+    path.distance_m.push_back(fit_distance(radius, fov_y_deg, aspect));
+    ++k;
+  }
+  return path;
+}
+
+// track:BODY: the body's centre averaged over the window, at a fixed distance (m).
+CameraPath track_path(const RunSamples& s, float distance) {
+  CameraPath path;
+  for (std::size_t k = 0; const auto& [lo, hi] : windows(s.time_s)) {
+    Vec3 centre = Vec3::Zero();
+    int n = 0;
+    for (std::size_t j = lo; j <= hi; ++j) {
+      if (!s.tracked[j].allFinite()) continue;
+      centre += s.tracked[j];
+      ++n;
+    }
+    path.time_s.push_back(s.time_s[k]);
+    path.target_m.push_back(n > 0 ? to_glm(centre / n)
+                                  : (path.target_m.empty() ? glm::vec3(0.0f) : path.target_m.back()));
+    path.distance_m.push_back(distance);
+    ++k;
+  }
+  return path;
+}
+
+// The index of the body that --camera track:`text` names in `world`: a scene file's body name,
+// else an index from 0. Throws UsageError naming the bodies.
+std::size_t tracked_body(const scenes::Scene& scene, const World& world, const std::string& text) {
+  const std::vector<std::string> names = scenes::body_names(scene);
+  for (std::size_t i = 0; i < names.size() && i < world.bodies().size(); ++i) {
+    if (!names[i].empty() && names[i] == text) return i;
+  }
+  const std::size_t n = world.bodies().size();
+  if (!text.empty() && text.size() < 10 &&
+      std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    const std::size_t index = std::stoul(text);
+    if (index < n) return index;
+  }
+  std::string message = "--camera track:" + text + ": ";
+  std::vector<std::string> named;
+  for (const std::string& name : names) {
+    if (!name.empty()) named.push_back(name);
+  }
+  if (named.empty()) {
+    message += "no body of " + std::string(scene.name) + " has that index; give a body index from 0 to " +
+               std::to_string(n - 1);
+  } else {
+    message += "no body is named so; did you mean '" + nearest_name(text, named) +
+               "'? (or give a body index from 0 to " + std::to_string(n - 1) + ")";
+  }
+  throw UsageError(message);
+}
+
+}  // namespace
+
+std::string check_camera_name(std::string_view name) {
+  for (std::string_view n : kCameraNames) {
+    if (n == name && n != "track:BODY") return {};
+  }
+  if (name.starts_with("track:") && name.size() > 6) return {};
+  return camera_name_error(name);
+}
+
 DrawStyle resolve_style(const scenes::Scene& scene, std::span<const World* const> as_built,
                         const View& view, float aspect, double seconds) {
   if (as_built.empty()) throw std::invalid_argument("resolve_style: no world");
+  if (const std::string error = check_camera_name(view.camera); !error.empty()) throw UsageError(error);
   const World& first = *as_built.front();
+  const std::string& name = view.camera;
+  const bool fit = name.starts_with("fit");
+  const bool per_run = name == "fit:panel" && !view.one_picture;
+  const bool per_frame = name == "fit:frame";
+  std::optional<std::size_t> tracked;
+  if (name.starts_with("track:")) tracked = tracked_body(scene, first, name.substr(6));
+
   const std::optional<scenes::CameraPreset> preset =
-      camera_preset(view.preset ? view.preset : scene.camera, first, view.camera, aspect);
+      camera_preset(view.preset ? view.preset : scene.camera, first, name, aspect);
   DrawStyle style;
   style.camera = preset ? camera_from_preset(*preset) : frame_world(first, aspect);
   style.plane_opacity = static_cast<float>(scene.plane_opacity);
   style.overlays = view.overlays;
   style.body_colours = scenes::body_colours(scene);
   if (view.fov_y_deg) style.camera.fov_y_deg = static_cast<float>(*view.fov_y_deg);
-  Bounds bounds;
-  if (view.camera == "fit") {
-    bounds = run_bounds(as_built, seconds);
-    if (bounds.any) {
-      // The bounding sphere of the run's bounds, seen along the named camera's direction.
-      const glm::vec3 lo = to_glm(bounds.lo);
-      const glm::vec3 hi = to_glm(bounds.hi);
-      const float radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
-      const float half_v = glm::radians(0.5f * style.camera.fov_y_deg);
-      const float half_h = std::atan(std::tan(half_v) * aspect);
-      const float distance = 1.1f * radius / std::sin(std::min(half_v, half_h));
-      const glm::vec3 dir = glm::normalize(style.camera.eye - style.camera.target);
-      style.camera.target = 0.5f * (lo + hi);
-      style.camera.eye = style.camera.target + distance * dir;
+  const glm::vec3 dir = glm::normalize(style.camera.eye - style.camera.target);
+
+  Bounds bounds;  // what the planes are drawn around
+  if (fit || tracked) {
+    std::vector<RunSamples> samples;
+    for (const World* w : as_built) samples.push_back(sample_run(*w, seconds, tracked));
+    Bounds action;  // over every run and time
+    for (const RunSamples& s : samples) {
+      bounds.add(s.all);
+      for (const Bounds& b : s.action) action.add(b);
+    }
+    if (fit && action.any) {
+      // The bounding sphere of the action over the whole run, seen along the named camera's direction.
+      const auto [centre, radius] = sphere_of(action);
+      const float distance = fit_distance(radius, style.camera.fov_y_deg, aspect);
+      style.camera.target = centre;
+      style.camera.eye = centre + distance * dir;
       style.camera.near_m = distance / 50.0f;
       style.camera.far_m = distance * 50.0f;
+    }
+    if (per_run) {
+      for (const RunSamples& s : samples) {
+        Bounds run_action;
+        for (const Bounds& b : s.action) run_action.add(b);
+        if (!run_action.any) run_action = action;
+        const auto [centre, radius] = sphere_of(run_action);
+        style.paths.push_back({{0.0}, {centre}, {fit_distance(radius, style.camera.fov_y_deg, aspect)}});
+      }
+    } else if (per_frame) {
+      if (view.one_picture) {
+        // One picture: at each time of the first run, the union of every run's bounds at the
+        // latest of its own times not after it.
+        std::vector<Bounds> merged = samples.front().action;
+        for (std::size_t r = 1; r < samples.size(); ++r) {
+          std::size_t j = 0;
+          for (std::size_t k = 0; k < merged.size(); ++k) {
+            const double t = samples.front().time_s[k];
+            while (j + 1 < samples[r].time_s.size() && samples[r].time_s[j + 1] <= t) ++j;
+            merged[k].add(samples[r].action[j]);
+          }
+        }
+        style.paths.push_back(frame_path(samples.front().time_s, merged, style.camera.fov_y_deg, aspect));
+      } else {
+        for (const RunSamples& s : samples) {
+          style.paths.push_back(frame_path(s.time_s, s.action, style.camera.fov_y_deg, aspect));
+        }
+      }
+    } else if (tracked) {
+      const float distance = glm::length(style.camera.eye - style.camera.target);
+      for (const RunSamples& s : samples) style.paths.push_back(track_path(s, distance));
+      if (view.one_picture) style.paths.resize(1);
     }
   } else {
     for (const World* w : as_built) bounds.add(world_bounds(*w));
@@ -330,10 +636,16 @@ DrawStyle resolve_style(const scenes::Scene& scene, std::span<const World* const
   }
   plane_extent(bounds, style.plane_centre, style.plane_half_size_m);
   // Far enough that the planes' edges lie near the far clip plane (50 eye-target distances),
-  // so the ground reaches the horizon instead of ending as a visible square.
-  const float view_distance = glm::length(style.camera.eye - style.camera.target);
-  style.plane_half_size_m = std::max(style.plane_half_size_m,
-                                     40.0f * view_distance + glm::length(style.camera.target - style.plane_centre));
+  // so the ground reaches the horizon instead of ending as a visible square, for every camera
+  // of every path.
+  float reach = glm::length(style.camera.eye - style.camera.target) * 40.0f +
+                glm::length(style.camera.target - style.plane_centre);
+  for (const CameraPath& path : style.paths) {
+    for (std::size_t k = 0; k < path.time_s.size(); ++k) {
+      reach = std::max(reach, 40.0f * path.distance_m[k] + glm::length(path.target_m[k] - style.plane_centre));
+    }
+  }
+  style.plane_half_size_m = std::max(style.plane_half_size_m, reach);
   return style;
 }
 

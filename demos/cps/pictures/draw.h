@@ -32,6 +32,16 @@ struct Overlays {
   double orbit_deg_per_s = 0.0;
 };
 
+/// A camera that moves with its run (--camera track:BODY and fit:frame), or holds a run's own
+/// framing (fit:panel): keyframes at the run's step times, each a target (m) and an eye-target
+/// distance (m, > 0); between keyframes both are interpolated linearly, before the first and
+/// after the last they hold. The eye lies along the style camera's eye - target direction.
+struct CameraPath {
+  std::vector<double> time_s;         ///< increasing, s
+  std::vector<glm::vec3> target_m;    ///< one per time
+  std::vector<float> distance_m;      ///< one per time, > 0
+};
+
 /// How to draw a world: the camera, the opacity of its planes ([0, 1]), where the planes are
 /// drawn and the overlays. resolve_style makes one for a scene, once for a whole run.
 struct DrawStyle {
@@ -51,7 +61,15 @@ struct DrawStyle {
   /// from frame to frame (resolve_style: around the bodies' bounds, see plane_extent).
   glm::vec3 plane_centre{0.0f};
   float plane_half_size_m = 30.0f;
+  /// By run (the order of resolve_style's as_built): the camera path of each run, for
+  /// --camera fit:panel, fit:frame and track:BODY; empty: `camera` for every run and time.
+  std::vector<CameraPath> paths;
 };
+
+/// The camera of run `run` (index into style.paths; one past the end takes the last path) at
+/// time t (s): style.camera, moved along the run's path if there is one (near and far clip
+/// planes following the distance). The orbit is not applied (draw_list does). No errors.
+render::Camera camera_at(const DrawStyle& style, std::size_t run, double t);
 
 /// Axis-aligned bounds (m) of what a scene shows: its movable boxes and spheres (oriented boxes
 /// bounded by |R| h) and the end points of its distance constraints (rods and their fixed
@@ -97,6 +115,9 @@ struct View {
   std::optional<Vec3> target;
   std::optional<double> fov_y_deg;
   Overlays overlays;
+  /// True when every run is drawn in one picture (--overlay): the per-run framings (fit:panel,
+  /// fit:frame) frame all runs together and track:BODY follows the body of the first run.
+  bool one_picture = false;
 };
 
 /// The colour (linear RGB, each in [0, 1]) draw_list gives body `body` (its index in the world)
@@ -108,25 +129,49 @@ glm::vec3 body_colour(std::size_t body, const DrawStyle& style);
 /// rod (unless style.overlays.rods is false), every plane (checkered, on the square of
 /// style.plane_centre and style.plane_half_size_m), the contact overlay if asked. Colours come
 /// from style.body_colours, else from the body index, so a body keeps its colour from frame to
-/// frame. With an orbit, the camera eye is turned about the vertical axis
+/// frame. The camera is camera_at(style, run, world.time()) (`run`: the world's index among
+/// the runs style was resolved for); with an orbit, its eye is turned about the vertical axis
 /// through the target by orbit_deg_per_s * world.time() degrees.
-render::DrawList draw_list(const World& world, const DrawStyle& style);
+render::DrawList draw_list(const World& world, const DrawStyle& style, std::size_t run = 0);
 
 /// The camera as JSON for run.json and figure sidecars: eye_m, target_m (m), fov_y_deg.
 nlohmann::json camera_json(const render::Camera& camera);
 
 /// The names `--camera` takes: "preset" (the scene's own view; for a scene without one, the
 /// automatic framing, and for a scene file without a "camera" in `cps render` and `cps figure`,
-/// "fit": see scene_view), "auto" (frame the bodies as built), "fit" (frame every body over the
-/// whole run: the bounds of a headless pre-run, see run_bounds, seen from the preset's
-/// direction), and "front", "side", "top": the preset's target seen from the same distance
-/// along +z, along +x, and from above.
+/// "fit": see scene_view), "auto" (frame the bodies as built), "fit" (frame the bodies in the
+/// action over the whole run and every run: action_bounds of a headless pre-run, seen from the
+/// preset's direction), "fit:panel" (the same, each run framed on its own), "fit:frame" (each
+/// run framed on its own at each time, smoothed over kCameraSmoothing_s), "front", "side",
+/// "top" (the preset's target seen from the same distance along +z, along +x, and from above)
+/// and "track:BODY" (camera_names lists it as "track:BODY"; BODY a body's name in a scene file
+/// or its index from 0): the preset's view moved so that its target follows the body's centre,
+/// averaged over kCameraSmoothing_s.
 std::span<const std::string_view> camera_names();
+
+/// "" if `name` is a --camera value camera_names() allows (track:BODY with any non-empty BODY:
+/// resolve_style checks the body), else the message: the allowed names and the nearest.
+std::string check_camera_name(std::string_view name);
+
+/// The window (s) over which fit:frame and track:BODY smooth the camera: a centred average,
+/// so the camera moves without the jitter of a body's contacts. Typical 0.5 s.
+inline constexpr double kCameraSmoothing_s = 0.5;
+
+/// The bounds of the bodies of `world` in the action now: a movable box or sphere is kept while
+/// its centre lies within R of the median of the movable bodies' centres (per axis), where
+/// R = max(2.5 x the median distance of the centres from that median, floor_m); its whole extent is
+/// added, and every end of a distance constraint within R of the median too. So one body thrown
+/// or sliding far away leaves the framing while the rest stays. floor_m (m, >= 0): a radius that
+/// always counts as in the action (resolve_style: the farthest body as built, so that every body
+/// as built is kept). Non-finite positions are skipped; a world without movable bodies gives
+/// world_bounds.
+Bounds action_bounds(const World& world, double floor_m);
 
 /// The view `cps render` and `cps figure` draw `scene` with: `view`, except that the default
 /// --camera preset on a scene file (scenes::is_file_scene) without a "camera" and without
 /// view.preset becomes "fit", so that bodies that move far (a thrown ball) stay in the picture
-/// over the whole run; a built-in scene keeps its preset or its framing as built. No errors.
+/// over the whole run; a built-in scene takes its Scene::default_camera (its preset as it
+/// stands, or a framing such as fit:frame). No errors.
 View scene_view(const scenes::Scene& scene, View view);
 
 /// The one place a scene's pictures get their camera and style: the camera that view.camera
@@ -143,17 +188,23 @@ DrawStyle resolve_style(const scenes::Scene& scene, const World& as_built, const
                         float aspect);
 
 /// The camera and style of a job whose runs start from `as_built` (one world per run, e.g. the
-/// variants of --compare; at least one) and last `seconds` (s, >= 0). "fit" frames run_bounds
-/// of all of them over [0, seconds]: the bounding sphere of those bounds (centre the target,
-/// radius r = |hi - lo| / 2) is seen from the direction of the preset's eye (or of the
-/// automatic framing's) at distance d = 1.1 r / sin(min(half vertical, half horizontal field
-/// of view)), so it fits the picture with 10 % margin, for any orbit. Then view.fov_y_deg,
-/// view.eye and view.target replace the camera's (with "fit", the field of view is set before
-/// the distance is computed). The planes are drawn on the square plane_extent gives for the
-/// pre-run bounds with "fit", else for the bounds as built (of all runs), widened to at least 40
-/// eye-target distances (plus the target's offset from its centre) so that the ground reaches
-/// the horizon, short of the far clip plane at 50 distances. Throws UsageError if
-/// the eye equals the target.
+/// variants of --compare; at least one) and last `seconds` (s, >= 0). "fit" frames the
+/// action_bounds of a headless pre-run of all of them over [0, seconds] (each world with the
+/// floor of its own as built): the bounding sphere of those bounds (centre the target, radius
+/// r = |hi - lo| / 2) is seen from the direction of the preset's eye (or of the automatic
+/// framing's) at distance d = 1.1 r / sin(min(half vertical, half horizontal field of view)),
+/// so it fits the picture with 10 % margin, for any orbit. "fit:panel" does so for each run on
+/// its own (style.paths, one keyframe a run); "fit:frame" at each step of each run, the sphere
+/// smoothed (frame_path); "track:BODY" keeps the preset's direction and distance and moves its
+/// target along the body's smoothed centre. With view.one_picture, fit:panel is fit, fit:frame
+/// frames every run together and track follows the first run's body. Then view.fov_y_deg,
+/// view.eye and view.target replace the camera's (the field of view before any distance is
+/// computed; on a moving camera eye and target set only its direction). The planes are drawn on
+/// the square plane_extent gives for the pre-run's world_bounds with fit and track, else for
+/// the bounds as built (of all runs), widened to at least 40 eye-target distances of every
+/// camera (plus its target's offset from the centre) so that the ground reaches the horizon,
+/// short of the far clip plane at 50 distances. Throws UsageError for a camera name
+/// check_camera_name refuses, a track:BODY naming no body, or an eye equal to the target.
 DrawStyle resolve_style(const scenes::Scene& scene, std::span<const World* const> as_built,
                         const View& view, float aspect, double seconds);
 

@@ -333,6 +333,58 @@ TEST_CASE("track:BODY keeps the body at the picture's centre", "[views]") {
   CHECK(cli::check_camera_name("fit:frame") == "");
 }
 
+TEST_CASE("a rod's fixed end is drawn as a pin, hidden with the rods", "[views]") {
+  const scenes::Scene& scene = *scenes::find_scene("pendulum_grid");
+  const scenes::Run run = scenes::make_run(scene);
+  std::size_t fixed_ends = 0;
+  for (const DistanceConstraint& d : run.world.distances()) {
+    for (int body : {d.body_a, d.body_b}) {
+      fixed_ends += body == kWorldBody || run.world.bodies()[static_cast<std::size_t>(body)].is_static();
+    }
+  }
+  REQUIRE(fixed_ends > 0);
+  std::size_t balls = 0;
+  for (const Body& b : run.world.bodies()) balls += b.shape.kind == ShapeKind::sphere;
+  DrawStyle style = cli::resolve_style(scene, run.world, View{}, kAspect);
+  const render::DrawList with = cli::draw_list(run.world, style);
+  CHECK(with.spheres.size() == balls + fixed_ends);
+  // Each pin sits on a rod's end that is no body's centre, smaller than the ball it holds.
+  std::size_t pins_on_rod_ends = 0;
+  for (const render::SphereItem& s : with.spheres) {
+    for (const render::LineItem& rod : with.lines) {
+      if (s.center == rod.a || s.center == rod.b) ++pins_on_rod_ends;
+    }
+  }
+  CHECK(pins_on_rod_ends >= fixed_ends);
+  style.overlays.rods = false;
+  CHECK(cli::draw_list(run.world, style).spheres.size() == balls);
+}
+
+TEST_CASE("the pendulum wave's row spans at least half the picture's width", "[views]") {
+  // The default view of render (16:9) and the one of figure paper's Fig. 10 (3:2): the balls'
+  // centres from the first to the last span at least 1 in NDC (half of the picture's width),
+  // as built and at 5 s, when the wave has spread.
+  const scenes::Scene& scene = *scenes::find_scene("pendulum_wave");
+  scenes::Run run = scenes::make_run(scene);
+  const DrawStyle style = cli::resolve_style(scene, run.world, View{}, kAspect);
+  for (double t : {0.0, 5.0}) {
+    run.advance_to(t);
+    float lo = 1e9f;
+    float hi = -1e9f;
+    for (const Body& b : run.world.bodies()) {
+      if (b.shape.kind != ShapeKind::sphere) continue;
+      const std::optional<glm::vec2> q = ndc(style.camera, b.x);
+      REQUIRE(q);
+      lo = std::min(lo, q->x);
+      hi = std::max(hi, q->x);
+    }
+    INFO("t = " << t << " s: the row spans NDC x " << lo << " to " << hi);
+    CHECK(hi - lo >= 1.0f);
+    CHECK(lo > -1.0f);
+    CHECK(hi < 1.0f);
+  }
+}
+
 TEST_CASE("run_bounds holds every body at every step and leaves the worlds unchanged", "[views]") {
   const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
   scenes::Run run = scenes::make_run(scene);

@@ -85,7 +85,8 @@ void add_view_options(CLI::App& cmd, View& view, bool& label, bool label_default
                  "its index), front, side or top (the preset's target from the same distance)")
       ->capture_default_str()
       ->check(CLI::Validator(
-          [](std::string& input) { return check_camera_name(input); }, camera_choices()));
+          [](std::string& input) { return check_camera_name(input); }, camera_choices()))
+      ->each([&view](const std::string&) { view.camera_given = true; });
   const CLI::Validator point(
       [](std::string& input) { return check_point(input, nullptr); }, "X,Y,Z");
   cmd.add_option_function<std::string>(

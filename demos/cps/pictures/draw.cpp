@@ -138,8 +138,24 @@ render::DrawList draw_list(const World& world, const DrawStyle& style, std::size
     Vec3 p_a;
     Vec3 p_b;
     distance_endpoints(d, bodies, p_a, p_b);
-    list.lines.push_back(
-        {to_glm(p_a), to_glm(p_b), style.body_colour ? 0.5f * *style.body_colour : glm::vec3(0.15f), 2.0f});
+    const glm::vec3 rod_colour = style.body_colour ? 0.5f * *style.body_colour : glm::vec3(0.15f);
+    list.lines.push_back({to_glm(p_a), to_glm(p_b), rod_colour, 2.0f});
+    // A fixed end (the world, or a static body) as a pin: a small sphere in the rod's colour,
+    // a quarter of the size of the body the rod holds, at most 5 % of the rod's length (3 % if
+    // it holds no sized body).
+    const auto fixed = [&](int body) {
+      return body == kWorldBody || bodies[static_cast<std::size_t>(body)].is_static();
+    };
+    const auto size_of = [&](int body) {
+      return body == kWorldBody ? 0.0 : body_size(bodies[static_cast<std::size_t>(body)]);
+    };
+    const double held = std::max(size_of(d.body_a), size_of(d.body_b));
+    const float pin = static_cast<float>(held > 0.0 ? std::min(0.25 * held, 0.05 * d.length) : 0.03 * d.length);
+    for (const auto& [body, p] : {std::pair{d.body_a, p_a}, std::pair{d.body_b, p_b}}) {
+      if (fixed(body) && p.allFinite()) {
+        list.spheres.push_back({to_glm(p), glm::quat(1.0f, 0.0f, 0.0f, 0.0f), pin, rod_colour, style.body_alpha});
+      }
+    }
   }
   if (style.overlays.contacts) add_contacts(world, list);
   for (const Body& b : bodies) {
@@ -389,7 +405,7 @@ View scene_view(const scenes::Scene& scene, View view) {
   if (view.camera == "preset" && !view.preset) {
     if (!scene.camera && scenes::is_file_scene(scene)) {
       view.camera = "fit";
-    } else {
+    } else if (!view.camera_given) {
       view.camera = scene.default_camera;
     }
   }

@@ -105,6 +105,8 @@ void plane_extent(const Bounds& b, glm::vec3& centre, float& half_size_m);
 struct View {
   /// A name from camera_names() (--camera).
   std::string camera = "preset";
+  /// Whether --camera was given: if not, scene_view takes the scene's default_camera.
+  bool camera_given = false;
   /// Replaces the scene's own camera preset (for "preset", "front", "side", "top") if set: the
   /// views of `cps figure paper`.
   std::optional<scenes::CameraPreset> preset;
@@ -171,7 +173,7 @@ Bounds action_bounds(const World& world, double floor_m);
 /// --camera preset on a scene file (scenes::is_file_scene) without a "camera" and without
 /// view.preset becomes "fit", so that bodies that move far (a thrown ball) stay in the picture
 /// over the whole run; a built-in scene takes its Scene::default_camera (its preset as it
-/// stands, or a framing such as fit:frame). No errors.
+/// stands, or a framing such as fit:frame) unless view.camera_given. No errors.
 View scene_view(const scenes::Scene& scene, View view);
 
 /// The one place a scene's pictures get their camera and style: the camera that view.camera

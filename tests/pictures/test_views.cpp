@@ -385,6 +385,56 @@ TEST_CASE("the pendulum wave's row spans at least half the picture's width", "[v
   }
 }
 
+TEST_CASE("velocity arrows show the push factor's velocity after one step, and none for split",
+          "[views]") {
+  // After one step of the intersecting stack, the push factor (Sec. 5.3) has put the overlap
+  // into the cubes' velocities (several m/s up); the single frame push factor (Sec. 8.1) moved
+  // them apart without any, so its arrows stay short (gravity's dt g = 0.16 m/s at most, plus
+  // round-off). Each arrow is a shaft and two barbs; the shaft is v x 0.1 s, starting outside
+  // the body's bounding sphere on the eye's side.
+  const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
+  for (const PushMode push : {PushMode::baumgarte, PushMode::split}) {
+    scenes::Overrides o;
+    o.set("push", push);
+    scenes::Run run = scenes::make_run(scene, o);
+    DrawStyle style = cli::resolve_style(scene, run.world, View{}, kAspect);
+    style.overlays.rods = false;
+    style.overlays.velocities = true;
+    CHECK(cli::draw_list(run.world, style).lines.empty());  // at rest as built
+    run.step();
+    const render::DrawList list = cli::draw_list(run.world, style);
+    double longest = 0.0;
+    std::size_t moving = 0;
+    for (const Body& b : run.world.bodies()) {
+      if (b.is_static()) continue;
+      const Vec3 v = b.velocity();
+      if ((cli::kVelocityArrow_s * v).norm() >= 1e-3) ++moving;
+      longest = std::max(longest, v.norm());
+      // The shaft of this body: the line whose vector is v x 0.1 s.
+      bool found = false;
+      for (const render::LineItem& l : list.lines) {
+        const glm::vec3 d = l.b - l.a;
+        const Vec3 shaft(d.x, d.y, d.z);
+        if ((shaft - cli::kVelocityArrow_s * v).norm() < 1e-4) {
+          found = true;
+          const Vec3 start(l.a.x, l.a.y, l.a.z);
+          CHECK((start - b.x).norm() >= b.shape.half_extents.norm());
+          const glm::vec3 eye = list.camera.eye;
+          CHECK((start - b.x).dot(Vec3(eye.x, eye.y, eye.z) - b.x) > 0.0);
+        }
+      }
+      if ((cli::kVelocityArrow_s * v).norm() >= 1e-3) CHECK(found);
+    }
+    CHECK(list.lines.size() == 3 * moving);
+    INFO("push " << static_cast<int>(push) << ": fastest cube " << longest << " m/s");
+    if (push == PushMode::baumgarte) {
+      CHECK(longest > 5.0);
+    } else {
+      CHECK(longest < 0.2);
+    }
+  }
+}
+
 TEST_CASE("run_bounds holds every body at every step and leaves the worlds unchanged", "[views]") {
   const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
   scenes::Run run = scenes::make_run(scene);

@@ -236,6 +236,7 @@ nlohmann::json figure_json(const FigureSpec& spec, const PageLayout& layout, int
           {"fov_y_deg", spec.view.fov_y_deg ? nlohmann::json(*spec.view.fov_y_deg) : nlohmann::json(nullptr)},
           {"overlays",
            {{"contacts", spec.view.overlays.contacts},
+            {"velocities", spec.view.overlays.velocities},
             {"rods", spec.view.overlays.rods},
             {"orbit_deg_per_s", spec.view.overlays.orbit_deg_per_s},
             {"label", spec.label}}},

@@ -482,6 +482,7 @@ nlohmann::json frames_info(const RenderOptions& o, const RenderPlan& plan, const
        {"fov_y_deg", o.view.fov_y_deg ? nlohmann::json(*o.view.fov_y_deg) : nlohmann::json(nullptr)},
        {"orbit_deg_per_s", overlays.orbit_deg_per_s},
        {"contacts", overlays.contacts},
+       {"velocities", overlays.velocities},
        {"rods", overlays.rods},
        {"label", o.label},
        {"overrides", overrides_json(o.overrides)},

@@ -66,6 +66,9 @@ void add_view_options(CLI::App& cmd, View& view, bool& label, bool label_default
   cmd.add_flag("--contacts", overlays.contacts,
                "draw the last step's contact points (red spheres) and normals (red segments, about "
                "one body size long (m), from body a towards body b); default: off");
+  cmd.add_flag("--velocities", overlays.velocities,
+               "draw each body's velocity as a dark blue arrow from its centre, as long as the way "
+               "it goes in 0.1 s (m); default: off");
   // Each switch once: "--label --no-label" is refused, not decided by the last.
   cmd.add_flag("--rods,!--no-rods", overlays.rods,
                "draw distance constraints as rods; default: on (--no-rods hides them)")

@@ -71,6 +71,46 @@ void add_contacts(const World& world, render::DrawList& list) {
   }
 }
 
+// An arrow from a to b (m) in `colour`: the shaft and two barbs a fifth of its length, turned
+// 25 degrees off it in the plane that faces the eye, so the head reads from the camera.
+void add_arrow(const glm::vec3& a, const glm::vec3& b, const glm::vec3& colour, const glm::vec3& eye,
+               render::DrawList& list) {
+  const glm::vec3 shaft = b - a;
+  const float length = glm::length(shaft);
+  if (!(length > 0.0f)) return;
+  const glm::vec3 along = shaft / length;
+  glm::vec3 side = glm::cross(along, eye - b);
+  if (!(glm::length(side) > 1e-6f * length)) side = glm::cross(along, glm::vec3(0.0f, 1.0f, 0.0f));
+  if (!(glm::length(side) > 0.0f)) side = glm::vec3(1.0f, 0.0f, 0.0f);
+  side = glm::normalize(side);
+  const float barb = 0.2f * length;
+  const float c = std::cos(glm::radians(25.0f));
+  const float s = std::sin(glm::radians(25.0f));
+  list.lines.push_back({a, b, colour, 3.0f});
+  list.lines.push_back({b, b - barb * (c * along + s * side), colour, 3.0f});
+  list.lines.push_back({b, b - barb * (c * along - s * side), colour, 3.0f});
+}
+
+// Velocity overlay: an arrow x -> x + v kVelocityArrow_s for every movable body, moved towards
+// the eye out of the body's bounding sphere so that the body does not hide it.
+void add_velocities(const World& world, const glm::vec3& eye, render::DrawList& list) {
+  const glm::vec3 blue(0.05f, 0.10f, 0.55f);
+  for (const Body& b : world.bodies()) {
+    const Vec3 v = b.velocity();
+    if (b.is_static() || !b.x.allFinite() || !v.allFinite()) continue;
+    const glm::vec3 shaft = to_glm(kVelocityArrow_s * v);
+    if (!(glm::length(shaft) >= 1e-3f)) continue;
+    const glm::vec3 x = to_glm(b.x);
+    const glm::vec3 to_eye = eye - x;
+    // Out of the body's bounding sphere (a box's half diagonal), on the side facing the eye.
+    const double reach = 1.05 * (b.shape.kind == ShapeKind::box ? b.shape.half_extents.norm() : body_size(b));
+    const glm::vec3 start = glm::length(to_eye) > 0.0f
+                                ? x + static_cast<float>(reach) * glm::normalize(to_eye)
+                                : x;
+    add_arrow(start, start + shaft, blue, eye, list);
+  }
+}
+
 // `camera` turned about the vertical axis through its target by `deg` degrees.
 render::Camera orbit(render::Camera camera, double deg) {
   const float a = static_cast<float>(deg * 3.14159265358979323846 / 180.0);
@@ -158,6 +198,7 @@ render::DrawList draw_list(const World& world, const DrawStyle& style, std::size
     }
   }
   if (style.overlays.contacts) add_contacts(world, list);
+  if (style.overlays.velocities) add_velocities(world, list.camera.eye, list);
   for (const Body& b : bodies) {
     if (b.shape.kind != ShapeKind::plane) continue;
     const Vec3 n = b.rotation() * b.shape.normal;

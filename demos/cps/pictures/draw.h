@@ -26,6 +26,10 @@ struct Overlays {
   /// Distance constraints (Sec. 5.2) drawn as dark rods from p_a to p_b. On by default: the
   /// pendulum scenes read as loose balls without them.
   bool rods = true;
+  /// Each movable body's linear velocity v (m/s) as a dark blue arrow v kVelocityArrow_s long
+  /// (the way it would go in that time), drawn from its centre of mass moved towards the eye out
+  /// of its bounding sphere, so that the body does not hide it; none below 1 mm.
+  bool velocities = false;
   /// Rotation of the camera eye about the vertical axis through its target, in degrees per
   /// second of simulated time (0: fixed camera; typical 10). The angle at a picture is
   /// orbit_deg_per_s * world.time().
@@ -41,6 +45,10 @@ struct CameraPath {
   std::vector<glm::vec3> target_m;    ///< one per time
   std::vector<float> distance_m;      ///< one per time, > 0
 };
+
+/// The time (s) a velocity arrow stands for: an arrow is v x this long (m). 0.1 s: a body at
+/// 10 m/s gets a 1 m arrow.
+inline constexpr double kVelocityArrow_s = 0.1;
 
 /// How to draw a world: the camera, the opacity of its planes ([0, 1]), where the planes are
 /// drawn and the overlays. resolve_style makes one for a scene, once for a whole run.

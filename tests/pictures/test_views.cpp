@@ -592,4 +592,56 @@ TEST_CASE("every scene's default view shows its bodies", "[views][render]") {
     CHECK(share >= least);
   }
 }
+
+// The rows of the picture (as a share of its height) between the first and the last that hold
+// a magenta pixel, drawn as body_share draws: the bodies' height in the picture.
+double body_height_share(render::Renderer& renderer, const render::DrawList& drawn) {
+  render::DrawList list = drawn;
+  list.lines.clear();
+  list.spheres.clear();  // tower_roll's ball: only the tower is measured
+  for (render::BoxItem& b : list.boxes) b.color = glm::vec3(1.0f, 0.0f, 1.0f);
+  const render::Image image = renderer.draw(list);
+  int first = -1;
+  int last = -1;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::size_t i = 3 * (static_cast<std::size_t>(y) * image.width + x);
+      const int r = image.pixels[i];
+      const int g = image.pixels[i + 1];
+      const int b = image.pixels[i + 2];
+      if (r - g > 40 && b - g > 40) {
+        if (first < 0) first = y;
+        last = y;
+        break;
+      }
+    }
+  }
+  return first < 0 ? 0.0 : static_cast<double>(last - first + 1) / image.height;
+}
+
+TEST_CASE("camera fit draws the tower a ball rolls away from at least 45 % of the picture tall",
+          "[views][render]") {
+  // Measured from the image (160x90): at 0, 2 and 4 s the tower of tower_roll spans at least
+  // 45 % of the picture's height under fit; framed on every body (the ball 25 m away at the end),
+  // under 30 %.
+  render::Renderer renderer(160, 90);
+  const scenes::Scene& scene = tower_roll();
+  scenes::Run run = scenes::make_run(scene);
+  const World* worlds[] = {&run.world};
+  View view;
+  view.camera = "fit";
+  const DrawStyle fit = cli::resolve_style(scene, worlds, view, kAspect, 4.0);
+  DrawStyle all = fit;
+  all.camera = all_bodies_camera(fit.camera, worlds, 4.0);
+  for (double t : {0.0, 2.0, 4.0}) {
+    run.advance_to(t);
+    const double with_fit = body_height_share(renderer, cli::draw_list(run.world, fit));
+    const double with_all = body_height_share(renderer, cli::draw_list(run.world, all));
+    INFO("t = " << t << " s: the tower spans " << 100.0 * with_fit << " % of the height under fit, "
+                << 100.0 * with_all << " % framed on every body");
+    CHECK(with_fit >= 0.45);
+    CHECK(with_fit < 1.0);
+    CHECK(with_all < 0.30);
+  }
+}
 #endif

@@ -151,6 +151,7 @@ FileBody read_body(const std::string& origin, const json& j, std::size_t index, 
   if (j.contains("velocity_mps")) d.velocity = vec3_of(j["velocity_mps"]);
   if (j.contains("angular_velocity_radps")) d.angular_velocity = vec3_of(j["angular_velocity_radps"]);
   if (j.contains("restitution")) d.restitution = j["restitution"].get<double>();  // [0, 1]: the schema
+  if (j.contains("friction")) d.friction = j["friction"].get<double>();  // [0, 1e6]: the schema
   if (j.contains("orientation_wxyz")) {
     const json& q = j["orientation_wxyz"];
     d.orientation = Quat(q[0].get<double>(), q[1].get<double>(), q[2].get<double>(), q[3].get<double>());

@@ -163,6 +163,7 @@ nlohmann::json scene_file_json(const Scene& scene, const World& as_built) {
       if (w != Vec3::Zero()) body["angular_velocity_radps"] = json_of(w);
     }
     if (!std::isnan(b.restitution)) body["restitution"] = b.restitution;
+    if (!std::isnan(b.friction)) body["friction"] = b.friction;
     if (i < colours.size() && colours[i]) body["color"] = hex_colour(*colours[i]);
     bodies.push_back(body);
   }

@@ -136,9 +136,15 @@ Body make_body(const BodyDef& def) {
                                 " is not allowed: it must be in [0, 1] (or NaN for the world's)");
   }
 
+  if (!std::isnan(def.friction) && !in_range(def.friction, 0.0, 1.0e6)) {
+    throw std::invalid_argument("body friction " + num(def.friction) +
+                                " is not allowed: it must be in [0, 1e6] (or NaN for the world's)");
+  }
+
   Body b;
   b.shape = def.shape;
   b.restitution = def.restitution;
+  b.friction = def.friction;
   b.x = def.position;
   b.o = def.orientation.normalized();
   if (!def.is_static) {

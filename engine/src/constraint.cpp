@@ -108,7 +108,7 @@ void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
 void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
                           const RowParams& params, int first_normal_row,
                           std::vector<ConstraintRow>& rows, const Vec3* tangents) {
-  if (params.friction <= 0.0 || m.count == 0) return;
+  if ((params.friction <= 0.0 && !params.body_friction) || m.count == 0) return;
   const std::size_t first = rows.size();
   rows.resize(first + 2 * static_cast<std::size_t>(m.count));
   write_friction_rows(m, bodies, params, first_normal_row, rows.data() + first, tangents);
@@ -117,9 +117,10 @@ void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
 void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
                          const RowParams& params, int first_normal_row, ConstraintRow* out,
                          const Vec3* tangents) {
-  if (params.friction <= 0.0 || m.count == 0) return;
+  if ((params.friction <= 0.0 && !params.body_friction) || m.count == 0) return;
   const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
   const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
+  const double mu = pair_friction(params.friction, a.friction, b.friction);
   // Sec. 5.4: m is the combined mass of both bodies divided over the contact points (a static
   // body has mass 0 here, so the movable body's mass remains).
   const double mass_per_point = (a.mass + b.mass) / static_cast<double>(m.count);
@@ -127,7 +128,7 @@ void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
     const Contact& c = m.contacts[static_cast<std::size_t>(i)];
     const Vec3 r_a = c.point - a.x;
     const Vec3 r_b = c.point - b.x;
-    const double limit = params.friction * mass_per_point * std::abs(params.gravity.dot(c.normal));
+    const double limit = mu * mass_per_point * std::abs(params.gravity.dot(c.normal));
     Vec3 t[2];
     if (tangents != nullptr) {
       t[0] = tangents[i];
@@ -145,7 +146,7 @@ void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
       friction.c_min = -limit;
       friction.c_max = limit;
       friction.normal_row = first_normal_row + i;
-      friction.mu = params.friction;
+      friction.mu = mu;
     }
   }
 }

@@ -84,6 +84,7 @@ void World::set_def(const WorldDef& def) {
 
 int World::add_body(const BodyDef& def) {
   bodies_.push_back(make_body(def));  // make_body throws before anything is added
+  body_friction_ = body_friction_ || !std::isnan(def.friction);
   return static_cast<int>(bodies_.size()) - 1;
 }
 
@@ -299,12 +300,14 @@ void World::build_rows() {
                    .gravity = def_.gravity,
                    .restitution = def_.restitution,
                    .restitution_threshold = def_.restitution_threshold,
-                   .penetration_slop = def_.penetration_slop};
+                   .penetration_slop = def_.penetration_slop,
+                   .body_friction = body_friction_};
   push_->adjust_rows(def_, params);  // the paper's methods leave params as they are
   // The row count is known from the manifolds: make room once, with headroom (no allocation in
   // steady state).
   const std::size_t points = contact_point_count(ctx.manifolds);
-  const bool friction = params.friction > 0.0;  // two friction rows a point (write_friction_rows)
+  // Two friction rows a point (write_friction_rows).
+  const bool friction = params.friction > 0.0 || params.body_friction;
   ctx.layout = RowLayout{.points = points, .friction = friction, .rods = distances_.size()};
   detail::reserve_with_headroom(rows, ctx.layout.size());
   // Each body's v and w (w needs I^-1 = R I_body^-1 R^T) once, for the bodies in a manifold

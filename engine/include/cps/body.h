@@ -62,12 +62,23 @@ inline double pair_restitution(double world, double a, double b) {
   return std::max(std::isnan(a) ? world : a, std::isnan(b) ? world : b);
 }
 
+/// The friction coefficient mu (dimensionless, >= 0) of a contact between bodies a and b (Sec.
+/// 5.4 takes one mu): the geometric mean sqrt(mu_a mu_b) of the two bodies' own, a body without
+/// its own (NaN) taking `world` (WorldDef::friction), as Box2D v3 mixes friction, so that an icy
+/// body (0) slides on anything; two bodies without their own give `world` exactly. No errors.
+inline double pair_friction(double world, double a, double b) {
+  if (std::isnan(a) && std::isnan(b)) return world;
+  return std::sqrt((std::isnan(a) ? world : a) * (std::isnan(b) ? world : b));
+}
+
 /// What a body is made from. mass (kg): finite and > 0 for a movable body; ignored when
 /// is_static. position (m), orientation (unit quaternion, body to world; |o| within 1e-9 of 1),
 /// velocity (m/s) and angular_velocity (rad/s) are the initial state, all in world space.
 /// restitution: the body's own coefficient of restitution eps (dimensionless, in [0, 1]; typical
 /// 0.5 for a ball), or NaN, the default, for the world's (WorldDef::restitution); see
-/// pair_restitution.
+/// pair_restitution. friction: the body's own friction coefficient mu (dimensionless, in
+/// [0, 1e6]; typical 0.1 for ice, 1 for rubber), or NaN, the default, for the world's
+/// (WorldDef::friction); see pair_friction.
 struct BodyDef {
   Shape shape;
   bool is_static = false;
@@ -77,6 +88,7 @@ struct BodyDef {
   Vec3 velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();
   double restitution = std::numeric_limits<double>::quiet_NaN();
+  double friction = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// A rigid body as the paper keeps it (Sec. 3.1): position x (m), orientation o (unit
@@ -94,6 +106,8 @@ struct Body {
   Mat3 inv_inertia_body = Mat3::Zero();
   /// Its own coefficient of restitution (BodyDef::restitution): in [0, 1], or NaN for the world's.
   double restitution = std::numeric_limits<double>::quiet_NaN();
+  /// Its own friction coefficient (BodyDef::friction): in [0, 1e6], or NaN for the world's.
+  double friction = std::numeric_limits<double>::quiet_NaN();
 
   bool is_static() const { return inv_mass == 0.0; }
   /// Rotation matrix R of o (3 x 3, body to world).

@@ -58,8 +58,8 @@ Vec12 axis_row(const Vec3& n, const Vec3& r_a, const Vec3& r_b);
 void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2);
 
 /// Parameters of the row builder. beta: push factor constant (dimensionless, [0, 1], typical
-/// 0.2); dt: time step (s); friction: coefficient mu (dimensionless, >= 0, typical 0.5; 0 builds
-/// no friction rows); gravity: (m/s^2) for the friction limit mu m |g . n|; restitution:
+/// 0.2); dt: time step (s); friction: the world's coefficient mu (dimensionless, >= 0, typical
+/// 0.5; 0 builds no friction rows unless body_friction); gravity: (m/s^2) for the friction limit mu m |g . n|; restitution:
 /// coefficient eps (dimensionless, [0, 1], typical 0 to 0.5); restitution_threshold: approach
 /// speed (m/s, >= 0, typical 1) below which a contact gets no restitution, so resting contacts
 /// do not bounce.
@@ -71,6 +71,9 @@ struct RowParams {
   double restitution = 0.0;
   double restitution_threshold = 1.0;
   double penetration_slop = 0.0;  ///< m, >= 0: depth the push leaves (WorldDef::penetration_slop)
+  /// Some body has its own friction coefficient (Body::friction): friction rows are built even
+  /// when `friction` (the world's) is 0, each with its pair's mu (pair_friction).
+  bool body_friction = false;
   /// m: contacts no deeper than this keep their push in the velocity solve (it is moved into
   /// bias). The split impulse (engine/src/push/split_impulse.cpp) sets it to WorldDef::split_impulse_threshold;
   /// -inf (the default) moves nothing.
@@ -120,11 +123,12 @@ void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
                        const RowParams& params, ConstraintRow* out);
 
 /// Appends two friction rows per point of m (Sec. 5.4), in point order, along t1 and t2 of
-/// tangent_basis(n): target 0, limits +-mu m |g . n| (N) where m (kg) is the combined mass of
+/// tangent_basis(n): target 0, limits +-mu m |g . n| (N), mu the pair's (pair_friction of
+/// params.friction and the two bodies' own), where m (kg) is the combined mass of
 /// the two bodies divided over the manifold's points (the movable body's mass when the other is
 /// static). normal_row of point i's rows is first_normal_row + i: the index in `rows` of that
 /// point's contact row (append_normal_rows), for the coupled limit mu lambda_n. Appends nothing
-/// when params.friction is 0. tangents: nullptr (the paper's directions), or m.count unit
+/// when params.friction is 0 and params.body_friction is false. tangents: nullptr (the paper's directions), or m.count unit
 /// vectors t1 perpendicular to each point's normal, with t2 = n x t1 (the warm start keeps a
 /// persisting contact's directions so its friction lambdas carry over). No errors.
 void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
@@ -132,7 +136,7 @@ void append_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
                           std::vector<ConstraintRow>& rows, const Vec3* tangents = nullptr);
 
 /// The rows of append_friction_rows written to out[0, 2 m.count) instead (each row replaced
-/// whole; nothing when params.friction is 0). No errors.
+/// whole; nothing when append_friction_rows appends nothing). No errors.
 void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
                          const RowParams& params, int first_normal_row, ConstraintRow* out,
                          const Vec3* tangents = nullptr);

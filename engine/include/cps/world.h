@@ -195,6 +195,8 @@ class World {
   std::vector<double> margins_;  // per body (m), when the push method asks for them
   std::vector<BodyVelocity> velocities_;
   std::vector<unsigned char> velocity_known_;
+  // Whether some body has its own friction coefficient (Body::friction, RowParams::body_friction).
+  bool body_friction_ = false;
 };
 
 }  // namespace cps

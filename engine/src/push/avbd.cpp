@@ -120,6 +120,7 @@ struct ContactState {
   std::array<double, 3> C0{};
   std::array<double, 3> lambda{};  // N, compressive < 0
   std::array<double, 3> k{};       // N/m
+  double mu = 0.0;                 // the pair's friction coefficient (pair_friction)
   bool stick = false;
   auto key() const { return std::tuple(a, b, feature); }
 };
@@ -215,6 +216,7 @@ class Avbd final : public PushMethod {
       s.a = m.body_a;
       s.b = m.body_b;
       s.feature = c.feature;
+      s.mu = pair_friction(def.friction, a.friction, b.friction);
       s.local_a = Ra_t * (c.point + 0.5 * c.depth * c.normal - a.x);
       s.local_b = Rb_t * (c.point - 0.5 * c.depth * c.normal - b.x);
       s.lambda = {0.0, 0.0, 0.0};
@@ -353,7 +355,7 @@ class Avbd final : public PushMethod {
       if (entry >= 0) {
         const ContactState& c = contacts_[static_cast<std::size_t>(entry)];
         for (int r = 0; r < 3; ++r) {
-          const auto [lo, hi] = limits(c, r, def.friction);
+          const auto [lo, hi] = limits(c, r, c.mu);
           const std::size_t ru = static_cast<std::size_t>(r);
           const double f = std::clamp(c.k[ru] * contact_value(c, r, alpha) + c.lambda[ru], lo, hi);
           const Vec6& J = c.a == body ? c.Ja[ru] : c.Jb[ru];
@@ -389,14 +391,14 @@ class Avbd final : public PushMethod {
     for (ContactState& c : contacts_) {
       for (int r = 0; r < 3; ++r) {
         const std::size_t ru = static_cast<std::size_t>(r);
-        const auto [lo, hi] = limits(c, r, def.friction);
+        const auto [lo, hi] = limits(c, r, c.mu);
         const double C = contact_value(c, r, alpha);
         const double lambda = std::clamp(c.k[ru] * C + c.lambda[ru], lo, hi);
         if (lambda > lo && lambda < hi) ramp(c.k[ru], C);
         if (!stabilising) c.lambda[ru] = lambda;
       }
       if (stabilising) continue;
-      const double cone = def.friction * std::abs(c.lambda[0]);
+      const double cone = c.mu * std::abs(c.lambda[0]);
       const double tangential = std::hypot(c.lambda[1], c.lambda[2]);
       c.stick = tangential < cone && std::hypot(c.C0[1], c.C0[2]) < kStickDistance;
     }

@@ -302,7 +302,7 @@ class SoftStep final : public PushMethod {
     max_push_ = def.contact_push_max_speed;
 
     const std::size_t points = contact_point_count(ctx.manifolds);
-    const bool friction = def.friction > 0.0;
+    const bool friction = ctx.layout.friction;  // the rows carry each pair's mu
     const bool coupled = def.friction_model == FrictionModel::coupled;
     // Box3D's friction centre weight: 1 for touching points, falling to 0 past twice the
     // speculative distance (m).

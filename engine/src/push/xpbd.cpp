@@ -357,7 +357,8 @@ class Xpbd final : public PushMethod {
       const double C = p.normal.dot(pb - pa) + p.allowed;
       if (!(C < 0.0)) continue;
       p.lambda_n = correct(&a, ia, &b, ib, pa, pb, p.normal, C, 0.0);
-      if (!(def.friction > 0.0)) continue;
+      const double mu = pair_friction(def.friction, a.friction, b.friction);
+      if (!(mu > 0.0)) continue;
       // Static friction (Sec. 3.5): the points' tangential motion over the substep, undone when
       // the impulse it takes stays within mu lambda_n. Gauss-Seidel reads the points after the
       // normal correction; Jacobi the state of the sweep.
@@ -371,7 +372,7 @@ class Xpbd final : public PushMethod {
       if (!(slip > 0.0)) continue;
       const Vec3 t = dp_t / slip;  // a's motion relative to b
       const double w = inverse_mass(&a, qa - a.x, t) + inverse_mass(&b, qb - b.x, t);
-      if (!(w > 0.0) || !(slip / w < def.friction * p.lambda_n)) continue;
+      if (!(w > 0.0) || !(slip / w < mu * p.lambda_n)) continue;
       // -C along t moves b by +slip/w t and a by -slip/w t: the relative motion cancelled.
       correct(&a, ia, &b, ib, qa, qb, t, -slip, 0.0);
       p.friction = (slip / w) * t;
@@ -410,10 +411,11 @@ class Xpbd final : public PushMethod {
       const Vec3 ut = u - vn * p.normal;
       Vec3 impulse = Vec3::Zero();  // on b (N s)
       const double slide = ut.norm();
-      if (def.friction > 0.0 && slide > 0.0) {
+      const double mu = pair_friction(def.friction, a.friction, b.friction);
+      if (mu > 0.0 && slide > 0.0) {
         const Vec3 t = ut / slide;
         const double w = inverse_mass(&a, ra, t) + inverse_mass(&b, rb, t);
-        if (w > 0.0) impulse -= std::min(def.friction * p.lambda_n / h, slide / w) * t;
+        if (w > 0.0) impulse -= std::min(mu * p.lambda_n / h, slide / w) * t;
       }
       const Vec3 u_before = (state_[ib].v + state_[ib].w.cross(rb)) - (state_[ia].v + state_[ia].w.cross(ra));
       const double vn_before = p.normal.dot(u_before);

@@ -54,7 +54,7 @@ declare -A KIND=(
   ['*:--help']=skip ['top:--version']=skip
   ['*:--json']=flag ['*:--force']=flag ['*:--quick']=flag ['*:--list-runs']=flag
   ['*:--quiet']=flag ['*:--warnings-as-errors']=flag
-  ['*:--rendering']=flag ['*:--contacts']=flag ['*:--velocities']=flag ['*:--rods']=flag ['*:--label']=flag
+  ['*:--rendering']=flag ['*:--contacts']=flag ['*:--velocities']=flag ['*:--forces']=flag ['*:--rods']=flag ['*:--label']=flag
   ['*:--overlay']=flag ['*:--compare']=compare
   ['*:--seconds']=seconds ['*:--fps']=fps ['*:--orbit']=orbit ['*:--speed']=speed
   ['*:--eye']=point ['*:--target']=point ['*:--fov']=fov

@@ -141,6 +141,24 @@ TEST_CASE("the intersecting stack's column fills a quarter of each panel of a 2-
   }
 }
 
+TEST_CASE("captions take at most a quarter of a small panel: 8 methods at 640x360 keep 65 % of "
+          "each cell for the picture",
+          "[cli][compare]") {
+  // 4 x 2 cells of 160 x 180 px at 10 px text: the scene's name once as the frame's title, each
+  // caption its variant and time (two lines, about 30 px); with every label's description and
+  // the scene's name in each caption (five lines and more) the pictures kept about half.
+  const fs::path dir = fresh_dir("cps_compare_captions");
+  const Result r = run("render intersecting_stack --compare push --label --seconds 0.1 --fps 10 "
+                       "--size 640x360 --out out",
+                       dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const fs::path folder = dir / "out" / "intersecting_stack-compare-push";
+  const std::vector<Rect> at = panels_of(nlohmann::json::parse(slurp(folder / "run.json")));
+  REQUIRE(at.size() == 8);
+  for (const Rect& cell : at) CHECK(cell.height >= 0.65 * 180);
+}
+
 TEST_CASE("cps render --compare with three values of beta lays out 3 labelled panels that differ",
           "[cli][compare]") {
   const fs::path dir = fresh_dir("cps_compare_grid");

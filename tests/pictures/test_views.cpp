@@ -435,6 +435,51 @@ TEST_CASE("velocity arrows show the push factor's velocity after one step, and n
   }
 }
 
+TEST_CASE("contact forces: the ground's equal the stack's change of momentum less its weight, drawn as arrows", "[views]") {
+  // Over one step of the paper's push (the first solve's lambda is the whole contact impulse),
+  // the forces the ground's contacts put on the bottom cube, F, change the column's momentum P
+  // with gravity: F dt = P(t + dt) - P(t) - M g dt, to round-off; forces between cubes cancel
+  // in the sum. Near rest (4 s) F is close to the weight.
+  const scenes::Scene& scene = *scenes::find_scene("stack");
+  scenes::Run run = scenes::make_run(scene);
+  DrawStyle style = cli::resolve_style(scene, run.world, View{}, kAspect);
+  style.overlays.forces = true;
+  CHECK(cli::contact_forces(run.world).empty());  // no step yet: no rows
+  CHECK(cli::draw_list(run.world, style).lines.empty());
+  run.advance_to(4.0);
+  const auto momentum = [&] {
+    Vec3 p = Vec3::Zero();
+    for (const Body& b : run.world.bodies()) p += b.p;
+    return p;
+  };
+  const Vec3 before = momentum();
+  run.step();
+  const Vec3 after = momentum();
+  double mass = 0.0;
+  for (const Body& b : run.world.bodies()) mass += b.mass;
+  const WorldDef& def = run.world.def();
+  const std::vector<Vec3> forces = cli::contact_forces(run.world);
+  Vec3 from_ground = Vec3::Zero();
+  std::size_t k = 0;
+  for (const Manifold& m : run.world.manifolds()) {
+    for (int i = 0; i < m.count; ++i, ++k) {
+      REQUIRE(k < forces.size());
+      if (run.world.body(m.body_a).is_static()) from_ground += forces[k];
+    }
+  }
+  CHECK(forces.size() == k);
+  const Vec3 expected = (after - before) / def.dt - mass * def.gravity;
+  INFO("ground force " << from_ground.transpose() << " N, momentum balance " << expected.transpose() << " N");
+  CHECK((from_ground - expected).norm() < 1e-9 * mass * def.gravity.norm());
+  CHECK(from_ground.y() == Approx(-mass * def.gravity.y()).epsilon(0.05));
+  // An arrow (shaft and two barbs) for each point whose arrow is at least 1 mm.
+  style.overlays.rods = false;
+  const render::DrawList list = cli::draw_list(run.world, style);
+  CHECK(list.lines.size() % 3 == 0);
+  CHECK(list.lines.size() >= 3 * 4);
+  CHECK(list.lines.size() <= 3 * k);
+}
+
 TEST_CASE("run_bounds holds every body at every step and leaves the worlds unchanged", "[views]") {
   const scenes::Scene& scene = *scenes::find_scene("intersecting_stack");
   scenes::Run run = scenes::make_run(scene);

@@ -237,6 +237,7 @@ nlohmann::json figure_json(const FigureSpec& spec, const PageLayout& layout, int
           {"overlays",
            {{"contacts", spec.view.overlays.contacts},
             {"velocities", spec.view.overlays.velocities},
+            {"forces", spec.view.overlays.forces},
             {"rods", spec.view.overlays.rods},
             {"orbit_deg_per_s", spec.view.overlays.orbit_deg_per_s},
             {"label", spec.label}}},

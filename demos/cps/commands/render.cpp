@@ -67,6 +67,38 @@ std::string frame_caption(const std::string& label, double t, double spacing) {
 
 }  // namespace
 
+std::string caption_for_cell(const std::string& label, double cell_width, double cell_height,
+                             double font) {
+  if (label.empty()) return label;
+  const double per_line = std::max(1.0, std::floor(cell_width / (0.55 * font)));  // glyphs
+  double lines = 1.0;  // the time below
+  for (std::size_t start = 0; start <= label.size();) {
+    const std::size_t nl = std::min(label.find('\n', start), label.size());
+    lines += std::max(1.0, std::ceil(static_cast<double>(nl - start) / per_line));
+    start = nl + 1;
+  }
+  if (lines * 1.25 * font <= 0.25 * cell_height) return label;
+  return label.substr(0, label.find('\n'));
+}
+
+namespace {
+
+// `labels` fitted to the cells of `page` (its grid, size and font: frame_page's) by
+// caption_for_cell; when one is cut to its first line, all are, so the panels read alike.
+std::vector<std::string> fitted_labels(const FigurePage& page, const std::vector<std::string>& labels) {
+  const double cell_width = static_cast<double>(page.width) / page.columns;
+  const double cell_height = static_cast<double>(page.height) / page.rows;
+  bool cut = false;
+  for (const std::string& label : labels) {
+    cut = cut || caption_for_cell(label, cell_width, cell_height, page.font_size) != label;
+  }
+  std::vector<std::string> out;
+  for (const std::string& label : labels) out.push_back(cut ? label.substr(0, label.find('\n')) : label);
+  return out;
+}
+
+}  // namespace
+
 bool frame_has_captions(const RenderJob& job, const std::vector<std::string>& labels) {
   if (job.frame_width <= 0 || job.frame_height <= 0) return false;
   if (job.overlay) return true;
@@ -90,8 +122,10 @@ FigurePage frame_page(const RenderJob& job, const std::vector<std::string>& labe
   page.font_size = std::max(10.0, job.frame_height / static_cast<double>(page.rows) / 30.0);
   page.width = job.frame_width;
   page.height = job.frame_height;
+  page.title = job.title;
+  const std::vector<std::string> fitted = fitted_labels(page, labels);
   for (std::size_t p = 0; p < panels; ++p) {
-    page.panels.push_back({nullptr, "", frame_caption(labels.empty() ? std::string() : labels[p], t,
+    page.panels.push_back({nullptr, "", frame_caption(labels.empty() ? std::string() : fitted[p], t,
                                                           job.speed / job.fps)});
   }
   // A last row that the variants do not fill: its empty cells have no caption.
@@ -147,6 +181,8 @@ long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, cons
     }
     layout = layout_page(*base);
   }
+  // Each label as the captions fit it to its cell (caption_for_cell), for every frame.
+  const std::vector<std::string> fitted = captions ? fitted_labels(*base, labels) : labels;
   std::vector<render::Image> pictures(job.overlay ? 1 : panels.size());
   for (long long k = 0; k < frames; ++k) {
     const double t = frame_time(job, k);
@@ -168,7 +204,7 @@ long long render_frames(const DrawStyle& style, std::vector<Panel>& panels, cons
       FigurePage page = *base;
       for (std::size_t p = 0; p < pictures.size(); ++p) {
         page.panels[p].image = &pictures[p];
-        page.panels[p].text = frame_caption(labels[p], worlds[p]->time(), job.speed / job.fps);
+        page.panels[p].text = frame_caption(fitted[p], worlds[p]->time(), job.speed / job.fps);
       }
       writer.write(job.folder / frame_name(k), compose_page_pixels(page, *layout));
     }
@@ -256,9 +292,10 @@ SceneRender scene_runs(const RenderOptions& o, const scenes::Scene& scene,
   for (const Variant& v : variants) {
     job.runs.push_back(make_run_or_usage_error(scene, v.overrides));
     job.energy.push_back(scenes::watch_energy_rise(job.runs.back()));
-    // --overlay: the legend names the variants; the label, the scene (with --label).
+    // --overlay: the legend names the variants; the label, the scene (with --label). Several
+    // panels: the scene's name is the frame's title (plan_scene), not on every panel.
     std::string label = o.overlay ? "" : v.label;
-    if (o.label) {
+    if (o.label && (variants.size() == 1 || o.overlay)) {
       label = std::string(scenes::output_name(scene)) + (label.empty() ? "" : "\n" + label);
     }
     job.labels.push_back(label);
@@ -352,6 +389,7 @@ void place_panels(const RenderOptions& o, std::size_t panels, SceneRender& job) 
 // UsageError.
 void plan_scene(const RenderOptions& o, const RenderPlan& plan, SceneRender& job) {
   job.spec = frames_spec(o, plan, *job.scene);
+  if (o.label && !o.overlay && plan.variants.size() > 1) job.spec.title = std::string(scenes::output_name(*job.scene));
   check_render_work(o, plan.size, job);
   place_panels(o, o.overlay ? 1 : plan.variants.size(), job);
   std::vector<const World*> worlds;
@@ -483,6 +521,7 @@ nlohmann::json frames_info(const RenderOptions& o, const RenderPlan& plan, const
        {"orbit_deg_per_s", overlays.orbit_deg_per_s},
        {"contacts", overlays.contacts},
        {"velocities", overlays.velocities},
+       {"forces", overlays.forces},
        {"rods", overlays.rods},
        {"label", o.label},
        {"overrides", overrides_json(o.overrides)},

@@ -38,6 +38,9 @@ struct RenderJob {
   bool overlay = false;
   std::string legend_heading;
   std::vector<PageLegendEntry> legend;
+  /// The title strip above the panels (with --label and several panels: the scene's name, which
+  /// the panels' captions then leave out); empty: none.
+  std::string title;
 };
 
 /// Number of frames of a job: floor(seconds * fps / speed) + 1 (frame 0 at t = 0), in 64-bit
@@ -66,10 +69,19 @@ struct Panel {
 /// The caption page of a frame of `job` at simulated time t (s) whose panels carry these labels:
 /// a grid of job.columns (one panel with job.overlay) filling job.frame_width x
 /// job.frame_height, each caption its label (if any) and time_caption(t), the overlay's legend,
-/// no title, text of max(10, cell height / 30) px (the frame's cell height, so a 1280x720 frame
-/// of one panel has 24 px text, a 2x3 grid of it 12 px). The panel size is fit_panels's and no
-/// image is set. Throws std::invalid_argument if job.frame_width or frame_height is <= 0.
+/// job.title, text of max(10, cell height / 30) px (the frame's cell height, so a 1280x720 frame
+/// of one panel has 24 px text, a 2x3 grid of it 12 px). A caption takes at most a quarter of
+/// its cell's height (caption_for_cell): a label's lines after its first (a method's description)
+/// are left out of small cells, of every cell when of one. The panel size is fit_panels's and no image is set. Throws
+/// std::invalid_argument if job.frame_width or frame_height is <= 0.
 FigurePage frame_page(const RenderJob& job, const std::vector<std::string>& labels, double t);
+
+/// `label` as a caption of a cell cell_width x cell_height px (> 0) in text of `font` px with a
+/// time line below it: whole if its lines (wrapped, estimating a glyph 0.55 em wide) take at
+/// most a quarter of the cell's height at 1.25 em a line; else its first line only (the variant,
+/// "push = split"), so that small panels keep their picture. No errors.
+std::string caption_for_cell(const std::string& label, double cell_width, double cell_height,
+                             double font);
 
 /// Whether the frames of `job` carry caption strips: with job.overlay (the time and the legend)
 /// or when any label is not empty, and a frame size is set.

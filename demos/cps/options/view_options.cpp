@@ -69,6 +69,10 @@ void add_view_options(CLI::App& cmd, View& view, bool& label, bool label_default
   cmd.add_flag("--velocities", overlays.velocities,
                "draw each body's velocity as a dark blue arrow from its centre, as long as the way "
                "it goes in 0.1 s (m); default: off");
+  cmd.add_flag("--forces", overlays.forces,
+               "draw each contact point's force on its body b over the last step as an orange "
+               "arrow, as long as the lighter body's size when the force equals its weight; "
+               "default: off");
   // Each switch once: "--label --no-label" is refused, not decided by the last.
   cmd.add_flag("--rods,!--no-rods", overlays.rods,
                "draw distance constraints as rods; default: on (--no-rods hides them)")

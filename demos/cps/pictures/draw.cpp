@@ -111,6 +111,32 @@ void add_velocities(const World& world, const glm::vec3& eye, render::DrawList& 
   }
 }
 
+// Force overlay: at each contact point an arrow of its force on b (contact_forces), scaled to
+// the lighter movable body of the pair: its weight is as long as its size.
+void add_forces(const World& world, const glm::vec3& eye, render::DrawList& list) {
+  const std::vector<Vec3> forces = contact_forces(world);
+  if (forces.empty()) return;
+  const glm::vec3 orange(0.95f, 0.45f, 0.0f);
+  const double g = world.def().gravity.norm();
+  const auto& bodies = world.bodies();
+  std::size_t k = 0;
+  for (const Manifold& m : world.manifolds()) {
+    const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
+    const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
+    // The lighter movable body (a static one has mass 0 here).
+    const Body& light = a.is_static() ? b : b.is_static() ? a : (a.mass <= b.mass ? a : b);
+    const double weight = light.mass * g;
+    const double size = body_size(light);
+    for (int i = 0; i < m.count; ++i, ++k) {
+      if (!(weight > 0.0) || !(size > 0.0) || k >= forces.size()) continue;
+      const Vec3 arrow = forces[k] * (size / weight);
+      if (!arrow.allFinite() || arrow.norm() < 1e-3) continue;
+      const Vec3& p = m.contacts[static_cast<std::size_t>(i)].point;
+      add_arrow(to_glm(p), to_glm(p + arrow), orange, eye, list);
+    }
+  }
+}
+
 // `camera` turned about the vertical axis through its target by `deg` degrees.
 render::Camera orbit(render::Camera camera, double deg) {
   const float a = static_cast<float>(deg * 3.14159265358979323846 / 180.0);
@@ -130,6 +156,30 @@ std::string vec_text(const glm::vec3& v) {
 }
 
 }  // namespace
+
+std::vector<Vec3> contact_forces(const World& world) {
+  std::size_t points = 0;
+  for (const Manifold& m : world.manifolds()) points += static_cast<std::size_t>(m.count);
+  const std::vector<ConstraintRow>& rows = world.rows();
+  const std::vector<double>& lambda = world.lambda();
+  if (points == 0 || rows.size() < points || lambda.size() != rows.size()) return {};
+  for (std::size_t r = 0; r < points; ++r) {
+    if (rows[r].kind != RowKind::contact) return {};
+  }
+  std::vector<Vec3> forces(points, Vec3::Zero());
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    const ConstraintRow& row = rows[r];
+    // j = [-n, -(r_a x n), n, r_b x n]: its third block is the row's direction on b.
+    const Vec3 on_b = row.j.segment<3>(6);
+    if (row.kind == RowKind::contact && r < points) {
+      forces[r] += lambda[r] * on_b;
+    } else if (row.kind == RowKind::friction && row.normal_row >= 0 &&
+               static_cast<std::size_t>(row.normal_row) < points) {
+      forces[static_cast<std::size_t>(row.normal_row)] += lambda[r] * on_b;
+    }
+  }
+  return forces;
+}
 
 render::Camera camera_at(const DrawStyle& style, std::size_t run, double t) {
   render::Camera camera = style.camera;
@@ -199,6 +249,7 @@ render::DrawList draw_list(const World& world, const DrawStyle& style, std::size
   }
   if (style.overlays.contacts) add_contacts(world, list);
   if (style.overlays.velocities) add_velocities(world, list.camera.eye, list);
+  if (style.overlays.forces) add_forces(world, list.camera.eye, list);
   for (const Body& b : bodies) {
     if (b.shape.kind != ShapeKind::plane) continue;
     const Vec3 n = b.rotation() * b.shape.normal;

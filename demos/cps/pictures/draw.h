@@ -30,6 +30,11 @@ struct Overlays {
   /// (the way it would go in that time), drawn from its centre of mass moved towards the eye out
   /// of its bounding sphere, so that the body does not hide it; none below 1 mm.
   bool velocities = false;
+  /// Each contact point's force on body b over the last step (contact_forces: its contact and
+  /// friction rows' lambda, N) as an orange arrow from the point, as long as the size of the
+  /// pair's lighter movable body when the force equals that body's weight m |g|; none below
+  /// 1 mm, and none where the step kept no rows.
+  bool forces = false;
   /// Rotation of the camera eye about the vertical axis through its target, in degrees per
   /// second of simulated time (0: fixed camera; typical 10). The angle at a picture is
   /// orbit_deg_per_s * world.time().
@@ -45,6 +50,14 @@ struct CameraPath {
   std::vector<glm::vec3> target_m;    ///< one per time
   std::vector<float> distance_m;      ///< one per time, > 0
 };
+
+/// The force (N, world frame) each contact point of the last step put on body b of its
+/// manifold (World::manifolds, in order; normals from a to b): the sum over the point's contact
+/// row and its two friction rows of lambda j_b, from World::rows and World::lambda (the first
+/// solve's lambda: with the paper's push factor the whole contact force; the split push's second
+/// solve is the push, not a force). Empty when the step's first rows are not one contact row a
+/// point (a world before its first step). No errors.
+std::vector<Vec3> contact_forces(const World& world);
 
 /// The time (s) a velocity arrow stands for: an arrow is v x this long (m). 0.1 s: a body at
 /// 10 m/s gets a 1 m arrow.

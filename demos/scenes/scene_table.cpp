@@ -146,7 +146,10 @@ const std::array kScenes = {
           .populate = &populate_pendulum_wave,
           .make_metrics = &make_pendulum_wave_metrics,
           .plane_opacity = 1.0,
-          .camera = CameraPreset{Vec3(2.2, 2.1, 1.7), Vec3(1.225, 0.72, 0.0), 45.0},
+          // From the front and above (55 degrees): the pendulums swing in the y-z plane, so
+          // their swing shows across the picture as the wave, not towards the eye; the 2.45 m
+          // row spans about 80 % of a 16:9 picture's width.
+          .camera = CameraPreset{Vec3(1.225, 2.5, 1.4), Vec3(1.225, 0.95, 0.0), 45.0},
           .bench = {.start_s = 1.0, .seconds = 3.0,
                     .reason = "from 1 s: the pendulums swing on their rods (the scene has no contacts)"},
           .report = {.horizon_s = std::nullopt,

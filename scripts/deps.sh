@@ -28,6 +28,9 @@ cps_packages=(
   # FCLIB files of `cps export --fclib` (optional: without it the option says it was left out).
   # fclib.h at build time; cps opens libfclib.so.0 (libfclib0, a dependency) only for --fclib.
   libfclib-dev
+  # The Python module cps (demos/python, docs/python.md) and its tests: pybind11 and Debian's
+  # python3 with numpy and pytest; matplotlib draws the worked example's plot (docs/python.md).
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
 )
 
 cps_install_missing() {

@@ -88,6 +88,25 @@ int World::add_body(const BodyDef& def) {
   return static_cast<int>(bodies_.size()) - 1;
 }
 
+void World::set_body_state(int i, const Vec3& x, const Quat& o, const Vec3& v, const Vec3& w) {
+  if (i < 0 || i >= static_cast<int>(bodies_.size())) {
+    throw std::invalid_argument("body " + std::to_string(i) + " does not exist (there are " +
+                                std::to_string(bodies_.size()) + " bodies)");
+  }
+  const Body& old = bodies_[static_cast<std::size_t>(i)];
+  BodyDef def;
+  def.shape = old.shape;
+  def.is_static = old.is_static();
+  if (!def.is_static) def.mass = old.mass;
+  def.position = x;
+  def.orientation = o;
+  def.velocity = v;
+  def.angular_velocity = w;
+  def.restitution = old.restitution;
+  def.friction = old.friction;
+  bodies_[static_cast<std::size_t>(i)] = make_body(def);  // throws before anything changes
+}
+
 int World::add_distance(const DistanceConstraint& d) {
   const int n = static_cast<int>(bodies_.size());
   std::ostringstream why;

@@ -107,6 +107,13 @@ class World {
   /// Adds a body and returns its index. Throws std::invalid_argument (see make_body) and leaves
   /// the world unchanged on bad input.
   int add_body(const BodyDef& def);
+  /// Replaces body i's state: position x (m, 3), orientation o (unit quaternion, body to world),
+  /// linear velocity v (m/s, 3) and angular velocity w (rad/s, 3, world frame); a static body
+  /// keeps p = l = 0 whatever v and w say. Its shape, mass and coefficients stay. The last
+  /// step's manifolds, rows and warm-start cache stay too (the next step collides again).
+  /// Throws std::invalid_argument for an index outside [0, bodies), or any value make_body
+  /// refuses, and leaves the world unchanged.
+  void set_body_state(int i, const Vec3& x, const Quat& o, const Vec3& v, const Vec3& w);
 
   /// Adds a distance constraint (Sec. 5.2) and returns its index. Throws std::invalid_argument
   /// naming the value, leaving the world unchanged, for a body index that does not exist or is

@@ -29,4 +29,18 @@ scenes=("$share"/scenes/*.json)
 # An installed example scene file runs by its path.
 PATH="$dir/prefix/bin:$PATH" cps simulate "${scenes[0]}" --seconds 0.1 > /dev/null ||
   fail "an installed example scene file does not run"
-echo "install: cps runs from $dir/prefix/bin; schema, ${#scenes[@]} example scenes and the baselines in share/cps"
+# Where the Python module was built, it is installed and imports from PREFIX/lib/python3/dist-packages
+# (PYTHON: the interpreter it was built for; PYTHON is unset where it was not built).
+python_note=""
+if [ -n "${PYTHON:-}" ]; then
+  modules=("$dir"/prefix/lib/python3/dist-packages/cps*.so)
+  [ -f "${modules[0]}" ] || fail "no Python module in PREFIX/lib/python3/dist-packages"
+  hash=$(PYTHONPATH="$dir/prefix/lib/python3/dist-packages" "$PYTHON" -c \
+         "import cps; r = cps.Run('stack'); r.advance_to(0.5); print(r.state_hash())") ||
+    fail "the installed Python module does not import and step"
+  expected=$(PATH="$dir/prefix/bin:$PATH" cps simulate stack --seconds 0.5 --json)
+  grep -q "\"state_hash\": \"$hash\"" <<< "$expected" ||
+    fail "the installed Python module's state hash $hash is not cps simulate's"
+  python_note="; the Python module in lib/python3/dist-packages"
+fi
+echo "install: cps runs from $dir/prefix/bin; schema, ${#scenes[@]} example scenes and the baselines in share/cps$python_note"

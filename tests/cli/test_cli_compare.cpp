@@ -139,6 +139,21 @@ TEST_CASE("the intersecting stack's column fills a quarter of each panel of a 2-
     INFO("column from row " << top << " to " << bottom);
     CHECK(bottom - top + 1 >= 90);
   }
+  // run.json records the moving camera: each panel's at the first and the last frame, the
+  // split run's (the column at rest) nearer than the Baumgarte run's (cubes in flight) at 1 s.
+  const nlohmann::json c = nlohmann::json::parse(slurp(folder / "run.json"))["parameters"];
+  CHECK(c["camera"] == "fit:frame");
+  REQUIRE(c["camera_resolved"]["moves"] == true);
+  const auto distance = [&](int panel) {
+    const nlohmann::json& cam = c["camera_resolved"]["last_frame_by_panel"][panel];
+    double d2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const double d = cam["eye_m"][a].get<double>() - cam["target_m"][a].get<double>();
+      d2 += d * d;
+    }
+    return std::sqrt(d2);
+  };
+  CHECK(distance(1) < 0.5 * distance(0));
 }
 
 TEST_CASE("captions take at most a quarter of a small panel: 8 methods at 640x360 keep 65 % of "

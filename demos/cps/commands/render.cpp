@@ -384,6 +384,19 @@ void place_panels(const RenderOptions& o, std::size_t panels, SceneRender& job) 
   }
 }
 
+// run.json's camera_resolved: the camera of every frame, or for a camera that moves or differs
+// by panel (fit:panel, fit:frame, track:BODY) each panel's at the first and the last frame.
+nlohmann::json resolved_camera_json(const DrawStyle& style, std::size_t panels, double last_t) {
+  if (style.paths.empty()) return camera_json(style.camera);
+  nlohmann::json first = nlohmann::json::array();
+  nlohmann::json last = nlohmann::json::array();
+  for (std::size_t p = 0; p < std::max<std::size_t>(1, std::min(panels, style.paths.size())); ++p) {
+    first.push_back(camera_json(camera_at(style, p, 0.0)));
+    last.push_back(camera_json(camera_at(style, p, last_t)));
+  }
+  return {{"moves", true}, {"first_frame_by_panel", first}, {"last_frame_by_panel", last}};
+}
+
 // Plans one scene's frames: what they are, the work bound, the panels, the camera (resolve_style
 // at the scene's aspect) and the frames folder (plan_output: its foreign files). Throws
 // UsageError.
@@ -512,7 +525,7 @@ nlohmann::json frames_info(const RenderOptions& o, const RenderPlan& plan, const
        {"layout", layout},
        {"backend", o.backend},
        {"camera", scene_view(*job.scene, o.view).camera},
-       {"camera_resolved", camera_json(job.style.camera)},
+       {"camera_resolved", resolved_camera_json(job.style, job.runs.size(), frame_time(spec, frame_count(spec) - 1))},
        {"eye_m", o.view.eye ? nlohmann::json{o.view.eye->x(), o.view.eye->y(), o.view.eye->z()}
                             : nlohmann::json(nullptr)},
        {"target_m", o.view.target ? nlohmann::json{o.view.target->x(), o.view.target->y(), o.view.target->z()}

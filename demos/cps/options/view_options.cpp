@@ -82,7 +82,9 @@ void add_view_options(CLI::App& cmd, View& view, bool& label, bool label_default
                    (label_default ? "on (--no-label leaves the pictures bare)" : "off (variants of --compare are always labelled)"))
       ->multi_option_policy(CLI::MultiOptionPolicy::Throw);
   cmd.add_option("--camera", view.camera,
-                 "view: preset (the scene's own; fit for a scene file without a camera), auto "
+                 "view: preset (the scene's own; when --camera is not given a scene may frame "
+                 "itself instead: fit:frame for intersecting_stack, fit for a scene file without "
+                 "a camera), auto "
                  "(framed on the bodies as built), fit "
                  "(framed on the bodies in the action over the whole run: a headless pre-run of "
                  "the same length, all --compare variants, seen from the preset's direction; a "

@@ -10,6 +10,13 @@
 
 namespace cps::cli {
 
+/// Runs the cps command line argv[0, argc) (argv[0] the program's name, argv[1] the command) as
+/// the `cps` executable does: parses it, runs the command, prints its output and messages, and
+/// returns the exit status: 0, 1 (a failure), 2 (a usage error) or 3 (a warning under
+/// --warnings-as-errors). The diagnostics (--quiet, the warnings printed) start anew each call.
+/// No exception escapes (cli_main.cpp).
+int run_command(int argc, char** argv);
+
 /// A registered command: its CLI11 subcommand, and what runs it once the command line is parsed
 /// (the options it reads live as long as `run`).
 struct Command {

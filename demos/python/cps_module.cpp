@@ -3,6 +3,7 @@
 // (docs/python.md). Errors: bad input raises ValueError with the command's message, a file that
 // cannot be read OSError; no call lets a C++ exception or a crash reach the interpreter.
 #include "box3d_pyramids.h"
+#include "command.h"
 #include "options/options.h"
 #include "pictures/draw.h"
 #include "scene.h"
@@ -21,6 +22,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -176,6 +178,68 @@ py::array_t<double, py::array::c_style | py::array::forcecast> checked(const py:
     }
   }
   return a;
+}
+
+// Runs a cps command line in this process (run_command) with argv ["cps", args...]. Its messages
+// on std::cerr are kept and printed after it; exit 2 raises ValueError with them, exit 1
+// RuntimeError; else the exit status (0, or 3 for a warning under --warnings-as-errors).
+int command(const std::vector<std::string>& args) {
+  if (args.empty()) throw py::value_error("cps.command: give the command and its arguments, e.g. ['list']");
+  std::vector<std::string> words = {"cps"};
+  words.insert(words.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  std::ostringstream messages;
+  int status = 0;
+  {
+    py::gil_scoped_release release;
+    std::cout.flush();
+    std::streambuf* old = std::cerr.rdbuf(messages.rdbuf());
+    status = cli::run_command(static_cast<int>(words.size()), argv.data());
+    std::cerr.rdbuf(old);
+    std::cout.flush();
+  }
+  std::string text = messages.str();
+  if (!text.empty()) std::cerr << text << std::flush;
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  if (status == 2) throw py::value_error(text);
+  if (status == 1) throw std::runtime_error(text);
+  return status;
+}
+
+// The command line of `cps COMMAND scene` with **options as flags: key k becomes --k with '_' as
+// '-'; True alone, False and None left out; a (width, height) size as WxH; a list or tuple joined
+// by commas; numbers with 17 digits.
+int command_with_options(const std::string& name, const std::string& scene, const py::kwargs& options) {
+  std::vector<std::string> args = {name, scene};
+  for (const auto& [key, value] : options) {
+    std::string flag = "--" + py::str(key).cast<std::string>();
+    for (char& c : flag) c = c == '_' ? '-' : c;
+    if (value.is_none()) continue;
+    if (py::isinstance<py::bool_>(value)) {
+      if (value.cast<bool>()) args.push_back(flag);
+      continue;
+    }
+    const auto text = [](const py::handle& v) -> std::string {
+      if (py::isinstance<py::float_>(v)) {
+        char buffer[64];
+        std::snprintf(buffer, sizeof buffer, "%.17g", v.cast<double>());
+        return buffer;
+      }
+      return py::str(v).cast<std::string>();
+    };
+    std::string joined;
+    if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
+      const char* separator = flag == "--size" ? "x" : ",";
+      for (const py::handle item : value) joined += (joined.empty() ? "" : separator) + text(item);
+    } else {
+      joined = text(value);
+    }
+    args.push_back(flag);
+    args.push_back(joined);
+  }
+  return command(args);
 }
 
 /// A world built from a scene (cps.Run): see the docstrings below.
@@ -423,6 +487,30 @@ PYBIND11_MODULE(cps, m) {
         "The world parameter table: a list of dicts with name (a keyword of cps.Run), json_key "
         "(also a keyword), flag (the command's option), unit (SI), allowed, default (as text), "
         "help and choices.");
+  m.def("command", &cps::python::command, py::arg("args"),
+        "Runs a cps command line in this process, as the `cps` executable runs it: "
+        "cps.command(['figure', 'stack', '--times', '0,1', '--out', 'figs/']). Its output and "
+        "messages print as the command's do; files go where the command puts them, under its "
+        "output rule (nothing foreign overwritten, nothing half written). Returns the exit status "
+        "(0, or 3 for a warning under --warnings-as-errors). Raises ValueError for a usage error "
+        "(exit 2, with the command's message), RuntimeError for a failure (exit 1).");
+  m.def("render",
+        [](const std::string& scene, const py::kwargs& options) {
+          return cps::python::command_with_options("render", scene, options);
+        },
+        py::arg("scene"),
+        "`cps render SCENE` with options as keywords (out='out', seconds=2, fps=1, "
+        "size=(160, 120), camera='fit', compare='push', push='split', video='mp4', label=True): "
+        "writes the frames (and video) under the command's output rule. Returns and raises as "
+        "cps.command.");
+  m.def("figure",
+        [](const std::string& scene, const py::kwargs& options) {
+          return cps::python::command_with_options("figure", scene, options);
+        },
+        py::arg("scene"),
+        "`cps figure SCENE` with options as keywords (times=[0, 1, 2], size=(400, 225), "
+        "out='figs/', compare='push', velocities=True): writes the figure and its sidecar under "
+        "the command's output rule. Returns and raises as cps.command.");
   py::class_<PyRun>(m, "Run",
                     "A world built from a scene, ready to step.\n\n"
                     "Run(scene, **params): scene is a built-in name ('stack', 'pyramid_100', "

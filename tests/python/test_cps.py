@@ -219,3 +219,43 @@ def test_the_worked_example_runs_and_draws_its_plot(tmp_path):
     moved = run.state()["positions"][top] - start[top]
     assert f"{math.hypot(moved[0], moved[2]):.4f} m" in lines[-1]
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_figure_and_render_write_what_the_command_writes(tmp_path):
+    # The same figure through cps.figure and through the command: the same PNG bytes; the frames
+    # of cps.render where the command puts them.
+    if not CPS_EXE:
+        pytest.skip("CPS_EXE is not set")
+    assert cps.figure("stack", times=[0, 1], size=(160, 90), out=str(tmp_path / "py") + "/") == 0
+    subprocess.run([CPS_EXE, "figure", "stack", "--times", "0,1", "--size", "160x90", "--out",
+                    str(tmp_path / "cmd") + "/"], check=True, capture_output=True)
+    assert (tmp_path / "py" / "stack.png").read_bytes() == (tmp_path / "cmd" / "stack.png").read_bytes()
+    assert cps.render("stack", seconds=1, fps=1, size=(160, 120), out=str(tmp_path / "frames"), quiet=True) == 0
+    assert sorted(p.name for p in (tmp_path / "frames" / "stack").glob("*.png")) == \
+        ["frame_000000.png", "frame_000001.png"]
+
+
+def test_command_keeps_the_output_rule_and_raises_the_commands_errors(tmp_path):
+    # A file cps did not write is never overwritten: the call raises ValueError (exit 2) and the
+    # file keeps its bytes.
+    out = tmp_path / "figs"
+    out.mkdir()
+    (out / "stack.png").write_bytes(b"mine")
+    with pytest.raises(ValueError) as e:
+        cps.figure("stack", times=[0], size=(64, 36), out=str(out) + "/")
+    assert "stack.png" in str(e.value)
+    assert (out / "stack.png").read_bytes() == b"mine"
+    with pytest.raises(ValueError) as e:
+        cps.render("stack", secnds=1)
+    assert "did you mean '--seconds'" in str(e.value)
+    with pytest.raises(ValueError):
+        cps.command([])
+    assert cps.command(["list"]) == 0
+
+
+def test_each_command_is_judged_on_its_own_warnings():
+    # --warnings-as-errors makes the Baumgarte push's energy warning exit 3; the same run again
+    # without the flag exits 0: the flag does not carry over between calls.
+    args = ["simulate", "intersecting_stack", "--seconds", "0.1", "--quiet"]
+    assert cps.command(args + ["--warnings-as-errors"]) == 3
+    assert cps.command(args) == 0

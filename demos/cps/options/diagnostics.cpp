@@ -30,6 +30,14 @@ void add_diagnostic_flags(CLI::App& command) {
                    "that a CI job fails on it");
 }
 
+void reset_diagnostics() {
+  State& s = state();
+  s.quiet = false;
+  s.warnings_as_errors = false;
+  s.warnings = 0;
+  s.kinds_printed.clear();
+}
+
 bool quiet() { return state().quiet; }
 
 void note(const std::string& text) {

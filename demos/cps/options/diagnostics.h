@@ -17,6 +17,11 @@ inline constexpr int kWarningsExit = 3;
 /// command parsed sets them. No errors.
 void add_diagnostic_flags(CLI::App& command);
 
+/// Clears what the diagnostics hold (--quiet, --warnings-as-errors, the warnings printed and
+/// their kinds), so that a process running several command lines (run_command) judges each on
+/// its own. No errors.
+void reset_diagnostics();
+
 /// --quiet: no progress, no notes, each kind of warning once as one line (warn). No errors.
 bool quiet();
 

@@ -118,6 +118,7 @@ namespace cps::cli {
 
 int run_command(int argc, char** argv) {
   reset_diagnostics();
+  clear_inputs();
   CLI::App app{"cps: the constraint based physics solver of Tamis & Maggiore (2015)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", version_text);

@@ -259,3 +259,16 @@ def test_each_command_is_judged_on_its_own_warnings():
     args = ["simulate", "intersecting_stack", "--seconds", "0.1", "--quiet"]
     assert cps.command(args + ["--warnings-as-errors"]) == 3
     assert cps.command(args) == 0
+
+
+def test_an_input_of_one_command_may_be_the_output_of_the_next(tmp_path, monkeypatch):
+    # A command never writes over its own input; the inputs of an earlier call in the same
+    # process are not this call's: a scene file read by simulate is then written by scene.
+    monkeypatch.chdir(tmp_path)
+    assert cps.command(["scene", "stack", "--out", "a.json"]) == 0
+    assert cps.command(["simulate", "a.json", "--seconds", "0.1", "--quiet"]) == 0
+    assert cps.command(["scene", "stack", "--out", "a.json", "--force"]) == 0
+    # Within one command it still is refused: simulate's --trace onto its own scene file.
+    with pytest.raises(ValueError) as e:
+        cps.command(["simulate", "a.json", "--seconds", "0.1", "--trace", "a.json", "--force"])
+    assert "input" in str(e.value)

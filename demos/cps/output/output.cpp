@@ -406,6 +406,12 @@ void note_input(const fs::path& path) {
   i.paths.push_back(path);
 }
 
+void clear_inputs() {
+  Inputs& i = inputs();
+  const std::lock_guard<std::mutex> lock(i.mutex);
+  i.paths.clear();
+}
+
 namespace {
 
 // Throws UsageError if `target` is one of this command's inputs (the same file by any path).

@@ -81,6 +81,10 @@ struct OutputPlan {
 /// target that is this file (the same inode, by any path), with or without force. Thread-safe.
 void note_input(const std::filesystem::path& path);
 
+/// Forgets the inputs noted so far, so that a process running several command lines
+/// (run_command) checks each against its own. Thread-safe.
+void clear_inputs();
+
 /// Checks that `request.folder` may receive `request.files` and returns the plan. Reads only
 /// (hashing the folder's own files); writes nothing. Throws UsageError (exit 2), naming the path
 /// and what to do (`request.option` names the option to change):

@@ -35,6 +35,13 @@ namespace py = pybind11;
 namespace cps::python {
 namespace {
 
+// A number as the command line takes it: 17 significant digits, so it parses back exactly.
+std::string decimal(double v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
 // A JSON value as the Python object json.loads gives.
 py::object to_python(const nlohmann::json& j) {
   return py::module_::import("json").attr("loads")(j.dump());
@@ -100,9 +107,7 @@ ParameterValue parameter_value(const Parameter& p, const py::handle& value) {
   if (py::isinstance<py::bool_>(value)) {
     text = value.cast<bool>() ? "true" : "false";
   } else if (py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value)) {
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, "%.17g", value.cast<double>());
-    text = buffer;
+    text = decimal(value.cast<double>());
   } else if (py::isinstance<py::str>(value)) {
     text = value.cast<std::string>();
   } else if (py::isinstance<py::sequence>(value) && py::len(value) == 3) {
@@ -111,9 +116,7 @@ ParameterValue parameter_value(const Parameter& p, const py::handle& value) {
           py::isinstance<py::bool_>(item)) {
         throw py::value_error(std::string(p.json_key) + ": three numbers are needed");
       }
-      char buffer[64];
-      std::snprintf(buffer, sizeof buffer, "%.17g", item.cast<double>());
-      text += (text.empty() ? "" : ",") + std::string(buffer);
+      text += (text.empty() ? "" : ",") + decimal(item.cast<double>());
     }
   } else {
     throw py::value_error(std::string(p.json_key) + ": a value of type " +
@@ -222,17 +225,16 @@ int command_with_options(const std::string& name, const std::string& scene, cons
       continue;
     }
     const auto text = [](const py::handle& v) -> std::string {
-      if (py::isinstance<py::float_>(v)) {
-        char buffer[64];
-        std::snprintf(buffer, sizeof buffer, "%.17g", v.cast<double>());
-        return buffer;
-      }
+      if (py::isinstance<py::float_>(v)) return decimal(v.cast<double>());
       return py::str(v).cast<std::string>();
     };
     std::string joined;
     if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
       const char* separator = flag == "--size" ? "x" : ",";
-      for (const py::handle item : value) joined += (joined.empty() ? "" : separator) + text(item);
+      for (const py::handle item : value) {
+        if (!joined.empty()) joined += separator;
+        joined += text(item);
+      }
     } else {
       joined = text(value);
     }

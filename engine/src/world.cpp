@@ -53,7 +53,8 @@ World::World(const World& other)
       bodies_(other.bodies_),
       distances_(other.distances_),
       ctx_(std::make_unique<StepContext>(*other.ctx_)),
-      broad_phase_(std::make_unique<BroadPhase>()) {}
+      broad_phase_(std::make_unique<BroadPhase>()),
+      body_friction_(other.body_friction_) {}
 
 World& World::operator=(const World& other) {
   if (this != &other) *this = World(other);

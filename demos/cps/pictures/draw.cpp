@@ -633,12 +633,12 @@ std::size_t tracked_body(const scenes::Scene& scene, const World& world, const s
   for (const std::string& name : names) {
     if (!name.empty()) named.push_back(name);
   }
+  const std::string range = n == 0 ? std::string("the world has no body")
+                                    : "give a body index from 0 to " + std::to_string(n - 1);
   if (named.empty()) {
-    message += "no body of " + std::string(scene.name) + " has that index; give a body index from 0 to " +
-               std::to_string(n - 1);
+    message += "no body of " + std::string(scene.name) + " is named or numbered so (its bodies have no names); " + range;
   } else {
-    message += "no body is named so; did you mean '" + nearest_name(text, named) +
-               "'? (or give a body index from 0 to " + std::to_string(n - 1) + ")";
+    message += "no body is named so; did you mean '" + nearest_name(text, named) + "'? (or " + range + ")";
   }
   throw UsageError(message);
 }

@@ -69,4 +69,28 @@ cps_configure() {
 cps_build() {
   cps_configure build -DCMAKE_BUILD_TYPE=Release "$@"
   cmake --build build --parallel "$(nproc)"
+  cps_link_python
+}
+
+# Where the build folder (default build) has the Python module, points its interpreter's user
+# site at FOLDER/python with the file cps-build.pth (what an editable install writes), so that
+# `import cps` finds this build from any folder. The file names one folder; a build in another
+# clone replaces it. Skipped where the interpreter has no user site; `cmake --install` or
+# PYTHONPATH then. Usage: cps_link_python [FOLDER]
+cps_link_python() {
+  local build=${1:-build}
+  [ -f "$build/python/interpreter.txt" ] || return 0
+  compgen -G "$build/python/cps.*.so" > /dev/null || return 0
+  local python site
+  python=$(head -n 1 "$build/python/interpreter.txt")
+  site=$("$python" -c 'import site; print(site.getusersitepackages() if site.ENABLE_USER_SITE else "")' 2> /dev/null) || return 0
+  [ -n "$site" ] || return 0
+  local pth="$site/cps-build.pth" folder
+  folder=$(cd "$build/python" && pwd)
+  if [ "$(cat "$pth" 2> /dev/null)" != "$folder" ]; then
+    mkdir -p "$site"
+    printf '%s\n' "$folder" > "$pth.tmp.$$"
+    mv "$pth.tmp.$$" "$pth"
+  fi
+  echo "cps: $python imports cps from $folder ($pth)"
 }

@@ -6,7 +6,8 @@
 # Usage: install.sh CMAKE BUILD_DIR
 set -euo pipefail
 cmake=$1
-build=$2
+build=$(cd "$2" && pwd)
+scripts=$(cd "$(dirname "$0")/../../scripts" && pwd)
 dir=$(mktemp -d "${TMPDIR:-/tmp}/cps-install.XXXXXX")
 trap 'rm -rf "$dir"' EXIT
 fail() { echo "install: $1" >&2; exit 1; }
@@ -41,6 +42,23 @@ if [ -n "${PYTHON:-}" ]; then
   expected=$(PATH="$dir/prefix/bin:$PATH" cps simulate stack --seconds 0.5 --json)
   grep -q "\"state_hash\": \"$hash\"" <<< "$expected" ||
     fail "the installed Python module's state hash $hash is not cps simulate's"
-  python_note="; the Python module in lib/python3/dist-packages"
+  # --prefix at the interpreter's user base (~/.local) installs into its user site, where a bare
+  # `import cps` finds it.
+  userbase="$dir/userbase"
+  PYTHONUSERBASE=$userbase "$cmake" --install "$build" --prefix "$userbase" > "$dir/install-user.log" ||
+    fail "$(cat "$dir/install-user.log")"
+  usersite=$(PYTHONUSERBASE=$userbase "$PYTHON" -c 'import site; print(site.getusersitepackages())')
+  found=$(PYTHONUSERBASE=$userbase "$PYTHON" -c 'import cps; print(cps.__file__)') ||
+    fail "after cmake --install --prefix USERBASE, import cps fails"
+  [[ $found == "$usersite"/cps.* ]] || fail "import cps found $found, not the module in $usersite"
+  # The quick start's build (cps_link_python of scripts/deps.sh) makes a bare `import cps` find the
+  # build folder's module; a second call keeps the same file.
+  linkbase="$dir/linkbase"
+  (source "$scripts/deps.sh" && PYTHONUSERBASE=$linkbase cps_link_python "$build") > "$dir/link.log" ||
+    fail "cps_link_python failed: $(cat "$dir/link.log")"
+  found=$(PYTHONUSERBASE=$linkbase "$PYTHON" -c 'import cps; print(cps.__file__)') ||
+    fail "after cps_link_python, import cps fails"
+  [[ $found == "$(cd "$build/python" && pwd)"/cps.* ]] || fail "after cps_link_python, import cps found $found"
+  python_note="; the Python module in lib/python3/dist-packages and in a user site; the build's through cps-build.pth"
 fi
 echo "install: cps runs from $dir/prefix/bin; schema, ${#scenes[@]} example scenes and the baselines in share/cps$python_note"

@@ -1,8 +1,10 @@
 // Augmented Vertex Block Descent: `--push avbd`. Sources: C. Giles, E. Diaz, C. Yuksel,
 // "Augmented Vertex Block Descent", ACM TOG 44(4) (SIGGRAPH 2025), Eqs. 2-19; the authors' 2D
 // demo savant117/avbd-demo2d (source/solver.cpp Solver::step, manifold.cpp, joint.cpp), read for
-// the order of the updates and its defaults; A. Chen, Z. Chen, C. Yuksel, "Vertex Block Descent"
-// (2024) for the adaptive warm start. The authors published 2D only; the 3D block is derived here.
+// the order of the updates and its defaults, and their 3D demo savant117/avbd-demo3d
+// (manifold.cpp: the friction cone and the stick test; solver.cpp: the sweep order); A. Chen, Z.
+// Chen, C. Yuksel, "Vertex Block Descent" (2024) for the adaptive warm start. The rods' geometric
+// stiffness is derived here.
 //
 // A primal solver: no A lambda = b is solved (the rows World::step built are not used, so
 // `--solver`, `--assembly`, `--friction-model` and `--warm-start` have no effect; they are
@@ -12,8 +14,8 @@
 //   vector, rad); the inertial target y = (v dt + g dt^2, w dt) (Eq. 2);
 //   the initial guess dx = v dt + g a dt^2, theta = w dt, a = clamp((v - v_prev) . g / |g|^2,
 //   0, 1) (the adaptive warm start of VBD, as the demo).
-// Then `iterations` sweeps of block coordinate descent over the bodies (Gauss-Seidel order of
-// body index), each body solving with Eigen's LDLT the 6 x 6 system (Eqs. 4-6, 13, 17)
+// Then `iterations` sweeps of block coordinate descent over the bodies (Gauss-Seidel, the last
+// body added first, as the 3D demo's lists), each body solving with Eigen's LDLT the 6 x 6 system (Eqs. 4-6, 13, 17)
 //   H dq = -g,  H = M / dt^2 + sum_j k_j J_j J_j^T + G_j,
 //               g = M / dt^2 (q - y) + sum_j J_j f_j,  f_j = clamp(k_j C_j + lambda_j, limits)
 // with M = diag(m, m, m, I) and J_j the 6-gradient of constraint j for this body; G_j the
@@ -22,7 +24,8 @@
 // additive (the exact derivative of exp(theta) R0 r is dtheta x (R r) only at theta = 0: an
 // approximation of order |theta|, the rotation in one step). After each sweep the dual update
 // (Eqs. 11, 16): lambda_j = clamp(k_j C_j + lambda_j, limits), and where lambda_j is strictly
-// inside its limits, k_j = min(k_j + beta |C_j|, k_max). After the `iterations` sweeps:
+// inside its limits, k_j = min(k_j + beta |C_j|, k_max) (a contact's tangent rows: while its
+// friction is inside the cone). After the `iterations` sweeps:
 // v = dx / dt, w = theta / dt (BDF1), p = m v, l = I(o) w.
 //
 // Error correction (Eq. 18): C_j = C_j(q) - alpha C_j(q = 0). With post-stabilisation
@@ -42,11 +45,12 @@
 //       C_k = (1 - alpha) k . (p_b - p_a + slop n) + J_a,k . q_a + J_b,k . q_b,
 //       J_a,k = -(k, r_a x k), J_b,k = (k, r_b x k)
 //     (penetration_slop in place of the demo's collision margin, so it rests slop deep); the
-//     normal row's force in (-inf, 0]; each tangent row's in [-mu |lambda_n|, mu |lambda_n|] (a
-//     friction pyramid, as the demo's 1D bound per tangent). Static friction by position (the
-//     demo's "stick"): a point whose tangent force stayed inside its cone and whose tangential
-//     offset is below kStickDistance keeps its witness points in the bodies' frames into the
-//     next step (matched by body pair and contact feature), so the tangent rows pull it back.
+//     force F = K C + lambda of the three rows, its normal part clamped to F_n <= 0 and its
+//     tangential part projected onto the friction cone |F_t| <= mu |F_n| of the same sweep (the
+//     3D demo's). Static friction by position (the demo's "stick"): a point whose friction was
+//     inside the cone at the last sweep with a tangential error below kStickDistance keeps its
+//     witness points in the bodies' frames into the next step (matched by body pair and contact
+//     feature), so the tangent rows pull it back.
 //   rod (both ends in bodies, or one a world point): C = |p_b - p_a| - l, an equality (no
 //     limits), non-linear: with u the unit axis, L = |p_b - p_a|, P = I - u u^T, r = R local,
 //       J_b = (u, r_b x u), J_a = -(u, r_a x u),
@@ -74,8 +78,9 @@ namespace {
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
-// The demo's STICK_THRESH: a point slid further than this (m) from its anchors is not held.
-constexpr double kStickDistance = 0.01;
+// The 3D demo's STICK_THRESH (m): a point whose tangential error is below it at the end of a
+// sweep, its friction inside the cone, keeps its anchors into the next step.
+constexpr double kStickDistance = 1e-5;
 
 Mat3 skew(const Vec3& r) {
   Mat3 s;
@@ -149,7 +154,8 @@ class Avbd final : public PushMethod {
     const int total = def.iterations + post;
     for (int it = 0; it < total; ++it) {
       const double alpha = post > 0 ? (it < def.iterations ? 1.0 : 0.0) : def.avbd_alpha;
-      for (std::size_t i = 0; i < state_.size(); ++i) {
+      // The demo's order: its bodies newest first, so the last body added is solved first.
+      for (std::size_t i = state_.size(); i-- > 0;) {
         if (state_[i].movable) primal(static_cast<int>(i), alpha, def, rods);
       }
       dual(alpha, def, rods, /*stabilising=*/it >= def.iterations);
@@ -297,11 +303,30 @@ class Avbd final : public PushMethod {
            c.Jb[static_cast<std::size_t>(r)].dot(q(c.b));
   }
 
-  // The force limits of row r of contact c (N).
-  static std::pair<double, double> limits(const ContactState& c, int r, double mu) {
-    if (r == 0) return {-kInfinity, 0.0};
-    const double bound = mu * std::abs(c.lambda[0]);
-    return {-bound, bound};
+  // A contact's force along (n, t1, t2) (N) and what the dual update needs: F = K C + lambda, the
+  // normal part clamped to F_n <= 0 and the tangential part projected onto the friction cone
+  // |F_t| <= mu |F_n| (the 3D demo's manifold.cpp updatePrimal and updateDual).
+  struct ContactForce {
+    Vec3 force = Vec3::Zero();
+    Vec3 C = Vec3::Zero();      // m: the rows' errors
+    bool in_cone = false;       // |F_t| <= mu |F_n| before the projection
+  };
+  ContactForce contact_force(const ContactState& c, double alpha) const {
+    ContactForce out;
+    for (int r = 0; r < 3; ++r) {
+      const std::size_t ru = static_cast<std::size_t>(r);
+      out.C[r] = contact_value(c, r, alpha);
+      out.force[r] = c.k[ru] * out.C[r] + c.lambda[ru];
+    }
+    out.force[0] = std::min(out.force[0], 0.0);
+    const double bound = c.mu * std::abs(out.force[0]);
+    const double tangential = std::hypot(out.force[1], out.force[2]);
+    out.in_cone = tangential <= bound;
+    if (!out.in_cone && tangential > 0.0) {
+      out.force[1] *= bound / tangential;
+      out.force[2] *= bound / tangential;
+    }
+    return out;
   }
 
   // The current length error of rod d (m); with `for_body` and outputs, this body's gradient J
@@ -354,13 +379,11 @@ class Avbd final : public PushMethod {
       const int entry = entries_[static_cast<std::size_t>(e)];
       if (entry >= 0) {
         const ContactState& c = contacts_[static_cast<std::size_t>(entry)];
-        for (int r = 0; r < 3; ++r) {
-          const auto [lo, hi] = limits(c, r, c.mu);
-          const std::size_t ru = static_cast<std::size_t>(r);
-          const double f = std::clamp(c.k[ru] * contact_value(c, r, alpha) + c.lambda[ru], lo, hi);
-          const Vec6& J = c.a == body ? c.Ja[ru] : c.Jb[ru];
-          g += J * f;
-          H += c.k[ru] * J * J.transpose();
+        const Vec3 f = contact_force(c, alpha).force;
+        for (std::size_t r = 0; r < 3; ++r) {
+          const Vec6& J = c.a == body ? c.Ja[r] : c.Jb[r];
+          g += J * f[static_cast<Eigen::Index>(r)];
+          H += c.k[r] * J * J.transpose();
         }
       } else {
         const std::size_t i = static_cast<std::size_t>(-entry - 1);
@@ -389,18 +412,16 @@ class Avbd final : public PushMethod {
       k = std::min(k + def.avbd_beta * std::abs(C), def.avbd_k_max);
     };
     for (ContactState& c : contacts_) {
-      for (int r = 0; r < 3; ++r) {
-        const std::size_t ru = static_cast<std::size_t>(r);
-        const auto [lo, hi] = limits(c, r, c.mu);
-        const double C = contact_value(c, r, alpha);
-        const double lambda = std::clamp(c.k[ru] * C + c.lambda[ru], lo, hi);
-        if (lambda > lo && lambda < hi) ramp(c.k[ru], C);
-        if (!stabilising) c.lambda[ru] = lambda;
+      const ContactForce f = contact_force(c, alpha);
+      if (f.force[0] < 0.0) ramp(c.k[0], f.C[0]);
+      if (f.in_cone) {
+        ramp(c.k[1], f.C[1]);
+        ramp(c.k[2], f.C[2]);
+        if (!stabilising) c.stick = std::hypot(f.C[1], f.C[2]) < kStickDistance;
       }
-      if (stabilising) continue;
-      const double cone = c.mu * std::abs(c.lambda[0]);
-      const double tangential = std::hypot(c.lambda[1], c.lambda[2]);
-      c.stick = tangential < cone && std::hypot(c.C0[1], c.C0[2]) < kStickDistance;
+      if (!stabilising) {
+        for (int r = 0; r < 3; ++r) c.lambda[static_cast<std::size_t>(r)] = f.force[r];
+      }
     }
     for (std::size_t i = 0; i < rods.size(); ++i) {
       const double C = rod_value(rods[i], nullptr, nullptr, nullptr) - alpha * rod_[i].C0;

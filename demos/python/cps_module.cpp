@@ -2,6 +2,7 @@
 // its pictures as numpy arrays, over the same engine, scenes and renderer as the `cps` command
 // (docs/python.md). Errors: bad input raises ValueError with the command's message, a file that
 // cannot be read OSError; no call lets a C++ exception or a crash reach the interpreter.
+#include "avbd_demo.h"
 #include "box3d_pyramids.h"
 #include "command.h"
 #include "options/options.h"
@@ -62,6 +63,7 @@ py::list scene_list() {
   for (const scenes::Scene& s : scenes::paper_scenes()) out.append(scene_row(s, "paper"));
   for (const scenes::Scene& s : scenes::stress_scenes()) out.append(scene_row(s, "stress"));
   for (const scenes::Scene& s : scenes::benchmark_scenes()) out.append(scene_row(s, "benchmark"));
+  for (const scenes::Scene& s : scenes::avbd_demo_scenes()) out.append(scene_row(s, "avbd demo"));
   for (const std::string_view name : scenes::example_scene_names()) {
     out.append(scene_row(*scenes::find_example_scene(name), "example"));
   }

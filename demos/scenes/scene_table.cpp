@@ -1,3 +1,4 @@
+#include "avbd_demo.h"
 #include "box3d_pyramids.h"
 #include "divergence.h"
 #include "scene.h"
@@ -187,6 +188,9 @@ const Scene* find_scene(std::string_view name) {
       std::find_if(all.begin(), all.end(), [name](const Scene& s) { return s.name == name; });
   if (it != all.end()) return &*it;
   for (const Scene& s : benchmark_scenes()) {
+    if (s.name == name) return &s;
+  }
+  for (const Scene& s : avbd_demo_scenes()) {
     if (s.name == name) return &s;
   }
   if (const Scene* example = find_example_scene(name)) return example;

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 using namespace cps;
 
@@ -64,4 +65,83 @@ TEST_CASE("avbd at the demo's defaults holds heavy_rope at 25 iterations", "[avb
   CHECK(m["nan"] == false);
   CHECK(m["holds"] == true);
   CHECK(m["final_displacement_m"].get<double>() < m["leave_distance_m"].get<double>());
+}
+
+namespace {
+
+// The centre heights (m, above the ground's top face, bottom to top) of a demo scene's boxes at
+// t (s), at the scene's own settings (the demo's).
+std::vector<double> demo_heights(const char* name, double t) {
+  const scenes::Scene* scene = scenes::find_scene(name);
+  REQUIRE(scene != nullptr);
+  scenes::Run run = scenes::make_run(*scene);
+  run.advance_to(t);
+  std::vector<double> heights;
+  for (const Body& b : run.world.bodies()) {
+    if (!b.is_static()) heights.push_back(b.x.y());
+  }
+  return heights;
+}
+
+}  // namespace
+
+TEST_CASE("the AVBD 3D demo's Stack and Stack Ratio rest where the demo's own solver leaves them",
+          "[avbd][avbd_demo]") {
+  // The reference: the demo (savant117/avbd-demo3d at 7701bd4, its solver built headless with a
+  // driver that runs sceneStack and sceneStackRatio at the demo's defaults; docs/findings.md,
+  // "AVBD against its 3D demo"), its centre heights less the ground box's top face (z = 0.5),
+  // printed to 0.1 mm. The issue's bound is 1 mm; with the slop of 0.1 mm printing leaves, the
+  // check is 1 mm. A cube sunk or lifted by one contact's resting depth (the demo's margin, 1
+  // cm) fails it tenfold.
+  struct Reference {
+    const char* scene;
+    double t;
+    std::vector<double> heights;
+  };
+  const Reference references[] = {
+      {"avbd_stack", 5.0, {0.4899, 1.4791, 2.4688, 3.4592, 4.4424, 5.4263, 6.4148, 7.3994, 8.3795, 9.3551}},
+      {"avbd_stack", 10.0, {0.4896, 1.4792, 2.4687, 3.4583, 4.4476, 5.4369, 6.4264, 7.4158, 8.4050, 9.3941}},
+      {"avbd_stack_ratio", 5.0, {0.4775, 1.9550, 4.9327, 10.9115}},
+      {"avbd_stack_ratio", 10.0, {0.4790, 1.9580, 4.9370, 10.9166}},
+  };
+  for (const Reference& r : references) {
+    INFO(r.scene << " at " << r.t << " s");
+    const std::vector<double> heights = demo_heights(r.scene, r.t);
+    REQUIRE(heights.size() == r.heights.size());
+    for (std::size_t i = 0; i < heights.size(); ++i) {
+      INFO("box " << i);
+      CHECK(std::isfinite(heights[i]));
+      CHECK(std::abs(heights[i] - r.heights[i]) < 1e-3);
+    }
+  }
+}
+
+TEST_CASE("the AVBD demo's Dynamic Friction slabs stop near v0^2 / (2 mu g)", "[avbd][avbd_demo]") {
+  // Coulomb friction stops a slab sent at v0 = 10 m/s after v0^2 / (2 mu g), mu = sqrt(mu_box
+  // 0.5) the pair's (g = 10 m/s^2). The friction of a new contact builds up over the first steps
+  // (its penalty starts at 1 N/m), so the bound is two steps' travel at v0, 2 v0 dt = 0.33 m; the
+  // demo's own solver is within it (0.31 m beyond at mu 1, 0.09 m short at mu 0.5:
+  // docs/findings.md). The slab without friction slides 10 m/s x 5 s.
+  const scenes::Scene* scene = scenes::find_scene("avbd_dynamic_friction");
+  REQUIRE(scene != nullptr);
+  scenes::Run run = scenes::make_run(*scene);
+  std::vector<double> start;
+  for (const Body& b : run.world.bodies()) {
+    if (!b.is_static()) start.push_back(b.x.x());
+  }
+  run.advance_to(5.0);
+  std::size_t i = 0;
+  for (const Body& b : run.world.bodies()) {
+    if (b.is_static()) continue;
+    const double mu = std::sqrt(b.friction * 0.5);
+    const double slid = b.x.x() - start[i++];
+    INFO("slab of mu_box " << b.friction << ": slid " << slid << " m");
+    REQUIRE(std::isfinite(slid));
+    if (mu > 0.0) {
+      CHECK(std::abs(slid - 100.0 / (2.0 * mu * 10.0)) < 2.0 * 10.0 * run.world.def().dt);
+      CHECK(b.velocity().norm() < 1e-2);
+    } else {
+      CHECK(slid == Approx(50.0).margin(1e-6));
+    }
+  }
 }

@@ -1,6 +1,7 @@
 // `cps list`: the scenes with their default duration and summary.
 #include "command.h"
 
+#include "avbd_demo.h"
 #include "box3d_pyramids.h"
 #include "scene.h"
 #include "scene_file.h"
@@ -35,6 +36,8 @@ Command add_list(CLI::App& app) {
                         "random --seed N)\n", "random_SEED", "");
             print_table("Box3D's benchmark scenes, with Box3D's world as their defaults:",
                         scenes::benchmark_scenes());
+            print_table("The AVBD authors' 3D demo scenes, with the demo's solver settings as their defaults:",
+                        scenes::avbd_demo_scenes());
             std::printf("Example scene files (assets/scenes, built into cps; type the name, or "
                         "'cps scene NAME' to get the file):\n");
             for (const std::string_view name : scenes::example_scene_names()) {

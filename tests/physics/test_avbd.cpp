@@ -90,9 +90,9 @@ TEST_CASE("the AVBD 3D demo's Stack and Stack Ratio rest where the demo's own so
   // The reference: the demo (savant117/avbd-demo3d at 7701bd4, its solver built headless with a
   // driver that runs sceneStack and sceneStackRatio at the demo's defaults; docs/findings.md,
   // "AVBD against its 3D demo"), its centre heights less the ground box's top face (z = 0.5),
-  // printed to 0.1 mm. The issue's bound is 1 mm; with the slop of 0.1 mm printing leaves, the
-  // check is 1 mm. A cube sunk or lifted by one contact's resting depth (the demo's margin, 1
-  // cm) fails it tenfold.
+  // printed to 0.1 mm. The bound, 1 mm, is twenty times the rounding of the printed digits; a
+  // cube sunk or lifted by one contact's resting depth (the demo's margin, 1 cm) fails it
+  // tenfold.
   struct Reference {
     const char* scene;
     double t;

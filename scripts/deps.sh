@@ -88,9 +88,11 @@ cps_link_python() {
   local pth="$site/cps-build.pth" folder
   folder=$(cd "$build/python" && pwd)
   if [ "$(cat "$pth" 2> /dev/null)" != "$folder" ]; then
-    mkdir -p "$site"
-    printf '%s\n' "$folder" > "$pth.tmp.$$"
-    mv "$pth.tmp.$$" "$pth"
+    if ! { mkdir -p "$site" && printf '%s\n' "$folder" > "$pth.tmp.$$" && mv "$pth.tmp.$$" "$pth"; } 2> /dev/null; then
+      rm -f "$pth.tmp.$$" 2> /dev/null || true
+      echo "cps: could not write $pth; to import cps, set PYTHONPATH=$folder"
+      return 0
+    fi
   fi
   echo "cps: $python imports cps from $folder ($pth)"
 }

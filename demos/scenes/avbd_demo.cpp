@@ -12,12 +12,10 @@
 // top face is the ground plane y = 0.
 #include "avbd_demo.h"
 
-#include "stress/stress.h"
-
+#include <algorithm>
 #include <array>
-#include <cmath>
 #include <numbers>
-#include <string>
+#include <vector>
 
 namespace cps::scenes {
 namespace {

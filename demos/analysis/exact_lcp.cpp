@@ -426,7 +426,13 @@ void polish_solution(const StepSystem& s, const Eigen::MatrixXd& A, const std::v
 
 }  // namespace
 
-ExactSolution solve_exact(const StepSystem& s) {
+ExactSolution solve_exact(const StepSystem& s) { return solve_exact(s, 1e-9); }
+
+ExactSolution solve_exact(const StepSystem& s, double tolerance) {
+  if (!(tolerance > 0.0 && tolerance <= 1e-3)) {
+    throw std::invalid_argument("exact solve: residual tolerance " + std::to_string(tolerance) +
+                                " of the force scale; allowed: (0, 1e-3]");
+  }
   check_sizes(s);
   siconos();  // opened here: a missing library is an error, not a Lemke failure to fall back from
   const Eigen::MatrixXd A(s.A);
@@ -446,7 +452,7 @@ ExactSolution solve_exact(const StepSystem& s) {
     lemke_failure = e.what();
   }
   const auto passes = [&](const ExactSolution& x) {
-    return x.lambda.size() == s.rows() && x.residual_max <= 1e-9 * force_scale(A, s.b, x.lambda);
+    return x.lambda.size() == s.rows() && x.residual_max <= tolerance * force_scale(A, s.b, x.lambda);
   };
   if (!passes(out)) {  // Lemke stopped, or its polished result is not exact: start from PGS
     ExactSolution retry;
@@ -463,7 +469,7 @@ ExactSolution solve_exact(const StepSystem& s) {
             << " N; ";
       }
       why << "from " << kFallbackSweeps << " PGS sweeps the polished solution has "
-          << retry.residual_max << " N, both above 1e-9 of the force scale "
+          << retry.residual_max << " N, both above " << tolerance << " of the force scale "
           << force_scale(A, s.b, retry.lambda) << " N";
       throw std::runtime_error(why.str());
     }

@@ -108,4 +108,10 @@ struct ExactSolution::Distance {
 /// found when cps was configured (CMake's CPS_SICONOS_SONAME, e.g. libsiconos_numerics.so.7).
 ExactSolution solve_exact(const StepSystem& s);
 
+/// As solve_exact(s), with the residual check at `tolerance` of the force scale in place of 1e-9
+/// (dimensionless, in (0, 1e-3]; typical 1e-9 for a reference, 1e-6 where a step only has to be
+/// solved far past what the engine's sweeps reach, as the mass ratio scorecard's). Throws as
+/// solve_exact, and std::invalid_argument for a tolerance outside (0, 1e-3].
+ExactSolution solve_exact(const StepSystem& s, double tolerance);
+
 }  // namespace cps::analysis

@@ -12,6 +12,8 @@
 #include "stress/stress.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace cps::scenes {
 namespace {
@@ -56,7 +58,13 @@ std::unique_ptr<Metrics> make_heavy_on_light_metrics(const World& world) {
 
 WorldDef heavy_rope_world_def() { return stack_world_def(); }
 
-void populate_heavy_rope(World& world) {
+void populate_heavy_rope(World& world) { populate_heavy_rope_ratio(world, kHeavyRopeBlockRatio); }
+
+void populate_heavy_rope_ratio(World& world, double ratio) {
+  if (!(std::isfinite(ratio) && ratio > 0.0)) {
+    throw std::invalid_argument("heavy rope: block to link mass ratio " + std::to_string(ratio) +
+                                " must be finite and > 0");
+  }
   add_ground(world);  // 1.15 m under the block: where it lands if the rope gives way
   for (int i = 0; i < kHeavyRopeLinks; ++i) {
     BodyDef link;
@@ -75,7 +83,7 @@ void populate_heavy_rope(World& world) {
   const Vec3 last_link = kRopeAnchor - Vec3(0.0, kHeavyRopeRodLengthM * kHeavyRopeLinks, 0.0);
   BodyDef block;
   block.shape = Shape::box(Vec3::Constant(kHeavyRopeBlockHalfM));
-  block.mass = kHeavyRopeBlockRatio * kHeavyRopeLinkMassKg;
+  block.mass = ratio * kHeavyRopeLinkMassKg;
   block.position = last_link - Vec3(0.0, kHeavyRopeRodLengthM + kHeavyRopeBlockHalfM, 0.0);
   const int index = world.add_body(block);
   DistanceConstraint rod;  // from the middle of the block's top face to the last link's centre

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 namespace cps::scenes {
 namespace {
@@ -36,16 +37,20 @@ class MassRatioMetrics final : public Metrics {
   double max_penetration_ = 0.0;
 };
 
-}  // namespace
-
-WorldDef mass_ratio_world_def() { return stack_world_def(); }
-
-void populate_mass_ratio(World& world, double ratio) {
+void check_mass_ratio(double ratio) {
   if (!(std::isfinite(ratio) && ratio > 0.0)) {
     std::ostringstream s;
     s << "mass ratio " << ratio << " must be finite and > 0";
     throw std::invalid_argument(s.str());
   }
+}
+
+}  // namespace
+
+WorldDef mass_ratio_world_def() { return stack_world_def(); }
+
+void populate_mass_ratio(World& world, double ratio) {
+  check_mass_ratio(ratio);
   add_ground(world);
   BodyDef cube;
   cube.shape = Shape::box(Vec3::Constant(kMassRatioHalfEdge));
@@ -55,6 +60,21 @@ void populate_mass_ratio(World& world, double ratio) {
   cube.mass = ratio * kMassRatioLightMass;
   cube.position = Vec3(0.0, 3.0 * kMassRatioHalfEdge, 0.0);
   world.add_body(cube);
+}
+
+void populate_mass_ratio_stack(World& world, double ratio, int boxes) {
+  if (boxes < 2) {
+    throw std::invalid_argument("a mass ratio stack needs at least 2 boxes, not " + std::to_string(boxes));
+  }
+  check_mass_ratio(ratio);
+  add_ground(world);
+  BodyDef cube;
+  cube.shape = Shape::box(Vec3::Constant(kMassRatioHalfEdge));
+  for (int k = 0; k < boxes; ++k) {
+    cube.mass = std::pow(ratio, static_cast<double>(k) / (boxes - 1)) * kMassRatioLightMass;
+    cube.position = Vec3(0.0, (2 * k + 1) * kMassRatioHalfEdge, 0.0);
+    world.add_body(cube);
+  }
 }
 
 void populate_mass_ratio_10(World& world) { populate_mass_ratio(world, 10.0); }

@@ -28,6 +28,14 @@ struct MassRatioOutcome {
   double top_height_m = 0.0;        ///< heavy cube centre height at the end (m)
 };
 
+/// Adds the static ground plane y = 0 and a column of `boxes` cubes of edge 1 m (half edge
+/// kMassRatioHalfEdge), resting on one another, touching, at rest: cube k (k = 0 at the bottom,
+/// body k + 1) has its centre at (0, (2 k + 1) h, 0) and mass ratio^(k / (boxes - 1)) x 1 kg, so
+/// that the top cube is `ratio` times the bottom one and each is the same factor heavier than
+/// the one below. boxes = 2 is populate_mass_ratio. ratio: finite and > 0; boxes >= 2; throws
+/// std::invalid_argument otherwise.
+void populate_mass_ratio_stack(World& world, double ratio, int boxes);
+
 /// True if the heavy cube's centre is above the light cube's centre and within 0.1 m of it
 /// horizontally, and the deepest overlap now is below half the light cube's half edge (0.25 m).
 /// world: a world made by populate_mass_ratio.

@@ -255,6 +255,10 @@ std::unique_ptr<Metrics> make_heavy_on_light_metrics(const World& world);
 /// the last by the middle of its top face, its bottom 1.15 m above the ground; at rest.
 WorldDef heavy_rope_world_def();
 void populate_heavy_rope(World& world);
+/// heavy_rope with the block `ratio` times a link's mass (finite, > 0; dimensionless), the rest as
+/// populate_heavy_rope (which is this at kHeavyRopeBlockRatio). Throws std::invalid_argument for a
+/// bad ratio.
+void populate_heavy_rope_ratio(World& world, double ratio);
 std::unique_ptr<Metrics> make_heavy_rope_metrics(const World& world);
 /// stack_20_long: stack_20 (scaled.cpp) for kLongRunSteps steps.
 void populate_stack_20_long(World& world);

@@ -37,15 +37,6 @@ double manifold_overlap(const World& world) {
   return d;
 }
 
-// Largest speed |v| (m/s) of the centre of mass of any movable body.
-double largest_speed(const World& world) {
-  double v = 0.0;
-  for (const Body& b : world.bodies()) {
-    if (!b.is_static()) v = std::max(v, b.velocity().norm());
-  }
-  return v;
-}
-
 // The resting state of a column: the movable bodies, taken in the order of their heights as
 // built, stacked on the ground plane one on the next without overlap: each centre at the top of
 // the one below plus its own half height (a box's extent along y, a ball's radius). Returns the
@@ -266,6 +257,14 @@ std::optional<Method> push_method_named(const std::string& name) {
     if (m.name == name) return m;
   }
   return std::nullopt;
+}
+
+double largest_speed(const World& world) {
+  double v = 0.0;
+  for (const Body& b : world.bodies()) {
+    if (!b.is_static()) v = std::max(v, b.velocity().norm());
+  }
+  return v;
 }
 
 std::vector<Method> push_methods() {

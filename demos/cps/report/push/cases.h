@@ -170,6 +170,9 @@ HardResult run_hard_case(const scenes::Scene& scene, const Method& m, double sec
 /// The method called `name` among push_methods(), or nullopt.
 std::optional<Method> push_method_named(const std::string& name);
 
+/// The largest speed |v| (m/s) of the centre of mass of any movable body of `world`. No errors.
+double largest_speed(const World& world);
+
 /// A metric's number, or NaN where it is missing or not a number (null: never happened).
 double metric(const nlohmann::json& metrics, const char* key);
 

@@ -1,6 +1,7 @@
 // `cps report push`: the push methods side by side (see push/report.h): the cases run per
 // method (push/cases.h), then push.csv, push.md and the diagrams written from their results.
 #include "report/push/report.h"
+#include "report/push/scorecard.h"
 
 #include "divergence.h"
 #include "options/progress.h"
@@ -44,7 +45,10 @@ constexpr const char* kNone = "none";
 
 std::string numbers(const std::vector<double>& values) {
   std::string s;
-  for (const double v : values) s += (s.empty() ? "" : " ") + number(v);
+  for (const double v : values) {
+    if (!s.empty()) s += ' ';
+    s += number(v);
+  }
   return s;
 }
 
@@ -608,11 +612,22 @@ std::vector<MethodResults> run_methods(const PushPlan& plan) {
   return results;
 }
 
+// Runs the mass ratio scorecard of the plan's methods, with progress on stderr.
+std::vector<ScoreResult> run_score(const PushPlan& plan) {
+  const std::vector<ScoreRow> rows = score_rows(plan.methods);
+  Progress progress("report push: mass ratio scorecard",
+                    static_cast<long long>(rows.size() * kScoreCases.size()) * kScoreRatioPowers, "runs");
+  long long done = 0;
+  std::vector<ScoreResult> score = run_scorecard(rows, [&] { progress.update(++done); });
+  progress.finish();
+  return score;
+}
+
 }  // namespace
 
 std::vector<std::string> push_report_files() {
   return {"push.csv", "push.md", "push_overlap.png", "push_overlap.pdf", "push_speed.png",
-          "push_speed.pdf"};
+          "push_speed.pdf", "score.csv"};
 }
 
 std::vector<std::string> push_plot_files() {
@@ -645,6 +660,7 @@ int run_push_report(const fs::path& out, bool quick, bool force, const nlohmann:
   const PushPlan plan = plan_push_report(quick);
   const auto started = std::chrono::steady_clock::now();
   const std::vector<MethodResults> results = run_methods(plan);
+  const std::vector<ScoreResult> score = run_score(plan);
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   const CsvTable csv = push_table(plan, results);
   const SeriesData data = series_data(plan, results);
@@ -652,7 +668,9 @@ int run_push_report(const fs::path& out, bool quick, bool force, const nlohmann:
   begin_output(main, info);
   begin_output(plots, info);
   write_csv(out / "push.csv", csv);
-  write_text_atomic(out / "push.md", push_markdown(plan, csv, results, elapsed));
+  write_csv(out / "score.csv", score_table(score));
+  write_text_atomic(out / "push.md",
+                    push_markdown(plan, csv, results, elapsed) + "\n" + score_markdown(score, plan.methods));
   write_diagram(out, "push_overlap", data.text,
                 diagram_script(out / "plots" / "push_overlap.dat", plan.methods, 1,
                                "largest overlap against time (values under " +

@@ -25,7 +25,7 @@ inline constexpr const char* kPushReport = "push";
 /// The files `cps report push` writes into its output folder (plain names): push.csv, push.md,
 /// push_overlap.png (the largest overlap against time) and push_speed.png (the largest body
 /// speed against time), each also as a PDF of the same name (.pdf, gnuplot's pdfcairo: vector
-/// lines and text).
+/// lines and text), and score.csv (the mass ratio scorecard, scorecard.h).
 std::vector<std::string> push_report_files();
 
 /// The files it writes into OUT/plots: the gnuplot data and script of each diagram

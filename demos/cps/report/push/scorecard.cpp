@@ -296,16 +296,22 @@ std::string score_row_name(const ScoreRow& row) {
 
 const char* score_settings_name(ScoreSettings s) { return s == ScoreSettings::paper ? "paper" : "source"; }
 
-// The largest ratio held from 2 up ("none"), and ", then not run" when the next was not run.
+// The largest ratio held from 2 up ("none"), ", then not run" when the next was not run, and the
+// largest ratio held where it is larger.
 std::string score_up_to_cell(const std::vector<ScoreCell>& cells) {
   const double up_to = held_up_to(cells);
   std::string text = up_to == 0.0 ? "none" : number(up_to);
+  double largest = 0.0;
+  for (const ScoreCell& c : cells) {
+    if (c.held && *c.held) largest = c.ratio;
+  }
   for (const ScoreCell& c : cells) {
     if (c.ratio > up_to) {
       if (!c.held) text += ", then not run";
       break;
     }
   }
+  if (largest > up_to) text += " (" + number(largest) + " held)";
   return text;
 }
 
@@ -330,7 +336,8 @@ std::string score_markdown(const std::vector<ScoreResult>& results,
         "penetration slop by more than " << number(kScoreErrorM * 1e3) << " mm, no rod is off "
         "its length by more than " << number(kScoreErrorM * 1e3) << " mm and no body's centre is "
         "faster than " << number(kScoreSpeedMps * 1e3) << " mm/s. **held up to** is the largest R "
-        "such that every ratio from 2 to R held. Settings: **paper**, the paper's (dt 1/60 s, 25 "
+        "such that every ratio from 2 to R held, with the largest ratio held in brackets where it is "
+        "larger. Settings: **paper**, the paper's (dt 1/60 s, 25 "
         "PGS sweeps, beta 0.2, mu 0.5) with only the push changed; **source**, the method's own "
         "source's defaults at the same dt and mu:\n\n";
   for (const Method& m : methods) md << "- " << m.name << ": " << score_source(m) << ".\n";

@@ -3,6 +3,7 @@
 #include "cli_support.h"
 #include "push_methods.h"
 #include "report/push/cases.h"
+#include "report/push/scorecard.h"
 #include "report_csv.h"
 #include "stress/stress.h"
 
@@ -85,6 +86,21 @@ TEST_CASE("cps report push --quick compares every push method of the table: file
   for (const char* pdf : {"push_overlap.pdf", "push_speed.pdf"}) {
     CHECK(slurp(dir / "q" / pdf).substr(0, 5) == "%PDF-");
   }
+  // The mass ratio scorecard: a row per method and setting (avbd's tuned pair, the exact solve),
+  // case and ratio, each held (1, 0) or, only in the exact row, not run with the reason.
+  const cli_test::CsvRows score = cli_test::read_report_csv(dir / "q" / "score.csv");
+  CHECK(score.rows.size() == (2 * methods.size() + 3) * 3 * static_cast<std::size_t>(cps::cli::kScoreRatioPowers));
+  for (const auto& row : score.rows) {
+    INFO(row.at("push") << " " << row.at("variant") << " " << row.at("case") << " " << row.at("mass_ratio"));
+    const std::string& held = row.at("held");
+    if (held.empty()) {
+      CHECK(row.at("variant") == "exact solve");
+      CHECK(row.at("why").find("exact solve refused") != std::string::npos);
+    } else {
+      CHECK((held == "1") == row.at("why").empty());
+    }
+  }
+  CHECK(slurp(dir / "q" / "push.md").find("## Mass ratio scorecard") != std::string::npos);
 
   // push.csv: one row per method per case, every column with its unit (or a name, not a
   // quantity), every measure a finite number or the documented "never" / "none".

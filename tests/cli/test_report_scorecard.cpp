@@ -98,7 +98,7 @@ TEST_CASE("scorecard: held up to counts from 2 and stops at the first ratio that
   CHECK(held_up_to(cells) == 2.0);
 }
 
-TEST_CASE("scorecard: each row runs its settings; the source rows take their source's world",
+TEST_CASE("scorecard: each row runs its settings, the source rows their source's world",
           "[cli][report][scorecard]") {
   const WorldDef paper = score_world(ScoreCase::two_box, row_of("soft", ScoreSettings::paper));
   CHECK(paper.push == PushMode::soft);

@@ -1,5 +1,6 @@
 // The scenes of the AVBD authors' 3D demo (savant117/avbd-demo3d, source/scenes.h: sceneStack,
-// sceneStackRatio, scenePyramid, sceneDynamicFriction, sceneStaticFriction), built with the
+// sceneStackRatio, scenePyramid, sceneRope, sceneHeavyRope, sceneDynamicFriction,
+// sceneStaticFriction), built with the
 // demo's geometry, densities and friction, and the demo's solver settings as their own world
 // (source/solver.cpp defaultParams, solver.h): AVBD at dt 1/60 s, 10 iterations, penalty ramp
 // beta 1e4 N/m^2 (the demo's linear beta: every row here is linear), alpha 0.99, gamma 0.999,
@@ -89,6 +90,57 @@ void populate_demo_pyramid(World& world) {
   }
 }
 
+// The demo's Rope and Heavy Rope: link 0 static (the demo's density 0), links 1 x 0.5 x 0.5 m
+// (0.25 kg) along x at 1 m, the demo's height 10 m over its ground box centred 20 m down; each
+// link joined to the next by a ball joint (the demo's Joint with stiffnessLin infinite,
+// stiffnessAng 0) at their touching faces, the joined links not colliding (as the demo's
+// constrainedTo). Each joint's feet lie on link i - 1: one 0.25 m in from the centre of its +x
+// face, two on that face's edges.
+constexpr int kRopeLinks = 20;
+constexpr double kRopeGroundTop = -19.5;  // the demo's ground box at z = -20, 1 m thick
+constexpr double kRopeArm = 0.25;         // m: the tripod's arm, the links' half width
+
+// Adds link i of the rope (static for i = 0) and returns its index.
+int add_rope_link(World& world, int i) {
+  BodyDef link;
+  link.shape = Shape::box(Vec3(0.5, 0.25, 0.25));
+  link.is_static = i == 0;
+  link.mass = i == 0 ? 0.0 : 0.25;
+  link.position = Vec3(i, 10.0 - kRopeGroundTop, 0.0);
+  link.friction = 0.5;
+  return world.add_body(link);
+}
+
+// The ground and links 0 to count - 1, each joined to the one before; returns the last's index.
+int add_rope(World& world, int count) {
+  add_ground(world);
+  int previous = add_rope_link(world, 0);
+  for (int i = 1; i < count; ++i) {
+    const int link = add_rope_link(world, i);
+    add_ball_joint(world, previous, Vec3(0.5, 0.0, 0.0), link, Vec3(-0.5, 0.0, 0.0), kRopeArm,
+                   Vec3(-1.0, 1.0, 1.0));
+    previous = link;
+  }
+  return previous;
+}
+
+// sceneRope: 20 links, the first static, hanging out along x and released.
+void populate_demo_rope(World& world) { add_rope(world, kRopeLinks); }
+
+// sceneHeavyRope: the rope's first 19 links and, as the 20th, a 5 m cube of 125 kg (500 times a
+// link) whose joint point (-2.5, 0, 0) starts 0.5 m from the last link's, as in the demo. The
+// cube carries that joint's feet (arm 2.5 m: its centre and two edges of its -x face).
+void populate_demo_heavy_rope(World& world) {
+  const int previous = add_rope(world, kRopeLinks - 1);
+  BodyDef cube;
+  cube.shape = Shape::box(Vec3::Constant(2.5));
+  cube.mass = 125.0;
+  cube.position = Vec3(21.5, 10.0 - kRopeGroundTop, 0.0);
+  cube.friction = 0.5;
+  const int heavy = world.add_body(cube);
+  add_ball_joint(world, heavy, Vec3(-2.5, 0.0, 0.0), previous, Vec3(0.5, 0.0, 0.0), 2.5);
+}
+
 // sceneDynamicFriction: eleven 1 x 1 x 0.5 m slabs (0.5 kg) resting on the ground, sent at 10
 // m/s along x, with their own friction 5, 4.5, ..., 0 (against the ground's 0.5).
 void populate_demo_dynamic_friction(World& world) {
@@ -166,6 +218,60 @@ std::unique_ptr<Metrics> make_demo_metrics(const World& world) {
   return observed<DemoMetrics>(world);
 }
 
+// The gap (m) of each ball joint of a world whose rods are add_ball_joint's triples, in order:
+// the distance between the joint's point on the body with the feet, (f_1.x, f_0.y, f_0.z) in
+// its frame (f_i the feet), and the point on the other body that the three rods share.
+std::vector<double> ball_joint_gaps(const World& world) {
+  const auto& rods = world.distances();
+  const auto& bodies = world.bodies();
+  std::vector<double> gaps;
+  for (std::size_t k = 0; k + 2 < rods.size(); k += 3) {
+    const DistanceConstraint& r0 = rods[k];
+    const DistanceConstraint& r1 = rods[k + 1];
+    // The shared point is the same end of all three rods; the feet the other.
+    const bool feet_on_b = r0.local_a == r1.local_a && r0.body_a == r1.body_a;
+    const int feet_body = feet_on_b ? r0.body_b : r0.body_a;
+    const Vec3 f0 = feet_on_b ? r0.local_b : r0.local_a;
+    const Vec3 f1 = feet_on_b ? r1.local_b : r1.local_a;
+    const int apex_body = feet_on_b ? r0.body_a : r0.body_b;
+    const Vec3 apex_local = feet_on_b ? r0.local_a : r0.local_b;
+    const Body& fb = bodies[static_cast<std::size_t>(feet_body)];
+    const Body& ab = bodies[static_cast<std::size_t>(apex_body)];
+    const Vec3 joint = fb.x + fb.rotation() * Vec3(f1.x(), f0.y(), f0.z());
+    const Vec3 apex = ab.x + ab.rotation() * apex_local;
+    gaps.push_back((apex - joint).norm());
+  }
+  return gaps;
+}
+
+// The demo's measures and each ball joint's gap (m) now, the largest now and the largest over
+// the run.
+class RopeMetrics final : public Metrics {
+ public:
+  void observe(const World& world) override {
+    demo_.observe(world);
+    gaps_ = ball_joint_gaps(world);
+    const double now = gaps_.empty() ? 0.0 : *std::max_element(gaps_.begin(), gaps_.end());
+    largest_ = std::max(largest_, now);
+  }
+  nlohmann::json report() const override {
+    nlohmann::json j = demo_.report();
+    j["joint_gaps_m"] = gaps_;
+    j["max_joint_gap_m"] = gaps_.empty() ? 0.0 : *std::max_element(gaps_.begin(), gaps_.end());
+    j["largest_joint_gap_m"] = largest_;
+    return j;
+  }
+
+ private:
+  DemoMetrics demo_;
+  std::vector<double> gaps_;
+  double largest_ = 0.0;
+};
+
+std::unique_ptr<Metrics> make_rope_metrics(const World& world) {
+  return observed<RopeMetrics>(world);
+}
+
 constexpr BenchTraits kDemoBench{.start_s = 1.0,
                              .seconds = 1.0,
                              .reason = "from 1 s: the bodies have landed (the demo's scenes at rest or sliding)"};
@@ -197,6 +303,24 @@ const std::array kDemoScenes = {
           .make_metrics = &make_demo_metrics,
           .camera = std::nullopt,  // framed automatically
           .bench = kDemoBench,
+          .report = {}},
+    Scene{.name = "avbd_rope",
+          .summary = "the AVBD 3D demo's Rope: 20 links of 1 x 0.5 x 0.5 m joined by ball joints, the first fixed, released level",
+          .default_seconds = 10.0,
+          .world_def = &avbd_demo_world_def,
+          .populate = &populate_demo_rope,
+          .make_metrics = &make_rope_metrics,
+          .camera = CameraPreset{Vec3(0.0, 20.0, 45.0), Vec3(0.0, 20.0, 0.0), 45.0},
+          .bench = BenchTraits{.start_s = 0.0, .seconds = 1.0, .reason = "the rope swings from the start"},
+          .report = {}},
+    Scene{.name = "avbd_heavy_rope",
+          .summary = "the AVBD 3D demo's Heavy Rope: the rope with a 125 kg cube (500 times a link) as its last link",
+          .default_seconds = 10.0,
+          .world_def = &avbd_demo_world_def,
+          .populate = &populate_demo_heavy_rope,
+          .make_metrics = &make_rope_metrics,
+          .camera = CameraPreset{Vec3(0.0, 20.0, 50.0), Vec3(0.0, 18.0, 0.0), 45.0},
+          .bench = BenchTraits{.start_s = 0.0, .seconds = 1.0, .reason = "the rope swings from the start"},
           .report = {}},
     Scene{.name = "avbd_dynamic_friction",
           .summary = "the AVBD 3D demo's Dynamic Friction: eleven slabs sent at 10 m/s, their friction 5 down to 0",

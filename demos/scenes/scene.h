@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -247,6 +248,18 @@ double max_penetration_now(const World& world);
 
 /// Adds the static ground plane y = 0 (solid below, normal +y) and returns its body index.
 int add_ground(World& world);
+
+/// A ball joint: point local_a of body_a and point local_b of body_b (body frames, m) held
+/// together, made of three rods (Sec. 5.2 rows) from the point on body_b to the three feet
+/// local_a + arm s_i e_i on body_a (e_i body_a's axes, s_i = signs(i) = +-1, so that the feet can
+/// lie inside body_a; arm in m, typically the body's half width). At the joint's solution the
+/// three rows are a ball joint's: J along body_a's three axes, torque arms to the joint point;
+/// away from it they differ by second order in error / arm. The two bodies get no contacts with
+/// each other (DistanceConstraint::collide false). Either body may be static, not both. Throws
+/// std::invalid_argument (World::add_distance's errors, or arm not in (0, 1e6] m, or a sign not
+/// +-1). Returns the three rods' indices.
+std::array<int, 3> add_ball_joint(World& world, int body_a, const Vec3& local_a, int body_b,
+                                  const Vec3& local_b, double arm, const Vec3& signs = Vec3::Ones());
 
 /// Adds the static ground plane y = 0 and the paper's column of five cubes (edge 2.4 m, mass
 /// 1.2 kg) with centres (0, bottom + spacing i, 0), i = 0..4 (m). Shared by the stack (Sec. 10.1)

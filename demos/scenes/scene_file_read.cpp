@@ -256,6 +256,7 @@ SceneFile parse_scene_file(std::string_view text, const std::string& origin) {
       if (r.contains("point_a_m")) d.local_a = vec3_of(r["point_a_m"]);
       if (r.contains("point_b_m")) d.local_b = vec3_of(r["point_b_m"]);
       d.length = r["length_m"];
+      if (r.contains("collide")) d.collide = r["collide"].get<bool>();
       if (d.body_a != kWorldBody && file.bodies[static_cast<std::size_t>(d.body_a)].def.is_static) {
         fail(origin, at + "/body_a",
              shown(r["body_a"]) + " is not allowed: body_a must be a movable body (a rod to a static "

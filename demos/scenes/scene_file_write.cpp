@@ -171,11 +171,13 @@ nlohmann::json scene_file_json(const Scene& scene, const World& as_built) {
   if (!as_built.distances().empty()) {
     json rods = json::array();
     for (const DistanceConstraint& d : as_built.distances()) {
-      rods.push_back({{"body_a", d.body_a},
-                      {"point_a_m", json_of(d.local_a)},
-                      {"body_b", d.body_b == kWorldBody ? json(nullptr) : json(d.body_b)},
-                      {"point_b_m", json_of(d.local_b)},
-                      {"length_m", d.length}});
+      json rod = {{"body_a", d.body_a},
+                  {"point_a_m", json_of(d.local_a)},
+                  {"body_b", d.body_b == kWorldBody ? json(nullptr) : json(d.body_b)},
+                  {"point_b_m", json_of(d.local_b)},
+                  {"length_m", d.length}};
+      if (!d.collide) rod["collide"] = false;
+      rods.push_back(rod);
     }
     j["rods"] = rods;
   }

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <deque>
 #include <mutex>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -304,6 +305,39 @@ int add_ground(World& world) {
   ground.shape = Shape::plane(Vec3::UnitY(), 0.0);
   ground.is_static = true;
   return world.add_body(ground);
+}
+
+std::array<int, 3> add_ball_joint(World& world, int body_a, const Vec3& local_a, int body_b,
+                                  const Vec3& local_b, double arm, const Vec3& signs) {
+  std::ostringstream why;
+  if (!(arm > 0.0 && arm <= 1e6)) why << "arm " << arm << " m must be in (0, 1e6] m";
+  for (int i = 0; i < 3 && why.str().empty(); ++i) {
+    if (std::abs(signs[i]) != 1.0) why << "sign " << signs[i] << " must be +1 or -1";
+  }
+  if (!why.str().empty()) throw std::invalid_argument("ball joint: " + why.str());
+  const auto& bodies = world.bodies();
+  const bool a_static = body_a >= 0 && body_a < static_cast<int>(bodies.size()) &&
+                        bodies[static_cast<std::size_t>(body_a)].is_static();
+  std::array<int, 3> rods{};
+  for (int i = 0; i < 3; ++i) {
+    DistanceConstraint d;
+    const Vec3 foot = local_a + arm * signs[i] * Vec3::Unit(i);
+    if (a_static) {  // a rod's body_a must be movable: the point on body_b holds the rod
+      d.body_a = body_b;
+      d.local_a = local_b;
+      d.body_b = body_a;
+      d.local_b = foot;
+    } else {
+      d.body_a = body_a;
+      d.local_a = foot;
+      d.body_b = body_b;
+      d.local_b = local_b;
+    }
+    d.length = arm;
+    d.collide = false;
+    rods[static_cast<std::size_t>(i)] = world.add_distance(d);
+  }
+  return rods;
 }
 
 double kinetic_energy(const World& world) {

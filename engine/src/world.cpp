@@ -52,6 +52,7 @@ World::World(const World& other)
     : def_(other.def_),
       bodies_(other.bodies_),
       distances_(other.distances_),
+      apart_(other.apart_),
       ctx_(std::make_unique<StepContext>(*other.ctx_)),
       broad_phase_(std::make_unique<BroadPhase>()),
       body_friction_(other.body_friction_) {}
@@ -127,6 +128,11 @@ int World::add_distance(const DistanceConstraint& d) {
   }
   if (!why.str().empty()) throw std::invalid_argument("distance constraint: " + why.str());
   distances_.push_back(d);
+  if (!d.collide && d.body_b != kWorldBody) {
+    const std::pair<int, int> pair = std::minmax(d.body_a, d.body_b);
+    const auto at = std::lower_bound(apart_.begin(), apart_.end(), pair);
+    if (at == apart_.end() || *at != pair) apart_.insert(at, pair);
+  }
   return static_cast<int>(distances_.size()) - 1;
 }
 
@@ -203,6 +209,11 @@ void World::collide() {
     broad_margin += 2.0 * widest;
   }
   broad_phase_->find_pairs(bodies_, rotations_, broad_margin, kMaxCandidatePairs, pairs_);
+  if (!apart_.empty()) {  // the pairs joined by a rod that does not collide (both lists sorted)
+    std::erase_if(pairs_, [this](const std::pair<int, int>& pair) {
+      return std::binary_search(apart_.begin(), apart_.end(), pair);
+    });
+  }
   // Room for the manifolds a world of this size usually has (a body touches a few others); a
   // crowded step grows it as it finds them, never to a worst case of one per pair.
   detail::reserve_with_headroom(manifolds, std::min(pairs_.size(), 8 * bodies_.size()));

@@ -1,12 +1,15 @@
 // Distance constraints (Sec. 5.2), restitution (Sec. 8.2), friction (Sec. 5.4), the solver and
 // rotation alternatives, checked against analytic results.
 #include "cps/world.h"
+#include "scene.h"
 #include "solver.h"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 using namespace cps;
 
@@ -213,4 +216,98 @@ TEST_CASE("invalid distance constraints are rejected", "[constraint][validation]
   CHECK_THROWS_WITH(world.add_distance({1, Vec3::Zero(), 0, Vec3::Zero(), 1.0}),
                     Catch::Contains("static"));
   CHECK(world.distances().empty());
+}
+
+TEST_CASE("a rod that does not collide leaves its two bodies without contacts", "[constraint][distance]") {
+  // Two unit boxes overlapping by 0.2 m, and a third overlapping the second: with collide =
+  // false on a rod between the first two, only the pair (1, 2) has a manifold; with true, both.
+  for (const bool collide : {true, false}) {
+    WorldDef def;
+    def.gravity = Vec3::Zero();
+    World world(def);
+    for (int i = 0; i < 3; ++i) {
+      BodyDef b;
+      b.shape = Shape::box(Vec3::Constant(0.5));
+      b.mass = 1.0;
+      b.position = Vec3(0.8 * i, 0.0, 0.0);
+      world.add_body(b);
+    }
+    DistanceConstraint d{0, Vec3::Zero(), 1, Vec3::Zero(), 0.8};
+    d.collide = collide;
+    world.add_distance(d);
+    world.step();
+    bool pair01 = false;
+    bool pair12 = false;
+    for (const Manifold& m : world.manifolds()) {
+      pair01 = pair01 || (m.body_a == 0 && m.body_b == 1);
+      pair12 = pair12 || (m.body_a == 1 && m.body_b == 2);
+    }
+    INFO("collide " << collide);
+    CHECK(pair01 == collide);
+    CHECK(pair12);
+  }
+}
+
+TEST_CASE("a box on a ball joint swings as a physical pendulum about either axis",
+          "[constraint][ball_joint]") {
+  // A 1 x 0.5 x 0.5 m box (m = 0.25 kg, long axis vertical) hangs from a static body by a ball
+  // joint (scenes::add_ball_joint: three rods) at the centre of its top face, d = 0.5 m above its
+  // centre, and is sent swinging about z or about x at amplitude theta0 = 0.05 rad. A physical
+  // pendulum's period is T = 2 pi sqrt(I_p / (m g d)), I_p = m (1^2 + 0.5^2) / 12 + m d^2 about
+  // either axis. Bound 0.5 %: the amplitude adds theta0^2 / 16 = 1.6e-4, the integrator (omega
+  // dt)^2 / 24 < 1e-5 at dt = 1/600 s; a joint that held a direction (a hinge about the other
+  // axis, or rods pulling the box's top sideways) changes T or stops the swing.
+  const double m = 0.25;
+  const double d = 0.5;
+  const double g = 9.81;
+  const double inertia = m * (1.0 + 0.25) / 12.0 + m * d * d;
+  const double period = 2.0 * kPi * std::sqrt(inertia / (m * g * d));
+  const double omega0 = 0.05 * 2.0 * kPi / period;  // rad/s: amplitude 0.05 rad
+  for (const int axis : {0, 2}) {
+    WorldDef def;
+    def.gravity = Vec3(0.0, -g, 0.0);
+    def.dt = 1.0 / 600.0;
+    def.collision = false;
+    World world(def);
+    BodyDef top;
+    top.shape = Shape::box(Vec3::Constant(0.25));
+    top.is_static = true;
+    top.mass = 0.0;
+    top.position = Vec3(0.0, 0.75, 0.0);
+    const int fixed = world.add_body(top);
+    BodyDef link;
+    link.shape = Shape::box(Vec3(0.25, 0.5, 0.25));
+    link.mass = m;
+    link.position = Vec3::Zero();
+    // Turning at omega0 about the joint point (0, d, 0): the centre moves at omega x (-d y).
+    const Vec3 w = omega0 * Vec3::Unit(axis);
+    link.angular_velocity = w;
+    link.velocity = w.cross(Vec3(0.0, -d, 0.0));
+    const int body = world.add_body(link);
+    scenes::add_ball_joint(world, fixed, Vec3(0.0, -0.25, 0.0), body, Vec3(0.0, d, 0.0), 0.25,
+                           Vec3(1.0, -1.0, 1.0));
+    // The side the centre moves to: x for a swing about z, z for one about x.
+    const int side = axis == 0 ? 2 : 0;
+    std::vector<double> crossings;  // s: the centre through 0 along `side`, going the first way
+    double previous = world.bodies()[1].x[side];
+    double largest_gap = 0.0;
+    while (world.time() < 3.5 * period) {
+      world.step();
+      const Body& b = world.bodies()[1];
+      const double now = b.x[side];
+      if (previous < 0.0 && now >= 0.0) {
+        crossings.push_back(world.time() - def.dt * now / (now - previous));
+      }
+      previous = now;
+      const Vec3 joint = b.x + b.rotation() * Vec3(0.0, d, 0.0);
+      largest_gap = std::max(largest_gap, (joint - Vec3(0.0, d, 0.0)).norm());
+    }
+    INFO("swing about axis " << axis << ", " << crossings.size() << " crossings, joint gap "
+                             << largest_gap << " m");
+    REQUIRE(crossings.size() >= 3);
+    const double measured = (crossings.back() - crossings.front()) / (crossings.size() - 1.0);
+    INFO("period " << measured << " s against " << period << " s");
+    CHECK(std::abs(measured / period - 1.0) < 5e-3);
+    CHECK(largest_gap < 1e-3);
+  }
 }

@@ -144,12 +144,16 @@ void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
 /// A distance constraint (Sec. 5.2): point local_a of body_a and point local_b of body_b stay
 /// `length` apart (m, >= 0). local_a, local_b are in body space (m); when body_b is kWorldBody,
 /// local_b is a fixed world point (m). The row is unbounded (c_min = -inf, c_max = +inf).
+/// collide: whether body_a and body_b still get contacts with each other (true, the paper's);
+/// false leaves the pair out of the broad phase, as joined bodies are in the AVBD 3D demo and in
+/// most engines (no effect with the world).
 struct DistanceConstraint {
   int body_a = 0;
   Vec3 local_a = Vec3::Zero();
   int body_b = kWorldBody;
   Vec3 local_b = Vec3::Zero();
   double length = 1.0;
+  bool collide = true;
 };
 
 /// World positions (m) of the two end points of a distance constraint.

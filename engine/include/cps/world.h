@@ -187,6 +187,8 @@ class World {
   WorldDef def_;
   std::vector<Body> bodies_;
   std::vector<DistanceConstraint> distances_;
+  // Pairs (a < b) that get no contacts: the bodies of rods with collide = false, sorted, unique.
+  std::vector<std::pair<int, int>> apart_;
   // What the stages share and keep (step_context.h): manifolds, rows, lambdas, forces, the
   // solver, the warm-start cache, the counters.
   std::unique_ptr<StepContext> ctx_;

@@ -1,12 +1,11 @@
 // The scenes of the AVBD authors' 3D demo (savant117/avbd-demo3d, source/scenes.h: sceneStack,
 // sceneStackRatio, scenePyramid, sceneRope, sceneHeavyRope, sceneDynamicFriction,
-// sceneStaticFriction), built with the
-// demo's geometry, densities and friction, and the demo's solver settings as their own world
-// (source/solver.cpp defaultParams, solver.h): AVBD at dt 1/60 s, 10 iterations, penalty ramp
-// beta 1e4 N/m^2 (the demo's linear beta: every row here is linear), alpha 0.99, gamma 0.999,
-// penalties in [1, 1e10] N/m, no post-stabilisation, g = -10 m/s^2. The demo's contacts rest
-// at its collision margin, 0.01 m deep: here the penetration slop. Friction mixes as the demo's,
-// sqrt(mu_a mu_b) (pair_friction).
+// sceneStaticFriction), built with the demo's geometry, densities and friction, and the demo's
+// solver settings as their own world (source/solver.cpp defaultParams, solver.h): AVBD at dt 1/60
+// s, 10 iterations, penalty ramp beta 1e4 N/m^2 (the demo's linear beta: every row here is linear),
+// alpha 0.99, gamma 0.999, penalties in [1, 1e10] N/m, no post-stabilisation, g = -10 m/s^2. The
+// demo's contacts rest at its collision margin, 0.01 m deep: here the penetration slop. Friction
+// mixes as the demo's, sqrt(mu_a mu_b) (pair_friction).
 //
 // Axes: the demo's z is up; here y is. A demo point (x, y, z) is (x, z - top, -y) here, top the
 // height of the top face of the demo's ground box (a 100 m x 100 m x 1 m static box), so that its
@@ -251,13 +250,13 @@ class RopeMetrics final : public Metrics {
   void observe(const World& world) override {
     demo_.observe(world);
     gaps_ = ball_joint_gaps(world);
-    const double now = gaps_.empty() ? 0.0 : *std::max_element(gaps_.begin(), gaps_.end());
-    largest_ = std::max(largest_, now);
+    now_ = gaps_.empty() ? 0.0 : *std::max_element(gaps_.begin(), gaps_.end());
+    largest_ = std::max(largest_, now_);
   }
   nlohmann::json report() const override {
     nlohmann::json j = demo_.report();
     j["joint_gaps_m"] = gaps_;
-    j["max_joint_gap_m"] = gaps_.empty() ? 0.0 : *std::max_element(gaps_.begin(), gaps_.end());
+    j["max_joint_gap_m"] = now_;
     j["largest_joint_gap_m"] = largest_;
     return j;
   }
@@ -265,7 +264,8 @@ class RopeMetrics final : public Metrics {
  private:
   DemoMetrics demo_;
   std::vector<double> gaps_;
-  double largest_ = 0.0;
+  double now_ = 0.0;      // m: the largest gap now
+  double largest_ = 0.0;  // m: the largest gap over the run
 };
 
 std::unique_ptr<Metrics> make_rope_metrics(const World& world) {

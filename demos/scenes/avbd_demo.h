@@ -1,7 +1,8 @@
 #pragma once
 // The AVBD authors' 3D demo scenes (avbd_demo.cpp): avbd_stack, avbd_stack_ratio, avbd_pyramid,
 // avbd_rope, avbd_heavy_rope, avbd_dynamic_friction and avbd_static_friction, with the demo's
-// geometry and its solver settings as their own defaults. Listed apart ("cps list"); found by name (find_scene).
+// geometry and its solver settings as their own defaults. Listed apart ("cps list"); found by
+// name (find_scene).
 
 #include "scene.h"
 

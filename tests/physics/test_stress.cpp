@@ -742,14 +742,21 @@ TEST_CASE("the push methods beyond the paper's keep the energy bound in the stif
           // (soft_step.cpp).
           o.set("soft_relax", SoftRelax::restart);
         }
+        const double seconds = std::min(5.0, scene(name).default_seconds);
         if (method == "xpbd" && std::string(name) == "chain_20") {
           // One sweep a substep along the 20 links leaves stretch (2.1 mm at 20 substeps) that the
-          // next substep corrects, as a velocity: measured step excess 8.8 J at 20 substeps,
-          // 0.65 J at 30, 0.012 J at 40, -0.033 J at 60 (tolerance about 0.017 J). Checked at 60,
-          // where the sweeps keep up with the chain (docs/findings.md, "TGS and XPBD").
+          // next substep corrects, as a velocity: a step excess of 8.8 J at the default 20
+          // substeps, 0.65 J at 30, 0.012 J at 40, -0.033 J at 60 (tolerance about 0.017 J). The
+          // source's own step gives the same 8.8 J (the test "xpbd steps a chain as Mueller et
+          // al.'s Algorithm 2 does", test_push_methods.cpp; docs/findings.md, "TGS and XPBD"):
+          // at 20 substeps the rods store and give back energy as avbd's springs do, so the bound
+          // holds over the run; step by step at 60, where the sweeps keep up with the chain.
+          const CheckedRun source = run_checked(name, seconds, o);
+          INFO(source.metrics.dump());
+          check_run_energy_bound(source.energy);
           o.set("xpbd_substeps", 60);
         }
-        const CheckedRun c = run_checked(name, std::min(5.0, scene(name).default_seconds), o);
+        const CheckedRun c = run_checked(name, seconds, o);
         INFO(c.metrics.dump());
         if (bound_step_by_step(choice)) {
           check_energy_bound(c.energy);
@@ -764,13 +771,15 @@ TEST_CASE("the push methods beyond the paper's keep the energy bound in the stif
 TEST_CASE("random piles keep the energy bound with the push methods beyond the paper's",
           "[stress][random][push_methods]") {
   // As the random pile test above (section 9), for every method of the push table but the
-  // paper's two (avbd over the run alone: bound_step_by_step), over a tenth of its seeds.
-  int seeds = 200;
-  if (const char* env = std::getenv("CPS_RANDOM_SEEDS")) seeds = std::atoi(env);
-  seeds = std::max(1, seeds / 10);
-  for (int seed = 0; seed < seeds; ++seed) {
+  // paper's two (avbd over the run alone: bound_step_by_step), over a tenth of its seeds; xpbd,
+  // whose pre-stabilisation turns bodies started deep in each other, over all of them.
+  int all_seeds = 200;
+  if (const char* env = std::getenv("CPS_RANDOM_SEEDS")) all_seeds = std::atoi(env);
+  const int seeds = std::max(1, all_seeds / 10);
+  for (int seed = 0; seed < std::max(seeds, all_seeds); ++seed) {
     for (const Choice& choice : parameter("push").choices) {
       if (!beyond_the_paper(choice)) continue;
+      if (seed >= seeds && std::string(choice.name) != "xpbd") continue;
       const auto push = static_cast<PushMode>(choice.value);
       WorldDef def = scenes::stack_world_def();
       def.push = push;
@@ -791,5 +800,5 @@ TEST_CASE("random piles keep the energy bound with the push methods beyond the p
       }
     }
   }
-  SUCCEED(seeds << " seeds");
+  SUCCEED(seeds << " seeds, " << all_seeds << " for xpbd");
 }

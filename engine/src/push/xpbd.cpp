@@ -63,7 +63,11 @@
 // out to that depth by N Gauss-Seidel sweeps, each followed by a sweep that holds the rods at
 // their lengths of the start of the step; such a point keeps, through the substeps, the overlap
 // it is then left with. The solver's own residual of the last step is pushed out at the same
-// time, and new overlap made within the step is corrected in full, as the paper does.
+// time, and new overlap made within the step is corrected in full, as the paper does. A body
+// that the pre-stabilisation turns by Delta R keeps its angular momentum in its own frame (l :=
+// Delta R l), so its rotational kinetic energy 1/2 l . I^-1 l, with I turned by Delta R too, is
+// unchanged: at a fixed world l the turn alone changed it (up to 200 J a step in a pile of boxes
+// started 1.5 m deep in each other).
 //
 // Solvers: PGS is the paper's Gauss-Seidel sweep, each correction applied at once. Jacobi
 // computes every correction of a sweep (and of the velocity pass) from the same state and
@@ -312,13 +316,16 @@ class Xpbd final : public PushMethod {
   // that holds the rods at the lengths they had at the start of the step (so that what the
   // contacts move does not become rod error, which the substeps would turn into velocity). Then
   // every point may keep, through the substeps, the overlap it is left with (a point that the
-  // others pushed deeper too: the substeps would turn that into velocity).
+  // others pushed deeper too: the substeps would turn that into velocity). Each body turned by
+  // Delta R keeps its angular momentum in its own frame (l := Delta R l): no kinetic energy is
+  // added. Uses state_ (n) for the orientations before.
   void prestabilise(std::vector<Body>& bodies, const std::vector<DistanceConstraint>& distances,
                     const WorldDef& def, int sweeps) {
     if (std::none_of(points_.begin(), points_.end(),
                      [&](const Point& p) { return overlap(bodies, p) > p.target; })) {
       return;  // nothing to move (the usual case)
     }
+    for (std::size_t i = 0; i < bodies.size(); ++i) state_[i].o = bodies[i].o;
     detail::resize_with_headroom(rod_lengths_, distances.size());
     for (std::size_t r = 0; r < distances.size(); ++r) {
       Vec3 pa;
@@ -337,6 +344,10 @@ class Xpbd final : public PushMethod {
       }
       flush(bodies, false);
       sweep_rods(bodies, distances, &rod_lengths_, 0.0, nullptr);
+    }
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      if (bodies[i].is_static()) continue;
+      bodies[i].l = (bodies[i].o * state_[i].o.conjugate()).toRotationMatrix() * bodies[i].l;
     }
     for (Point& p : points_) p.allowed = std::max(overlap(bodies, p), def.penetration_slop);
   }

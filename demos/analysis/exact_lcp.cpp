@@ -32,6 +32,13 @@ constexpr int kMaxFixedPoint = 20;
 // Sweeps of the projected Gauss-Seidel start used when Lemke stops (pgs_start): enough for the
 // active set of the paper's scenes (PGS converges in velocity there; docs/exact_reference.md).
 constexpr int kFallbackSweeps = 2000;
+// The proximal point start used when both starts above fail (proximal_start): the weights eps
+// tried in turn, as parts of A's largest diagonal entry (1/kg), and the iterations of each.
+constexpr double kProximalWeights[] = {1e-5, 1e-6, 1e-7};
+constexpr int kProximalIterations = 100;
+// Active-set passes of one strictly convex problem of the proximal point start (it ends sooner
+// when the active set repeats).
+constexpr int kDefinitePasses = 50;
 
 // The bounds of a box problem, per row (N).
 struct Box {
@@ -375,6 +382,89 @@ Eigen::VectorXd pgs_start(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, co
   return x;
 }
 
+// Solves the strictly convex box problem min 1/2 x^T M x - q^T x, lo <= x <= hi, on the movable
+// rows (M = A + eps I: positive definite there; the other rows stay at 0) from x, by the primal-
+// dual active set method (Hintermueller, Ito & Kunisch 2003) with exact solves of M_FF: at most
+// kDefinitePasses passes, ending when the active set repeats.
+void solve_definite_box(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Box& box,
+                        const std::vector<bool>& movable, Eigen::VectorXd& x) {
+  const Eigen::Index c = q.size();
+  std::vector<signed char> last;
+  for (int pass = 0; pass < kDefinitePasses; ++pass) {
+    const Eigen::VectorXd w = M * x - q;
+    std::vector<signed char> state(static_cast<std::size_t>(c), 0);  // -1 lo, 1 hi, 0 free
+    std::vector<int> free_rows;
+    for (Eigen::Index j = 0; j < c; ++j) {
+      if (!movable[static_cast<std::size_t>(j)]) {
+        x[j] = 0.0;
+        state[static_cast<std::size_t>(j)] = 2;
+        continue;
+      }
+      const double trial = x[j] - w[j] / M(j, j);
+      if (trial <= box.lo[j]) {
+        x[j] = box.lo[j];
+        state[static_cast<std::size_t>(j)] = -1;
+      } else if (trial >= box.hi[j]) {
+        x[j] = box.hi[j];
+        state[static_cast<std::size_t>(j)] = 1;
+      } else {
+        free_rows.push_back(static_cast<int>(j));
+      }
+    }
+    const auto f = static_cast<Eigen::Index>(free_rows.size());
+    if (f > 0) {
+      Eigen::MatrixXd M_FF(f, f);
+      Eigen::VectorXd r_F(f);
+      for (Eigen::Index k = 0; k < f; ++k) x[free_rows[static_cast<std::size_t>(k)]] = 0.0;
+      const Eigen::VectorXd fixed_part = M * x;
+      for (Eigen::Index k = 0; k < f; ++k) {
+        const int row = free_rows[static_cast<std::size_t>(k)];
+        r_F[k] = q[row] - fixed_part[row];
+        for (Eigen::Index l = 0; l < f; ++l) M_FF(k, l) = M(row, free_rows[static_cast<std::size_t>(l)]);
+      }
+      const Eigen::VectorXd x_F = M_FF.ldlt().solve(r_F);
+      for (Eigen::Index k = 0; k < f; ++k) x[free_rows[static_cast<std::size_t>(k)]] = x_F[k];
+    }
+    if (state == last) break;
+    last = std::move(state);
+  }
+}
+
+// The start of the polish when Lemke's and PGS's both fail (fixed friction; a stack's redundant
+// corner rows make A singular, or nearly so, and the polish's active set cycles): the proximal
+// point method (Rockafellar, SIAM J. Control Optim. 14, 1976) on the box problem's quadratic
+// program, min 1/2 x^T A x - b^T x over the box, whose minimisers are its solutions (A symmetric
+// positive semi-definite): x_{k+1} minimises it plus eps/2 |x - x_k|^2, a strictly convex
+// problem (solve_definite_box). The iterates approach a solution while each subproblem stays
+// well posed; each is polished (polish) and the first whose residual is under `tolerance` of
+// its force scale is returned, else the one with the smallest residual. eps: kProximalWeights of A's largest
+// diagonal entry, in turn, kProximalIterations each.
+Eigen::VectorXd proximal_start(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Box& box,
+                               const std::vector<bool>& movable, double tolerance) {
+  const Eigen::Index c = b.size();
+  double largest = 0.0;
+  for (Eigen::Index j = 0; j < c; ++j) largest = std::max(largest, A(j, j));
+  Eigen::VectorXd best = Eigen::VectorXd::Zero(c);
+  double best_residual = std::numeric_limits<double>::infinity();
+  for (const double weight : kProximalWeights) {
+    const double eps = weight * largest;
+    const Eigen::MatrixXd M = A + eps * Eigen::MatrixXd::Identity(c, c);
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(c).cwiseMax(box.lo).cwiseMin(box.hi);
+    for (int k = 0; k < kProximalIterations; ++k) {
+      solve_definite_box(M, b + eps * x, box, movable, x);
+      Eigen::VectorXd candidate = x;
+      polish(A, b, box, movable, candidate);
+      const double residual = box_residual(A, b, box, movable, candidate);
+      if (residual < best_residual) {
+        best = candidate;
+        best_residual = residual;
+      }
+      if (residual <= tolerance * force_scale(A, b, candidate)) return best;
+    }
+  }
+  return best;
+}
+
 // The bounds of s's rows with coupled friction limits from `lambda`'s contact rows.
 Box coupled_box(const StepSystem& s, const Eigen::VectorXd& lambda) {
   Box box{s.c_min, s.c_max};
@@ -459,6 +549,13 @@ ExactSolution solve_exact(const StepSystem& s, double tolerance) {
     retry.lambda = pgs_start(A, s.b, box, movable, coupled ? &coupling : nullptr);
     retry.method = coupled ? "pgs start (coupled bounds) + polish" : "pgs start + polish";
     polish_solution(s, A, movable, retry);
+    ExactSolution proximal;
+    if (!passes(retry) && !coupled) {  // both active sets cycle: the proximal point start
+      proximal.lambda = proximal_start(A, s.b, box, movable, tolerance);
+      proximal.method = "proximal point start + polish";
+      polish_solution(s, A, movable, proximal);
+      if (passes(proximal)) retry = std::move(proximal);
+    }
     if (!passes(retry)) {
       std::ostringstream why;
       why << "exact solve: ";
@@ -469,7 +566,9 @@ ExactSolution solve_exact(const StepSystem& s, double tolerance) {
             << " N; ";
       }
       why << "from " << kFallbackSweeps << " PGS sweeps the polished solution has "
-          << retry.residual_max << " N, both above " << tolerance << " of the force scale "
+          << retry.residual_max << " N";
+      if (!coupled) why << ", from the proximal point start " << proximal.residual_max << " N";
+      why << ", all above " << tolerance << " of the force scale "
           << force_scale(A, s.b, retry.lambda) << " N";
       throw std::runtime_error(why.str());
     }

@@ -20,8 +20,12 @@
 //
 // Where Lemke stops (its pivot limit: degenerate problems such as a stack's redundant corner
 // rows can make it cycle; or a ray), the polish starts instead from 2000 sweeps of projected
-// Gauss-Seidel; either way the result counts as exact only if its natural-map residual is under
-// 1e-9 of the force scale, else solve_exact throws.
+// Gauss-Seidel. Where that fails too with fixed friction (a stack's corner rows make A singular
+// or nearly so, and the polish's active set cycles), from the iterates of the proximal point
+// method on the problem's quadratic program (Rockafellar 1976: each iterate the solution of the
+// strictly convex problem with A + eps I). Whichever start, the result counts as exact only if
+// its natural-map residual is under 1e-9 of the force scale (or the tolerance given), else
+// solve_exact throws.
 //
 // A = J M^-1 J^T is only positive semi-definite: a box resting on four contact points, or a pile
 // of balls with more contact rows than degrees of freedom, has many lambda that solve the
@@ -50,7 +54,8 @@ struct ExactSolution {
   /// (coupled bounds) + polish", or, where Lemke stopped at its pivot limit or a ray or its
   /// polished result missed the residual check, "pgs start + polish" ("pgs start (coupled
   /// bounds) + polish"): the polish from 2000 PGS sweeps, exact all the same since it passed
-  /// the residual check.
+  /// the residual check; where that missed it too (fixed friction), "proximal point start +
+  /// polish".
   std::string method;
   /// Coupled friction: rounds of the polish, each with the bounds of the last lambda (0 for
   /// fixed friction).
@@ -101,9 +106,9 @@ struct ExactSolution::Distance {
 /// Solves s exactly (see the file comment). Throws std::invalid_argument for a system whose
 /// sizes disagree (or a coupled friction row whose contact row is not bounded [0, inf)),
 /// std::runtime_error when the polished solution's natural-map residual is above 1e-9 of the
-/// problem's force scale (max |lambda_j|, |b_j| / A_jj; N), whether the polish started from
-/// Lemke's solution or, where Lemke stopped, from PGS sweeps, and std::runtime_error naming the
-/// library when Siconos numerics cannot be opened. Siconos is opened (dlopen) by the first solve
+/// problem's force scale (max |lambda_j|, |b_j| / A_jj; N) from every start (Lemke's solution,
+/// PGS sweeps, the proximal point iterates), and std::runtime_error naming the library when
+/// Siconos numerics cannot be opened. Siconos is opened (dlopen) by the first solve
 /// that needs Lemke, not at start-up: CPS_SICONOS_LIBRARY if set and not empty, else the SONAME
 /// found when cps was configured (CMake's CPS_SICONOS_SONAME, e.g. libsiconos_numerics.so.7).
 ExactSolution solve_exact(const StepSystem& s);

@@ -342,7 +342,8 @@ std::string score_markdown(const std::vector<ScoreResult>& results,
         "source's defaults at the same dt and mu:\n\n";
   for (const Method& m : methods) md << "- " << m.name << ": " << score_source(m) << ".\n";
   md << "\nThe **exact solve** row is the paper's push at the paper's settings with every step's "
-        "A lambda = b solved exactly (Siconos numerics' Lemke, polished; "
+        "A lambda = b solved exactly (Siconos numerics' Lemke, polished, or where its active set "
+        "cycles the polish from PGS sweeps or from proximal point iterates; "
         "World::set_solve_override; each solve's natural-map residual under "
      << number(kScoreExactTolerance) << " of its force scale) in place of the 25 sweeps: what "
         "is left of a failure there is the step's (the time step, the push factor, the paper's "

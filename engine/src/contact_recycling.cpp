@@ -26,7 +26,7 @@ bool pair_below(int a, int b, int c, int d) { return a < c || (a == c && b < d);
 
 }  // namespace
 
-void ContactRecycler::begin_step() { next_.clear(); }
+void ContactRecycler::begin_step() { next_count_ = 0; }
 
 ContactRecycler::Cursor ContactRecycler::cursor_at(int a, int b) const {
   const auto first = std::lower_bound(last_.begin(), last_.end(), std::pair{a, b},
@@ -84,16 +84,31 @@ bool ContactRecycler::recycle(int a, int b, const std::vector<Body>& bodies, dou
 }
 
 void ContactRecycler::keep(const Manifold& m, const std::vector<Body>& bodies, std::size_t found) {
-  next_.emplace_back();
-  keep_at(next_.size() - 1, m, bodies, found);
+  if (next_count_ == next_.size()) next_.emplace_back();
+  keep_at(next_count_++, m, bodies, found);
 }
 
-void ContactRecycler::resize_kept(std::size_t count) { next_.resize(count); }
+void ContactRecycler::resize_kept(std::size_t count) {
+  if (next_.size() < count) next_.resize(count);
+  next_count_ = count;
+}
+
+void ContactRecycler::copy_used(const Cached& from, Cached& to) {
+  to.a = from.a;
+  to.b = from.b;
+  to.normal = from.normal;
+  to.x_a = from.x_a;
+  to.x_b = from.x_b;
+  to.o_a = from.o_a;
+  to.o_b = from.o_b;
+  to.count = from.count;
+  std::copy_n(from.points.begin(), from.count, to.points.begin());
+}
 
 void ContactRecycler::keep_at(std::size_t at, const Manifold& m, const std::vector<Body>& bodies,
                               std::size_t found) {
   if (found != kNone && last_[found].a == m.body_a && last_[found].b == m.body_b) {
-    next_[at] = last_[found];  // the poses of its caching, so that motion adds up
+    copy_used(last_[found], next_[at]);  // the poses of its caching, so that motion adds up
     return;
   }
   const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];
@@ -117,6 +132,9 @@ void ContactRecycler::keep_at(std::size_t at, const Manifold& m, const std::vect
   }
 }
 
-void ContactRecycler::end_step() { last_.swap(next_); }
+void ContactRecycler::end_step() {
+  next_.resize(next_count_);  // never grows here: drops the entries past this step's
+  last_.swap(next_);
+}
 
 }  // namespace cps

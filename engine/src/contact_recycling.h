@@ -84,8 +84,15 @@ class ContactRecycler {
     std::array<CachedPoint, kMaxManifoldPoints> points{};
   };
 
+  // Copies an entry's pair, poses, normal and its `count` points (the rest are never read), so
+  // that a copy moves only what is used.
+  static void copy_used(const Cached& from, Cached& to);
+
   std::vector<Cached> last_;  // the last step's, in pair order
-  std::vector<Cached> next_;  // this step's
+  // This step's: its first next_count_ entries. The vector only grows (its entries are made once
+  // and then written over), so a step builds no entries it already has storage for.
+  std::vector<Cached> next_;
+  std::size_t next_count_ = 0;
 };
 
 }  // namespace cps

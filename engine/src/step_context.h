@@ -98,7 +98,8 @@ struct StepContext {
   /// touching pairs of its consecutive pairs, in pair order, and for each the last step's
   /// recycled entry (ContactRecycler::kNone: made anew).
   struct NarrowShare {
-    std::vector<Manifold> manifolds;
+    std::vector<Manifold> manifolds;  ///< the first `used` are this step's; the rest storage
+    std::size_t used = 0;
     std::vector<std::size_t> found;
     std::size_t first = 0;   ///< its first manifold's place in the step's manifolds
     std::size_t points = 0;  ///< contact points in its manifolds

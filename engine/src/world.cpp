@@ -190,9 +190,32 @@ void World::external_forces() { gravity_forces(bodies_, def_.gravity, ctx_->f_ex
 // so manifolds and rows do not depend on how the candidates were found.
 void World::collide() {
   std::vector<Manifold>& manifolds = ctx_->manifolds;
-  StepCounters& counters = ctx_->counters;
-  manifolds.clear();
+  Workers* workers = ctx_->workers();
+  // On threads the manifolds keep their storage and count until the join resizes them (so that
+  // only those past last step's count are made, not every one); any error clears them first.
+  if (workers == nullptr || !def_.collision) manifolds.clear();
   if (!def_.collision) return;
+  try {
+    collide_pairs(workers);
+  } catch (...) {
+    manifolds.clear();
+    throw;
+  }
+}
+
+namespace {
+// Copies a manifold's pair, count and its `count` contacts (the slots past them are never read).
+void copy_used_contacts(const Manifold& from, Manifold& to) {
+  to.body_a = from.body_a;
+  to.body_b = from.body_b;
+  to.count = from.count;
+  std::copy_n(from.contacts.begin(), from.count, to.contacts.begin());
+}
+}  // namespace
+
+void World::collide_pairs(Workers* workers) {
+  std::vector<Manifold>& manifolds = ctx_->manifolds;
+  StepCounters& counters = ctx_->counters;
   // The rotation matrix of each box and plane, once: the broad phase's bounds and the narrow
   // phase both read it (spheres need none).
   rotations_.resize(bodies_.size());
@@ -259,7 +282,6 @@ void World::collide() {
     if (points > kMaxContactPoints) too_many_points();
   };
   counters.pairs_tested += static_cast<std::int64_t>(pairs_.size());
-  Workers* workers = ctx_->workers();
   if (workers == nullptr) {
     Cursor cursor;
     for (const std::pair<int, int>& pair : pairs_) {
@@ -275,7 +297,8 @@ void World::collide() {
     // The pairs in chunks of consecutive pairs, each into its own list (the threads take the
     // chunks as they come free: the pairs' cost is uneven, and a plane's pairs come together);
     // the lists are joined in chunk order, so the manifolds are those of one thread, in the same
-    // order.
+    // order. A list's manifolds are made once and written over from step to step (`used` of
+    // them this step), and only their used contacts are copied.
     std::vector<StepContext::NarrowShare>& shares = ctx_->narrow_shares;
     const std::size_t chunks = (pairs_.size() + kPairsPerChunk - 1) / kPairsPerChunk;
     if (shares.size() < chunks) shares.resize(chunks);
@@ -283,17 +306,18 @@ void World::collide() {
       const std::size_t begin = k * kPairsPerChunk;
       const std::size_t end = std::min(begin + kPairsPerChunk, pairs_.size());
       StepContext::NarrowShare& share = shares[k];
-      share.manifolds.clear();
+      share.used = 0;
       share.found.clear();
       Cursor cursor = recycler != nullptr ? recycler->cursor_at(pairs_[begin].first, pairs_[begin].second) : Cursor{};
       share.points = 0;
       for (std::size_t i = begin; i < end; ++i) {
-        Manifold& m = share.manifolds.emplace_back();
+        if (share.used == share.manifolds.size()) share.manifolds.emplace_back();
+        Manifold& m = share.manifolds[share.used];
+        m.count = 0;
         if (narrow(pairs_[i], m, cursor)) {
           share.found.push_back(cursor.found);
           share.points += static_cast<std::size_t>(m.count);
-        } else {
-          share.manifolds.pop_back();
+          ++share.used;
         }
       }
     });
@@ -303,7 +327,7 @@ void World::collide() {
     for (std::size_t k = 0; k < chunks; ++k) {
       StepContext::NarrowShare& share = shares[k];
       share.first = count;
-      count += share.manifolds.size();
+      count += share.used;
       points += share.points;
       counters.contacts += static_cast<std::int64_t>(share.points);
       for (const std::size_t found : share.found) counters.recycled += found != ContactRecycler::kNone ? 1 : 0;
@@ -313,8 +337,8 @@ void World::collide() {
     if (recycler != nullptr) recycler->resize_kept(count);
     parallel_chunks(workers, chunks, [&](std::size_t k) {
       const StepContext::NarrowShare& share = shares[k];
-      for (std::size_t i = 0; i < share.manifolds.size(); ++i) {
-        manifolds[share.first + i] = share.manifolds[i];
+      for (std::size_t i = 0; i < share.used; ++i) {
+        copy_used_contacts(share.manifolds[i], manifolds[share.first + i]);
         if (recycler != nullptr) recycler->keep_at(share.first + i, share.manifolds[i], bodies_, share.found[i]);
       }
     });

@@ -37,6 +37,7 @@ namespace cps {
 class BroadPhase;
 struct StepContext;
 class PushMethod;
+class Workers;
 
 /// The most candidate pairs the broad phase may list in one step (count). A pair costs 8 bytes;
 /// the largest scaled scenes list about 10 per body. Beyond it World::step throws.
@@ -182,6 +183,7 @@ class World {
  private:
   void external_forces();
   void collide();
+  void collide_pairs(Workers* workers);  // collide()'s broad and narrow phase
   void build_rows();
 
   WorldDef def_;

@@ -392,7 +392,8 @@ void solve_definite_box(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, cons
   std::vector<signed char> last;
   for (int pass = 0; pass < kDefinitePasses; ++pass) {
     const Eigen::VectorXd w = M * x - q;
-    std::vector<signed char> state(static_cast<std::size_t>(c), 0);  // -1 lo, 1 hi, 0 free
+    // Per row: -1 on lo, 1 on hi, 0 free, 2 not movable.
+    std::vector<signed char> state(static_cast<std::size_t>(c), 0);
     std::vector<int> free_rows;
     for (Eigen::Index j = 0; j < c; ++j) {
       if (!movable[static_cast<std::size_t>(j)]) {
@@ -420,7 +421,9 @@ void solve_definite_box(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, cons
       for (Eigen::Index k = 0; k < f; ++k) {
         const int row = free_rows[static_cast<std::size_t>(k)];
         r_F[k] = q[row] - fixed_part[row];
-        for (Eigen::Index l = 0; l < f; ++l) M_FF(k, l) = M(row, free_rows[static_cast<std::size_t>(l)]);
+        for (Eigen::Index l = 0; l < f; ++l) {
+          M_FF(k, l) = M(row, free_rows[static_cast<std::size_t>(l)]);
+        }
       }
       const Eigen::VectorXd x_F = M_FF.ldlt().solve(r_F);
       for (Eigen::Index k = 0; k < f; ++k) x[free_rows[static_cast<std::size_t>(k)]] = x_F[k];
@@ -437,8 +440,8 @@ void solve_definite_box(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, cons
 // positive semi-definite): x_{k+1} minimises it plus eps/2 |x - x_k|^2, a strictly convex
 // problem (solve_definite_box). The iterates approach a solution while each subproblem stays
 // well posed; each is polished (polish) and the first whose residual is under `tolerance` of
-// its force scale is returned, else the one with the smallest residual. eps: kProximalWeights of A's largest
-// diagonal entry, in turn, kProximalIterations each.
+// its force scale is returned, else the one with the smallest residual. eps: kProximalWeights of
+// A's largest diagonal entry, in turn, kProximalIterations each.
 Eigen::VectorXd proximal_start(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Box& box,
                                const std::vector<bool>& movable, double tolerance) {
   const Eigen::Index c = b.size();

@@ -232,7 +232,8 @@ TEST_CASE("xpbd steps a chain as Mueller et al.'s Algorithm 2 does", "[push_meth
   for (std::size_t i = 0; i < x.size(); ++i) {
     largest = std::max(largest, finite_or_inf((world.body(static_cast<int>(i)).x - x[i]).norm()));
   }
-  INFO("largest distance between the two runs' balls after " << steps << " steps: " << largest << " m");
+  INFO("largest distance between the two runs' balls after " << steps << " steps: "
+                                                               << largest << " m");
   CHECK(largest < 1e-6);
 }
 

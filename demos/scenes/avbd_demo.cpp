@@ -275,6 +275,8 @@ std::unique_ptr<Metrics> make_rope_metrics(const World& world) {
 constexpr BenchTraits kDemoBench{.start_s = 1.0,
                              .seconds = 1.0,
                              .reason = "from 1 s: the bodies have landed (the demo's scenes at rest or sliding)"};
+constexpr BenchTraits kRopeBench{.start_s = 0.0, .seconds = 1.0,
+                                 .reason = "the rope swings from the start"};
 
 const std::array kDemoScenes = {
     Scene{.name = "avbd_stack",
@@ -311,7 +313,7 @@ const std::array kDemoScenes = {
           .populate = &populate_demo_rope,
           .make_metrics = &make_rope_metrics,
           .camera = CameraPreset{Vec3(0.0, 20.0, 45.0), Vec3(0.0, 20.0, 0.0), 45.0},
-          .bench = BenchTraits{.start_s = 0.0, .seconds = 1.0, .reason = "the rope swings from the start"},
+          .bench = kRopeBench,
           .report = {}},
     Scene{.name = "avbd_heavy_rope",
           .summary = "the AVBD 3D demo's Heavy Rope: the rope with a 125 kg cube (500 times a link) as its last link",
@@ -320,7 +322,7 @@ const std::array kDemoScenes = {
           .populate = &populate_demo_heavy_rope,
           .make_metrics = &make_rope_metrics,
           .camera = CameraPreset{Vec3(0.0, 20.0, 50.0), Vec3(0.0, 18.0, 0.0), 45.0},
-          .bench = BenchTraits{.start_s = 0.0, .seconds = 1.0, .reason = "the rope swings from the start"},
+          .bench = kRopeBench,
           .report = {}},
     Scene{.name = "avbd_dynamic_friction",
           .summary = "the AVBD 3D demo's Dynamic Friction: eleven slabs sent at 10 m/s, their friction 5 down to 0",

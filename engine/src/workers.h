@@ -1,13 +1,14 @@
 #pragma once
 // Threads that run one task together, in the single-program style of Box2D v3's solver stages
 // (erincatto/box2d src/solver.c, b2SolverStep): every thread runs the same task with its own
-// index and they meet at barriers between the stages, so a step wakes the threads once.
+// index and they meet at barriers between the stages. Between tasks the workers spin a while
+// before they sleep, as Box2D v3's and enkiTS's workers do: a step runs a dozen short tasks
+// with a little serial work between them, and waking a sleeping thread costs tens of
+// microseconds on a virtual machine.
 
 #include <atomic>
 #include <cstddef>
-#include <condition_variable>
 #include <cstdint>
-#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -54,18 +55,23 @@ class Workers {
   void loop(int t);
   void stop_and_join();
 
-  /// Pauses a waiting thread spins for before it sleeps (count; about 10 to 40 us).
+  /// Pauses a waiting thread spins for before it sleeps, at a barrier and while the caller
+  /// waits for a task's end (count; about 10 to 40 us).
   static constexpr int kSpins = 2000;
+  /// Pauses an idle worker spins for before it sleeps, waiting for the next task (count; about
+  /// 0.2 to 1 ms, by the processor's pause: longer than the serial work between a step's tasks).
+  static constexpr int kIdleSpins = 20000;
+
+  // Spins for up to `spins` pauses while value == old, then sleeps until it changes.
+  template <class T>
+  static void wait_while(const std::atomic<T>& value, T old, int spins);
 
   int count_ = 1;
-  std::atomic<int> arrived_{0};            // threads at the current barrier
-  std::atomic<std::uint32_t> phase_{0};    // barriers passed
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::condition_variable done_;
-  std::uint64_t generation_ = 0;  // tasks started
-  int running_ = 0;               // workers still in the current task
-  bool stop_ = false;
+  std::atomic<int> arrived_{0};               // threads at the current barrier
+  std::atomic<std::uint32_t> phase_{0};       // barriers passed
+  std::atomic<std::uint32_t> generation_{0};  // tasks started (and the stop)
+  std::atomic<int> running_{0};               // workers still in the current task
+  std::atomic<bool> stop_{false};
   void (*call_)(void*, int) = nullptr;
   void* task_ = nullptr;
   std::vector<std::thread> threads_;
@@ -123,6 +129,17 @@ inline Workers::Workers(int count) : count_(count < 1 ? 1 : count) {
 
 inline Workers::~Workers() { stop_and_join(); }
 
+template <class T>
+inline void Workers::wait_while(const std::atomic<T>& value, T old, int spins) {
+  for (int i = 0; i < spins; ++i) {
+    if (value.load(std::memory_order_acquire) != old) return;
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  }
+  while (value.load(std::memory_order_acquire) == old) value.wait(old, std::memory_order_acquire);
+}
+
 inline void Workers::sync() {
   if (count_ == 1) return;
   // The phase cannot move on before this thread arrives, so this is the barrier's own phase.
@@ -133,55 +150,40 @@ inline void Workers::sync() {
     phase_.notify_all();
     return;
   }
-  for (int i = 0; i < kSpins; ++i) {
-    if (phase_.load(std::memory_order_acquire) != phase) return;
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#endif
-  }
-  while (phase_.load(std::memory_order_acquire) == phase) phase_.wait(phase, std::memory_order_acquire);
+  wait_while(phase_, phase, kSpins);
 }
 
 inline void Workers::stop_and_join() {
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
+  stop_.store(true, std::memory_order_release);
+  generation_.fetch_add(1, std::memory_order_acq_rel);
+  generation_.notify_all();
   for (std::thread& thread : threads_) thread.join();
   threads_.clear();
 }
 
 inline void Workers::start() {
-  {
-    std::lock_guard lock(mutex_);
-    ++generation_;
-    running_ = count_ - 1;
-  }
-  wake_.notify_all();
+  // The task and the count are written before the generation moves on (release), so a worker
+  // that sees the new generation sees them.
+  running_.store(count_ - 1, std::memory_order_relaxed);
+  generation_.fetch_add(1, std::memory_order_acq_rel);
+  generation_.notify_all();
 }
 
 inline void Workers::finish() {
-  std::unique_lock lock(mutex_);
-  done_.wait(lock, [this] { return running_ == 0; });
+  for (int left = running_.load(std::memory_order_acquire); left != 0;
+       left = running_.load(std::memory_order_acquire)) {
+    wait_while(running_, left, kSpins);
+  }
 }
 
 inline void Workers::loop(int t) {
-  std::uint64_t seen = 0;
+  std::uint32_t seen = 0;
   for (;;) {
-    {
-      std::unique_lock lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
-      if (stop_) return;
-      seen = generation_;
-    }
+    wait_while(generation_, seen, kIdleSpins);
+    seen = generation_.load(std::memory_order_acquire);
+    if (stop_.load(std::memory_order_acquire)) return;
     call_(task_, t);
-    bool last = false;
-    {
-      std::lock_guard lock(mutex_);
-      last = --running_ == 0;
-    }
-    if (last) done_.notify_one();
+    if (running_.fetch_sub(1, std::memory_order_acq_rel) == 1) running_.notify_all();
   }
 }
 

@@ -28,6 +28,9 @@ constexpr double kMaxCell = 1073741824.0;
 // bounds (count; typical 32): below it the n^2 / 2 tests cost less than building the grid
 // (measured on the paper's scenes, 6 to 31 bodies).
 constexpr std::size_t kAllPairsMax = 32;
+// Fewest bodies whose pairs the threads share (count; typical 512): below it waking them costs
+// about what listing the pairs does.
+constexpr std::size_t kMinParallelPairs = 512;
 
 // Closed intervals overlap on all three axes: no axis separates them (evaluated without
 // branches: | not ||).
@@ -49,10 +52,22 @@ void check_pair_count(std::size_t count, std::size_t max_pairs, std::size_t bodi
 
 }  // namespace
 
+bool BroadPhase::reaches_plane(std::size_t body, std::size_t plane) const {
+  const Plane& p = plane_[plane];
+  const Bounds& b = bounds_[body];
+  const Vec3 centre = 0.5 * (b.lo + b.hi);
+  const Vec3 half = 0.5 * (b.hi - b.lo);
+  const double centre_height = p.normal.dot(centre) - p.offset;
+  const double reach = p.normal.cwiseAbs().dot(half);
+  // Round-off of the bounds and of the narrow phase's vertices, relative to the coordinates.
+  const double slack = 1e-9 * (1.0 + std::abs(centre_height) + std::abs(p.offset) + reach);
+  // Not `>`: a NaN height keeps the pair, as the grid keeps bodies with non-finite positions.
+  return !(centre_height - reach > grow_ + slack);
+}
 
 // Broad phase: axis-aligned bounds grown by the contact margin; a pair is a candidate when its
-// bounds overlap (closed intervals on x, y and z) and not both bodies are static; every plane is
-// a candidate with every movable body. Bounds go into a uniform grid of cubic cells a little
+// bounds overlap (closed intervals on x, y and z) and not both bodies are static; a plane is a
+// candidate with every movable body whose bounds come within half the margin of it. Bounds go into a uniform grid of cubic cells a little
 // wider than the widest body (Ericson 2005, Sec. 7.1), put in order of their cell's bucket by a
 // counting sort, so the cost grows with the body count and the pairs, not with their square or
 // a sort. Two overlapping bounds have lower corners at most one cell apart, so each body looks
@@ -62,7 +77,7 @@ void check_pair_count(std::size_t count, std::size_t max_pairs, std::size_t bodi
 // against every body, so that one large body does not make every cell large.
 void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<Mat3>& rotations,
                             double contact_margin, std::size_t max_pairs,
-                            std::vector<std::pair<int, int>>& pairs) {
+                            std::vector<std::pair<int, int>>& pairs, Workers* workers) {
   const std::size_t n = bodies.size();
   pairs.clear();
   classify(bodies, rotations, contact_margin);
@@ -76,15 +91,31 @@ void BroadPhase::find_pairs(const std::vector<Body>& bodies, const std::vector<M
     return;
   }
   build_grid(bodies);
-  detail::resize_with_headroom(candidates_, n + planes_.size());
-  for (std::size_t ia = 0; ia < n; ++ia) {
-    check_pair_count(pairs.size(), max_pairs, n);  // at most n pairs past the limit
-    if (broad_class_[ia] != BroadClass::gridded) {
-      pairs_of_ungridded(bodies, ia, pairs);
-    } else {
-      pairs_of_gridded(bodies, ia, pairs);
-    }
+  const auto threads = static_cast<std::size_t>(
+      workers != nullptr && n >= kMinParallelPairs ? workers->count() : 1);
+  if (candidates_.size() < threads) candidates_.resize(threads);
+  if (lists_.size() < threads) lists_.resize(threads);
+  for (std::size_t t = 0; t < threads; ++t) {
+    detail::resize_with_headroom(candidates_[t], n + planes_.size());
   }
+  // Each thread lists its share of the bodies in order (the first into `pairs`), and stops once
+  // its list passes the limit (at most n pairs past it); the lists are joined in order.
+  parallel_for(threads > 1 ? workers : nullptr, n, kMinParallelPairs, [&](int t, std::size_t begin, std::size_t end) {
+    const auto k = static_cast<std::size_t>(t);
+    std::vector<std::pair<int, int>>& out = k == 0 ? pairs : lists_[k];
+    out.clear();
+    for (std::size_t ia = begin; ia < end && out.size() <= max_pairs; ++ia) {
+      if (broad_class_[ia] != BroadClass::gridded) {
+        pairs_of_ungridded(bodies, ia, out);
+      } else {
+        pairs_of_gridded(bodies, ia, out, candidates_[k]);
+      }
+    }
+  });
+  std::size_t count = pairs.size();
+  for (std::size_t t = 1; t < threads; ++t) count += lists_[t].size();
+  check_pair_count(count, max_pairs, n);
+  for (std::size_t t = 1; t < threads; ++t) pairs.insert(pairs.end(), lists_[t].begin(), lists_[t].end());
 }
 
 void BroadPhase::classify(const std::vector<Body>& bodies, const std::vector<Mat3>& rotations,
@@ -94,6 +125,7 @@ void BroadPhase::classify(const std::vector<Body>& bodies, const std::vector<Mat
   broad_class_.resize(n);
   cell_.resize(n);
   bucket_of_.resize(n);
+  plane_.resize(n);
   planes_.clear();
   oversize_.clear();
   widths_.clear();
@@ -101,14 +133,19 @@ void BroadPhase::classify(const std::vector<Body>& bodies, const std::vector<Mat
   detail::reserve_with_headroom(planes_, n);
   detail::reserve_with_headroom(oversize_, n);
   const double grow = 0.5 * contact_margin;
+  grow_ = grow;
   for (std::size_t i = 0; i < n; ++i) {
     const Body& b = bodies[i];
     Vec3 half = Vec3::Zero();
     switch (b.shape.kind) {
-      case ShapeKind::plane:
+      case ShapeKind::plane: {
         broad_class_[i] = BroadClass::plane;
         planes_.push_back(static_cast<int>(i));
+        Plane& p = plane_[i];  // as the narrow phase places it (collision.cpp)
+        p.normal = rotations[i] * b.shape.normal;
+        p.offset = b.shape.offset + p.normal.dot(b.x);
         continue;
+      }
       case ShapeKind::box:
         half = rotations[i].cwiseAbs() * b.shape.half_extents;
         break;
@@ -222,7 +259,8 @@ void BroadPhase::build_grid(const std::vector<Body>& bodies) {
 }
 
 void BroadPhase::pairs_of_gridded(const std::vector<Body>& bodies, std::size_t ia,
-                                  std::vector<std::pair<int, int>>& pairs) {
+                                  std::vector<std::pair<int, int>>& pairs,
+                                  std::vector<int>& candidates) const {
   const GridShape& g = shape_;
   const int a = static_cast<int>(ia);
   const bool a_static = bodies[ia].is_static();
@@ -239,7 +277,7 @@ void BroadPhase::pairs_of_gridded(const std::vector<Body>& bodies, std::size_t i
       // and fail the bounds test.
       const bool hit = (e.body > a) & (e.cell[1] == y) & (e.cell[2] == z) &
                        !(a_static & e.is_static) & bounds_overlap(ba, e.bounds);
-      candidates_[count] = e.body;
+      candidates[count] = e.body;
       count += hit ? 1 : 0;
     }
   };
@@ -259,21 +297,21 @@ void BroadPhase::pairs_of_gridded(const std::vector<Body>& bodies, std::size_t i
   for (const int b : oversize_) {
     const auto ib = static_cast<std::size_t>(b);
     if (b > a && !(a_static && bodies[ib].is_static()) && bounds_overlap(ba, bounds_[ib])) {
-      candidates_[count++] = b;
+      candidates[count++] = b;
     }
   }
   if (!a_static) {
     for (const int p : planes_) {
-      if (p > a) candidates_[count++] = p;
+      if (p > a && reaches_plane(ia, static_cast<std::size_t>(p))) candidates[count++] = p;
     }
   }
-  std::sort(candidates_.begin(), candidates_.begin() + static_cast<std::ptrdiff_t>(count));
-  for (std::size_t k = 0; k < count; ++k) pairs.emplace_back(a, candidates_[k]);
+  std::sort(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(count));
+  for (std::size_t k = 0; k < count; ++k) pairs.emplace_back(a, candidates[k]);
 }
 
 // The pairs (ia, b), b > ia, in order, of a body kept out of the grid: a plane pairs with every
-// movable body; an oversize body with every plane (when it is movable) and every body whose
-// bounds overlap its own, not both static.
+// movable body whose bounds reach it; an oversize body with every plane it reaches (when it is
+// movable) and every body whose bounds overlap its own, not both static.
 void BroadPhase::pairs_of_ungridded(const std::vector<Body>& bodies, std::size_t ia,
                                     std::vector<std::pair<int, int>>& pairs) const {
   const std::size_t n = bodies.size();
@@ -281,7 +319,7 @@ void BroadPhase::pairs_of_ungridded(const std::vector<Body>& bodies, std::size_t
   const bool a_static = bodies[ia].is_static();
   if (broad_class_[ia] == BroadClass::plane) {
     for (std::size_t ib = ia + 1; ib < n; ++ib) {
-      if (broad_class_[ib] != BroadClass::plane && !bodies[ib].is_static()) {
+      if (broad_class_[ib] != BroadClass::plane && !bodies[ib].is_static() && reaches_plane(ib, ia)) {
         pairs.emplace_back(a, static_cast<int>(ib));
       }
     }
@@ -289,7 +327,7 @@ void BroadPhase::pairs_of_ungridded(const std::vector<Body>& bodies, std::size_t
   }
   for (std::size_t ib = ia + 1; ib < n; ++ib) {
     if (broad_class_[ib] == BroadClass::plane) {
-      if (!a_static) pairs.emplace_back(a, static_cast<int>(ib));
+      if (!a_static && reaches_plane(ia, ib)) pairs.emplace_back(a, static_cast<int>(ib));
     } else if (!(a_static && bodies[ib].is_static()) && bounds_overlap(bounds_[ia], bounds_[ib])) {
       pairs.emplace_back(a, static_cast<int>(ib));
     }

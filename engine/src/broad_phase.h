@@ -4,6 +4,7 @@
 // for each pair it lists.
 
 #include "cps/body.h"
+#include "workers.h"
 
 #include <array>
 #include <cstdint>
@@ -14,7 +15,8 @@ namespace cps {
 
 /// Lists the candidate pairs of a step. Bodies get axis-aligned bounds grown by half the contact
 /// margin; a pair is a candidate when its bounds overlap (closed intervals on x, y and z) and not
-/// both bodies are static; every plane is a candidate with every movable body. Worlds of at most
+/// both bodies are static; a plane is a candidate with every movable body whose bounds come
+/// within half the margin of it (the bounds' lowest point along its normal). Worlds of at most
 /// 32 bodies test every pair of bounds; larger ones sort the bounds into a uniform grid of cubic
 /// cells a little wider than the widest body (Ericson, "Real-Time Collision Detection", 2005,
 /// Sec. 7.1) by a counting sort, so the cost grows with the bodies and the pairs, not with their
@@ -30,10 +32,11 @@ class BroadPhase {
   /// contact_margin (m, >= 0): the speculative contact distance. Bodies far out or with
   /// non-finite positions share the grid's edge cells (more candidates, never fewer). Throws
   /// std::length_error naming the count once more than max_pairs pairs have been listed (it
-  /// stops there, so the storage stays bounded).
+  /// stops there, so the storage stays bounded). workers: the step's threads, or nullptr: the
+  /// threads list the pairs of their shares of the bodies, joined in order (the same pairs).
   void find_pairs(const std::vector<Body>& bodies, const std::vector<Mat3>& rotations,
                   double contact_margin, std::size_t max_pairs,
-                  std::vector<std::pair<int, int>>& pairs);
+                  std::vector<std::pair<int, int>>& pairs, Workers* workers = nullptr);
 
  private:
   struct Bounds {
@@ -41,6 +44,11 @@ class BroadPhase {
     Vec3 hi;  ///< m
   };
   enum class BroadClass : unsigned char { plane, gridded, oversize };
+  // A plane body in world space, {x : normal . x = offset}, as the narrow phase places it.
+  struct Plane {
+    Vec3 normal = Vec3::UnitY();  ///< unit
+    double offset = 0.0;          ///< m
+  };
   // A gridded body as the grid stores it, by bucket: what the pair test needs, side by side.
   struct GridEntry {
     int body;                          // index
@@ -72,9 +80,13 @@ class BroadPhase {
   // shape of the grid and its buckets, and the counting sort of the gridded bodies by bucket.
   void build_grid(const std::vector<Body>& bodies);
   // Stage 3: the pairs (ia, b), b > ia, in order, of a gridded body, from the 27 cells around
-  // its own, the oversize bodies and the planes.
+  // its own, the oversize bodies and the planes. candidates: scratch of n + planes entries.
   void pairs_of_gridded(const std::vector<Body>& bodies, std::size_t ia,
-                        std::vector<std::pair<int, int>>& pairs);
+                        std::vector<std::pair<int, int>>& pairs, std::vector<int>& candidates) const;
+  // Whether the bounds of `body` (not a plane) come within the contact margin of the plane body
+  // `plane`: false only when no point of the body can (a superset of the narrow phase's
+  // contacts, with a relative slack of 1e-9 for round-off).
+  bool reaches_plane(std::size_t body, std::size_t plane) const;
   // The pairs (ia, b), b > ia, in order, of a body kept out of the grid.
   void pairs_of_ungridded(const std::vector<Body>& bodies, std::size_t ia,
                           std::vector<std::pair<int, int>>& pairs) const;
@@ -89,8 +101,11 @@ class BroadPhase {
   std::vector<GridEntry> grid_;                    // gridded bodies by bucket, then index
   std::vector<double> widths_;                     // scratch: widths (m) for the median
   std::vector<int> planes_;                        // plane bodies, by index
+  std::vector<Plane> plane_;                       // per body: its plane (planes only)
+  double grow_ = 0.0;                              // m: half the contact margin
   std::vector<int> oversize_;                      // bodies too wide for the grid, by index
-  std::vector<int> candidates_;                    // scratch (n + planes): b > a near a
+  std::vector<std::vector<int>> candidates_;       // per thread, scratch (n + planes): b > a near a
+  std::vector<std::vector<std::pair<int, int>>> lists_;  // per thread past the first: its pairs
 };
 
 }  // namespace cps

@@ -231,15 +231,16 @@ void World::collide_pairs(Workers* workers) {
     for (const double m : margins_) widest = std::max(widest, m);
     broad_margin += 2.0 * widest;
   }
-  broad_phase_->find_pairs(bodies_, rotations_, broad_margin, kMaxCandidatePairs, pairs_);
+  broad_phase_->find_pairs(bodies_, rotations_, broad_margin, kMaxCandidatePairs, pairs_, workers);
   if (!apart_.empty()) {  // the pairs joined by a rod that does not collide (both lists sorted)
     std::erase_if(pairs_, [this](const std::pair<int, int>& pair) {
       return std::binary_search(apart_.begin(), apart_.end(), pair);
     });
   }
-  // Room for the manifolds a world of this size usually has (a body touches a few others); a
-  // crowded step grows it as it finds them, never to a worst case of one per pair.
-  detail::reserve_with_headroom(manifolds, std::min(pairs_.size(), 8 * bodies_.size()));
+  // Room for the manifolds a world of this size usually has (a body touches a few others, and
+  // the pairs come and go as bodies approach: at least two a body); a crowded step grows it as
+  // it finds them, never to a worst case of one per pair.
+  detail::reserve_with_headroom(manifolds, std::min(std::max(pairs_.size(), 2 * bodies_.size()), 8 * bodies_.size()));
   // Contact recycling: a pair that barely moved keeps last step's manifold (contact_recycling.h).
   const double recycle = def_.contact_recycle_distance;
   if (recycle > 0.0) {
@@ -294,15 +295,37 @@ void World::collide_pairs(Workers* workers) {
       }
     }
   } else {
-    // The pairs in chunks of consecutive pairs, each into its own list (the threads take the
-    // chunks as they come free: the pairs' cost is uneven, and a plane's pairs come together);
-    // the lists are joined in chunk order, so the manifolds are those of one thread, in the same
-    // order. A list's manifolds are made once and written over from step to step (`used` of
-    // them this step), and only their used contacts are copied.
+    // The pairs in chunks of consecutive pairs. The calling thread makes the manifolds of the
+    // first chunks, its even share of them, in place as on one thread; the rest the threads take
+    // as they come free (the pairs' cost is uneven, and a plane's pairs come together), each
+    // chunk into its own list. The lists are joined after the first chunks' manifolds in chunk
+    // order, so the manifolds are those of one thread, in the same order. Which chunks go to the
+    // lists depends only on their count, so a list's storage grows in the same steps on every
+    // run: its manifolds are made once and written over from step to step (`used` of them this
+    // step), and only their used contacts are copied.
     std::vector<StepContext::NarrowShare>& shares = ctx_->narrow_shares;
     const std::size_t chunks = (pairs_.size() + kPairsPerChunk - 1) / kPairsPerChunk;
     if (shares.size() < chunks) shares.resize(chunks);
-    parallel_chunks(workers, chunks, [&](std::size_t k) {
+    const std::size_t front_chunks = chunks / static_cast<std::size_t>(workers->count());
+    std::atomic<std::size_t> next_chunk{front_chunks};  // the first chunk no thread has taken
+    std::size_t front_used = 0;      // manifolds the calling thread made in place
+    std::size_t front_points = 0;    // their contact points
+    std::size_t front_recycled = 0;  // those of them recycled
+    const auto front = [&] {
+      Cursor cursor;
+      for (std::size_t i = 0, end = front_chunks * kPairsPerChunk; i < end; ++i) {
+        if (front_used == manifolds.size()) manifolds.emplace_back();
+        Manifold& m = manifolds[front_used];
+        m.count = 0;
+        if (narrow(pairs_[i], m, cursor)) {
+          if (recycler != nullptr) recycler->keep(m, bodies_, cursor.found);
+          front_recycled += cursor.found != ContactRecycler::kNone ? 1 : 0;
+          front_points += static_cast<std::size_t>(m.count);
+          ++front_used;
+        }
+      }
+    };
+    const auto back_chunk = [&](std::size_t k) {
       const std::size_t begin = k * kPairsPerChunk;
       const std::size_t end = std::min(begin + kPairsPerChunk, pairs_.size());
       StepContext::NarrowShare& share = shares[k];
@@ -320,11 +343,22 @@ void World::collide_pairs(Workers* workers) {
           ++share.used;
         }
       }
-    });
-    // Counted and bounded in chunk order, then copied to their places (and cached for recycling)
-    // on the threads.
-    std::size_t count = 0;
-    for (std::size_t k = 0; k < chunks; ++k) {
+    };
+    auto take = [&](int t) {
+      if (t == 0) front();
+      for (std::size_t k = next_chunk.fetch_add(1, std::memory_order_relaxed); k < chunks;
+           k = next_chunk.fetch_add(1, std::memory_order_relaxed)) {
+        back_chunk(k);
+      }
+    };
+    workers->run(take);
+    // Counted and bounded in chunk order, then the lists' copied to their places (and cached
+    // for recycling) on the threads.
+    std::size_t count = front_used;
+    points += front_points;
+    counters.contacts += static_cast<std::int64_t>(front_points);
+    counters.recycled += static_cast<std::int64_t>(front_recycled);
+    for (std::size_t k = front_chunks; k < chunks; ++k) {
       StepContext::NarrowShare& share = shares[k];
       share.first = count;
       count += share.used;
@@ -335,8 +369,8 @@ void World::collide_pairs(Workers* workers) {
     if (points > kMaxContactPoints) too_many_points();
     manifolds.resize(count);
     if (recycler != nullptr) recycler->resize_kept(count);
-    parallel_chunks(workers, chunks, [&](std::size_t k) {
-      const StepContext::NarrowShare& share = shares[k];
+    parallel_chunks(workers, chunks - front_chunks, [&](std::size_t j) {
+      const StepContext::NarrowShare& share = shares[front_chunks + j];
       for (std::size_t i = 0; i < share.used; ++i) {
         copy_used_contacts(share.manifolds[i], manifolds[share.first + i]);
         if (recycler != nullptr) recycler->keep_at(share.first + i, share.manifolds[i], bodies_, share.found[i]);

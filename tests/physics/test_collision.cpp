@@ -243,16 +243,19 @@ TEST_CASE("a speculative margin reports near features with a negative depth", "[
 // crowded random world with bodies of 0.05 to 2 m, a 60 m static slab (wider than the grid's
 // cells) and planes between the other bodies is checked against that definition evaluated
 // over all pairs; once as it is (the grid numbers its cells densely) and once with one more body
-// 1e7 m away (the grid's box is then too large and it hashes its rows).
+// 1e7 m away (the grid's box is then too large and it hashes its rows). On two threads the
+// broad phase and the narrow phase share the work and must give the same manifolds.
 TEST_CASE("the broad phase finds the manifolds of the all-pairs test, in index order",
           "[collision][broad]") {
   const double margin = GENERATE(0.0, 0.02);
+  const int threads = GENERATE(1, 2);
   // 0: the mixed world (dense grid); 1: the same with one body 1e7 m away (hashed rows);
   // 2: 600 small balls in two clusters 400 m apart (hashed rows that share buckets); 3: 30
   // bodies in a 2 m box (a small world: every pair tested, no grid).
   const int layout = GENERATE(0, 1, 2, 3);
   WorldDef def;
   def.contact_margin = margin;
+  def.threads = threads;
   World world(def);
   std::mt19937 random(7);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -343,6 +346,58 @@ TEST_CASE("the broad phase finds the manifolds of the all-pairs test, in index o
       CHECK(found[k].contacts[c].point == expected[k].contacts[c].point);
       CHECK(found[k].contacts[c].depth == expected[k].contacts[c].depth);
     }
+  }
+}
+
+// A plane is a candidate only with the bodies whose bounds come within half the margin of it: a
+// box tilted about two axes, its lowest corner just inside or just outside the contact margin
+// above a tilted plane, gets its speculative contact or no candidate pair at all; alone (every
+// pair of bounds tested) and among 40 far boxes (the grid), on one and two threads.
+TEST_CASE("a plane pairs only with the bodies that come within the margin of it", "[collision][broad]") {
+  const double margin = 0.01;
+  const bool grid = GENERATE(false, true);
+  const int threads = GENERATE(1, 2);
+  const double gap = GENERATE(0.99, 1.01);  // the lowest corner's height over the margin
+  WorldDef def;
+  def.contact_margin = margin;
+  def.gravity = Vec3::Zero();
+  def.threads = threads;
+  World world(def);
+  const Vec3 normal = Vec3(0.3, 1.0, -0.2).normalized();
+  BodyDef plane;
+  plane.shape = Shape::plane(normal, 0.5);
+  plane.is_static = true;
+  world.add_body(plane);
+  BodyDef box;
+  box.shape = Shape::box(Vec3(0.5, 0.3, 0.2));
+  box.orientation = Quat(Eigen::AngleAxisd(0.4, Vec3::UnitX()) * Eigen::AngleAxisd(0.7, Vec3::UnitZ()));
+  // The corner lowest along the normal, then the box lifted so that it lies gap * margin above.
+  const Mat3 R = box.orientation.toRotationMatrix();
+  double lowest = kInfinity;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0, (corner & 4) ? 1.0 : -1.0);
+    lowest = std::min(lowest, normal.dot(R * sign.cwiseProduct(box.shape.half_extents)));
+  }
+  box.position = (0.5 - lowest + gap * margin) * normal;
+  world.add_body(box);
+  for (int i = 0; grid && i < 40; ++i) {
+    BodyDef far = box;
+    far.position = Vec3(3.0 * (i % 8), 50.0 + 3.0 * (i / 8), 0.0);
+    world.add_body(far);
+  }
+  world.step();
+  INFO("grid " << grid << ", threads " << threads << ", gap " << gap);
+  const std::vector<Manifold>& found = world.manifolds();
+  if (gap < 1.0) {
+    REQUIRE(found.size() == 1u);
+    CHECK(found[0].count == 1);
+    CHECK(found[0].contacts[0].depth == Approx(-gap * margin).margin(1e-12));
+    CHECK(world.counters().pairs_tested == 1);
+  } else {
+    CHECK(found.empty());
+    // The box's bounds reach further along the normal than its corner: it may stay a candidate,
+    // but none of the 40 boxes 50 m up does, nor do they pair with each other.
+    CHECK(world.counters().pairs_tested <= 1);
   }
 }
 

@@ -23,14 +23,16 @@ std::size_t point_count(const std::vector<Manifold>& manifolds) {
 // (microseconds, tens on a virtual machine) costs about what the work does.
 constexpr std::size_t kMinParallel = 256;
 
-// Per manifold, the points of the manifolds before it, into first (no allocation once grown).
-void first_points(const std::vector<Manifold>& manifolds, std::vector<std::size_t>& first) {
+// Per manifold, the points of the manifolds before it, into first (no allocation once grown);
+// returns the number of points in all manifolds.
+std::size_t first_points(const std::vector<Manifold>& manifolds, std::vector<std::size_t>& first) {
   detail::resize_with_headroom(first, manifolds.size());
   std::size_t n = 0;
   for (std::size_t k = 0; k < manifolds.size(); ++k) {
     first[k] = n;
     n += static_cast<std::size_t>(manifolds[k].count);
   }
+  return n;
 }
 
 // Whether the rows hold two friction rows per point (rows = points + 2 points + rods).
@@ -41,11 +43,11 @@ bool rows_have_friction(std::size_t points, std::size_t rows, std::size_t rods) 
 }  // namespace
 
 void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* workers) {
-  const std::size_t points = point_count(manifolds);
-  detail::assign_with_headroom(match_, points, -1);
+  // Every entry is written below, by its manifold.
+  const std::size_t points = first_points(manifolds, first_point_);
+  detail::resize_with_headroom(match_, points);
   detail::resize_with_headroom(tangents_, points);
-  detail::assign_with_headroom(same_points_, manifolds.size(), static_cast<unsigned char>(0));
-  first_points(manifolds, first_point_);
+  detail::resize_with_headroom(same_points_, manifolds.size());
   const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
   detail::assign_with_headroom(matched_by_thread_, threads, std::size_t{0});
   parallel_for(workers, manifolds.size(), kMinParallel, [&](int t, std::size_t begin, std::size_t end) {
@@ -78,6 +80,7 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* work
         Vec3 t1;
         Vec3 t2;
         tangent_basis(c.normal, t1, t2);  // the paper's directions for a new point
+        match_[k] = -1;
         if (same_pair) {
           const CachedManifold& cm = manifolds_[j];
           for (int q = 0; q < cm.count; ++q) {
@@ -111,18 +114,31 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
                                      Workers* workers) const {
   const bool last = rule == WarmStartRule::last;
   const std::size_t c = rows.size();
-  const std::size_t points = point_count(manifolds);
-  const bool friction_rows = rows_have_friction(points, c, rods);
-  const bool coupled = friction == FrictionModel::coupled;
-  detail::assign_with_headroom(first, c, 0.0);
-  if (has_second_) {
-    detail::assign_with_headroom(second, c, 0.0);
-  } else {
-    second.clear();
-  }
   // Each manifold writes only its own rows: a share starts at its first manifold's first point
   // (match()'s first_point_; without a match() of these manifolds, one share from point 0).
   const bool matched = first_point_.size() == manifolds.size();
+  const std::size_t points =
+      matched && !manifolds.empty()
+          ? first_point_.back() + static_cast<std::size_t>(manifolds.back().count)
+          : point_count(manifolds);
+  const bool friction_rows = rows_have_friction(points, c, rods);
+  const bool coupled = friction == FrictionModel::coupled;
+  // Laid out as the class says, every row is written below (0 for a new one); else the rows
+  // past the layout stay 0.
+  const bool laid_out = c == (friction_rows ? 3 * points : points) + rods;
+  const auto make_room = [&](std::vector<double>& out) {
+    if (laid_out) {
+      detail::resize_with_headroom(out, c);
+    } else {
+      detail::assign_with_headroom(out, c, 0.0);
+    }
+  };
+  make_room(first);
+  if (has_second_) {
+    make_room(second);
+  } else {
+    second.clear();
+  }
   for (int solve = 0; solve < (has_second_ ? 2 : 1); ++solve) {
     std::vector<double>& out = solve == 0 ? first : second;
     parallel_for(matched ? workers : nullptr, manifolds.size(), kMinParallel,
@@ -131,14 +147,22 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
       for (std::size_t index = begin; index < end; ++index) {
         const Manifold& m = manifolds[index];
         for (int i = 0; i < m.count; ++i, ++k) {
-          if (k >= match_.size() || match_[k] < 0) continue;  // a new point: 0
+          if (k >= match_.size() || match_[k] < 0) {  // a new point: 0
+            out[k] = 0.0;
+            if (friction_rows) out[points + 2 * k] = out[points + 2 * k + 1] = 0.0;
+            continue;
+          }
           const CachedPoint& p = points_[static_cast<std::size_t>(match_[k])];
           const double* cached = solve == 0 ? p.first : p.second;
           const double older = p.older[solve];
           // Contact row k: the smaller of its last two lambdas (see the class comment).
           const double sustained = last ? cached[0] : std::max(0.0, std::min(cached[0], older));
           out[k] = factor * sustained;
-          if (!friction_rows || !has_friction_) continue;
+          if (!friction_rows) continue;
+          if (!has_friction_) {
+            out[points + 2 * k] = out[points + 2 * k + 1] = 0.0;
+            continue;
+          }
           // The cached friction force, scaled as the contact's, along this step's directions (t1
           // is the cached t1 in the new plane, so this is close to a copy), within the row's limits.
           const double scale = last ? 1.0 : cached[0] > 0.0 ? sustained / cached[0] : 0.0;
@@ -162,7 +186,11 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
     // when they have the same sign, else 0.
     const std::vector<double>& cached_rods = solve == 0 ? rods_first_ : rods_second_;
     const std::vector<double>& older_rods = solve == 0 ? rods_older_first_ : rods_older_second_;
-    for (std::size_t r = 0; r < rods && r < cached_rods.size(); ++r) {
+    for (std::size_t r = 0; r < rods; ++r) {
+      if (r >= cached_rods.size()) {  // a new rod
+        out[c - rods + r] = 0.0;
+        continue;
+      }
       const double a = cached_rods[r];
       const double b = older_rods[r];
       out[c - rods + r] = last                     ? factor * a
@@ -177,10 +205,9 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
                            const std::vector<double>& first, const std::vector<double>& second,
                            Workers* workers) {
   const std::size_t c = rows.size();
-  const std::size_t points = point_count(manifolds);
+  const std::size_t points = first_points(manifolds, first_point_);
   has_friction_ = rows_have_friction(points, c, rods);
   has_second_ = !second.empty();
-  first_points(manifolds, first_point_);
   detail::resize_with_headroom(manifolds_, manifolds.size());
   detail::resize_with_headroom(next_points_, points);
   // Each manifold writes only its own entry and points.

@@ -330,7 +330,9 @@ class SoftStep final : public PushMethod {
     detail::resize_with_headroom(contacts_, points);
     detail::resize_with_headroom(manifolds_, count);
     // Each manifold writes only its own slot and points: shared among the threads.
-    parallel_for(workers_, count, kMinParallel, [&](int, std::size_t k_begin, std::size_t k_end) {
+    detail::assign_with_headroom(restitution_by_thread_, threads, static_cast<unsigned char>(0));
+    parallel_for(workers_, count, kMinParallel, [&](int t, std::size_t k_begin, std::size_t k_end) {
+      bool restitution = false;
       for (std::size_t k = k_begin; k < k_end; ++k) {
         const Manifold& m = ctx.manifolds[k];
         std::size_t g = first_row_[k];  // the point's index over the step: its contact row
@@ -358,6 +360,7 @@ class SoftStep final : public PushMethod {
           p.r_b = c.point - body_b.x;
           p.base_separation = -c.depth - c.normal.dot(p.r_b - p.r_a);
           p.restitution = rows[g].restitution;
+          restitution = restitution || p.restitution > 0.0;
           p.touches_static = body_a.is_static() || body_b.is_static();
           p.normal = make_axis_row(c.normal, p.r_a, p.r_b, a, b, guess(g));
           const double weight = std::clamp(2.0 + c.depth * inv_tau, 1e-10, 1.0);
@@ -414,6 +417,7 @@ class SoftStep final : public PushMethod {
           }
         }
       }
+      if (restitution) restitution_by_thread_[static_cast<std::size_t>(t)] = 1;
     });
 
     const std::size_t first_rod = ctx.layout.first_rod();
@@ -743,6 +747,7 @@ class SoftStep final : public PushMethod {
 
   // Stage "restitution" (Eq. 8.2.1 as b3ApplyRestitution applies it).
   void apply_restitution() {
+    if (std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) == restitution_by_thread_.end()) return;
     for (ContactPoint& p : contacts_) {
       if (p.restitution <= 0.0 || p.total_impulse == 0.0) continue;
       SolverBody& a = body(p.a, 0);
@@ -768,9 +773,10 @@ class SoftStep final : public PushMethod {
         body.l = inertia_[i] * s.w;
       }
     });
-    detail::assign_with_headroom(ctx.lambda, ctx.rows.size(), 0.0);
+    // Every row is written below: the contact rows by their points, the friction rows (when the
+    // world has friction, every manifold has them) by their manifolds, the rods' by the rods.
+    detail::resize_with_headroom(ctx.lambda, ctx.rows.size());
     const double inv_h = 1.0 / h;
-    for (const ContactPoint& p : contacts_) ctx.lambda[static_cast<std::size_t>(p.row)] = p.normal.impulse * inv_h;
     // A manifold's friction as forces at its points' friction rows: the force at the centre
     // shared equally, plus the twist as tangential forces F_i = tau (n x d_i) / sum |d_j|^2 (d_i
     // the point's offset from the centre across the normal), which sum to no force and to the
@@ -779,6 +785,9 @@ class SoftStep final : public PushMethod {
     parallel_for(workers_, manifolds_.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) {
         const ManifoldFriction& f = manifolds_[k];
+        for (std::size_t i = f.begin; i < f.end; ++i) {
+          ctx.lambda[static_cast<std::size_t>(contacts_[i].row)] = contacts_[i].normal.impulse * inv_h;
+        }
         if (f.first_friction_row < 0) continue;
         const Vec3 share = (f.impulse.x() * f.t1 + f.impulse.y() * f.t2) *
                            (inv_h / static_cast<double>(f.end - f.begin));
@@ -820,6 +829,7 @@ class SoftStep final : public PushMethod {
   std::vector<std::size_t> point_start_;  // per slot of manifolds_: its first point in contacts_
   std::vector<Mat3> inertia_;              // n: I (kg m^2, world frame) at the start of the step
   std::vector<ContactPoint> contacts_;     // one per contact row, by manifold in colour order
+  std::vector<unsigned char> restitution_by_thread_;  // per thread: 1 when one of its contacts has a restitution target
   std::vector<ManifoldFriction> manifolds_;     // one per manifold, in colour order
   std::vector<Rod> rods_;                  // one per distance constraint, in colour order
   std::vector<std::pair<Vec3, Vec3>> saved_velocities_;  // n + threads: v, w (SoftRelax::restart)

@@ -307,6 +307,10 @@ class SoftStep final : public PushMethod {
     // Box3D's friction centre weight: 1 for touching points, falling to 0 past twice the
     // speculative distance (m).
     const double inv_tau = 1.0 / std::max(def.contact_margin, 1e-9);
+    // The points' friction tangents as World::build_rows gave them to the friction rows, so that
+    // the warm start and store() need not read the rows back (tangent()).
+    cached_tangents_ =
+        friction && def.warm_start > 0.0 && ctx.warm_start != nullptr ? ctx.warm_start->tangents(0) : nullptr;
     const std::vector<DistanceConstraint>& distances = *ctx.distances;
     colour(ctx.manifolds, distances, moving);
     // Each manifold's first contact row (its points' rows follow in order).
@@ -402,7 +406,10 @@ class SoftStep final : public PushMethod {
           Vec3 P = Vec3::Zero();
           for (std::size_t i = f.begin; i < f.end; ++i) {
             const std::size_t r = first + 2 * (i - f.begin);
-            P += h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
+            Vec3 t1;
+            Vec3 t2;
+            tangents(contacts_[i], t1, t2);
+            P += h * ((*warm)[r] * t1 + (*warm)[r + 1] * t2);
           }
           f.impulse = Eigen::Vector2d(P.dot(f.t1), P.dot(f.t2));
           if (ctx.warm_start != nullptr && ctx.warm_start->same_points(k)) {
@@ -410,7 +417,10 @@ class SoftStep final : public PushMethod {
             double L = 0.0;
             for (std::size_t i = f.begin; i < f.end; ++i) {
               const std::size_t r = first + 2 * (i - f.begin);
-              const Vec3 F = h * ((*warm)[r] * rows[r].j.segment<3>(6) + (*warm)[r + 1] * rows[r + 1].j.segment<3>(6));
+              Vec3 t1;
+              Vec3 t2;
+              tangents(contacts_[i], t1, t2);
+              const Vec3 F = h * ((*warm)[r] * t1 + (*warm)[r + 1] * t2);
               L += f.normal.dot((contacts_[i].r_a - f.center_a).cross(F - share));
             }
             f.twist_impulse = L;
@@ -760,6 +770,19 @@ class SoftStep final : public PushMethod {
     }
   }
 
+  // A point's friction tangents t1, t2 (unit) as write_friction_rows gave them to its friction
+  // rows: t1 the warm-start cache's when warm starting (cached_tangents_), else tangent_basis's;
+  // t2 = n x t1.
+  void tangents(const ContactPoint& p, Vec3& t1, Vec3& t2) const {
+    const Vec3& n = p.normal.axis;
+    if (cached_tangents_ != nullptr) {
+      t1 = cached_tangents_[static_cast<std::size_t>(p.row)];
+      t2 = n.cross(t1);
+    } else {
+      tangent_basis(n, t1, t2);
+    }
+  }
+
   // Stage "store impulses": lambda = P / h per row into ctx (for the warm-start cache) and the
   // bodies' momenta.
   void store(StepContext& ctx, double h) {
@@ -801,8 +824,11 @@ class SoftStep final : public PushMethod {
           const Vec3 d = contacts_[i].r_a - f.center_a;
           const Vec3 F = share + tau * f.normal.cross(d);
           const std::size_t r = static_cast<std::size_t>(f.first_friction_row) + 2 * (i - f.begin);
-          ctx.lambda[r] = F.dot(ctx.rows[r].j.segment<3>(6));
-          ctx.lambda[r + 1] = F.dot(ctx.rows[r + 1].j.segment<3>(6));
+          Vec3 t1;
+          Vec3 t2;
+          tangents(contacts_[i], t1, t2);
+          ctx.lambda[r] = F.dot(t1);
+          ctx.lambda[r + 1] = F.dot(t2);
         }
       }
     });
@@ -828,6 +854,7 @@ class SoftStep final : public PushMethod {
   std::vector<std::size_t> slot_;         // per manifold of ctx: its place in manifolds_
   std::vector<std::size_t> point_start_;  // per slot of manifolds_: its first point in contacts_
   std::vector<Mat3> inertia_;              // n: I (kg m^2, world frame) at the start of the step
+  const Vec3* cached_tangents_ = nullptr;  // the warm-start cache's t1 per point of the step, or null
   std::vector<ContactPoint> contacts_;     // one per contact row, by manifold in colour order
   std::vector<unsigned char> restitution_by_thread_;  // per thread: 1 when one of its contacts has a restitution target
   std::vector<ManifoldFriction> manifolds_;     // one per manifold, in colour order

@@ -104,6 +104,7 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* work
   });
   matched_ = 0;
   for (const std::size_t m : matched_by_thread_) matched_ += m;
+  tangents_fresh_ = true;
 }
 
 void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
@@ -208,6 +209,9 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
   const std::size_t points = first_points(manifolds, first_point_);
   has_friction_ = rows_have_friction(points, c, rods);
   has_second_ = !second.empty();
+  // The friction rows' directions: match()'s t1 and n x t1 when this step's match() chose them
+  // (the same vectors, without reading the rows back), else the rows' own.
+  const bool own_tangents = tangents_fresh_ && tangents_.size() >= points;
   detail::resize_with_headroom(manifolds_, manifolds.size());
   detail::resize_with_headroom(next_points_, points);
   // Each manifold writes only its own entry and points.
@@ -232,7 +236,10 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
           out[1] = have && has_friction_ ? lambda[points + 2 * k] : 0.0;
           out[2] = have && has_friction_ ? lambda[points + 2 * k + 1] : 0.0;
         }
-        if (has_friction_) {
+        if (has_friction_ && own_tangents) {
+          p.t1 = tangents_[k];
+          p.t2 = contact.normal.cross(p.t1);
+        } else if (has_friction_) {
           // The directions of its friction rows: the linear part of body b's half of j is t.
           p.t1 = rows[points + 2 * k].j.segment<3>(6);
           p.t2 = rows[points + 2 * k + 1].j.segment<3>(6);
@@ -243,6 +250,7 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
     }
   });
   points_.swap(next_points_);
+  tangents_fresh_ = false;
   const std::size_t had_rods = rods_first_.size();
   rods_older_first_.swap(rods_first_);
   rods_older_second_.swap(rods_second_);
@@ -267,6 +275,7 @@ void WarmStartCache::clear() {
   has_second_ = false;
   has_friction_ = false;
   match_.clear();
+  tangents_fresh_ = false;
   same_points_.clear();
   matched_ = 0;
 }

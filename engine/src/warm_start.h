@@ -79,7 +79,8 @@ class WarmStartCache {
 
   /// Replaces the cache by this step's points (features, t1, t2) and lambdas: `first` (c, N)
   /// from the solve with the push, `second` (c, N, or empty) from the solve without it (Sec.
-  /// 8.1). The rows are laid out as the class says with `rods` rod rows at the end.
+  /// 8.1). The rows are laid out as the class says with `rods` rod rows at the end; after this
+  /// step's match(), its friction rows along tangents() (World::build_rows).
   void store(const std::vector<Manifold>& manifolds, const std::vector<ConstraintRow>& rows,
              std::size_t rods, const std::vector<double>& first,
              const std::vector<double>& second, Workers* workers = nullptr);
@@ -123,6 +124,7 @@ class WarmStartCache {
   // This step: per point, the cached point it matched (-1: none) and its t1.
   std::vector<int> match_;
   std::vector<Vec3> tangents_;
+  bool tangents_fresh_ = false;  // match() has run since the last store(): tangents_ are the step's
   std::vector<unsigned char> same_points_;  // per manifold: same_points()
   std::size_t matched_ = 0;
   // Per manifold of the step: the points of the manifolds before it (match() and store()).

@@ -138,12 +138,11 @@ struct SolverBody {
   double inv_mass = 0.0;       // 1/kg
 };
 
-// One row along a unit axis between anchors r_a, r_b (a contact's normal or tangent): what a
-// sweep reads, prepared once a step.
+// One row along a unit axis between anchors r_a, r_b (a contact's normal): what a sweep reads,
+// prepared once a step. r_a x axis and r_b x axis are not kept: the sweeps form them from the
+// anchors, which they read anyway, so that a point streams fewer bytes.
 struct AxisRow {
   Vec3 axis = Vec3::Zero();
-  Vec3 rn_a = Vec3::Zero();    // r_a x axis
-  Vec3 rn_b = Vec3::Zero();    // r_b x axis
   Vec3 Irn_a = Vec3::Zero();   // I_a^-1 (r_a x axis)
   Vec3 Irn_b = Vec3::Zero();   // I_b^-1 (r_b x axis)
   double mass = 0.0;           // kg: 1 / (J M^-1 J^T)
@@ -154,13 +153,13 @@ struct ContactPoint {
   int a = 0;
   int b = 0;
   int row = 0;                   // the contact row's index in ctx.rows
+  bool touches_static = false;
   Vec3 r_a = Vec3::Zero();       // m: anchor relative to a's centre of mass
   Vec3 r_b = Vec3::Zero();
   double base_separation = 0.0;  // m: s0 - n . (r_b - r_a)
   double restitution = 0.0;      // m/s: the row's restitution target (0: none)
   double total_impulse = 0.0;    // N s: sum of the normal impulses over the step
   double lever_arm = 0.0;        // m: distance from the manifold's friction centre (on a)
-  bool touches_static = false;
   AxisRow normal;
 };
 
@@ -203,9 +202,11 @@ struct Rod {
 // The velocity of a body's point at offset r (m/s).
 inline Vec3 point_velocity(const SolverBody& s, const Vec3& r) { return s.v + s.w.cross(r); }
 
-// j . v of an axis row (m/s): the rate at which the points separate along the axis.
-inline double row_speed(const AxisRow& row, const SolverBody& a, const SolverBody& b) {
-  return row.axis.dot(b.v - a.v) + row.rn_b.dot(b.w) - row.rn_a.dot(a.w);
+// j . v of an axis row with anchors r_a, r_b (m; m/s): the rate at which the points separate
+// along the axis.
+inline double row_speed(const AxisRow& row, const Vec3& r_a, const Vec3& r_b, const SolverBody& a,
+                        const SolverBody& b) {
+  return row.axis.dot(b.v - a.v) + r_b.cross(row.axis).dot(b.w) - r_a.cross(row.axis).dot(a.w);
 }
 
 // Applies impulse P (N s) along an axis row: -P to a, +P to b.
@@ -220,11 +221,11 @@ AxisRow make_axis_row(const Vec3& axis, const Vec3& r_a, const Vec3& r_b, const 
                       const SolverBody& b, double impulse) {
   AxisRow row;
   row.axis = axis;
-  row.rn_a = r_a.cross(axis);
-  row.rn_b = r_b.cross(axis);
-  row.Irn_a = a.inv_I * row.rn_a;
-  row.Irn_b = b.inv_I * row.rn_b;
-  const double k = a.inv_mass + b.inv_mass + row.rn_a.dot(row.Irn_a) + row.rn_b.dot(row.Irn_b);
+  const Vec3 rn_a = r_a.cross(axis);
+  const Vec3 rn_b = r_b.cross(axis);
+  row.Irn_a = a.inv_I * rn_a;
+  row.Irn_b = b.inv_I * rn_b;
+  const double k = a.inv_mass + b.inv_mass + rn_a.dot(row.Irn_a) + rn_b.dot(row.Irn_b);
   row.mass = k > 0.0 ? 1.0 / k : 0.0;
   row.impulse = impulse;
   return row;
@@ -353,6 +354,9 @@ class SoftStep final : public PushMethod {
         Vec3 center_a = Vec3::Zero();
         Vec3 center_b = Vec3::Zero();
         double total_weight = 0.0;
+        // The rows are read only where they hold something (a restitution target needs eps > 0,
+        // write_normal_rows): in large scenes each read misses the cache.
+        const bool bouncy = pair_restitution(def.restitution, body_a.restitution, body_b.restitution) > 0.0;
         for (int i = 0; i < m.count; ++i, ++g) {
           const Contact& c = m.contacts[static_cast<std::size_t>(i)];
           ContactPoint& p = contacts_[f.begin + static_cast<std::size_t>(i)];
@@ -363,7 +367,7 @@ class SoftStep final : public PushMethod {
           p.r_a = c.point - body_a.x;
           p.r_b = c.point - body_b.x;
           p.base_separation = -c.depth - c.normal.dot(p.r_b - p.r_a);
-          p.restitution = rows[g].restitution;
+          p.restitution = bouncy ? rows[g].restitution : 0.0;
           restitution = restitution || p.restitution > 0.0;
           p.touches_static = body_a.is_static() || body_b.is_static();
           p.normal = make_axis_row(c.normal, p.r_a, p.r_b, a, b, guess(g));
@@ -381,7 +385,7 @@ class SoftStep final : public PushMethod {
           contacts_[i].lever_arm = (contacts_[i].r_a - f.center_a).norm();
         }
         f.first_friction_row = static_cast<int>(first);
-        f.mu = rows[first].mu;
+        f.mu = pair_friction(def.friction, body_a.friction, body_b.friction);  // the rows' mu
         f.fixed_limit = coupled ? -1.0 : rows[first].c_max * h;
         tangent_basis(f.normal, f.t1, f.t2);
         const Vec3 rt_a1 = f.center_a.cross(f.t1);
@@ -702,7 +706,7 @@ class SoftStep final : public PushMethod {
       mass_scale = k.mass_scale;
       impulse_scale = k.impulse_scale;
     }
-    const double speed = row_speed(row, a, b);
+    const double speed = row_speed(row, p.r_a, p.r_b, a, b);
     const double old = row.impulse;
     const double next = std::max(old - row.mass * (mass_scale * speed + bias) - impulse_scale * old, 0.0);
     p.normal.impulse = next;
@@ -763,7 +767,7 @@ class SoftStep final : public PushMethod {
       SolverBody& a = body(p.a, 0);
       SolverBody& b = body(p.b, 0);
       const double old = p.normal.impulse;
-      const double next = std::max(old - p.normal.mass * (row_speed(p.normal, a, b) - p.restitution), 0.0);
+      const double next = std::max(old - p.normal.mass * (row_speed(p.normal, p.r_a, p.r_b, a, b) - p.restitution), 0.0);
       p.normal.impulse = next;
       p.total_impulse += next - old;
       apply(p.normal, next - old, a, b);

@@ -6,12 +6,25 @@
 
 namespace cps {
 
-Vec12 axis_row(const Vec3& n, const Vec3& r_a, const Vec3& r_b) {
+namespace {
+
+// axis_row written into j in place (the rows of a large scene are built straight into their
+// storage, with no 96-byte copy each).
+inline void write_axis_row(Vec12& j, const Vec3& n, const Vec3& r_a, const Vec3& r_b) {
   // Eq. 5.2.1 with p_b - p_a replaced by the unit axis n (Sec. 5.3, Sec. 9.2):
   //   c_dot = n . (v_b + w_b x r_b - v_a - w_a x r_a)
   //         = [-n, -(r_a x n), n, r_b x n] . [v_a, w_a, v_b, w_b]   (scalar triple product)
+  j.segment<3>(0) = -n;
+  j.segment<3>(3) = -r_a.cross(n);
+  j.segment<3>(6) = n;
+  j.segment<3>(9) = r_b.cross(n);
+}
+
+}  // namespace
+
+Vec12 axis_row(const Vec3& n, const Vec3& r_a, const Vec3& r_b) {
   Vec12 j;
-  j << -n, -r_a.cross(n), n, r_b.cross(n);
+  write_axis_row(j, n, r_a, r_b);
   return j;
 }
 
@@ -75,7 +88,7 @@ void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
     contact.kind = RowKind::contact;
     contact.body_a = m.body_a;
     contact.body_b = m.body_b;
-    contact.j = axis_row(c.normal, c.point - a.x, c.point - b.x);
+    write_axis_row(contact.j, c.normal, c.point - a.x, c.point - b.x);
     // j . v1 (m/s)
     const double approach = relative_velocity(contact.j, vel_a.v, vel_a.w, vel_b.v, vel_b.w);
     if (c.depth >= 0.0) {
@@ -142,7 +155,7 @@ void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
       friction.kind = RowKind::friction;
       friction.body_a = m.body_a;
       friction.body_b = m.body_b;
-      friction.j = axis_row(tangent, r_a, r_b);
+      write_axis_row(friction.j, tangent, r_a, r_b);
       friction.c_min = -limit;
       friction.c_max = limit;
       friction.normal_row = first_normal_row + i;

@@ -201,7 +201,7 @@ struct Rod {
 
 // m v for a 3 x 3 matrix m and a 3-vector v, the sum in Eigen's order (column 0, 1, then 2),
 // written out so that the sweeps inline it.
-inline Vec3 times(const Mat3& m, const Vec3& v) {
+[[gnu::always_inline]] inline Vec3 times(const Mat3& m, const Vec3& v) {
   return Vec3(m(0, 0) * v.x() + m(0, 1) * v.y() + m(0, 2) * v.z(),
               m(1, 0) * v.x() + m(1, 1) * v.y() + m(1, 2) * v.z(),
               m(2, 0) * v.x() + m(2, 1) * v.y() + m(2, 2) * v.z());
@@ -225,9 +225,10 @@ inline void apply(const AxisRow& row, double P, SolverBody& a, SolverBody& b) {
   b.w += P * row.Irn_b;
 }
 
-AxisRow make_axis_row(const Vec3& axis, const Vec3& r_a, const Vec3& r_b, const SolverBody& a,
-                      const SolverBody& b, double impulse) {
-  AxisRow row;
+// Sets `row` (in place: a contact point's is written straight into its storage) along unit
+// `axis` between anchors r_a, r_b (m) of bodies a and b, with accumulated impulse `impulse` (N s).
+void set_axis_row(AxisRow& row, const Vec3& axis, const Vec3& r_a, const Vec3& r_b, const SolverBody& a,
+                  const SolverBody& b, double impulse) {
   row.axis = axis;
   const Vec3 rn_a = r_a.cross(axis);
   const Vec3 rn_b = r_b.cross(axis);
@@ -236,7 +237,6 @@ AxisRow make_axis_row(const Vec3& axis, const Vec3& r_a, const Vec3& r_b, const 
   const double k = a.inv_mass + b.inv_mass + rn_a.dot(row.Irn_a) + rn_b.dot(row.Irn_b);
   row.mass = k > 0.0 ? 1.0 / k : 0.0;
   row.impulse = impulse;
-  return row;
 }
 
 class SoftStep final : public PushMethod {
@@ -378,7 +378,7 @@ class SoftStep final : public PushMethod {
           p.restitution = bouncy ? rows[g].restitution : 0.0;
           restitution = restitution || p.restitution > 0.0;
           p.touches_static = body_a.is_static() || body_b.is_static();
-          p.normal = make_axis_row(c.normal, p.r_a, p.r_b, a, b, guess(g));
+          set_axis_row(p.normal, c.normal, p.r_a, p.r_b, a, b, guess(g));
           const double weight = std::clamp(2.0 + c.depth * inv_tau, 1e-10, 1.0);
           center_a += weight * p.r_a;
           center_b += weight * p.r_b;
@@ -461,8 +461,9 @@ class SoftStep final : public PushMethod {
       rod.delta_center = x_b - x_a;
       rod.length = d.length;
       rod.axis0 = rows[first_rod + r].j.segment<3>(6);  // the row's axis (+y for coincident ends)
-      const AxisRow axial = make_axis_row(rod.axis0, rod.r_a, rod.r_b, solver_bodies_[index(d.body_a)],
-                                          solver_bodies_[index(d.body_b)], 0.0);
+      AxisRow axial;
+      set_axis_row(axial, rod.axis0, rod.r_a, rod.r_b, solver_bodies_[index(d.body_a)],
+                   solver_bodies_[index(d.body_b)], 0.0);
       rod.mass = axial.mass;
       rod.impulse = guess(first_rod + r);
     }

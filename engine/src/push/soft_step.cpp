@@ -199,14 +199,6 @@ struct Rod {
   Vec3 axis0 = Vec3::UnitY();  // the start of the step's axis, for a rod of length 0
 };
 
-// m v for a 3 x 3 matrix m and a 3-vector v, the sum in Eigen's order (column 0, 1, then 2),
-// written out so that the sweeps inline it.
-[[gnu::always_inline]] inline Vec3 times(const Mat3& m, const Vec3& v) {
-  return Vec3(m(0, 0) * v.x() + m(0, 1) * v.y() + m(0, 2) * v.z(),
-              m(1, 0) * v.x() + m(1, 1) * v.y() + m(1, 2) * v.z(),
-              m(2, 0) * v.x() + m(2, 1) * v.y() + m(2, 2) * v.z());
-}
-
 // The velocity of a body's point at offset r (m/s).
 inline Vec3 point_velocity(const SolverBody& s, const Vec3& r) { return s.v + s.w.cross(r); }
 
@@ -616,9 +608,9 @@ class SoftStep final : public PushMethod {
                         SolverBody& b) {
     const Vec3 impulse = P * axis;
     a.v -= a.inv_mass * impulse;
-    a.w -= times(a.inv_I, r_a.cross(impulse));
+    a.w -= a.inv_I * r_a.cross(impulse);
     b.v += b.inv_mass * impulse;
-    b.w += times(b.inv_I, r_b.cross(impulse));
+    b.w += b.inv_I * r_b.cross(impulse);
   }
 
   // Stage "warm start": every accumulated impulse applied to the velocities (thread t's share).
@@ -647,16 +639,16 @@ class SoftStep final : public PushMethod {
   // Applies a friction impulse P (N s, world frame) at the manifold's centre: -P to a, +P to b.
   static void apply_friction(const ManifoldFriction& f, const Vec3& P, SolverBody& a, SolverBody& b) {
     a.v -= a.inv_mass * P;
-    a.w -= times(a.inv_I, f.center_a.cross(P));
+    a.w -= a.inv_I * f.center_a.cross(P);
     b.v += b.inv_mass * P;
-    b.w += times(b.inv_I, f.center_b.cross(P));
+    b.w += b.inv_I * f.center_b.cross(P);
   }
 
   // Applies a twist impulse L (N m s) about the normal: -L to a, +L to b.
   static void apply_twist(const ManifoldFriction& f, double L, SolverBody& a, SolverBody& b) {
     const Vec3 torque = L * f.normal;
-    a.w -= times(a.inv_I, torque);
-    b.w += times(b.inv_I, torque);
+    a.w -= a.inv_I * torque;
+    b.w += b.inv_I * torque;
   }
 
   // One sweep of the stages "solve" (use_bias) or "relax", thread t's share: per colour its rods,

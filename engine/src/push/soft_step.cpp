@@ -309,7 +309,7 @@ class SoftStep final : public PushMethod {
     // speculative distance (m).
     const double inv_tau = 1.0 / std::max(def.contact_margin, 1e-9);
     // The points' friction tangents as World::build_rows gave them to the friction rows, so that
-    // the warm start and store() need not read the rows back (tangent()).
+    // the warm start and store() need not read the rows back (tangents()).
     cached_tangents_ =
         friction && def.warm_start > 0.0 && ctx.warm_start != nullptr ? ctx.warm_start->tangents(0) : nullptr;
     const std::vector<DistanceConstraint>& distances = *ctx.distances;

@@ -76,7 +76,12 @@
 // of a colour share no moving body, so WorldDef::threads threads share each colour's rows
 // (workers.h; a barrier after each colour) and every count gives the same result.
 //
-// Differences from Box3D: double precision, no SIMD lanes; the manifolds as the collide stage
+// Lanes: outside the overflow, a colour's manifolds are swept four at a time in SIMD lanes
+// (soft_lanes.h, Box3D's wide contact solver), each lane's arithmetic the scalar sweep's, so the
+// result is the same bit for bit; the overflow, the rods and the restart variant are swept one
+// at a time.
+//
+// Differences from Box3D: double precision (its lanes are floats); the manifolds as the collide stage
 // makes them (WorldDef::manifold_points and contact_recycle_distance choose Box3D's 4 points and
 // its recycling; Box3D's recycled anchors stay as they were, a cps point is midway between the
 // bodies' material points); the twist warm starts only when a manifold has the same points as
@@ -87,6 +92,7 @@
 // source sweeps them, Gauss-Seidel over body velocities.
 
 #include "push_method.h"
+#include "soft_lanes.h"
 
 #include "../buffers.h"
 #include "../constraint_graph.h"
@@ -108,12 +114,10 @@ namespace {
 // (microseconds, tens on a virtual machine) costs about what the work does.
 constexpr std::size_t kMinParallel = 256;
 
-// Box3D's soft coefficients of one kind of row over a substep (b3MakeSoft).
-struct Softness {
-  double bias_rate = 0.0;      // 1/s
-  double mass_scale = 1.0;     // dimensionless
-  double impulse_scale = 0.0;  // dimensionless
-};
+using soft::LaneGroup;
+using soft::LanePoint;
+using soft::Softness;
+using soft::SolverBody;
 
 // Stiffness `hertz` (Hz, >= 0), damping ratio zeta (>= 0), substep h (s, > 0). hertz = 0 gives a
 // rigid row without push.
@@ -125,18 +129,6 @@ Softness make_softness(double hertz, double zeta, double h) {
   const double a3 = 1.0 / (1.0 + a2);
   return {omega / a1, a2 * a3, a3};
 }
-
-// A body's state in the solver (after the n bodies, one zero stand-in per thread for the static
-// bodies and the world: body()).
-struct SolverBody {
-  Vec3 v = Vec3::Zero();   // m/s
-  Vec3 w = Vec3::Zero();   // rad/s
-  Vec3 dp = Vec3::Zero();  // m: displacement since the start of the step
-  Quat dq = Quat::Identity();  // rotation since the start of the step
-  Mat3 dR = Mat3::Identity();  // dq as a matrix, once a substep
-  Mat3 inv_I = Mat3::Zero();   // 1/(kg m^2), world frame, start of the step
-  double inv_mass = 0.0;       // 1/kg
-};
 
 // One row along a unit axis between anchors r_a, r_b (a contact's normal): what a sweep reads,
 // prepared once a step. r_a x axis and r_b x axis are not kept: the sweeps form them from the
@@ -251,6 +243,7 @@ class SoftStep final : public PushMethod {
     workers_->run(substeps);
     {
       StageTimer timer(ctx, &StageTimes::store);
+      unpack_lanes();
       apply_restitution();
       store(ctx, h);
     }
@@ -463,6 +456,140 @@ class SoftStep final : public PushMethod {
       detail::resize_with_headroom(saved_velocities_, solver_bodies_.size());
       detail::resize_with_headroom(saved_impulses_, contacts_.size() + rods_.size());
     }
+    lanes_ = def.soft_relax == SoftRelax::continue_solve;
+    if (lanes_) pack_lanes(friction, h);
+  }
+
+  // The colours' manifolds (the overflow's excepted) in groups of soft::kLanes, their points in
+  // lanes (soft_lanes.h): colour c's groups are [group_start_[c], group_start_[c + 1]).
+  void pack_lanes(bool friction, double h) {
+    constexpr auto kLanes = static_cast<std::size_t>(soft::kLanes);
+    std::size_t groups = 0;
+    for (int c = 0; c <= ConstraintGraph::kOverflow; ++c) {
+      const auto i = static_cast<std::size_t>(c);
+      group_start_[i] = groups;
+      if (c == ConstraintGraph::kOverflow) continue;  // swept one at a time
+      groups += (manifold_start_[i + 1] - manifold_start_[i] + kLanes - 1) / kLanes;
+    }
+    group_start_[ConstraintGraph::kOverflow + 1] = groups;
+    detail::resize_with_headroom(groups_, groups);
+    std::size_t points = 0;
+    for (int c = 0; c < ConstraintGraph::kOverflow; ++c) {
+      const auto i = static_cast<std::size_t>(c);
+      const std::size_t end = manifold_start_[i + 1];
+      for (std::size_t g = group_start_[i], k = manifold_start_[i]; g < group_start_[i + 1]; ++g, k += kLanes) {
+        groups_[g].first_point = points;
+        std::size_t most = 0;
+        for (std::size_t m = k; m < std::min(k + kLanes, end); ++m) {
+          most = std::max(most, manifolds_[m].end - manifolds_[m].begin);
+        }
+        groups_[g].points = static_cast<int>(most);
+        groups_[g].slot[0] = static_cast<int>(k);  // the group's first manifold, for the fill
+        points += most;
+      }
+    }
+    detail::resize_with_headroom(lane_points_, points);
+    parallel_for(workers_, groups, kMinParallel / kLanes, [&](int, std::size_t begin, std::size_t end) {
+      for (std::size_t g = begin; g < end; ++g) fill_group(g, friction);
+    });
+    sweep_.bodies = solver_bodies_.data();
+    sweep_.stand_in = &lane_stand_in_;
+    sweep_.points = lane_points_.data();
+    sweep_.friction = friction;
+    sweep_.inv_h = 1.0 / h;
+    sweep_.contact = contact_soft_;
+    sweep_.stiff = static_soft_;
+    sweep_.slop = slop_;
+    sweep_.max_push = max_push_;
+  }
+
+  // Group g's lanes from its manifolds (the first at groups_[g].slot[0], the rest after it in the
+  // same colour), zero where the colour has no more.
+  void fill_group(std::size_t g, bool friction) {
+    LaneGroup& group = groups_[g];
+    const auto first = static_cast<std::size_t>(group.slot[0]);
+    std::size_t colour_end = 0;
+    for (std::size_t c = 0; c < static_cast<std::size_t>(ConstraintGraph::kOverflow); ++c) {
+      if (g < group_start_[c + 1]) {
+        colour_end = manifold_start_[c + 1];
+        break;
+      }
+    }
+    const std::size_t first_point = group.first_point;
+    const int points = group.points;
+    group = LaneGroup{};
+    group.first_point = first_point;
+    group.points = points;
+    LanePoint* q = lane_points_.data() + first_point;
+    for (int k = 0; k < points; ++k) q[k] = LanePoint{};
+    for (int l = 0; l < soft::kLanes; ++l) {
+      const std::size_t m = first + static_cast<std::size_t>(l);
+      if (m >= colour_end) break;
+      const ManifoldFriction& f = manifolds_[m];
+      group.a[l] = f.a;
+      group.b[l] = f.b;
+      group.slot[l] = static_cast<int>(m);
+      group.count[l] = static_cast<double>(f.end - f.begin);
+      for (std::size_t i = f.begin; i < f.end; ++i) {
+        const ContactPoint& p = contacts_[i];
+        LanePoint& lp = q[i - f.begin];
+        put(lp.axis, l, p.normal.axis);
+        put(lp.Irn_a, l, p.normal.Irn_a);
+        put(lp.Irn_b, l, p.normal.Irn_b);
+        put(lp.r_a, l, p.r_a);
+        put(lp.r_b, l, p.r_b);
+        lp.mass[l] = p.normal.mass;
+        lp.impulse[l] = p.normal.impulse;
+        lp.base_separation[l] = p.base_separation;
+        lp.total_impulse[l] = p.total_impulse;
+        lp.lever_arm[l] = p.lever_arm;
+        lp.touches_static[l] = p.touches_static ? 1.0 : 0.0;
+      }
+      if (!friction) continue;
+      put(group.normal, l, f.normal);
+      put(group.t1, l, f.t1);
+      put(group.t2, l, f.t2);
+      put(group.center_a, l, f.center_a);
+      put(group.center_b, l, f.center_b);
+      group.k00[l] = f.tangent_mass(0, 0);
+      group.k01[l] = f.tangent_mass(0, 1);
+      group.k10[l] = f.tangent_mass(1, 0);
+      group.k11[l] = f.tangent_mass(1, 1);
+      group.impulse1[l] = f.impulse.x();
+      group.impulse2[l] = f.impulse.y();
+      group.twist_mass[l] = f.twist_mass;
+      group.twist_impulse[l] = f.twist_impulse;
+      group.mu[l] = f.mu;
+      group.fixed_limit[l] = f.fixed_limit;
+    }
+  }
+
+  static void put(soft::LaneVec3& lanes, int l, const Vec3& v) {
+    lanes.x[l] = v.x();
+    lanes.y[l] = v.y();
+    lanes.z[l] = v.z();
+  }
+
+  // The lanes' impulses back into the manifolds and points, for the restitution and the store.
+  void unpack_lanes() {
+    if (!lanes_) return;
+    parallel_for(workers_, group_start_[ConstraintGraph::kOverflow + 1], kMinParallel / soft::kLanes,
+                 [&](int, std::size_t begin, std::size_t end) {
+                   for (std::size_t g = begin; g < end; ++g) {
+                     const LaneGroup& group = groups_[g];
+                     const LanePoint* q = lane_points_.data() + group.first_point;
+                     for (int l = 0; l < soft::kLanes; ++l) {
+                       if (group.slot[l] < 0) break;
+                       ManifoldFriction& f = manifolds_[static_cast<std::size_t>(group.slot[l])];
+                       f.impulse = Eigen::Vector2d(group.impulse1[l], group.impulse2[l]);
+                       f.twist_impulse = group.twist_impulse[l];
+                       for (std::size_t i = f.begin; i < f.end; ++i) {
+                         contacts_[i].normal.impulse = q[i - f.begin].impulse[l];
+                         contacts_[i].total_impulse = q[i - f.begin].total_impulse[l];
+                       }
+                     }
+                   }
+                 });
   }
 
   // Colours the rods, then the manifolds, in order (constraint_graph.h; `moving` maps a body
@@ -527,9 +654,10 @@ class SoftStep final : public PushMethod {
 
   // Calls rod_fn(rod, t) and manifold_fn(manifold, t) for the overflow's rods and manifolds
   // (thread 0, in order), then for thread t's share of each colour's, colour by colour, with a
-  // barrier after each (Box3D's order: b3SolverStep).
-  template <class RodFn, class ManifoldFn>
-  void sweep_colours(int t, RodFn&& rod_fn, ManifoldFn&& manifold_fn) {
+  // barrier after each (Box3D's order: b3SolverStep); with lanes_, group_fn(groups, count) for
+  // thread t's share of a colour's groups in place of its manifolds.
+  template <class RodFn, class ManifoldFn, class GroupFn>
+  void sweep_colours(int t, RodFn&& rod_fn, ManifoldFn&& manifold_fn, GroupFn&& group_fn) {
     for (int k = 0; k < ConstraintGraph::kColours; ++k) {
       const bool overflow = k == 0;
       const auto c = static_cast<std::size_t>(sweep_colour(k));
@@ -539,6 +667,12 @@ class SoftStep final : public PushMethod {
       if (!overflow || t == 0) {
         const auto [rb, re] = overflow ? std::pair<std::size_t, std::size_t>{0, rods} : share(rods, t);
         for (std::size_t i = rb; i < re; ++i) rod_fn(rods_[rod_start_[c] + i], t);
+        if (lanes_ && !overflow) {  // the colour's manifolds in groups of lanes
+          const auto [gb, ge] = share(group_start_[c + 1] - group_start_[c], t);
+          if (ge > gb) group_fn(groups_.data() + group_start_[c] + gb, ge - gb);
+          workers_->sync();
+          continue;
+        }
         const auto [mb, me] =
             overflow ? std::pair<std::size_t, std::size_t>{0, manifolds} : share(manifolds, t);
         for (std::size_t i = mb; i < me; ++i) {
@@ -633,7 +767,8 @@ class SoftStep final : public PushMethod {
           if (f.first_friction_row < 0) return;
           apply_friction(f, f.impulse.x() * f.t1 + f.impulse.y() * f.t2, a, b);
           apply_twist(f, f.twist_impulse, a, b);
-        });
+        },
+        [this](const LaneGroup* groups, std::size_t count) { soft::warm_start_lanes(groups, count, sweep_); });
   }
 
   // Applies a friction impulse P (N s, world frame) at the manifold's centre: -P to a, +P to b.
@@ -669,7 +804,8 @@ class SoftStep final : public PushMethod {
             twist_limit += p.lever_arm * p.normal.impulse;
           }
           if (!use_bias && f.first_friction_row >= 0) solve_friction(f, total, twist_limit, a, b);
-        });
+        },
+        [this, use_bias](LaneGroup* groups, std::size_t count) { soft::solve_lanes(groups, count, sweep_, use_bias); });
   }
 
   void solve_rod(Rod& rod, bool use_bias, SolverBody& a, SolverBody& b) const {
@@ -864,6 +1000,12 @@ class SoftStep final : public PushMethod {
   std::vector<unsigned char> restitution_by_thread_;  // per thread: 1 when one of its contacts has a restitution target
   std::vector<ManifoldFriction> manifolds_;     // one per manifold, in colour order
   std::vector<Rod> rods_;                  // one per distance constraint, in colour order
+  bool lanes_ = false;                     // the colours' manifolds are swept in lanes (soft_lanes.h)
+  std::vector<LaneGroup> groups_;          // colour c's groups: [group_start_[c], group_start_[c + 1])
+  std::vector<LanePoint> lane_points_;     // the groups' points
+  ColourStarts group_start_{};
+  soft::LaneSweep sweep_;                  // what the lanes' sweeps read
+  SolverBody lane_stand_in_;               // the lanes' body for -1: zero, read only
   std::vector<std::pair<Vec3, Vec3>> saved_velocities_;  // n + threads: v, w (SoftRelax::restart)
   std::vector<double> saved_impulses_;                   // normal, then rod impulses (N s)
   Softness contact_soft_;

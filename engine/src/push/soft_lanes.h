@@ -1,0 +1,359 @@
+// The soft step's sweeps in SIMD lanes: a graph colour's manifolds four at a time, one per lane
+// (Box3D's wide contact solver, src/contact_solver.c: b3PrepareContactsTask's packing into
+// b3ContactConstraintSIMD, b3WarmStartContactsTask, b3SolveContactsTask, b3RelaxContactsTask;
+// Box2D v3's src/contact_solver.c, which it follows). A colour's manifolds share no moving body,
+// so the lanes' bodies are gathered, swept and scattered back independently.
+//
+// Each lane does, operation for operation, what soft_step.cpp's scalar sweep does for its
+// manifold, in double, in Eigen's order of the scalar code's sums (a 3-vector's dot product as
+// (x0 + x1) + x2; a 3 x 3 matrix times a vector with rows 0 and 1 as (m0 v0 + m1 v1) + m2 v2 and
+// row 2 as m0 v0 + (m1 v1 + m2 v2), the order Eigen 3.4 evaluates them in on x86-64), without
+// fused multiply-adds, so the lanes give the scalar sweep's state bit for bit. The kernels are
+// built twice on x86-64 with GCC (target_clones: AVX2 and the SSE2 baseline), the loader chooses
+// by the CPU, and both give the same bits. Differences from Box3D: double, not float; Box3D's
+// lanes are 4 (SSE2, NEON) or 8 (AVX2) floats.
+
+#ifndef CPS_ENGINE_PUSH_SOFT_LANES_H
+#define CPS_ENGINE_PUSH_SOFT_LANES_H
+
+#include "cps/math.h"
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define CPS_LANES_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define CPS_LANES_CLONES
+#endif
+
+namespace cps::soft {
+
+/// Four doubles, one per lane (GCC's and Clang's vector extension; split into two SSE2 registers
+/// where AVX is not enabled). Aligned to 32 bytes in every build, as the AVX2 kernels load them
+/// (without AVX, GCC would align the type to 16).
+using Lanes = double __attribute__((vector_size(4 * sizeof(double)), aligned(32)));
+/// A lane mask: all bits set (true) or clear, per lane, as the vector comparisons give it.
+using LaneMask = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t)), aligned(32)));
+inline constexpr int kLanes = 4;
+
+/// A body's state in the soft step's solver (soft_step.cpp; after the n bodies, zero stand-ins
+/// for the static bodies and the world).
+struct SolverBody {
+  Vec3 v = Vec3::Zero();       // m/s
+  Vec3 w = Vec3::Zero();       // rad/s
+  Vec3 dp = Vec3::Zero();      // m: displacement since the start of the step
+  Quat dq = Quat::Identity();  // rotation since the start of the step
+  Mat3 dR = Mat3::Identity();  // dq as a matrix, once a substep
+  Mat3 inv_I = Mat3::Zero();   // 1/(kg m^2), world frame, start of the step
+  double inv_mass = 0.0;       // 1/kg
+};
+
+/// Box3D's soft coefficients of one kind of row over a substep (b3MakeSoft; soft_step.cpp).
+struct Softness {
+  double bias_rate = 0.0;      // 1/s
+  double mass_scale = 1.0;     // dimensionless
+  double impulse_scale = 0.0;  // dimensionless
+};
+
+/// A 3-vector per lane (x, y, z: 4 lanes each).
+struct LaneVec3 {
+  Lanes x{};
+  Lanes y{};
+  Lanes z{};
+};
+
+/// Point k of each lane's manifold (zero in a lane whose manifold has fewer points): the scalar
+/// sweep's ContactPoint and its normal row, in lanes. Units as there: axis unit, Irn_a and Irn_b
+/// I^-1 (r x axis) in 1/(kg m), r_a and r_b m, mass kg, impulses N s, separations and lever arm m.
+struct LanePoint {
+  LaneVec3 axis;
+  LaneVec3 Irn_a;
+  LaneVec3 Irn_b;
+  LaneVec3 r_a;
+  LaneVec3 r_b;
+  Lanes mass{};
+  Lanes impulse{};
+  Lanes base_separation{};
+  Lanes total_impulse{};
+  Lanes lever_arm{};
+  Lanes touches_static{};  // 1 where the contact has a static body, else 0
+};
+
+/// Up to kLanes manifolds of one colour, their friction at the centre in lanes (the scalar
+/// sweep's ManifoldFriction) and their points from `first_point` in the group's point array.
+struct LaneGroup {
+  int a[kLanes] = {-1, -1, -1, -1};  // moving body index, or -1 (static, the world, no manifold)
+  int b[kLanes] = {-1, -1, -1, -1};
+  int slot[kLanes] = {-1, -1, -1, -1};  // the manifold's slot in the scalar arrays, or -1
+  std::size_t first_point = 0;
+  int points = 0;  // the most points of a lane's manifold
+  LaneVec3 normal;
+  LaneVec3 t1;
+  LaneVec3 t2;
+  LaneVec3 center_a;  // m
+  LaneVec3 center_b;
+  Lanes k00{};  // kg: the 2 x 2 tangent mass, row by row
+  Lanes k01{};
+  Lanes k10{};
+  Lanes k11{};
+  Lanes impulse1{};  // N s along t1
+  Lanes impulse2{};  // N s along t2
+  Lanes twist_mass{};     // kg m^2
+  Lanes twist_impulse{};  // N m s
+  Lanes mu{};
+  Lanes fixed_limit{};  // N s a substep per point; < 0: the coupled model
+  Lanes count{};        // the lane's points
+};
+
+/// What a sweep of lanes reads besides the groups (soft_step.cpp's members of the same names).
+struct LaneSweep {
+  SolverBody* bodies = nullptr;   // the solver bodies, indexed by LaneGroup::a and b
+  SolverBody* stand_in = nullptr;  // a zero body for index -1 (read, never written)
+  LanePoint* points = nullptr;
+  bool friction = false;           // the manifolds have friction rows
+  double inv_h = 0.0;              // 1/s
+  Softness contact;
+  Softness stiff;                  // contacts with a static body
+  double slop = 0.0;               // m
+  double max_push = 0.0;           // m/s
+};
+
+namespace lanes {
+
+[[gnu::always_inline]] inline Lanes splat(double x) { return Lanes{x, x, x, x}; }
+
+[[gnu::always_inline]] inline Lanes select(LaneMask m, Lanes a, Lanes b) { return m ? a : b; }
+
+[[gnu::always_inline]] inline LaneVec3 operator+(const LaneVec3& a, const LaneVec3& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+[[gnu::always_inline]] inline LaneVec3 operator-(const LaneVec3& a, const LaneVec3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+[[gnu::always_inline]] inline LaneVec3 operator*(Lanes s, const LaneVec3& a) { return {s * a.x, s * a.y, s * a.z}; }
+
+// Eigen's order for Vec3::dot: (x0 + x1) + x2.
+[[gnu::always_inline]] inline Lanes dot(const LaneVec3& a, const LaneVec3& b) {
+  return (a.x * b.x + a.y * b.y) + a.z * b.z;
+}
+
+[[gnu::always_inline]] inline LaneVec3 cross(const LaneVec3& a, const LaneVec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+/// A 3 x 3 matrix per lane, m[row][column].
+struct LaneMat3 {
+  Lanes m[3][3];
+};
+
+// Eigen 3.4's order for Mat3 * Vec3 on x86-64: rows 0 and 1 in a packet, row 2 as a reduction.
+[[gnu::always_inline]] inline LaneVec3 mul(const LaneMat3& M, const LaneVec3& v) {
+  return {(M.m[0][0] * v.x + M.m[0][1] * v.y) + M.m[0][2] * v.z,
+          (M.m[1][0] * v.x + M.m[1][1] * v.y) + M.m[1][2] * v.z,
+          M.m[2][0] * v.x + (M.m[2][1] * v.y + M.m[2][2] * v.z)};
+}
+
+// The lanes' bodies on one side of their rows.
+struct LaneBody {
+  LaneVec3 v;
+  LaneVec3 w;
+  LaneVec3 dp;
+  LaneMat3 dR{};
+  LaneMat3 inv_I{};
+  Lanes inv_mass{};
+  SolverBody* body[kLanes];
+  bool moving[kLanes];
+};
+
+// The lanes' bodies of `index` (kLanes body indices, -1 for the stand-in); their positions (dp,
+// dR) and inverse inertias only when asked for.
+[[gnu::always_inline]] inline void gather(LaneBody& L, const int* index, const LaneSweep& s, bool positions,
+                                          bool inertia) {
+  for (int l = 0; l < kLanes; ++l) {
+    L.moving[l] = index[l] >= 0;
+    L.body[l] = L.moving[l] ? s.bodies + index[l] : s.stand_in;
+  }
+  const SolverBody* const* b = L.body;
+  const auto lanes = [b](auto&& field) { return Lanes{field(*b[0]), field(*b[1]), field(*b[2]), field(*b[3])}; };
+  L.v = {lanes([](const SolverBody& x) { return x.v.x(); }), lanes([](const SolverBody& x) { return x.v.y(); }),
+         lanes([](const SolverBody& x) { return x.v.z(); })};
+  L.w = {lanes([](const SolverBody& x) { return x.w.x(); }), lanes([](const SolverBody& x) { return x.w.y(); }),
+         lanes([](const SolverBody& x) { return x.w.z(); })};
+  L.inv_mass = lanes([](const SolverBody& x) { return x.inv_mass; });
+  if (positions) {
+    L.dp = {lanes([](const SolverBody& x) { return x.dp.x(); }), lanes([](const SolverBody& x) { return x.dp.y(); }),
+            lanes([](const SolverBody& x) { return x.dp.z(); })};
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) L.dR.m[r][c] = lanes([r, c](const SolverBody& x) { return x.dR(r, c); });
+    }
+  }
+  if (inertia) {
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) L.inv_I.m[r][c] = lanes([r, c](const SolverBody& x) { return x.inv_I(r, c); });
+    }
+  }
+}
+
+// Writes the lanes' velocities back to their moving bodies (a stand-in's stay zero: it has no
+// mass and no inverse inertia).
+[[gnu::always_inline]] inline void scatter(const LaneBody& L) {
+  for (int l = 0; l < kLanes; ++l) {
+    if (!L.moving[l]) continue;
+    L.body[l]->v = Vec3(L.v.x[l], L.v.y[l], L.v.z[l]);
+    L.body[l]->w = Vec3(L.w.x[l], L.w.y[l], L.w.z[l]);
+  }
+}
+
+// soft_step.cpp's apply(): impulse P along a point's normal row, -P to a, +P to b.
+[[gnu::always_inline]] inline void apply(const LanePoint& q, Lanes P, LaneBody& A, LaneBody& B) {
+  A.v = A.v - (A.inv_mass * P) * q.axis;
+  A.w = A.w - P * q.Irn_a;
+  B.v = B.v + (B.inv_mass * P) * q.axis;
+  B.w = B.w + P * q.Irn_b;
+}
+
+// soft_step.cpp's apply_friction(): impulse P (world frame) at the manifold's centre.
+[[gnu::always_inline]] inline void apply_friction(const LaneGroup& g, const LaneVec3& P, LaneBody& A, LaneBody& B) {
+  A.v = A.v - A.inv_mass * P;
+  A.w = A.w - mul(A.inv_I, cross(g.center_a, P));
+  B.v = B.v + B.inv_mass * P;
+  B.w = B.w + mul(B.inv_I, cross(g.center_b, P));
+}
+
+// soft_step.cpp's apply_twist(): twist impulse L about the normal.
+[[gnu::always_inline]] inline void apply_twist(const LaneGroup& g, Lanes L, LaneBody& A, LaneBody& B) {
+  const LaneVec3 torque = L * g.normal;
+  A.w = A.w - mul(A.inv_I, torque);
+  B.w = B.w + mul(B.inv_I, torque);
+}
+
+[[gnu::always_inline]] inline void warm_start_group(const LaneGroup& g, const LaneSweep& s) {
+  LaneBody A;
+  LaneBody B;
+  gather(A, g.a, s, false, true);
+  gather(B, g.b, s, false, true);
+  const LanePoint* q = s.points + g.first_point;
+  for (int k = 0; k < g.points; ++k) apply(q[k], q[k].impulse, A, B);
+  if (s.friction) {
+    apply_friction(g, g.impulse1 * g.t1 + g.impulse2 * g.t2, A, B);
+    apply_twist(g, g.twist_impulse, A, B);
+  }
+  scatter(A);
+  scatter(B);
+}
+
+// soft_step.cpp's solve_normal() for point q of each lane.
+template <bool kBias>
+[[gnu::always_inline]] inline Lanes solve_normal(LanePoint& q, LaneBody& A, LaneBody& B, const LaneSweep& s) {
+  const LaneVec3 ds = (B.dp - A.dp) + (mul(B.dR, q.r_b) - mul(A.dR, q.r_a));
+  const Lanes sep = dot(q.axis, ds) + q.base_separation;
+  const LaneMask speculative = sep > 0.0;
+  Lanes bias = select(speculative, sep * s.inv_h, splat(0.0));
+  Lanes mass_scale = splat(1.0);
+  Lanes impulse_scale = splat(0.0);
+  if constexpr (kBias) {
+    const LaneMask stiff = q.touches_static != 0.0;
+    const Lanes k_mass = select(stiff, splat(s.stiff.mass_scale), splat(s.contact.mass_scale));
+    const Lanes k_rate = select(stiff, splat(s.stiff.bias_rate), splat(s.contact.bias_rate));
+    const Lanes k_impulse = select(stiff, splat(s.stiff.impulse_scale), splat(s.contact.impulse_scale));
+    const Lanes shifted = sep + s.slop;
+    const Lanes closing = select(0.0 < shifted, splat(0.0), shifted);  // std::min(s + slop, 0)
+    const Lanes push = (k_mass * k_rate) * closing;
+    const Lanes soft = select(push < -s.max_push, splat(-s.max_push), push);  // std::max(push, -max)
+    bias = select(speculative, bias, soft);
+    mass_scale = select(speculative, mass_scale, k_mass);
+    impulse_scale = select(speculative, impulse_scale, k_impulse);
+  }
+  const Lanes speed = (dot(q.axis, B.v - A.v) + dot(cross(q.r_b, q.axis), B.w)) - dot(cross(q.r_a, q.axis), A.w);
+  const Lanes old = q.impulse;
+  Lanes next = old - q.mass * (mass_scale * speed + bias) - impulse_scale * old;
+  next = select(next < 0.0, splat(0.0), next);  // std::max(next, 0)
+  q.impulse = next;
+  q.total_impulse = q.total_impulse + next;
+  apply(q, next - old, A, B);
+  return next;
+}
+
+// soft_step.cpp's solve_friction(): the twist, then the two tangent rows at the centre.
+[[gnu::always_inline]] inline void solve_friction(LaneGroup& g, Lanes total, Lanes twist_limit, LaneBody& A,
+                                                  LaneBody& B) {
+  Lanes limit = g.mu * total;
+  Lanes twist_max = g.mu * twist_limit;
+  const LaneMask fixed = g.fixed_limit >= 0.0;
+  const Lanes fixed_limit = g.fixed_limit * g.count;
+  // Every lane computes both sides of a choice: a denominator of 0 becomes 1 where its side is
+  // not taken, so that no lane divides by zero (the tests trap it).
+  const LaneMask pressed = total > 0.0;
+  const Lanes fixed_twist = select(pressed, fixed_limit * twist_limit / select(pressed, total, splat(1.0)), splat(0.0));
+  limit = select(fixed, fixed_limit, limit);
+  twist_max = select(fixed, fixed_twist, twist_max);
+  {
+    const Lanes speed = dot(g.normal, B.w - A.w);
+    const Lanes old = g.twist_impulse;
+    const Lanes raw = old - g.twist_mass * speed;
+    const Lanes low = -twist_max;
+    Lanes next = select(raw < low, low, select(twist_max < raw, twist_max, raw));  // std::clamp
+    g.twist_impulse = next;
+    apply_twist(g, next - old, A, B);
+  }
+  const LaneVec3 vr = (B.v + cross(B.w, g.center_b)) - (A.v + cross(A.w, g.center_a));
+  const Lanes vt1 = dot(vr, g.t1);
+  const Lanes vt2 = dot(vr, g.t2);
+  Lanes next1 = g.impulse1 - (g.k00 * vt1 + g.k01 * vt2);
+  Lanes next2 = g.impulse2 - (g.k10 * vt1 + g.k11 * vt2);
+  const Lanes length2 = next1 * next1 + next2 * next2;
+  const LaneMask outside = length2 > limit * limit;
+  const Lanes root{std::sqrt(length2[0]), std::sqrt(length2[1]), std::sqrt(length2[2]), std::sqrt(length2[3])};
+  const Lanes scale = limit / select(outside, root, splat(1.0));  // root > 0 where outside
+  next1 = select(outside, next1 * scale, next1);
+  next2 = select(outside, next2 * scale, next2);
+  const Lanes d1 = next1 - g.impulse1;
+  const Lanes d2 = next2 - g.impulse2;
+  g.impulse1 = next1;
+  g.impulse2 = next2;
+  apply_friction(g, d1 * g.t1 + d2 * g.t2, A, B);
+}
+
+template <bool kBias>
+[[gnu::always_inline]] inline void solve_group(LaneGroup& g, const LaneSweep& s) {
+  const bool friction = !kBias && s.friction;
+  LaneBody A;
+  LaneBody B;
+  gather(A, g.a, s, true, friction);
+  gather(B, g.b, s, true, friction);
+  LanePoint* q = s.points + g.first_point;
+  Lanes total = splat(0.0);
+  Lanes twist_limit = splat(0.0);
+  for (int k = 0; k < g.points; ++k) {
+    const Lanes next = solve_normal<kBias>(q[k], A, B, s);
+    total = total + next;
+    twist_limit = twist_limit + q[k].lever_arm * next;
+  }
+  if (friction) solve_friction(g, total, twist_limit, A, B);
+  scatter(A);
+  scatter(B);
+}
+
+}  // namespace lanes
+
+/// The warm start of groups [groups, groups + count): every point's accumulated normal impulse
+/// and each manifold's friction and twist applied to the bodies (soft_step.cpp's warm_start()).
+CPS_LANES_CLONES inline void warm_start_lanes(const LaneGroup* groups, std::size_t count, const LaneSweep& s) {
+  for (std::size_t i = 0; i < count; ++i) lanes::warm_start_group(groups[i], s);
+}
+
+/// One sweep of the solve (use_bias) or the relax over groups [groups, groups + count)
+/// (soft_step.cpp's solve()).
+CPS_LANES_CLONES inline void solve_lanes(LaneGroup* groups, std::size_t count, const LaneSweep& s, bool use_bias) {
+  if (use_bias) {
+    for (std::size_t i = 0; i < count; ++i) lanes::solve_group<true>(groups[i], s);
+  } else {
+    for (std::size_t i = 0; i < count; ++i) lanes::solve_group<false>(groups[i], s);
+  }
+}
+
+}  // namespace cps::soft
+
+#endif  // CPS_ENGINE_PUSH_SOFT_LANES_H

@@ -489,12 +489,18 @@ class SoftStep final : public PushMethod {
       }
     }
     detail::resize_with_headroom(lane_points_, points);
+    // The step's total normal impulses matter only to the restitution (apply_restitution()).
+    const bool restitution = std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) !=
+                             restitution_by_thread_.end();
+    lane_totals_.clear();
+    if (restitution) detail::resize_with_headroom(lane_totals_, points);
     parallel_for(workers_, groups, kMinParallel / kLanes, [&](int, std::size_t begin, std::size_t end) {
       for (std::size_t g = begin; g < end; ++g) fill_group(g, friction);
     });
     sweep_.bodies = solver_bodies_.data();
     sweep_.stand_in = &lane_stand_in_;
     sweep_.points = lane_points_.data();
+    sweep_.totals = restitution ? lane_totals_.data() : nullptr;
     sweep_.friction = friction;
     sweep_.inv_h = 1.0 / h;
     sweep_.contact = contact_soft_;
@@ -522,6 +528,9 @@ class SoftStep final : public PushMethod {
     group.points = points;
     LanePoint* q = lane_points_.data() + first_point;
     for (int k = 0; k < points; ++k) q[k] = LanePoint{};
+    const bool restitution = !lane_totals_.empty();
+    soft::LaneTotal* totals = restitution ? lane_totals_.data() + first_point : nullptr;
+    for (int k = 0; restitution && k < points; ++k) totals[k] = soft::LaneTotal{};
     for (int l = 0; l < soft::kLanes; ++l) {
       const std::size_t m = first + static_cast<std::size_t>(l);
       if (m >= colour_end) break;
@@ -534,17 +543,15 @@ class SoftStep final : public PushMethod {
         const ContactPoint& p = contacts_[i];
         LanePoint& lp = q[i - f.begin];
         put(lp.axis, l, p.normal.axis);
-        put(lp.Irn_a, l, p.normal.Irn_a);
-        put(lp.Irn_b, l, p.normal.Irn_b);
         put(lp.r_a, l, p.r_a);
         put(lp.r_b, l, p.r_b);
         lp.mass[l] = p.normal.mass;
         lp.impulse[l] = p.normal.impulse;
         lp.base_separation[l] = p.base_separation;
-        lp.total_impulse[l] = p.total_impulse;
         lp.lever_arm[l] = p.lever_arm;
-        lp.touches_static[l] = p.touches_static ? 1.0 : 0.0;
+        if (restitution) totals[i - f.begin].impulse[l] = p.total_impulse;
       }
+      group.touches_static[l] = f.begin < f.end && contacts_[f.begin].touches_static ? 1.0 : 0.0;
       if (!friction) continue;
       put(group.normal, l, f.normal);
       put(group.t1, l, f.t1);
@@ -578,6 +585,8 @@ class SoftStep final : public PushMethod {
                    for (std::size_t g = begin; g < end; ++g) {
                      const LaneGroup& group = groups_[g];
                      const LanePoint* q = lane_points_.data() + group.first_point;
+                     const soft::LaneTotal* totals =
+                         lane_totals_.empty() ? nullptr : lane_totals_.data() + group.first_point;
                      for (int l = 0; l < soft::kLanes; ++l) {
                        if (group.slot[l] < 0) break;
                        ManifoldFriction& f = manifolds_[static_cast<std::size_t>(group.slot[l])];
@@ -585,7 +594,7 @@ class SoftStep final : public PushMethod {
                        f.twist_impulse = group.twist_impulse[l];
                        for (std::size_t i = f.begin; i < f.end; ++i) {
                          contacts_[i].normal.impulse = q[i - f.begin].impulse[l];
-                         contacts_[i].total_impulse = q[i - f.begin].total_impulse[l];
+                         if (totals != nullptr) contacts_[i].total_impulse = totals[i - f.begin].impulse[l];
                        }
                      }
                    }
@@ -1003,6 +1012,7 @@ class SoftStep final : public PushMethod {
   bool lanes_ = false;                     // the colours' manifolds are swept in lanes (soft_lanes.h)
   std::vector<LaneGroup> groups_;          // colour c's groups: [group_start_[c], group_start_[c + 1])
   std::vector<LanePoint> lane_points_;     // the groups' points
+  std::vector<soft::LaneTotal> lane_totals_;  // per lane point: its total impulse (N s), when a contact has restitution
   ColourStarts group_start_{};
   soft::LaneSweep sweep_;                  // what the lanes' sweeps read
   SolverBody lane_stand_in_;               // the lanes' body for -1: zero, read only

@@ -1,8 +1,8 @@
 // The soft step's sweeps in SIMD lanes: a graph colour's manifolds four at a time, one per lane
-// (Box3D's wide contact solver, src/contact_solver.c: b3PrepareContactsTask's packing into
-// b3ContactConstraintSIMD, b3WarmStartContactsTask, b3SolveContactsTask, b3RelaxContactsTask;
-// Box2D v3's src/contact_solver.c, which it follows). A colour's manifolds share no moving body,
-// so the lanes' bodies are gathered, swept and scattered back independently.
+// (Box3D's wide contact solver, erincatto/box3d 0.1.0 src/contact_solver.c: b3GatherBodies,
+// b3ScatterBodies, b3WarmStartContacts_Convex, b3SolveContacts_Convex with useBias true and
+// false; Box2D v3's src/contact_solver.c, which it follows). A colour's manifolds share no moving
+// body, so the lanes' bodies are gathered, swept and scattered back independently.
 //
 // Each lane does, operation for operation, what soft_step.cpp's scalar sweep does for its
 // manifold, in double, in Eigen's order of the scalar code's sums (a 3-vector's dot product as
@@ -10,8 +10,8 @@
 // row 2 as m0 v0 + (m1 v1 + m2 v2), the order Eigen 3.4 evaluates them in on x86-64), without
 // fused multiply-adds, so the lanes give the scalar sweep's state bit for bit. The kernels are
 // built twice on x86-64 with GCC (target_clones: AVX2 and the SSE2 baseline), the loader chooses
-// by the CPU, and both give the same bits. Differences from Box3D: double, not float; Box3D's
-// lanes are 4 (SSE2, NEON) or 8 (AVX2) floats.
+// by the CPU, and both give the same bits. Differences from Box3D: four doubles a lane group
+// where Box3D has four floats (SSE2 or NEON); the points' I^-1 (r x n) formed in the sweep.
 
 #ifndef CPS_ENGINE_PUSH_SOFT_LANES_H
 #define CPS_ENGINE_PUSH_SOFT_LANES_H
@@ -68,7 +68,7 @@ struct LaneVec3 {
 /// sweep's ContactPoint and its normal row, in lanes, in the order a sweep reads them. Units as
 /// there: axis unit, r_a and r_b m, mass kg, impulse N s, separation and lever arm m. Its
 /// I^-1 (r x axis) are formed in the sweep from the bodies' I^-1, as prepare formed them, so that
-/// a point streams 104 bytes a lane instead of 152; its step's total impulse is kept apart
+/// a point streams 104 bytes a lane instead of 168; its step's total impulse is kept apart
 /// (LaneSweep::totals), summed only where a contact has a restitution target.
 struct LanePoint {
   LaneVec3 r_a;

@@ -182,23 +182,28 @@ struct LaneBody {
     L.moving[l] = index[l] >= 0;
     L.body[l] = L.moving[l] ? s.bodies + index[l] : s.stand_in;
   }
-  const SolverBody* const* b = L.body;
-  const auto lanes = [b](auto&& field) { return Lanes{field(*b[0]), field(*b[1]), field(*b[2]), field(*b[3])}; };
-  L.v = {lanes([](const SolverBody& x) { return x.v.x(); }), lanes([](const SolverBody& x) { return x.v.y(); }),
-         lanes([](const SolverBody& x) { return x.v.z(); })};
-  L.w = {lanes([](const SolverBody& x) { return x.w.x(); }), lanes([](const SolverBody& x) { return x.w.y(); }),
-         lanes([](const SolverBody& x) { return x.w.z(); })};
-  L.inv_mass = lanes([](const SolverBody& x) { return x.inv_mass; });
+  const SolverBody& b0 = *L.body[0];
+  const SolverBody& b1 = *L.body[1];
+  const SolverBody& b2 = *L.body[2];
+  const SolverBody& b3 = *L.body[3];
+  L.v.x = Lanes{b0.v.x(), b1.v.x(), b2.v.x(), b3.v.x()};
+  L.v.y = Lanes{b0.v.y(), b1.v.y(), b2.v.y(), b3.v.y()};
+  L.v.z = Lanes{b0.v.z(), b1.v.z(), b2.v.z(), b3.v.z()};
+  L.w.x = Lanes{b0.w.x(), b1.w.x(), b2.w.x(), b3.w.x()};
+  L.w.y = Lanes{b0.w.y(), b1.w.y(), b2.w.y(), b3.w.y()};
+  L.w.z = Lanes{b0.w.z(), b1.w.z(), b2.w.z(), b3.w.z()};
+  L.inv_mass = Lanes{b0.inv_mass, b1.inv_mass, b2.inv_mass, b3.inv_mass};
   if (positions) {
-    L.dp = {lanes([](const SolverBody& x) { return x.dp.x(); }), lanes([](const SolverBody& x) { return x.dp.y(); }),
-            lanes([](const SolverBody& x) { return x.dp.z(); })};
+    L.dp.x = Lanes{b0.dp.x(), b1.dp.x(), b2.dp.x(), b3.dp.x()};
+    L.dp.y = Lanes{b0.dp.y(), b1.dp.y(), b2.dp.y(), b3.dp.y()};
+    L.dp.z = Lanes{b0.dp.z(), b1.dp.z(), b2.dp.z(), b3.dp.z()};
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) L.dR.m[r][c] = lanes([r, c](const SolverBody& x) { return x.dR(r, c); });
+      for (int c = 0; c < 3; ++c) L.dR.m[r][c] = Lanes{b0.dR(r, c), b1.dR(r, c), b2.dR(r, c), b3.dR(r, c)};
     }
   }
   if (inertia) {
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) L.inv_I.m[r][c] = lanes([r, c](const SolverBody& x) { return x.inv_I(r, c); });
+      for (int c = 0; c < 3; ++c) L.inv_I.m[r][c] = Lanes{b0.inv_I(r, c), b1.inv_I(r, c), b2.inv_I(r, c), b3.inv_I(r, c)};
     }
   }
 }

@@ -175,7 +175,12 @@ struct LaneBody {
 };
 
 // The lanes' bodies of `index` (kLanes body indices, -1 for the stand-in); their positions (dp,
-// dR) and inverse inertias only when asked for.
+// dR) and inverse inertias only when asked for. (GCC 12 warns that the members it assigns may be
+// used uninitialized: it does not see that a sweep reads only what it gathered.)
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 [[gnu::always_inline]] inline void gather(LaneBody& L, const int* index, const LaneSweep& s, bool positions,
                                           bool inertia) {
   for (int l = 0; l < kLanes; ++l) {
@@ -207,6 +212,10 @@ struct LaneBody {
     }
   }
 }
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
 
 // Writes the lanes' velocities back to their moving bodies (a stand-in's stay zero: it has no
 // mass and no inverse inertia).

@@ -243,8 +243,7 @@ class SoftStep final : public PushMethod {
     workers_->run(substeps);
     {
       StageTimer timer(ctx, &StageTimes::store);
-      unpack_lanes();
-      apply_restitution();
+      apply_restitution(ctx.rows, ctx.layout);
       store(ctx, h);
     }
     ctx.store_warm_start();
@@ -283,9 +282,7 @@ class SoftStep final : public PushMethod {
     // A static body and the world (kWorldBody) are -1 in the sweeps (body()); read here, a
     // static body's entry and the stand-in n are both zero.
     const auto index = [n](int body) { return body == kWorldBody ? n : static_cast<std::size_t>(body); };
-    const auto moving = [&bodies](int body) {
-      return body == kWorldBody || bodies[static_cast<std::size_t>(body)].is_static() ? -1 : body;
-    };
+    const auto moving = [&bodies](int body) { return moving_index(bodies, body); };
 
     // Box3D's softness of a step (b3World_Step, b3PrepareJoint).
     const double contact_hertz = std::min(def.contact_hertz, 0.125 / h);
@@ -327,105 +324,52 @@ class SoftStep final : public PushMethod {
     for (std::size_t j = 0; j < count; ++j) point_start_[j + 1] += point_start_[j];
     detail::resize_with_headroom(contacts_, points);
     detail::resize_with_headroom(manifolds_, count);
-    // Each manifold writes only its own slot and points: shared among the threads.
+    const ManifoldInput in{def, bodies, rows, ctx.manifolds, ctx.layout, warm,
+                           ctx.warm_start.get(), h, friction, coupled, inv_tau};
+    lanes_ = def.soft_relax == SoftRelax::continue_solve;
+    if (lanes_) layout_lanes();
+    // With lanes, a colour's manifold goes straight into its group's lane (lane_of()) and only
+    // the overflow's into its slot. Each manifold writes only its own slot, points and lane:
+    // shared among the threads.
     detail::assign_with_headroom(restitution_by_thread_, threads, static_cast<unsigned char>(0));
-    parallel_for(workers_, count, kMinParallel, [&](int t, std::size_t k_begin, std::size_t k_end) {
+    parallel_for(workers_, count, kMinParallel, [&](int t, std::size_t begin, std::size_t end) {
       bool restitution = false;
-      for (std::size_t k = k_begin; k < k_end; ++k) {
-        const Manifold& m = ctx.manifolds[k];
-        std::size_t g = first_row_[k];  // the point's index over the step: its contact row
-        const Body& body_a = bodies[static_cast<std::size_t>(m.body_a)];
-        const Body& body_b = bodies[static_cast<std::size_t>(m.body_b)];
-        const SolverBody& a = solver_bodies_[static_cast<std::size_t>(m.body_a)];
-        const SolverBody& b = solver_bodies_[static_cast<std::size_t>(m.body_b)];
-        ManifoldFriction& f = manifolds_[slot_[k]];
-        f = ManifoldFriction{};
-        f.a = moving(m.body_a);
-        f.b = moving(m.body_b);
-        f.begin = point_start_[slot_[k]];
-        f.normal = m.contacts[0].normal;
-        Vec3 center_a = Vec3::Zero();
-        Vec3 center_b = Vec3::Zero();
-        double total_weight = 0.0;
-        // The rows are read only where they hold something (a restitution target needs eps > 0,
-        // write_normal_rows): in large scenes each read misses the cache.
-        const bool bouncy = pair_restitution(def.restitution, body_a.restitution, body_b.restitution) > 0.0;
-        for (int i = 0; i < m.count; ++i, ++g) {
-          const Contact& c = m.contacts[static_cast<std::size_t>(i)];
-          ContactPoint& p = contacts_[f.begin + static_cast<std::size_t>(i)];
-          p = ContactPoint{};
-          p.a = f.a;
-          p.b = f.b;
-          p.row = static_cast<int>(g);
-          p.r_a = c.point - body_a.x;
-          p.r_b = c.point - body_b.x;
-          p.base_separation = -c.depth - c.normal.dot(p.r_b - p.r_a);
-          p.restitution = bouncy ? rows[g].restitution : 0.0;
-          restitution = restitution || p.restitution > 0.0;
-          p.touches_static = body_a.is_static() || body_b.is_static();
-          set_axis_row(p.normal, c.normal, p.r_a, p.r_b, a, b, guess(g));
-          const double weight = std::clamp(2.0 + c.depth * inv_tau, 1e-10, 1.0);
-          center_a += weight * p.r_a;
-          center_b += weight * p.r_b;
-          total_weight += weight;
-        }
-        f.end = f.begin + static_cast<std::size_t>(m.count);
-        if (!friction) continue;
-        const std::size_t first = ctx.layout.friction_row(first_row_[k]);
-        f.center_a = center_a / total_weight;
-        f.center_b = center_b / total_weight;
-        for (std::size_t i = f.begin; i < f.end; ++i) {
-          contacts_[i].lever_arm = (contacts_[i].r_a - f.center_a).norm();
-        }
-        f.first_friction_row = static_cast<int>(first);
-        f.mu = pair_friction(def.friction, body_a.friction, body_b.friction);  // the rows' mu
-        f.fixed_limit = coupled ? -1.0 : rows[first].c_max * h;
-        tangent_basis(f.normal, f.t1, f.t2);
-        const Vec3 rt_a1 = f.center_a.cross(f.t1);
-        const Vec3 rt_a2 = f.center_a.cross(f.t2);
-        const Vec3 rt_b1 = f.center_b.cross(f.t1);
-        const Vec3 rt_b2 = f.center_b.cross(f.t2);
-        Eigen::Matrix2d K;
-        K(0, 0) = a.inv_mass + b.inv_mass + rt_a1.dot(a.inv_I * rt_a1) + rt_b1.dot(b.inv_I * rt_b1);
-        K(1, 1) = a.inv_mass + b.inv_mass + rt_a2.dot(a.inv_I * rt_a2) + rt_b2.dot(b.inv_I * rt_b2);
-        K(0, 1) = K(1, 0) = rt_a1.dot(a.inv_I * rt_a2) + rt_b1.dot(b.inv_I * rt_b2);
-        f.tangent_mass = K.determinant() != 0.0 ? Eigen::Matrix2d(K.inverse()) : Eigen::Matrix2d::Zero();
-        const double k_twist = f.normal.dot((a.inv_I + b.inv_I) * f.normal);
-        f.twist_mass = k_twist > 0.0 ? 1.0 / k_twist : 0.0;
-        // The warm start: the friction rows' initial lambdas (N, store() below) summed back into
-        // the force at the centre and its twist about the normal, as impulses over h. store()
-        // writes each point's force as an equal share of the centre's plus the twist's
-        // tangential force tau (n x d_i), so with the same points the twist is
-        // sum n . (d_i x (F_i - share)). Only then: from other points, or some of them, that
-        // moment is not the twist they carried, and warm starting it spun large_pyramid's bottom
-        // boxes about their normals at up to 11 rad/s within 1 s.
-        if (warm != nullptr) {
-          Vec3 P = Vec3::Zero();
-          for (std::size_t i = f.begin; i < f.end; ++i) {
-            const std::size_t r = first + 2 * (i - f.begin);
-            Vec3 t1;
-            Vec3 t2;
-            tangents(contacts_[i], t1, t2);
-            P += h * ((*warm)[r] * t1 + (*warm)[r + 1] * t2);
-          }
-          f.impulse = Eigen::Vector2d(P.dot(f.t1), P.dot(f.t2));
-          if (ctx.warm_start != nullptr && ctx.warm_start->same_points(k)) {
-            const Vec3 share = P / static_cast<double>(m.count);
-            double L = 0.0;
-            for (std::size_t i = f.begin; i < f.end; ++i) {
-              const std::size_t r = first + 2 * (i - f.begin);
-              Vec3 t1;
-              Vec3 t2;
-              tangents(contacts_[i], t1, t2);
-              const Vec3 F = h * ((*warm)[r] * t1 + (*warm)[r + 1] * t2);
-              L += f.normal.dot((contacts_[i].r_a - f.center_a).cross(F - share));
-            }
-            f.twist_impulse = L;
-          }
+      ManifoldFriction f;
+      std::array<ContactPoint, kMaxManifoldPoints> scratch;
+      for (std::size_t k = begin; k < end; ++k) {
+        const std::size_t j = slot_[k];
+        if (lanes_ && manifold_colour_[k] != ConstraintGraph::kOverflow) {
+          restitution = prepare_manifold(in, k, 0, f, scratch.data()) || restitution;
+          const auto [g, l] = lane_of(k);
+          put_lane(g, l, j, f, scratch.data());
+        } else {
+          restitution = prepare_manifold(in, k, point_start_[j], manifolds_[j], contacts_.data() + point_start_[j]) ||
+                        restitution;
         }
       }
       if (restitution) restitution_by_thread_[static_cast<std::size_t>(t)] = 1;
     });
+    if (lanes_) {
+      // The step's total normal impulses matter only to the restitution (apply_restitution()).
+      const bool restitution = std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) !=
+                               restitution_by_thread_.end();
+      if (restitution) {
+        detail::assign_with_headroom(lane_totals_, lane_points_.size(), soft::LaneTotal{});
+      } else {
+        lane_totals_.clear();
+      }
+      sweep_.bodies = solver_bodies_.data();
+      sweep_.stand_in = &lane_stand_in_;
+      sweep_.points = lane_points_.data();
+      sweep_.totals = restitution ? lane_totals_.data() : nullptr;
+      sweep_.friction = friction;
+      sweep_.inv_h = 1.0 / h;
+      sweep_.contact = contact_soft_;
+      sweep_.stiff = static_soft_;
+      sweep_.slop = slop_;
+      sweep_.max_push = max_push_;
+    }
+
 
     const std::size_t first_rod = ctx.layout.first_rod();
     rods_.clear();
@@ -456,13 +400,136 @@ class SoftStep final : public PushMethod {
       detail::resize_with_headroom(saved_velocities_, solver_bodies_.size());
       detail::resize_with_headroom(saved_impulses_, contacts_.size() + rods_.size());
     }
-    lanes_ = def.soft_relax == SoftRelax::continue_solve;
-    if (lanes_) pack_lanes(friction, h);
   }
 
-  // The colours' manifolds (the overflow's excepted) in groups of soft::kLanes, their points in
-  // lanes (soft_lanes.h): colour c's groups are [group_start_[c], group_start_[c + 1]).
-  void pack_lanes(bool friction, double h) {
+  // What prepare_manifold() reads: the step's world, bodies, rows and manifolds, the warm start,
+  // the substep h (s), whether the manifolds have friction rows and the coupled friction model,
+  // and 1 / the contact margin (1/m).
+  struct ManifoldInput {
+    const WorldDef& def;
+    const std::vector<Body>& bodies;
+    const std::vector<ConstraintRow>& rows;
+    const std::vector<Manifold>& manifolds;
+    const RowLayout& layout;
+    const std::vector<double>* warm;  // the rows' initial lambdas (N), or null
+    const WarmStartCache* cache;
+    double h;
+    bool friction;
+    bool coupled;
+    double inv_tau;
+  };
+
+  // A static body and the world are -1 in the sweeps (body()).
+  static int moving_index(const std::vector<Body>& bodies, int body) {
+    return body == kWorldBody || bodies[static_cast<std::size_t>(body)].is_static() ? -1 : body;
+  }
+
+  // Manifold k of ctx prepared into f and its points [points, points + count): anchors, normal
+  // rows with their warm-start impulses, the friction at the centre; f's points are numbered
+  // from `first` (its slot's point_start_, 0 for a lane's). True when a point has a restitution
+  // target.
+  bool prepare_manifold(const ManifoldInput& in, std::size_t k, std::size_t first, ManifoldFriction& f,
+                        ContactPoint* points) const {
+    const Manifold& m = in.manifolds[k];
+    const double h = in.h;
+    const auto guess = [&](std::size_t r) { return in.warm != nullptr ? (*in.warm)[r] * h : 0.0; };
+    std::size_t g = first_row_[k];  // the point's index over the step: its contact row
+    const Body& body_a = in.bodies[static_cast<std::size_t>(m.body_a)];
+    const Body& body_b = in.bodies[static_cast<std::size_t>(m.body_b)];
+    const SolverBody& a = solver_bodies_[static_cast<std::size_t>(m.body_a)];
+    const SolverBody& b = solver_bodies_[static_cast<std::size_t>(m.body_b)];
+    f = ManifoldFriction{};
+    f.a = moving_index(in.bodies, m.body_a);
+    f.b = moving_index(in.bodies, m.body_b);
+    f.begin = first;
+    f.normal = m.contacts[0].normal;
+    Vec3 center_a = Vec3::Zero();
+    Vec3 center_b = Vec3::Zero();
+    double total_weight = 0.0;
+    // The rows are read only where they hold something (a restitution target needs eps > 0,
+    // write_normal_rows): in large scenes each read misses the cache.
+    const bool bouncy = pair_restitution(in.def.restitution, body_a.restitution, body_b.restitution) > 0.0;
+    bool restitution = false;
+    const auto count = static_cast<std::size_t>(m.count);
+    for (std::size_t i = 0; i < count; ++i, ++g) {
+      const Contact& c = m.contacts[i];
+      ContactPoint& p = points[i];
+      p = ContactPoint{};
+      p.a = f.a;
+      p.b = f.b;
+      p.row = static_cast<int>(g);
+      p.r_a = c.point - body_a.x;
+      p.r_b = c.point - body_b.x;
+      p.base_separation = -c.depth - c.normal.dot(p.r_b - p.r_a);
+      p.restitution = bouncy ? in.rows[g].restitution : 0.0;
+      restitution = restitution || p.restitution > 0.0;
+      p.touches_static = body_a.is_static() || body_b.is_static();
+      set_axis_row(p.normal, c.normal, p.r_a, p.r_b, a, b, guess(g));
+      const double weight = std::clamp(2.0 + c.depth * in.inv_tau, 1e-10, 1.0);
+      center_a += weight * p.r_a;
+      center_b += weight * p.r_b;
+      total_weight += weight;
+    }
+    f.end = f.begin + count;
+    if (!in.friction) return restitution;
+    const std::size_t first_friction = in.layout.friction_row(first_row_[k]);
+    f.center_a = center_a / total_weight;
+    f.center_b = center_b / total_weight;
+    for (std::size_t i = 0; i < count; ++i) points[i].lever_arm = (points[i].r_a - f.center_a).norm();
+    f.first_friction_row = static_cast<int>(first_friction);
+    f.mu = pair_friction(in.def.friction, body_a.friction, body_b.friction);  // the rows' mu
+    f.fixed_limit = in.coupled ? -1.0 : in.rows[first_friction].c_max * h;
+    tangent_basis(f.normal, f.t1, f.t2);
+    const Vec3 rt_a1 = f.center_a.cross(f.t1);
+    const Vec3 rt_a2 = f.center_a.cross(f.t2);
+    const Vec3 rt_b1 = f.center_b.cross(f.t1);
+    const Vec3 rt_b2 = f.center_b.cross(f.t2);
+    Eigen::Matrix2d K;
+    K(0, 0) = a.inv_mass + b.inv_mass + rt_a1.dot(a.inv_I * rt_a1) + rt_b1.dot(b.inv_I * rt_b1);
+    K(1, 1) = a.inv_mass + b.inv_mass + rt_a2.dot(a.inv_I * rt_a2) + rt_b2.dot(b.inv_I * rt_b2);
+    K(0, 1) = K(1, 0) = rt_a1.dot(a.inv_I * rt_a2) + rt_b1.dot(b.inv_I * rt_b2);
+    f.tangent_mass = K.determinant() != 0.0 ? Eigen::Matrix2d(K.inverse()) : Eigen::Matrix2d::Zero();
+    const double k_twist = f.normal.dot((a.inv_I + b.inv_I) * f.normal);
+    f.twist_mass = k_twist > 0.0 ? 1.0 / k_twist : 0.0;
+    // The warm start: the friction rows' initial lambdas (N, store() below) summed back into
+    // the force at the centre and its twist about the normal, as impulses over h. store()
+    // writes each point's force as an equal share of the centre's plus the twist's
+    // tangential force tau (n x d_i), so with the same points the twist is
+    // sum n . (d_i x (F_i - share)). Only then: from other points, or some of them, that
+    // moment is not the twist they carried, and warm starting it spun large_pyramid's bottom
+    // boxes about their normals at up to 11 rad/s within 1 s.
+    if (in.warm == nullptr) return restitution;
+    const std::vector<double>& warm = *in.warm;
+    Vec3 P = Vec3::Zero();
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t r = first_friction + 2 * i;
+      Vec3 t1;
+      Vec3 t2;
+      tangents(points[i], t1, t2);
+      P += h * (warm[r] * t1 + warm[r + 1] * t2);
+    }
+    f.impulse = Eigen::Vector2d(P.dot(f.t1), P.dot(f.t2));
+    if (in.cache != nullptr && in.cache->same_points(k)) {
+      const Vec3 share = P / static_cast<double>(m.count);
+      double L = 0.0;
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t r = first_friction + 2 * i;
+        Vec3 t1;
+        Vec3 t2;
+        tangents(points[i], t1, t2);
+        const Vec3 F = h * (warm[r] * t1 + warm[r + 1] * t2);
+        L += f.normal.dot((points[i].r_a - f.center_a).cross(F - share));
+      }
+      f.twist_impulse = L;
+    }
+    return restitution;
+  }
+
+  // The colours' manifolds (the overflow's excepted) in groups of soft::kLanes (soft_lanes.h):
+  // colour c's groups are [group_start_[c], group_start_[c + 1]), group g's lanes the slots
+  // groups_[g].slot, its points from groups_[g].first_point in lane_points_. A lane without a
+  // manifold (in a colour's last group) is zero; put_lane() writes the others.
+  void layout_lanes() {
     constexpr auto kLanes = static_cast<std::size_t>(soft::kLanes);
     std::size_t groups = 0;
     for (int c = 0; c <= ConstraintGraph::kOverflow; ++c) {
@@ -478,127 +545,135 @@ class SoftStep final : public PushMethod {
       const auto i = static_cast<std::size_t>(c);
       const std::size_t end = manifold_start_[i + 1];
       for (std::size_t g = group_start_[i], k = manifold_start_[i]; g < group_start_[i + 1]; ++g, k += kLanes) {
-        groups_[g].first_point = points;
+        LaneGroup& group = groups_[g];
         std::size_t most = 0;
-        for (std::size_t m = k; m < std::min(k + kLanes, end); ++m) {
-          most = std::max(most, manifolds_[m].end - manifolds_[m].begin);
+        for (std::size_t l = 0; l < kLanes && k + l < end; ++l) {
+          most = std::max(most, point_start_[k + l + 1] - point_start_[k + l]);
         }
-        groups_[g].points = static_cast<int>(most);
-        groups_[g].slot[0] = static_cast<int>(k);  // the group's first manifold, for the fill
+        if (k + kLanes > end) group = LaneGroup{};  // lanes without a manifold
+        group.first_point = points;
+        group.points = static_cast<int>(most);
         points += most;
       }
     }
     detail::resize_with_headroom(lane_points_, points);
-    // The step's total normal impulses matter only to the restitution (apply_restitution()).
-    const bool restitution = std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) !=
-                             restitution_by_thread_.end();
-    lane_totals_.clear();
-    if (restitution) detail::resize_with_headroom(lane_totals_, points);
-    parallel_for(workers_, groups, kMinParallel / kLanes, [&](int, std::size_t begin, std::size_t end) {
-      for (std::size_t g = begin; g < end; ++g) fill_group(g, friction);
-    });
-    sweep_.bodies = solver_bodies_.data();
-    sweep_.stand_in = &lane_stand_in_;
-    sweep_.points = lane_points_.data();
-    sweep_.totals = restitution ? lane_totals_.data() : nullptr;
-    sweep_.friction = friction;
-    sweep_.inv_h = 1.0 / h;
-    sweep_.contact = contact_soft_;
-    sweep_.stiff = static_soft_;
-    sweep_.slop = slop_;
-    sweep_.max_push = max_push_;
+    for (int c = 0; c < ConstraintGraph::kOverflow; ++c) {  // the colours' last groups' empty lanes
+      const auto i = static_cast<std::size_t>(c);
+      const std::size_t used = (manifold_start_[i + 1] - manifold_start_[i]) % kLanes;
+      if (used == 0) continue;
+      const LaneGroup& group = groups_[group_start_[i + 1] - 1];
+      for (int k = 0; k < group.points; ++k) {
+        LanePoint& q = lane_points_[group.first_point + static_cast<std::size_t>(k)];
+        for (auto l = static_cast<int>(used); l < soft::kLanes; ++l) zero_lane(q, l);
+      }
+    }
   }
 
-  // Group g's lanes from its manifolds (the first at groups_[g].slot[0], the rest after it in the
-  // same colour), zero where the colour has no more.
-  void fill_group(std::size_t g, bool friction) {
-    LaneGroup& group = groups_[g];
-    const auto first = static_cast<std::size_t>(group.slot[0]);
-    std::size_t colour_end = 0;
-    for (std::size_t c = 0; c < static_cast<std::size_t>(ConstraintGraph::kOverflow); ++c) {
-      if (g < group_start_[c + 1]) {
-        colour_end = manifold_start_[c + 1];
-        break;
-      }
-    }
-    const std::size_t first_point = group.first_point;
-    const int points = group.points;
-    group = LaneGroup{};
-    group.first_point = first_point;
-    group.points = points;
-    LanePoint* q = lane_points_.data() + first_point;
-    for (int k = 0; k < points; ++k) q[k] = LanePoint{};
-    const bool restitution = !lane_totals_.empty();
-    soft::LaneTotal* totals = restitution ? lane_totals_.data() + first_point : nullptr;
-    for (int k = 0; restitution && k < points; ++k) totals[k] = soft::LaneTotal{};
-    for (int l = 0; l < soft::kLanes; ++l) {
-      const std::size_t m = first + static_cast<std::size_t>(l);
-      if (m >= colour_end) break;
-      const ManifoldFriction& f = manifolds_[m];
-      group.a[l] = f.a;
-      group.b[l] = f.b;
-      group.slot[l] = static_cast<int>(m);
-      group.count[l] = static_cast<double>(f.end - f.begin);
-      for (std::size_t i = f.begin; i < f.end; ++i) {
-        const ContactPoint& p = contacts_[i];
-        LanePoint& lp = q[i - f.begin];
-        put(lp.axis, l, p.normal.axis);
-        put(lp.r_a, l, p.r_a);
-        put(lp.r_b, l, p.r_b);
-        lp.mass[l] = p.normal.mass;
-        lp.impulse[l] = p.normal.impulse;
-        lp.base_separation[l] = p.base_separation;
-        lp.lever_arm[l] = p.lever_arm;
-        if (restitution) totals[i - f.begin].impulse[l] = p.total_impulse;
-      }
-      group.touches_static[l] = f.begin < f.end && contacts_[f.begin].touches_static ? 1.0 : 0.0;
-      if (!friction) continue;
-      put(group.normal, l, f.normal);
-      put(group.t1, l, f.t1);
-      put(group.t2, l, f.t2);
-      put(group.center_a, l, f.center_a);
-      put(group.center_b, l, f.center_b);
-      group.k00[l] = f.tangent_mass(0, 0);
-      group.k01[l] = f.tangent_mass(0, 1);
-      group.k10[l] = f.tangent_mass(1, 0);
-      group.k11[l] = f.tangent_mass(1, 1);
-      group.impulse1[l] = f.impulse.x();
-      group.impulse2[l] = f.impulse.y();
-      group.twist_mass[l] = f.twist_mass;
-      group.twist_impulse[l] = f.twist_impulse;
-      group.mu[l] = f.mu;
-      group.fixed_limit[l] = f.fixed_limit;
-    }
+  // The group and lane of manifold k of ctx, in a colour other than the overflow.
+  std::pair<std::size_t, int> lane_of(std::size_t k) const {
+    const auto c = static_cast<std::size_t>(manifold_colour_[k]);
+    const std::size_t offset = slot_[k] - manifold_start_[c];
+    return {group_start_[c] + offset / soft::kLanes, static_cast<int>(offset % soft::kLanes)};
   }
+
+  // Element l of a lane vector, written through a double (so that threads writing other lanes
+  // of the same vector write other objects).
+  static double& at(soft::Lanes& lanes, int l) { return reinterpret_cast<double*>(&lanes)[l]; }
 
   static void put(soft::LaneVec3& lanes, int l, const Vec3& v) {
-    lanes.x[l] = v.x();
-    lanes.y[l] = v.y();
-    lanes.z[l] = v.z();
+    at(lanes.x, l) = v.x();
+    at(lanes.y, l) = v.y();
+    at(lanes.z, l) = v.z();
   }
 
-  // The lanes' impulses back into the manifolds and points, for the restitution and the store.
-  void unpack_lanes() {
-    if (!lanes_) return;
-    parallel_for(workers_, group_start_[ConstraintGraph::kOverflow + 1], kMinParallel / soft::kLanes,
-                 [&](int, std::size_t begin, std::size_t end) {
-                   for (std::size_t g = begin; g < end; ++g) {
-                     const LaneGroup& group = groups_[g];
-                     const LanePoint* q = lane_points_.data() + group.first_point;
-                     const soft::LaneTotal* totals =
-                         lane_totals_.empty() ? nullptr : lane_totals_.data() + group.first_point;
-                     for (int l = 0; l < soft::kLanes; ++l) {
-                       if (group.slot[l] < 0) break;
-                       ManifoldFriction& f = manifolds_[static_cast<std::size_t>(group.slot[l])];
-                       f.impulse = Eigen::Vector2d(group.impulse1[l], group.impulse2[l]);
-                       f.twist_impulse = group.twist_impulse[l];
-                       for (std::size_t i = f.begin; i < f.end; ++i) {
-                         contacts_[i].normal.impulse = q[i - f.begin].impulse[l];
-                         if (totals != nullptr) contacts_[i].total_impulse = totals[i - f.begin].impulse[l];
-                       }
-                     }
-                   }
-                 });
+  static void zero_lane(LanePoint& q, int l) {
+    put(q.r_a, l, Vec3::Zero());
+    put(q.r_b, l, Vec3::Zero());
+    put(q.axis, l, Vec3::Zero());
+    at(q.base_separation, l) = 0.0;
+    at(q.mass, l) = 0.0;
+    at(q.impulse, l) = 0.0;
+    at(q.lever_arm, l) = 0.0;
+  }
+
+  // Manifold f of slot j and its points (prepare_manifold()) into lane l of group g, its lane of
+  // the group's points past its own zero.
+  void put_lane(std::size_t g, int l, std::size_t j, const ManifoldFriction& f, const ContactPoint* points) {
+    LaneGroup& group = groups_[g];
+    const std::size_t count = f.end - f.begin;
+    group.a[l] = f.a;
+    group.b[l] = f.b;
+    group.slot[l] = static_cast<int>(j);
+    LanePoint* q = lane_points_.data() + group.first_point;
+    for (std::size_t i = 0; i < count; ++i) {
+      const ContactPoint& p = points[i];
+      LanePoint& lp = q[i];
+      put(lp.axis, l, p.normal.axis);
+      put(lp.r_a, l, p.r_a);
+      put(lp.r_b, l, p.r_b);
+      at(lp.mass, l) = p.normal.mass;
+      at(lp.impulse, l) = p.normal.impulse;
+      at(lp.base_separation, l) = p.base_separation;
+      at(lp.lever_arm, l) = p.lever_arm;
+    }
+    for (auto i = static_cast<int>(count); i < group.points; ++i) zero_lane(q[i], l);
+    at(group.count, l) = static_cast<double>(count);
+    at(group.touches_static, l) = count > 0 && points[0].touches_static ? 1.0 : 0.0;
+    put(group.normal, l, f.normal);
+    put(group.t1, l, f.t1);
+    put(group.t2, l, f.t2);
+    put(group.center_a, l, f.center_a);
+    put(group.center_b, l, f.center_b);
+    at(group.k00, l) = f.tangent_mass(0, 0);
+    at(group.k01, l) = f.tangent_mass(0, 1);
+    at(group.k10, l) = f.tangent_mass(1, 0);
+    at(group.k11, l) = f.tangent_mass(1, 1);
+    at(group.impulse1, l) = f.impulse.x();
+    at(group.impulse2, l) = f.impulse.y();
+    at(group.twist_mass, l) = f.twist_mass;
+    at(group.twist_impulse, l) = f.twist_impulse;
+    at(group.mu, l) = f.mu;
+    at(group.fixed_limit, l) = f.fixed_limit;
+  }
+
+  // Lane l of group g as the scalar manifold and points the restitution and store() read: f
+  // (its bodies, friction at the centre and impulses; its points numbered from 0) and points
+  // [points, points + count) with their rows, anchors, normals, impulses and the step's totals
+  // when kept (their I^-1 (r x n) and masses are not kept in lanes: set_axis_row forms them).
+  // `rows`, when given, supplies the points' restitution targets (prepare_manifold() read them
+  // only where the pair has restitution; elsewhere the rows' are 0, write_normal_rows).
+  void lane_manifold(const RowLayout& layout, const std::vector<ConstraintRow>* rows, std::size_t g, int l,
+                     ManifoldFriction& f, ContactPoint* points) const {
+    const LaneGroup& group = groups_[g];
+    const LanePoint* q = lane_points_.data() + group.first_point;
+    const soft::LaneTotal* totals = lane_totals_.empty() ? nullptr : lane_totals_.data() + group.first_point;
+    const std::size_t k = manifold_order_[static_cast<std::size_t>(group.slot[l])];
+    f = ManifoldFriction{};
+    f.a = group.a[l];
+    f.b = group.b[l];
+    f.end = static_cast<std::size_t>(group.count[l]);
+    for (std::size_t i = 0; i < f.end; ++i) {
+      ContactPoint& p = points[i];
+      p = ContactPoint{};
+      p.a = f.a;
+      p.b = f.b;
+      p.row = static_cast<int>(first_row_[k] + i);
+      p.r_a = Vec3(q[i].r_a.x[l], q[i].r_a.y[l], q[i].r_a.z[l]);
+      p.r_b = Vec3(q[i].r_b.x[l], q[i].r_b.y[l], q[i].r_b.z[l]);
+      p.normal.axis = Vec3(q[i].axis.x[l], q[i].axis.y[l], q[i].axis.z[l]);
+      p.normal.impulse = q[i].impulse[l];
+      p.total_impulse = totals != nullptr ? totals[i].impulse[l] : 0.0;
+      p.restitution = rows != nullptr ? (*rows)[static_cast<std::size_t>(p.row)].restitution : 0.0;
+    }
+    if (!sweep_.friction) return;
+    f.first_friction_row = static_cast<int>(layout.friction_row(first_row_[k]));
+    f.normal = Vec3(group.normal.x[l], group.normal.y[l], group.normal.z[l]);
+    f.t1 = Vec3(group.t1.x[l], group.t1.y[l], group.t1.z[l]);
+    f.t2 = Vec3(group.t2.x[l], group.t2.y[l], group.t2.z[l]);
+    f.center_a = Vec3(group.center_a.x[l], group.center_a.y[l], group.center_a.z[l]);
+    f.center_b = Vec3(group.center_b.x[l], group.center_b.y[l], group.center_b.z[l]);
+    f.impulse = Eigen::Vector2d(group.impulse1[l], group.impulse2[l]);
+    f.twist_impulse = group.twist_impulse[l];
   }
 
   // Colours the rods, then the manifolds, in order (constraint_graph.h; `moving` maps a body
@@ -905,11 +980,12 @@ class SoftStep final : public PushMethod {
     }
   }
 
-  // Stage "restitution" (Eq. 8.2.1 as b3ApplyRestitution applies it).
-  void apply_restitution() {
+  // Stage "restitution" (Eq. 8.2.1 as b3ApplyRestitution applies it), point by point in the
+  // order of the slots: the lanes' manifolds by group and lane, then the overflow's.
+  void apply_restitution(const std::vector<ConstraintRow>& rows, const RowLayout& layout) {
     if (std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) == restitution_by_thread_.end()) return;
-    for (ContactPoint& p : contacts_) {
-      if (p.restitution <= 0.0 || p.total_impulse == 0.0) continue;
+    const auto bounce = [this](ContactPoint& p) {
+      if (p.restitution <= 0.0 || p.total_impulse == 0.0) return;
       SolverBody& a = body(p.a, 0);
       SolverBody& b = body(p.b, 0);
       const double old = p.normal.impulse;
@@ -917,7 +993,26 @@ class SoftStep final : public PushMethod {
       p.normal.impulse = next;
       p.total_impulse += next - old;
       apply(p.normal, next - old, a, b);
+    };
+    const std::size_t groups = lanes_ ? group_start_[ConstraintGraph::kOverflow + 1] : 0;
+    ManifoldFriction f;
+    std::array<ContactPoint, kMaxManifoldPoints> points;
+    for (std::size_t g = 0; g < groups; ++g) {
+      LanePoint* q = lane_points_.data() + groups_[g].first_point;
+      soft::LaneTotal* totals = lane_totals_.data() + groups_[g].first_point;
+      for (int l = 0; l < soft::kLanes && groups_[g].slot[l] >= 0; ++l) {
+        lane_manifold(layout, &rows, g, l, f, points.data());
+        for (std::size_t i = 0; i < f.end; ++i) {
+          ContactPoint& p = points[i];
+          set_axis_row(p.normal, p.normal.axis, p.r_a, p.r_b, body(p.a, 0), body(p.b, 0), p.normal.impulse);
+          bounce(p);
+          q[i].impulse[l] = points[i].normal.impulse;
+          totals[i].impulse[l] = points[i].total_impulse;
+        }
+      }
     }
+    const std::size_t first = lanes_ ? point_start_[manifold_start_[ConstraintGraph::kOverflow]] : 0;
+    for (std::size_t i = first; i < contacts_.size(); ++i) bounce(contacts_[i]);
   }
 
   // A point's friction tangents t1, t2 (unit) as write_friction_rows gave them to its friction
@@ -950,40 +1045,55 @@ class SoftStep final : public PushMethod {
     // world has friction, every manifold has them) by their manifolds, the rods' by the rods.
     detail::resize_with_headroom(ctx.lambda, ctx.rows.size());
     const double inv_h = 1.0 / h;
-    // A manifold's friction as forces at its points' friction rows: the force at the centre
-    // shared equally, plus the twist as tangential forces F_i = tau (n x d_i) / sum |d_j|^2 (d_i
-    // the point's offset from the centre across the normal), which sum to no force and to the
-    // torque tau about the normal; each row's lambda the component along its tangent. (A twist
-    // on a single point has no such forces and is dropped.)
+    // In ctx's order, which writes the rows and reads the warm-start cache's tangents in order.
     parallel_for(workers_, manifolds_.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+      ManifoldFriction f;
+      std::array<ContactPoint, kMaxManifoldPoints> scratch;
       for (std::size_t k = begin; k < end; ++k) {
-        const ManifoldFriction& f = manifolds_[k];
-        for (std::size_t i = f.begin; i < f.end; ++i) {
-          ctx.lambda[static_cast<std::size_t>(contacts_[i].row)] = contacts_[i].normal.impulse * inv_h;
-        }
-        if (f.first_friction_row < 0) continue;
-        const Vec3 share = (f.impulse.x() * f.t1 + f.impulse.y() * f.t2) *
-                           (inv_h / static_cast<double>(f.end - f.begin));
-        double spread = 0.0;  // m^2
-        for (std::size_t i = f.begin; i < f.end; ++i) {
-          const Vec3 d = contacts_[i].r_a - f.center_a;
-          spread += (d - f.normal.dot(d) * f.normal).squaredNorm();
-        }
-        const double tau = spread > 0.0 ? f.twist_impulse * inv_h / spread : 0.0;  // N / m
-        for (std::size_t i = f.begin; i < f.end; ++i) {
-          const Vec3 d = contacts_[i].r_a - f.center_a;
-          const Vec3 F = share + tau * f.normal.cross(d);
-          const std::size_t r = static_cast<std::size_t>(f.first_friction_row) + 2 * (i - f.begin);
-          Vec3 t1;
-          Vec3 t2;
-          tangents(contacts_[i], t1, t2);
-          ctx.lambda[r] = F.dot(t1);
-          ctx.lambda[r + 1] = F.dot(t2);
+        if (lanes_ && manifold_colour_[k] != ConstraintGraph::kOverflow) {
+          const auto [g, l] = lane_of(k);
+          lane_manifold(ctx.layout, nullptr, g, l, f, scratch.data());
+          store_manifold(f, scratch.data(), inv_h, ctx.lambda);
+        } else {
+          const ManifoldFriction& m = manifolds_[slot_[k]];
+          store_manifold(m, contacts_.data() + m.begin, inv_h, ctx.lambda);
         }
       }
     });
     for (const Rod& rod : rods_) ctx.lambda[static_cast<std::size_t>(rod.row)] = rod.impulse * inv_h;
     ctx.lambda_second.clear();
+  }
+
+  // Manifold f's rows of `lambda` (N) from its points [points, points + count) and impulses over
+  // a substep of 1 / inv_h (s). Its friction as forces at its points' friction rows: the force at
+  // the centre shared equally, plus the twist as tangential forces F_i = tau (n x d_i) /
+  // sum |d_j|^2 (d_i the point's offset from the centre across the normal), which sum to no
+  // force and to the torque tau about the normal; each row's lambda the component along its
+  // tangent. (A twist on a single point has no such forces and is dropped.)
+  void store_manifold(const ManifoldFriction& f, const ContactPoint* points, double inv_h,
+                      std::vector<double>& lambda) const {
+    const std::size_t count = f.end - f.begin;
+    for (std::size_t i = 0; i < count; ++i) {
+      lambda[static_cast<std::size_t>(points[i].row)] = points[i].normal.impulse * inv_h;
+    }
+    if (f.first_friction_row < 0) return;
+    const Vec3 share = (f.impulse.x() * f.t1 + f.impulse.y() * f.t2) * (inv_h / static_cast<double>(count));
+    double spread = 0.0;  // m^2
+    for (std::size_t i = 0; i < count; ++i) {
+      const Vec3 d = points[i].r_a - f.center_a;
+      spread += (d - f.normal.dot(d) * f.normal).squaredNorm();
+    }
+    const double tau = spread > 0.0 ? f.twist_impulse * inv_h / spread : 0.0;  // N / m
+    for (std::size_t i = 0; i < count; ++i) {
+      const Vec3 d = points[i].r_a - f.center_a;
+      const Vec3 F = share + tau * f.normal.cross(d);
+      const std::size_t r = static_cast<std::size_t>(f.first_friction_row) + 2 * i;
+      Vec3 t1;
+      Vec3 t2;
+      tangents(points[i], t1, t2);
+      lambda[r] = F.dot(t1);
+      lambda[r + 1] = F.dot(t2);
+    }
   }
 
   Workers* workers_ = nullptr;             // the step's threads (StepContext::workers) or one_thread_

@@ -636,18 +636,17 @@ class SoftStep final : public PushMethod {
     at(group.fixed_limit, l) = f.fixed_limit;
   }
 
-  // Lane l of group g as the scalar manifold and points the restitution and store() read: f
+  // Lane l of group g, manifold k of ctx, as the scalar manifold and points the restitution and store() read: f
   // (its bodies, friction at the centre and impulses; its points numbered from 0) and points
   // [points, points + count) with their rows, anchors, normals, impulses and the step's totals
   // when kept (their I^-1 (r x n) and masses are not kept in lanes: set_axis_row forms them).
   // `rows`, when given, supplies the points' restitution targets (prepare_manifold() read them
   // only where the pair has restitution; elsewhere the rows' are 0, write_normal_rows).
-  void lane_manifold(const RowLayout& layout, const std::vector<ConstraintRow>* rows, std::size_t g, int l,
-                     ManifoldFriction& f, ContactPoint* points) const {
+  void lane_manifold(const RowLayout& layout, const std::vector<ConstraintRow>* rows, std::size_t k,
+                     std::size_t g, int l, ManifoldFriction& f, ContactPoint* points) const {
     const LaneGroup& group = groups_[g];
     const LanePoint* q = lane_points_.data() + group.first_point;
     const soft::LaneTotal* totals = lane_totals_.empty() ? nullptr : lane_totals_.data() + group.first_point;
-    const std::size_t k = manifold_order_[static_cast<std::size_t>(group.slot[l])];
     f = ManifoldFriction{};
     f.a = group.a[l];
     f.b = group.b[l];
@@ -1001,7 +1000,8 @@ class SoftStep final : public PushMethod {
       LanePoint* q = lane_points_.data() + groups_[g].first_point;
       soft::LaneTotal* totals = lane_totals_.data() + groups_[g].first_point;
       for (int l = 0; l < soft::kLanes && groups_[g].slot[l] >= 0; ++l) {
-        lane_manifold(layout, &rows, g, l, f, points.data());
+        const std::size_t k = manifold_order_[static_cast<std::size_t>(groups_[g].slot[l])];
+        lane_manifold(layout, &rows, k, g, l, f, points.data());
         for (std::size_t i = 0; i < f.end; ++i) {
           ContactPoint& p = points[i];
           set_axis_row(p.normal, p.normal.axis, p.r_a, p.r_b, body(p.a, 0), body(p.b, 0), p.normal.impulse);
@@ -1052,7 +1052,7 @@ class SoftStep final : public PushMethod {
       for (std::size_t k = begin; k < end; ++k) {
         if (lanes_ && manifold_colour_[k] != ConstraintGraph::kOverflow) {
           const auto [g, l] = lane_of(k);
-          lane_manifold(ctx.layout, nullptr, g, l, f, scratch.data());
+          lane_manifold(ctx.layout, nullptr, k, g, l, f, scratch.data());
           store_manifold(f, scratch.data(), inv_h, ctx.lambda);
         } else {
           const ManifoldFriction& m = manifolds_[slot_[k]];

@@ -91,7 +91,7 @@ struct LaneTotal {
 struct LaneGroup {
   int a[kLanes] = {-1, -1, -1, -1};  // moving body index, or -1 (static, the world, no manifold)
   int b[kLanes] = {-1, -1, -1, -1};
-  int slot[kLanes] = {-1, -1, -1, -1};  // the manifold's slot in the scalar arrays, or -1
+  int slot[kLanes] = {-1, -1, -1, -1};  // the manifold's slot (its place in colour order), or -1
   std::size_t first_point = 0;
   int points = 0;  // the most points of a lane's manifold
   LaneVec3 normal;

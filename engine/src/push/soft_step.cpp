@@ -161,7 +161,7 @@ struct ContactPoint {
 struct ManifoldFriction {
   int a = 0;
   int b = 0;
-  std::size_t begin = 0;  // its points in contacts_
+  std::size_t begin = 0;  // its points in contacts_ (from 0 in a scratch buffer for a lane's)
   std::size_t end = 0;
   int first_friction_row = -1;  // the friction rows of its first point in ctx.rows, or -1
   Vec3 normal = Vec3::UnitY();
@@ -351,8 +351,7 @@ class SoftStep final : public PushMethod {
     });
     if (lanes_) {
       // The step's total normal impulses matter only to the restitution (apply_restitution()).
-      const bool restitution = std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) !=
-                               restitution_by_thread_.end();
+      const bool restitution = any_restitution();
       if (restitution) {
         detail::assign_with_headroom(lane_totals_, lane_points_.size(), soft::LaneTotal{});
       } else {
@@ -418,6 +417,11 @@ class SoftStep final : public PushMethod {
     bool coupled;
     double inv_tau;
   };
+
+  // Whether a contact of the step has a restitution target (prepare's per-thread flags).
+  bool any_restitution() const {
+    return std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) != restitution_by_thread_.end();
+  }
 
   // A static body and the world are -1 in the sweeps (body()).
   static int moving_index(const std::vector<Body>& bodies, int body) {
@@ -982,7 +986,7 @@ class SoftStep final : public PushMethod {
   // Stage "restitution" (Eq. 8.2.1 as b3ApplyRestitution applies it), point by point in the
   // order of the slots: the lanes' manifolds by group and lane, then the overflow's.
   void apply_restitution(const std::vector<ConstraintRow>& rows, const RowLayout& layout) {
-    if (std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) == restitution_by_thread_.end()) return;
+    if (!any_restitution()) return;
     const auto bounce = [this](ContactPoint& p) {
       if (p.restitution <= 0.0 || p.total_impulse == 0.0) return;
       SolverBody& a = body(p.a, 0);

@@ -7,7 +7,9 @@
 // body or the world) takes the last free colour from kOverflow - 1 down to 1, so that such
 // constraints are swept after most others in a sweep that goes by colour index. One that finds no
 // free colour goes to the overflow, swept before the colours, in order. Static bodies belong to no
-// colour (they are never written).
+// colour (they are never written). StaticColours::first instead gives a constraint with one moving
+// body the first free colour of all but the overflow, so that such constraints are swept early,
+// about where Gauss-Seidel in the rows' order sweeps them.
 
 #include <array>
 #include <bit>
@@ -19,6 +21,10 @@
 #include "buffers.h"
 
 namespace cps {
+
+/// Where a constraint with a single moving body goes: Box3D's last free colour from kOverflow - 1
+/// down to 1 (`last`), or the first free colour below the overflow (`first`).
+enum class StaticColours { last, first };
 
 /// The colours of one step's constraints. Bodies are indices into the step's bodies, or -1 for
 /// a static body or the world.
@@ -32,8 +38,12 @@ class ConstraintGraph {
   static constexpr int kDynamicColours = kColours - 4;
   static_assert(kColours <= 32, "a body's colours are the bits of a 32-bit mask");
 
-  /// Starts a new colouring for `bodies` bodies (count). No errors; allocates only to grow.
-  void reset(std::size_t bodies) { used_.assign(bodies, 0u); }
+  /// Starts a new colouring for `bodies` bodies (count), constraints with one moving body placed
+  /// by `statics`. No errors; allocates only to grow.
+  void reset(std::size_t bodies, StaticColours statics) {
+    used_.assign(bodies, 0u);
+    statics_ = statics;
+  }
 
   /// The colour of a constraint between a and b (indices below the count given to reset, or -1
   /// for a static body or the world), in [0, kOverflow], marked used for its moving bodies. A
@@ -50,6 +60,12 @@ class ConstraintGraph {
       used_b |= 1u << colour;
       return colour;
     }
+    if (statics_ == StaticColours::first) {
+      const int colour = std::countr_one(used_a);
+      if (colour >= kOverflow) return kOverflow;
+      used_a |= 1u << colour;
+      return colour;
+    }
     // The highest free colour below the overflow, down to 1: the top set bit of the free ones.
     const std::uint32_t free = ~used_a & (((1u << kOverflow) - 1u) & ~1u);
     if (free == 0u) return kOverflow;
@@ -60,6 +76,7 @@ class ConstraintGraph {
 
  private:
   std::vector<std::uint32_t> used_;  // per body: the colours it is in (bit k: colour k)
+  StaticColours statics_ = StaticColours::last;
 };
 
 /// The first item of each colour in an order by colour: colour c's items are

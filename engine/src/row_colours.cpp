@@ -29,7 +29,7 @@ void colour_rows(const std::vector<ConstraintRow>& rows, const std::vector<Body>
     out.runs.push_back({static_cast<int>(r), static_cast<int>(end - r), a, b});
     r = end;
   }
-  out.graph.reset(bodies.size());
+  out.graph.reset(bodies.size(), StaticColours::first);
   out.colours.clear();
   detail::reserve_with_headroom(out.colours, out.runs.size());
   for (const RowColours::Run& run : out.runs) out.colours.push_back(out.graph.add(run.a, run.b));

@@ -2,8 +2,9 @@
 // The sweep order of graph-coloured Gauss-Seidel (SolverKind::coloured_pgs) over the rows of
 // A lambda = b: the rows are cut into runs of consecutive rows on the same two movable bodies
 // (a manifold's contact and friction rows, a rod's row), the runs are coloured as Box3D and
-// Box2D v3 colour their constraints (constraint_graph.h), and a sweep updates the runs colour by
-// colour, the overflow first. The runs of one colour share no movable body, so their updates
+// Box2D v3 colour their constraints (constraint_graph.h) except that a run with one movable body
+// takes its first free colour (StaticColours::first: swept early, as the rows' order sweeps a
+// pile's supports), and a sweep updates the runs colour by colour, the overflow first. The runs of one colour share no movable body, so their updates
 // commute: any split of a colour among threads gives the same lambda, bit for bit.
 
 #include "constraint_graph.h"

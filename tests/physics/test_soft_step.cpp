@@ -135,49 +135,53 @@ TEST_CASE("the constraint graph's colours share no moving body, and the overflow
           "what fits in no colour", "[soft][colour]") {
   // Random constraints among 40 bodies, one in five static (-1), many per body, so that some
   // bodies fill every colour: each constraint's colour is checked against the bodies already in
-  // it, and the overflow against every colour open to it (Box3D's rule: two moving bodies take
-  // the first free of colours 0 to 19, one moving body the last free of 22 down to 1).
+  // it, and the overflow against every colour open to it. Two moving bodies take the first free
+  // of colours 0 to 19; one moving body the last free of 22 down to 1 (Box3D's rule,
+  // StaticColours::last) or the first free of 0 to 22 (StaticColours::first).
   constexpr int kBodies = 40;
-  ConstraintGraph graph;
-  graph.reset(kBodies);
-  std::vector<std::vector<bool>> in(ConstraintGraph::kColours, std::vector<bool>(kBodies, false));
-  std::uint64_t seed = 12345;
-  const auto next = [&seed](int n) {
-    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<int>((seed >> 33) % static_cast<std::uint64_t>(n));
-  };
-  int overflow = 0;
-  for (int k = 0; k < 2000; ++k) {
-    int a = next(kBodies);
-    int b = next(kBodies);
-    if (a == b) continue;
-    if (next(5) == 0) b = -1;
-    const int colour = graph.add(a, b);
-    REQUIRE(colour >= 0);
-    REQUIRE(colour <= ConstraintGraph::kOverflow);
-    const auto free_for = [&](int c) { return !in[c][a] && (b < 0 || !in[c][b]); };
-    if (colour == ConstraintGraph::kOverflow) {
-      ++overflow;
-      if (b >= 0) {
-        for (int c = 0; c < ConstraintGraph::kDynamicColours; ++c) CHECK_FALSE(free_for(c));
-      } else {
-        for (int c = 1; c < ConstraintGraph::kOverflow; ++c) CHECK_FALSE(free_for(c));
+  for (const StaticColours statics : {StaticColours::last, StaticColours::first}) {
+    const bool last = statics == StaticColours::last;
+    CAPTURE(last);
+    ConstraintGraph graph;
+    graph.reset(kBodies, statics);
+    std::vector<std::vector<bool>> in(ConstraintGraph::kColours, std::vector<bool>(kBodies, false));
+    std::uint64_t seed = 12345;
+    const auto next = [&seed](int n) {
+      seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+      return static_cast<int>((seed >> 33) % static_cast<std::uint64_t>(n));
+    };
+    int overflow = 0;
+    for (int k = 0; k < 2000; ++k) {
+      int a = next(kBodies);
+      int b = next(kBodies);
+      if (a == b) continue;
+      if (next(5) == 0) b = -1;
+      const int colour = graph.add(a, b);
+      REQUIRE(colour >= 0);
+      REQUIRE(colour <= ConstraintGraph::kOverflow);
+      const auto free_for = [&](int c) { return !in[c][a] && (b < 0 || !in[c][b]); };
+      // The colours open to this constraint.
+      const int lowest = b < 0 && last ? 1 : 0;
+      const int end = b >= 0 ? ConstraintGraph::kDynamicColours : ConstraintGraph::kOverflow;
+      if (colour == ConstraintGraph::kOverflow) {
+        ++overflow;
+        for (int c = lowest; c < end; ++c) CHECK_FALSE(free_for(c));
+        continue;
       }
-      continue;
+      CHECK(free_for(colour));
+      CHECK(colour >= lowest);
+      CHECK(colour < end);
+      if (b < 0 && last) {
+        for (int c = colour + 1; c < end; ++c) CHECK_FALSE(free_for(c));  // the last free one
+      } else {
+        for (int c = lowest; c < colour; ++c) CHECK_FALSE(free_for(c));  // the first free one
+      }
+      in[colour][a] = true;
+      if (b >= 0) in[colour][b] = true;
     }
-    CHECK(free_for(colour));
-    if (b >= 0) {
-      CHECK(colour < ConstraintGraph::kDynamicColours);
-      for (int c = 0; c < colour; ++c) CHECK_FALSE(free_for(c));  // the first free one
-    } else {
-      CHECK(colour >= 1);
-      for (int c = colour + 1; c < ConstraintGraph::kOverflow; ++c) CHECK_FALSE(free_for(c));
-    }
-    in[colour][a] = true;
-    if (b >= 0) in[colour][b] = true;
+    CHECK(overflow > 0);  // the test reaches the overflow
+    CHECK(graph.add(-1, -1) == ConstraintGraph::kOverflow);
   }
-  CHECK(overflow > 0);  // the test reaches the overflow
-  CHECK(graph.add(-1, -1) == ConstraintGraph::kOverflow);
 }
 
 TEST_CASE("the soft step ends in the same state on 1, 2 and 3 threads", "[soft][threads]") {

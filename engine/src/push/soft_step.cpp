@@ -685,7 +685,7 @@ class SoftStep final : public PushMethod {
   template <class Moving>
   void colour(const std::vector<Manifold>& manifolds, const std::vector<DistanceConstraint>& distances,
               Moving&& moving) {
-    graph_.reset(bodies_);
+    graph_.reset(bodies_, StaticColours::last);  // Box3D's
     rod_colour_.clear();
     for (const DistanceConstraint& d : distances) rod_colour_.push_back(graph_.add(moving(d.body_a), moving(d.body_b)));
     manifold_colour_.clear();

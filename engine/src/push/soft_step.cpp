@@ -369,7 +369,6 @@ class SoftStep final : public PushMethod {
       sweep_.max_push = max_push_;
     }
 
-
     const std::size_t first_rod = ctx.layout.first_rod();
     rods_.clear();
     detail::reserve_with_headroom(rods_, distances.size());

@@ -82,7 +82,13 @@ void EnergyRiseTracker::observe(const World& world) {
     }
   }
   previous_time_s_ = world.time();
-  if (!world.rows().empty()) rise_.constrained = true;
+  // Rows were built (contacts or rods), without asking for the rows themselves.
+  const auto& manifolds = world.manifolds();
+  if (world.counters().steps > 0 &&
+      (!world.distances().empty() ||
+       std::any_of(manifolds.begin(), manifolds.end(), [](const Manifold& m) { return m.count > 0; }))) {
+    rise_.constrained = true;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     previous_x_[i] = bodies[i].x;
     if (mass_[i] > 0.0) lowest_h_[i] = std::min(lowest_h_[i], up.dot(bodies[i].x));

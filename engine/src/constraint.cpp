@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace cps {
 
@@ -51,6 +52,22 @@ double relative_velocity(const Vec12& j, const Vec3& v_a, const Vec3& w_a, const
 
 BodyVelocity body_velocity(const Body& b) { return {b.velocity(), b.angular_velocity()}; }
 
+std::optional<double> restitution_target(const Vec12& j, const Contact& c, const BodyVelocity& v_a,
+                                         const BodyVelocity& v_b, double eps, double threshold, double dt) {
+  // Eq. 8.2.1: v_r = -eps j . v1, for points approaching faster than the threshold that touch,
+  // or will close their gap within this step.
+  const double approach = relative_velocity(j, v_a.v, v_a.w, v_b.v, v_b.w);  // j . v1 (m/s)
+  if (eps > 0.0 && approach < -threshold && approach * dt <= std::min(c.depth, 0.0)) return -eps * approach;
+  return std::nullopt;
+}
+
+double friction_limit(double mu, const Body& a, const Body& b, int points, const Vec3& gravity, const Vec3& n) {
+  // Sec. 5.4: m is the combined mass of both bodies divided over the contact points (a static
+  // body has mass 0 here, so the movable body's mass remains).
+  const double mass_per_point = (a.mass + b.mass) / static_cast<double>(points);
+  return mu * mass_per_point * std::abs(gravity.dot(n));
+}
+
 void append_contact_rows(const Manifold& m, const std::vector<Body>& bodies,
                          const RowParams& params, std::vector<ConstraintRow>& rows) {
   if (m.count == 0) return;
@@ -89,8 +106,6 @@ void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
     contact.body_a = m.body_a;
     contact.body_b = m.body_b;
     write_axis_row(contact.j, c.normal, c.point - a.x, c.point - b.x);
-    // j . v1 (m/s)
-    const double approach = relative_velocity(contact.j, vel_a.v, vel_a.w, vel_b.v, vel_b.w);
     if (c.depth >= 0.0) {
       // Eq. 5.3.1 (docs/conventions.md, Sec. 3): C = -d, v = -beta C / dt = beta d / dt > 0 opens
       // it; with a penetration slop s, C = -max(d - s, 0) (s = 0: the paper's push).
@@ -101,12 +116,12 @@ void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
       // solves of Sec. 8.1.
       contact.bias = c.depth / params.dt;
     }
-    // Eq. 8.2.1: v_r = -eps j . v1, for points approaching faster than the threshold that touch,
-    // or will close their gap within this step.
-    if (eps > 0.0 && approach < -params.restitution_threshold &&
-        approach * params.dt <= std::min(c.depth, 0.0)) {
-      contact.bias = -eps * approach;
-      contact.restitution = contact.bias;
+    if (eps > 0.0) {
+      if (const std::optional<double> target =
+              restitution_target(contact.j, c, vel_a, vel_b, eps, params.restitution_threshold, params.dt)) {
+        contact.bias = *target;
+        contact.restitution = *target;
+      }
     }
     // Split impulse (push/split_impulse.cpp): a shallow contact's push stays in the velocity solve.
     if (c.depth <= params.velocity_push_depth) {
@@ -134,14 +149,11 @@ void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
   const Body& a = bodies[static_cast<std::size_t>(m.body_a)];
   const Body& b = bodies[static_cast<std::size_t>(m.body_b)];
   const double mu = pair_friction(params.friction, a.friction, b.friction);
-  // Sec. 5.4: m is the combined mass of both bodies divided over the contact points (a static
-  // body has mass 0 here, so the movable body's mass remains).
-  const double mass_per_point = (a.mass + b.mass) / static_cast<double>(m.count);
   for (int i = 0; i < m.count; ++i) {
     const Contact& c = m.contacts[static_cast<std::size_t>(i)];
     const Vec3 r_a = c.point - a.x;
     const Vec3 r_b = c.point - b.x;
-    const double limit = mu * mass_per_point * std::abs(params.gravity.dot(c.normal));
+    const double limit = friction_limit(mu, a, b, m.count, params.gravity, c.normal);
     Vec3 t[2];
     if (tangents != nullptr) {
       t[0] = tangents[i];

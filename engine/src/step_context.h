@@ -106,6 +106,21 @@ struct StepContext {
   };
   std::vector<NarrowShare> narrow_shares;  ///< per chunk; not copied with the context
   std::vector<std::size_t> first_points;   ///< per manifold: its points before it (World::build_rows)
+  /// The contact and friction rows of `rows` that World::build_rows left unwritten for a push
+  /// method that does not read them (PushMethod::reads_contact_rows), for World::rows to write
+  /// when they are asked for: the row parameters, whether the warm start chose the friction
+  /// directions, and the bodies' positions x (n, m) at the start of the step. Not copied with
+  /// the context (a world writes its rows before it is copied).
+  struct DeferredRows {
+    bool pending = false;
+    bool warm = false;
+    RowParams params;
+    std::vector<Vec3> x;
+  };
+  DeferredRows deferred_rows;
+  /// Whether some pair of the step may have restitution (WorldDef::restitution or a body's own
+  /// above 0; World::build_rows): the rows' and the soft step's restitution targets.
+  bool may_bounce = false;
   StepCounters counters;
   ResidualStats residual;
   /// World::set_solve_observer's callback, or empty (the usual case: one branch a solve). Not

@@ -53,9 +53,10 @@ World::World(const World& other)
       bodies_(other.bodies_),
       distances_(other.distances_),
       apart_(other.apart_),
-      ctx_(std::make_unique<StepContext>(*other.ctx_)),
+      ctx_(std::make_unique<StepContext>(other.context_with_rows())),
       broad_phase_(std::make_unique<BroadPhase>()),
-      body_friction_(other.body_friction_) {}
+      body_friction_(other.body_friction_),
+      body_restitution_(other.body_restitution_) {}
 
 World& World::operator=(const World& other) {
   if (this != &other) *this = World(other);
@@ -75,7 +76,19 @@ void World::set_stage_timing(bool on) {
   ctx_->time_stages = on;
 }
 const std::vector<Manifold>& World::manifolds() const { return ctx_->manifolds; }
-const std::vector<ConstraintRow>& World::rows() const { return ctx_->rows; }
+const std::vector<ConstraintRow>& World::rows() const { return context_with_rows().rows; }
+
+const StepContext& World::context_with_rows() const {
+  StepContext::DeferredRows& deferred = ctx_->deferred_rows;
+  if (deferred.pending) {
+    // The bodies as they were when the step built its rows (only their positions have moved).
+    std::vector<Body> start = bodies_;
+    for (std::size_t i = 0; i < deferred.x.size(); ++i) start[i].x = deferred.x[i];
+    write_contact_rows(start, deferred.params, deferred.warm, nullptr);
+    deferred.pending = false;
+  }
+  return *ctx_;
+}
 const std::vector<double>& World::lambda() const { return ctx_->lambda; }
 const std::vector<double>& World::lambda_second() const { return ctx_->lambda_second; }
 
@@ -87,6 +100,7 @@ void World::set_def(const WorldDef& def) {
 int World::add_body(const BodyDef& def) {
   bodies_.push_back(make_body(def));  // make_body throws before anything is added
   body_friction_ = body_friction_ || !std::isnan(def.friction);
+  body_restitution_ = body_restitution_ || (!std::isnan(def.restitution) && def.restitution > 0.0);
   return static_cast<int>(bodies_.size()) - 1;
 }
 
@@ -164,7 +178,16 @@ void World::step() {
   {
     StageTimer timer(ctx, &StageTimes::collide);
     external_forces();  // Sec. 6.1: f_ext
-    collide();          // Sec. 4: manifolds
+    try {
+      collide();  // Sec. 4: manifolds
+    } catch (...) {
+      // The manifolds are no longer those of the rows left to write: the last step's rows go.
+      if (ctx.deferred_rows.pending) {
+        ctx.deferred_rows.pending = false;
+        ctx.rows.clear();
+      }
+      throw;
+    }
   }
   {
     StageTimer timer(ctx, &StageTimes::rows);
@@ -379,6 +402,31 @@ void World::collide_pairs(Workers* workers) {
   }
   if (recycler != nullptr) recycler->end_step();
 }
+
+// The contact and friction rows of every manifold of the step (build_rows' layout), from
+// `bodies` (the step's, or a copy with their positions at its start), velocities_ (where some
+// pair may bounce; no other row reads them) and the warm start's friction directions.
+void World::write_contact_rows(const std::vector<Body>& bodies, const RowParams& params, bool warm,
+                               Workers* workers) const {
+  StepContext& ctx = *ctx_;
+  const bool friction = ctx.layout.friction;
+  ConstraintRow* rows = ctx.rows.data();
+  const BodyVelocity unread{};
+  const auto velocity = [&](int body) -> const BodyVelocity& {
+    return ctx.may_bounce ? velocities_[static_cast<std::size_t>(body)] : unread;
+  };
+  parallel_for(workers, ctx.manifolds.size(), kMinParallelRows, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const Manifold& m = ctx.manifolds[k];
+      const std::size_t first = ctx.first_points[k];
+      write_normal_rows(m, bodies, velocity(m.body_a), velocity(m.body_b), params, rows + first);
+      if (!friction) continue;
+      write_friction_rows(m, bodies, params, static_cast<int>(first), rows + ctx.layout.friction_row(first),
+                          warm ? ctx.warm_start->tangents(first) : nullptr);
+    }
+  });
+}
+
 // Stage 2, Sec. 5: contact rows, friction rows, then distance rows.
 void World::build_rows() {
   StepContext& ctx = *ctx_;
@@ -400,19 +448,23 @@ void World::build_rows() {
   ctx.layout = RowLayout{.points = points, .friction = friction, .rods = distances_.size()};
   detail::reserve_with_headroom(rows, ctx.layout.size());
   // Each body's v and w (w needs I^-1 = R I_body^-1 R^T) once, for the bodies in a manifold
-  // (velocity_known_ marks them); a body typically sits in several.
-  velocity_known_.assign(bodies_.size(), 0);  // n bytes: no allocation once grown
-  velocities_.resize(bodies_.size());
-  for (const Manifold& m : ctx.manifolds) {
-    velocity_known_[static_cast<std::size_t>(m.body_a)] = 1;
-    velocity_known_[static_cast<std::size_t>(m.body_b)] = 1;
-  }
+  // (velocity_known_ marks them); a body typically sits in several. Only the restitution reads
+  // them (write_normal_rows).
   Workers* workers = ctx.workers();
-  parallel_for(workers, bodies_.size(), kMinParallelRows, [this](int, std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
-      if (velocity_known_[k]) velocities_[k] = body_velocity(bodies_[k]);
+  ctx.may_bounce = def_.restitution > 0.0 || body_restitution_;
+  if (ctx.may_bounce) {
+    velocity_known_.assign(bodies_.size(), 0);  // n bytes: no allocation once grown
+    velocities_.resize(bodies_.size());
+    for (const Manifold& m : ctx.manifolds) {
+      velocity_known_[static_cast<std::size_t>(m.body_a)] = 1;
+      velocity_known_[static_cast<std::size_t>(m.body_b)] = 1;
     }
-  });
+    parallel_for(workers, bodies_.size(), kMinParallelRows, [this](int, std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        if (velocity_known_[k]) velocities_[k] = body_velocity(bodies_[k]);
+      }
+    });
+  }
   // Warm starting: which contacts persist from the last step, and the friction directions that
   // carry their lambdas over (warm_start.h). Without it the cache is dropped.
   const bool warm = def_.warm_start > 0.0;
@@ -439,17 +491,17 @@ void World::build_rows() {
     p += static_cast<std::size_t>(ctx.manifolds[k].count);
   }
   rows.resize(ctx.layout.first_rod());  // rows left from the last step are written whole
-  parallel_for(workers, ctx.manifolds.size(), kMinParallelRows, [&](int, std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
-      const Manifold& m = ctx.manifolds[k];
-      const std::size_t first = first_point[k];
-      write_normal_rows(m, bodies_, velocities_[static_cast<std::size_t>(m.body_a)],
-                        velocities_[static_cast<std::size_t>(m.body_b)], params, rows.data() + first);
-      if (!friction) continue;
-      write_friction_rows(m, bodies_, params, static_cast<int>(first), rows.data() + ctx.layout.friction_row(first),
-                          warm ? ctx.warm_start->tangents(first) : nullptr);
-    }
-  });
+  // A method that does not read them (the soft step) leaves them to World::rows.
+  StepContext::DeferredRows& deferred = ctx.deferred_rows;
+  deferred.pending = !push_->reads_contact_rows(def_);
+  if (deferred.pending) {
+    deferred.warm = warm;
+    deferred.params = params;
+    detail::resize_with_headroom(deferred.x, bodies_.size());
+    for (std::size_t i = 0; i < bodies_.size(); ++i) deferred.x[i] = bodies_[i].x;
+  } else {
+    write_contact_rows(bodies_, params, warm, workers);
+  }
   for (const DistanceConstraint& d : distances_) append_distance_row(d, bodies_, params, rows);
   ctx.counters.rows += static_cast<std::int64_t>(rows.size());
   if (warm) {

@@ -6,6 +6,7 @@
 
 #include "cps/collision.h"
 
+#include <optional>
 #include <vector>
 
 namespace cps {
@@ -121,6 +122,20 @@ void append_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
 void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
                        const BodyVelocity& v_a, const BodyVelocity& v_b,
                        const RowParams& params, ConstraintRow* out);
+
+/// The restitution target v_r = -eps j . v1 (m/s, Eq. 8.2.1) of contact c with row j (its
+/// contact row's j: axis_row of c's normal and its offsets from the two centres of mass), when
+/// its points approach faster than `threshold` (j . v1 < -threshold, m/s) and touch or close
+/// their gap within the step (j . v1 dt <= min(d, 0), dt in s); none otherwise. eps: the pair's
+/// coefficient (pair_restitution, dimensionless, [0, 1]); v_a, v_b: the two bodies' velocities.
+/// No errors.
+std::optional<double> restitution_target(const Vec12& j, const Contact& c, const BodyVelocity& v_a,
+                                         const BodyVelocity& v_b, double eps, double threshold, double dt);
+
+/// The friction rows' limit mu m |g . n| (N, Sec. 5.4) on a manifold of `points` (>= 1) points
+/// between bodies a and b with normal n: m (kg) the two bodies' mass shared equally over the
+/// points (a static body counts 0), mu the pair's (dimensionless), gravity in m/s^2. No errors.
+double friction_limit(double mu, const Body& a, const Body& b, int points, const Vec3& gravity, const Vec3& n);
 
 /// Appends two friction rows per point of m (Sec. 5.4), in point order, along t1 and t2 of
 /// tangent_basis(n): target 0, limits +-mu m |g . n| (N), mu the pair's (pair_friction of

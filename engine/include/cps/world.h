@@ -147,7 +147,10 @@ class World {
   const StageTimes& stage_times() const;
   /// Manifolds found by the last step's collision stage (normals from a to b, depths in m).
   const std::vector<Manifold>& manifolds() const;
-  /// Rows built by the last step (c of them) and lambda of its first solve (c, N).
+  /// Rows built by the last step (c of them) and lambda of its first solve (c, N). Under a push
+  /// method that does not read its contact and friction rows (the soft step), those are written
+  /// at the first call after the step, from the bodies as they were at its start: the same rows.
+  /// Not to be called from two threads at once.
   const std::vector<ConstraintRow>& rows() const;
   const std::vector<double>& lambda() const;
   /// lambda of the last step's second solve (c, N; Sec. 8.1, push split only; empty otherwise).
@@ -185,6 +188,10 @@ class World {
   void collide();
   void collide_pairs(Workers* workers);  // collide()'s broad and narrow phase
   void build_rows();
+  void write_contact_rows(const std::vector<Body>& bodies, const RowParams& params, bool warm,
+                          Workers* workers) const;
+  // The context with the last step's rows all written (StepContext::DeferredRows).
+  const StepContext& context_with_rows() const;
 
   WorldDef def_;
   std::vector<Body> bodies_;
@@ -208,6 +215,8 @@ class World {
   std::vector<unsigned char> velocity_known_;
   // Whether some body has its own friction coefficient (Body::friction, RowParams::body_friction).
   bool body_friction_ = false;
+  // Whether some body has its own coefficient of restitution above 0 (Body::restitution).
+  bool body_restitution_ = false;
 };
 
 }  // namespace cps

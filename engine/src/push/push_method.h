@@ -49,6 +49,15 @@ class PushMethod {
     return WarmStartRule::sustained;
   }
 
+  /// Whether step() reads the contact and friction rows of ctx (Sec. 5.3, 5.4) under `def`; the
+  /// paper's methods do. When false, World::build_rows leaves them to be written when the world's
+  /// rows are asked for (World::rows), and step() must read no more of them than their count
+  /// (the rods' rows are written all the same). No errors.
+  virtual bool reads_contact_rows(const WorldDef& def) const {
+    (void)def;
+    return true;
+  }
+
   /// The solve and integrate stages: solves with ctx's rows and prepared solver, leaves the
   /// step's lambda (and lambda_second, or clears it) in ctx, stores the warm start, and moves the
   /// bodies over ctx.def->dt. No errors.

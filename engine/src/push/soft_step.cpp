@@ -50,8 +50,8 @@
 //        model, as Box3D) or the sum of its points' fixed limits mu m |g.n| / points (Sec. 5.4),
 //        the twist to the same times the points' lever arms.
 //   after the last substep:
-//     6. restitution: each contact row with a restitution target v_r (Eq. 8.2.1,
-//        ConstraintRow::restitution) that took an impulse in the step gets
+//     6. restitution: each contact point with a restitution target v_r (Eq. 8.2.1, its
+//        contact row's, restitution_target) that took an impulse in the step gets
 //        dP = -m (J v - v_r), the accumulated impulse clamped at 0 (b3ApplyRestitution);
 //     7. store impulses: lambda = P / h per row (N) for the warm-start cache and ctx.lambda (a
 //        manifold's friction as forces at its points' friction rows, store()); the bodies'
@@ -231,6 +231,9 @@ class SoftStep final : public PushMethod {
     return def.soft_relax == SoftRelax::restart ? WarmStartRule::sustained : WarmStartRule::last;
   }
 
+  // Prepared from the manifolds; only the sustained rule of the warm start reads the rows' limits.
+  bool reads_contact_rows(const WorldDef& def) const override { return def.soft_relax == SoftRelax::restart; }
+
   void step(StepContext& ctx) override {
     const WorldDef& def = *ctx.def;
     const double h = def.dt / static_cast<double>(def.soft_substeps);
@@ -243,16 +246,17 @@ class SoftStep final : public PushMethod {
     workers_->run(substeps);
     {
       StageTimer timer(ctx, &StageTimes::store);
-      apply_restitution(ctx.rows, ctx.layout);
+      apply_restitution(ctx.layout);
       store(ctx, h);
     }
     ctx.store_warm_start();
   }
 
  private:
-  // Stage "prepare": solver bodies, contact points and rods from ctx's bodies, manifolds and rows
-  // (contact rows in the manifolds' point order, then two friction rows per point when the world
-  // has friction, then one row per rod: World::build_rows), with the warm-start impulses.
+  // Stage "prepare": solver bodies, contact points and rods from ctx's bodies, manifolds and the
+  // rods' rows, with the warm-start impulses by row (contact rows in the manifolds' point order,
+  // then two friction rows per point when the world has friction, then one row per rod:
+  // World::build_rows, which leaves the contact and friction rows unwritten: reads_contact_rows).
   void prepare(StepContext& ctx, double h) {
     const WorldDef& def = *ctx.def;
     const std::vector<Body>& bodies = *ctx.bodies;
@@ -324,8 +328,24 @@ class SoftStep final : public PushMethod {
     for (std::size_t j = 0; j < count; ++j) point_start_[j + 1] += point_start_[j];
     detail::resize_with_headroom(contacts_, points);
     detail::resize_with_headroom(manifolds_, count);
-    const ManifoldInput in{def, bodies, rows, ctx.manifolds, ctx.layout, warm,
-                           ctx.warm_start.get(), h, friction, coupled, inv_tau};
+    // The points' restitution targets (m/s, by row), kept where some pair may bounce.
+    const bool may_bounce = ctx.may_bounce;
+    if (may_bounce) {
+      detail::resize_with_headroom(restitution_targets_, points);
+    } else {
+      restitution_targets_.clear();
+    }
+    const ManifoldInput in{def,
+                           bodies,
+                           ctx.manifolds,
+                           ctx.layout,
+                           warm,
+                           ctx.warm_start.get(),
+                           may_bounce ? restitution_targets_.data() : nullptr,
+                           h,
+                           friction,
+                           coupled,
+                           inv_tau};
     lanes_ = def.soft_relax == SoftRelax::continue_solve;
     if (lanes_) layout_lanes();
     // With lanes, a colour's manifold goes straight into its group's lane (lane_of()) and only
@@ -400,17 +420,17 @@ class SoftStep final : public PushMethod {
     }
   }
 
-  // What prepare_manifold() reads: the step's world, bodies, rows and manifolds, the warm start,
-  // the substep h (s), whether the manifolds have friction rows and the coupled friction model,
-  // and 1 / the contact margin (1/m).
+  // What prepare_manifold() reads: the step's world, bodies and manifolds, the warm start, where
+  // the points' restitution targets go, the substep h (s), whether the manifolds have friction
+  // rows and the coupled friction model, and 1 / the contact margin (1/m).
   struct ManifoldInput {
     const WorldDef& def;
     const std::vector<Body>& bodies;
-    const std::vector<ConstraintRow>& rows;
     const std::vector<Manifold>& manifolds;
     const RowLayout& layout;
     const std::vector<double>* warm;  // the rows' initial lambdas (N), or null
     const WarmStartCache* cache;
+    double* restitution_targets;  // m/s by contact row, or null where no pair may bounce
     double h;
     bool friction;
     bool coupled;
@@ -449,9 +469,11 @@ class SoftStep final : public PushMethod {
     Vec3 center_a = Vec3::Zero();
     Vec3 center_b = Vec3::Zero();
     double total_weight = 0.0;
-    // The rows are read only where they hold something (a restitution target needs eps > 0,
-    // write_normal_rows): in large scenes each read misses the cache.
-    const bool bouncy = pair_restitution(in.def.restitution, body_a.restitution, body_b.restitution) > 0.0;
+    // The restitution targets as write_normal_rows gives them to the contact rows (Eq. 8.2.1).
+    const double eps = pair_restitution(in.def.restitution, body_a.restitution, body_b.restitution);
+    const bool bouncy = eps > 0.0;
+    const BodyVelocity vel_a = bouncy ? body_velocity(body_a) : BodyVelocity{};
+    const BodyVelocity vel_b = bouncy ? body_velocity(body_b) : BodyVelocity{};
     bool restitution = false;
     const auto count = static_cast<std::size_t>(m.count);
     for (std::size_t i = 0; i < count; ++i, ++g) {
@@ -464,7 +486,12 @@ class SoftStep final : public PushMethod {
       p.r_a = c.point - body_a.x;
       p.r_b = c.point - body_b.x;
       p.base_separation = -c.depth - c.normal.dot(p.r_b - p.r_a);
-      p.restitution = bouncy ? in.rows[g].restitution : 0.0;
+      if (bouncy) {
+        p.restitution = restitution_target(axis_row(c.normal, p.r_a, p.r_b), c, vel_a, vel_b, eps,
+                                           in.def.restitution_threshold, in.def.dt)
+                            .value_or(0.0);
+      }
+      if (in.restitution_targets != nullptr) in.restitution_targets[g] = p.restitution;
       restitution = restitution || p.restitution > 0.0;
       p.touches_static = body_a.is_static() || body_b.is_static();
       set_axis_row(p.normal, c.normal, p.r_a, p.r_b, a, b, guess(g));
@@ -481,7 +508,8 @@ class SoftStep final : public PushMethod {
     for (std::size_t i = 0; i < count; ++i) points[i].lever_arm = (points[i].r_a - f.center_a).norm();
     f.first_friction_row = static_cast<int>(first_friction);
     f.mu = pair_friction(in.def.friction, body_a.friction, body_b.friction);  // the rows' mu
-    f.fixed_limit = in.coupled ? -1.0 : in.rows[first_friction].c_max * h;
+    // The fixed model's limit: its first point's friction rows' (write_friction_rows).
+    f.fixed_limit = in.coupled ? -1.0 : friction_limit(f.mu, body_a, body_b, m.count, in.def.gravity, f.normal) * h;
     tangent_basis(f.normal, f.t1, f.t2);
     const Vec3 rt_a1 = f.center_a.cross(f.t1);
     const Vec3 rt_a2 = f.center_a.cross(f.t2);
@@ -642,10 +670,9 @@ class SoftStep final : public PushMethod {
   // Lane l of group g, manifold k of ctx, as the scalar manifold and points the restitution and store() read: f
   // (its bodies, friction at the centre and impulses; its points numbered from 0) and points
   // [points, points + count) with their rows, anchors, normals, impulses and the step's totals
-  // when kept (their I^-1 (r x n) and masses are not kept in lanes: set_axis_row forms them).
-  // `rows`, when given, supplies the points' restitution targets (prepare_manifold() read them
-  // only where the pair has restitution; elsewhere the rows' are 0, write_normal_rows).
-  void lane_manifold(const RowLayout& layout, const std::vector<ConstraintRow>* rows, std::size_t k,
+  // when kept (their I^-1 (r x n) and masses are not kept in lanes: set_axis_row forms them),
+  // and their restitution targets where prepare() kept them.
+  void lane_manifold(const RowLayout& layout, std::size_t k,
                      std::size_t g, int l, ManifoldFriction& f, ContactPoint* points) const {
     const LaneGroup& group = groups_[g];
     const LanePoint* q = lane_points_.data() + group.first_point;
@@ -665,7 +692,7 @@ class SoftStep final : public PushMethod {
       p.normal.axis = Vec3(q[i].axis.x[l], q[i].axis.y[l], q[i].axis.z[l]);
       p.normal.impulse = q[i].impulse[l];
       p.total_impulse = totals != nullptr ? totals[i].impulse[l] : 0.0;
-      p.restitution = rows != nullptr ? (*rows)[static_cast<std::size_t>(p.row)].restitution : 0.0;
+      p.restitution = restitution_targets_.empty() ? 0.0 : restitution_targets_[static_cast<std::size_t>(p.row)];
     }
     if (!sweep_.friction) return;
     f.first_friction_row = static_cast<int>(layout.friction_row(first_row_[k]));
@@ -984,7 +1011,7 @@ class SoftStep final : public PushMethod {
 
   // Stage "restitution" (Eq. 8.2.1 as b3ApplyRestitution applies it), point by point in the
   // order of the slots: the lanes' manifolds by group and lane, then the overflow's.
-  void apply_restitution(const std::vector<ConstraintRow>& rows, const RowLayout& layout) {
+  void apply_restitution(const RowLayout& layout) {
     if (!any_restitution()) return;
     const auto bounce = [this](ContactPoint& p) {
       if (p.restitution <= 0.0 || p.total_impulse == 0.0) return;
@@ -1004,7 +1031,7 @@ class SoftStep final : public PushMethod {
       soft::LaneTotal* totals = lane_totals_.data() + groups_[g].first_point;
       for (int l = 0; l < soft::kLanes && groups_[g].slot[l] >= 0; ++l) {
         const std::size_t k = manifold_order_[static_cast<std::size_t>(groups_[g].slot[l])];
-        lane_manifold(layout, &rows, k, g, l, f, points.data());
+        lane_manifold(layout, k, g, l, f, points.data());
         for (std::size_t i = 0; i < f.end; ++i) {
           ContactPoint& p = points[i];
           set_axis_row(p.normal, p.normal.axis, p.r_a, p.r_b, body(p.a, 0), body(p.b, 0), p.normal.impulse);
@@ -1055,7 +1082,7 @@ class SoftStep final : public PushMethod {
       for (std::size_t k = begin; k < end; ++k) {
         if (lanes_ && manifold_colour_[k] != ConstraintGraph::kOverflow) {
           const auto [g, l] = lane_of(k);
-          lane_manifold(ctx.layout, nullptr, k, g, l, f, scratch.data());
+          lane_manifold(ctx.layout, k, g, l, f, scratch.data());
           store_manifold(f, scratch.data(), inv_h, ctx.lambda);
         } else {
           const ManifoldFriction& m = manifolds_[slot_[k]];
@@ -1114,6 +1141,7 @@ class SoftStep final : public PushMethod {
   ColourStarts rod_start_{};
   ColourStarts manifold_start_{};
   std::vector<std::size_t> first_row_;    // per manifold of ctx: its first contact row
+  std::vector<double> restitution_targets_;  // m/s by contact row; empty where no pair may bounce
   std::vector<std::size_t> slot_;         // per manifold of ctx: its place in manifolds_
   std::vector<std::size_t> point_start_;  // per slot of manifolds_: its first point in contacts_
   std::vector<Mat3> inertia_;              // n: I (kg m^2, world frame) at the start of the step

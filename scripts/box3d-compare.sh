@@ -130,7 +130,7 @@ b3 = {k: float(v) for k, v in b3.items()}
 cps = {k: v / 1000 for k, v in json.load(open(sys.argv[2]))["physics"][0]["matrix_free_stages_us_per_step"].items()}
 rows = [
     ("broad and narrow phase", b3["pairs"] + b3["collide"], "collide", cps["collide"]),
-    ("the paper's rows and the warm-start match", None, "rows", cps["rows"]),
+    ("the warm-start match (and the paper's rows where a method reads them)", None, "rows", cps["rows"]),
     ("prepare", b3["prepare"], "prepare", cps["prepare"]),
     ("warm start and biased sweeps", b3["warm_start"] + b3["solve"], "solve", cps["solve"]),
     ("relax", b3["relax"], "relax", cps["relax"]),

@@ -77,9 +77,8 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* work
       int matched_here = 0;
       for (int i = 0; i < m.count; ++i, ++k) {
         const Contact& c = m.contacts[static_cast<std::size_t>(i)];
+        bool kept = false;  // t1 the cached one's
         Vec3 t1;
-        Vec3 t2;
-        tangent_basis(c.normal, t1, t2);  // the paper's directions for a new point
         match_[k] = -1;
         if (same_pair) {
           const CachedManifold& cm = manifolds_[j];
@@ -92,9 +91,16 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* work
             ++matched_here;
             // The cached t1 in the new contact plane: the friction rows keep their directions.
             const Vec3 projected = p.t1 - p.t1.dot(c.normal) * c.normal;
-            if (projected.norm() > 0.5) t1 = projected.normalized();
+            if (projected.norm() > 0.5) {
+              t1 = projected.normalized();
+              kept = true;
+            }
             break;
           }
+        }
+        if (!kept) {
+          Vec3 t2;
+          tangent_basis(c.normal, t1, t2);  // the paper's directions for a new point
         }
         tangents_[k] = t1;
       }

@@ -4,8 +4,9 @@
 // (a manifold's contact and friction rows, a rod's row), the runs are coloured as Box3D and
 // Box2D v3 colour their constraints (constraint_graph.h) except that a run with one movable body
 // takes its first free colour (StaticColours::first: swept early, as the rows' order sweeps a
-// pile's supports), and a sweep updates the runs colour by colour, the overflow first. The runs of one colour share no movable body, so their updates
-// commute: any split of a colour among threads gives the same lambda, bit for bit.
+// pile's supports), and a sweep updates the runs colour by colour, the overflow first. The runs
+// of one colour share no movable body, so their updates commute: any split of a colour among
+// threads gives the same lambda, bit for bit.
 
 #include "constraint_graph.h"
 #include "cps/body.h"

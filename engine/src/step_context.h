@@ -109,13 +109,15 @@ struct StepContext {
   /// The contact and friction rows of `rows` that World::build_rows left unwritten for a push
   /// method that does not read them (PushMethod::reads_contact_rows), for World::rows to write
   /// when they are asked for: the row parameters, whether the warm start chose the friction
-  /// directions, and the bodies' positions x (n, m) at the start of the step. Not copied with
-  /// the context (a world writes its rows before it is copied).
+  /// directions, and the bodies' positions x (n, m) at the start of the step; `bodies` is
+  /// World::rows' copy of the bodies with those positions, kept so that it allocates only to
+  /// grow. Not copied with the context (a world writes its rows before it is copied).
   struct DeferredRows {
     bool pending = false;
     bool warm = false;
     RowParams params;
     std::vector<Vec3> x;
+    std::vector<Body> bodies;
   };
   DeferredRows deferred_rows;
   /// Whether some pair of the step may have restitution (WorldDef::restitution or a body's own

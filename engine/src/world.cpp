@@ -82,9 +82,9 @@ const StepContext& World::context_with_rows() const {
   StepContext::DeferredRows& deferred = ctx_->deferred_rows;
   if (deferred.pending) {
     // The bodies as they were when the step built its rows (only their positions have moved).
-    std::vector<Body> start = bodies_;
-    for (std::size_t i = 0; i < deferred.x.size(); ++i) start[i].x = deferred.x[i];
-    write_contact_rows(start, deferred.params, deferred.warm, nullptr);
+    deferred.bodies = bodies_;
+    for (std::size_t i = 0; i < deferred.x.size(); ++i) deferred.bodies[i].x = deferred.x[i];
+    write_contact_rows(deferred.bodies, deferred.params, deferred.warm, nullptr);
     deferred.pending = false;
   }
   return *ctx_;

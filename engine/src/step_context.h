@@ -120,6 +120,9 @@ struct StepContext {
     std::vector<Body> bodies;
   };
   DeferredRows deferred_rows;
+  /// Whether the push method left `lambda` to be written when it is asked for (World::lambda
+  /// calls PushMethod::write_lambda); cleared when the next step begins.
+  bool lambda_pending = false;
   /// Whether some pair of the step may have restitution (WorldDef::restitution or a body's own
   /// above 0; World::build_rows): the rows' and the soft step's restitution targets.
   bool may_bounce = false;

@@ -48,6 +48,7 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* work
   detail::resize_with_headroom(match_, points);
   detail::resize_with_headroom(tangents_, points);
   detail::resize_with_headroom(same_points_, manifolds.size());
+  detail::resize_with_headroom(pair_match_, manifolds.size());
   const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
   detail::assign_with_headroom(matched_by_thread_, threads, std::size_t{0});
   parallel_for(workers, manifolds.size(), kMinParallel, [&](int t, std::size_t begin, std::size_t end) {
@@ -73,6 +74,7 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* work
       }
       const bool same_pair = j < manifolds_.size() && manifolds_[j].body_a == m.body_a &&
                              manifolds_[j].body_b == m.body_b;
+      pair_match_[index] = same_pair ? static_cast<int>(j) : -1;
       unsigned used = 0;  // cached points of this pair already matched (at most 8: one bit each)
       int matched_here = 0;
       for (int i = 0; i < m.count; ++i, ++k) {
@@ -117,9 +119,7 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
                                      const std::vector<ConstraintRow>& rows, std::size_t rods,
                                      double factor, FrictionModel friction,
                                      std::vector<double>& first,
-                                     std::vector<double>& second, WarmStartRule rule,
-                                     Workers* workers) const {
-  const bool last = rule == WarmStartRule::last;
+                                     std::vector<double>& second, Workers* workers) const {
   const std::size_t c = rows.size();
   // Each manifold writes only its own rows: a share starts at its first manifold's first point
   // (match()'s first_point_; without a match() of these manifolds, one share from point 0).
@@ -163,7 +163,7 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
           const double* cached = solve == 0 ? p.first : p.second;
           const double older = p.older[solve];
           // Contact row k: the smaller of its last two lambdas (see the class comment).
-          const double sustained = last ? cached[0] : std::max(0.0, std::min(cached[0], older));
+          const double sustained = std::max(0.0, std::min(cached[0], older));
           out[k] = factor * sustained;
           if (!friction_rows) continue;
           if (!has_friction_) {
@@ -172,15 +172,15 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
           }
           // The cached friction force, scaled as the contact's, along this step's directions (t1
           // is the cached t1 in the new plane, so this is close to a copy), within the row's limits.
-          const double scale = last ? 1.0 : cached[0] > 0.0 ? sustained / cached[0] : 0.0;
+          const double scale = cached[0] > 0.0 ? sustained / cached[0] : 0.0;
           const Vec3 force = scale * (cached[1] * p.t1 + cached[2] * p.t2);
           const Vec3& t1 = tangents_[k];
           const Vec3 t2 = m.contacts[static_cast<std::size_t>(i)].normal.cross(t1);
           for (int r = 0; r < 2; ++r) {
             const std::size_t row = points + 2 * k + static_cast<std::size_t>(r);
-            double lo = last ? -kInfinity : rows[row].c_min;
-            double hi = last ? kInfinity : rows[row].c_max;
-            if (coupled && !last) {
+            double lo = rows[row].c_min;
+            double hi = rows[row].c_max;
+            if (coupled) {
               hi = rows[row].mu * out[k];
               lo = -hi;
             }
@@ -200,9 +200,7 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
       }
       const double a = cached_rods[r];
       const double b = older_rods[r];
-      out[c - rods + r] = last                     ? factor * a
-                          : (a > 0.0) == (b > 0.0) ? factor * (std::abs(a) < std::abs(b) ? a : b)
-                                                   : 0.0;
+      out[c - rods + r] = (a > 0.0) == (b > 0.0) ? factor * (std::abs(a) < std::abs(b) ? a : b) : 0.0;
     }
   }
 }
@@ -225,7 +223,7 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
     for (std::size_t index = begin; index < end; ++index) {
       const Manifold& m = manifolds[index];
       std::size_t k = first_point_[index];
-      manifolds_[index] = {m.body_a, m.body_b, static_cast<int>(k), m.count};
+      manifolds_[index] = {m.body_a, m.body_b, static_cast<int>(k), m.count, Vec3::Zero(), 0.0};
       for (int i = 0; i < m.count; ++i, ++k) {
         CachedPoint& p = next_points_[k];
         const bool matched = k < match_.size() && match_[k] >= 0;
@@ -271,6 +269,46 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
   }
 }
 
+void WarmStartCache::begin_store(const std::vector<Manifold>& manifolds) {
+  const std::size_t points = first_points(manifolds, first_point_);
+  has_friction_ = false;
+  has_second_ = false;
+  detail::resize_with_headroom(manifolds_, manifolds.size());
+  detail::resize_with_headroom(next_points_, points);
+}
+
+void WarmStartCache::store_manifold(std::size_t m, const Manifold& manifold, const double* normal,
+                                    const Vec3& friction, double twist) {
+  std::size_t k = first_point_[m];
+  manifolds_[m] = {manifold.body_a, manifold.body_b, static_cast<int>(k), manifold.count, friction, twist};
+  const bool own_tangents = tangents_fresh_ && k + static_cast<std::size_t>(manifold.count) <= tangents_.size();
+  for (int i = 0; i < manifold.count; ++i, ++k) {
+    const Contact& contact = manifold.contacts[static_cast<std::size_t>(i)];
+    CachedPoint& p = next_points_[k];
+    p.feature = contact.feature;
+    if (own_tangents) {
+      p.t1 = tangents_[k];
+      p.t2 = contact.normal.cross(p.t1);
+    } else {
+      tangent_basis(contact.normal, p.t1, p.t2);
+    }
+    p.first[0] = normal[i];
+    p.first[1] = p.first[2] = 0.0;
+    p.second[0] = p.second[1] = p.second[2] = 0.0;
+    p.older[0] = p.older[1] = 0.0;
+  }
+}
+
+void WarmStartCache::end_store(const double* rods, std::size_t count) {
+  points_.swap(next_points_);
+  tangents_fresh_ = false;
+  detail::resize_with_headroom(rods_first_, count);
+  std::copy_n(rods, count, rods_first_.begin());
+  detail::assign_with_headroom(rods_second_, count, 0.0);
+  detail::assign_with_headroom(rods_older_first_, count, 0.0);
+  detail::assign_with_headroom(rods_older_second_, count, 0.0);
+}
+
 void WarmStartCache::clear() {
   manifolds_.clear();
   points_.clear();
@@ -281,6 +319,7 @@ void WarmStartCache::clear() {
   has_second_ = false;
   has_friction_ = false;
   match_.clear();
+  pair_match_.clear();
   tangents_fresh_ = false;
   same_points_.clear();
   matched_ = 0;

@@ -21,9 +21,13 @@ namespace cps {
 enum class WarmStartRule {
   /// The smaller of the last two lambdas, friction within its row's limits (the class comment).
   sustained,
-  /// The last step's lambdas as they are, friction unclamped: Box3D's and Box2D v3's warm start
-  /// (b3PrepareContacts: the stored impulses times the warm-start scale), which the soft step runs.
-  last,
+  /// Box3D's warm start (b3UpdateContact, b3PrepareContacts, b3StoreImpulses), which the soft
+  /// step runs: each point's normal lambda of the last step as it is, found by its feature id,
+  /// and the friction force (a vector) and twist of the last step's manifold of the same body
+  /// pair, kept with the pair whichever points it has. The method reads them itself
+  /// (last_normal(), last_friction(), last_rod()) and stores them (begin_store()); it calls
+  /// neither initial_guesses() nor store().
+  manifold,
 };
 
 /// The contacts and rods of the last step with their lambdas, and this step's matches to them.
@@ -68,13 +72,10 @@ class WarmStartCache {
   /// within +-mu times its contact row's guess (coupled model). `first` is for the solve with the
   /// push (Sec. 7), `second` for the solve without it (Sec. 8.1), each from the cached lambda of
   /// the same solve; `second` is left empty when the cache holds no second solve.
-  /// With WarmStartRule::last each guess is instead `factor` times the row's last lambda (a
-  /// friction row's re-expressed along this step's t1, t2, not clamped).
   void initial_guesses(const std::vector<Manifold>& manifolds,
                        const std::vector<ConstraintRow>& rows, std::size_t rods, double factor,
                        FrictionModel friction, std::vector<double>& first,
                        std::vector<double>& second,
-                       WarmStartRule rule = WarmStartRule::sustained,
                        Workers* workers = nullptr) const;
 
   /// Replaces the cache by this step's points (features, t1, t2) and lambdas: `first` (c, N)
@@ -84,6 +85,37 @@ class WarmStartCache {
   void store(const std::vector<Manifold>& manifolds, const std::vector<ConstraintRow>& rows,
              std::size_t rods, const std::vector<double>& first,
              const std::vector<double>& second, Workers* workers = nullptr);
+
+  /// WarmStartRule::manifold, after match(): the contact row's lambda (N) of the cached point
+  /// that this step's point k (its contact row) matched, 0 for a new point.
+  double last_normal(std::size_t k) const {
+    return k < match_.size() && match_[k] >= 0 ? points_[static_cast<std::size_t>(match_[k])].first[0] : 0.0;
+  }
+  /// WarmStartRule::manifold, after match(): the friction force (N, a world vector; its last
+  /// contact plane's) and twist (N m about its last normal) of the cached manifold with the body
+  /// pair of this step's manifold m, 0 for a new pair. Where a step was stored by store(), both
+  /// are 0.
+  void last_friction(std::size_t m, Vec3& friction, double& twist) const {
+    const int j = m < pair_match_.size() ? pair_match_[m] : -1;
+    friction = j >= 0 ? manifolds_[static_cast<std::size_t>(j)].friction : Vec3::Zero();
+    twist = j >= 0 ? manifolds_[static_cast<std::size_t>(j)].twist : 0.0;
+  }
+  /// Rod r's lambda (N) of the last step, 0 for a new rod.
+  double last_rod(std::size_t r) const { return r < rods_first_.size() ? rods_first_[r] : 0.0; }
+
+  /// WarmStartRule::manifold: replaces the cache by this step's manifolds (after this step's
+  /// match()) in three calls: begin_store(), then store_manifold() once for each manifold (from
+  /// any thread, each manifold its own), then end_store(). The cached points keep match()'s
+  /// t1 (tangents()) and only their contact row's lambda; the sustained rule of another method
+  /// finds no friction and, lacking an older lambda, starts the contacts from 0.
+  void begin_store(const std::vector<Manifold>& manifolds);
+  /// Manifold m of the step (`manifold`, as given to begin_store()) with its points' contact
+  /// lambdas normal[0, manifold.count) (N), its friction force (N, a world vector) and twist
+  /// (N m about its normal). No errors.
+  void store_manifold(std::size_t m, const Manifold& manifold, const double* normal, const Vec3& friction,
+                      double twist);
+  /// The rods' lambdas rods[0, count) (N, in the order of the world's rods); ends the store.
+  void end_store(const double* rods, std::size_t count);
 
   /// Forgets everything: the next step starts every row from 0.
   void clear();
@@ -102,6 +134,8 @@ class WarmStartCache {
     int body_b;
     int first;  // first point in points_
     int count;
+    Vec3 friction;  // N: the manifold's friction force (WarmStartRule::manifold; else 0)
+    double twist;   // N m: its twist about the normal (the same)
   };
   struct CachedPoint {
     std::uint32_t feature;
@@ -123,6 +157,7 @@ class WarmStartCache {
   bool has_friction_ = false;
   // This step: per point, the cached point it matched (-1: none) and its t1.
   std::vector<int> match_;
+  std::vector<int> pair_match_;  // per manifold: its pair's cached manifold, or -1
   std::vector<Vec3> tangents_;
   bool tangents_fresh_ = false;  // match() has run since the last store(): tangents_ are the step's
   std::vector<unsigned char> same_points_;  // per manifold: same_points()

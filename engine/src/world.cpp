@@ -53,7 +53,7 @@ World::World(const World& other)
       bodies_(other.bodies_),
       distances_(other.distances_),
       apart_(other.apart_),
-      ctx_(std::make_unique<StepContext>(other.context_with_rows())),
+      ctx_(std::make_unique<StepContext>(other.settled_context())),
       broad_phase_(std::make_unique<BroadPhase>()),
       body_friction_(other.body_friction_),
       body_restitution_(other.body_restitution_) {}
@@ -76,9 +76,9 @@ void World::set_stage_timing(bool on) {
   ctx_->time_stages = on;
 }
 const std::vector<Manifold>& World::manifolds() const { return ctx_->manifolds; }
-const std::vector<ConstraintRow>& World::rows() const { return context_with_rows().rows; }
+const std::vector<ConstraintRow>& World::rows() const { return settled_context().rows; }
 
-const StepContext& World::context_with_rows() const {
+const StepContext& World::settled_context() const {
   StepContext::DeferredRows& deferred = ctx_->deferred_rows;
   if (deferred.pending) {
     // The bodies as they were when the step built its rows (only their positions have moved).
@@ -87,9 +87,13 @@ const StepContext& World::context_with_rows() const {
     write_contact_rows(deferred.bodies, deferred.params, deferred.warm, nullptr);
     deferred.pending = false;
   }
+  if (ctx_->lambda_pending) {
+    push_->write_lambda(*ctx_);
+    ctx_->lambda_pending = false;
+  }
   return *ctx_;
 }
-const std::vector<double>& World::lambda() const { return ctx_->lambda; }
+const std::vector<double>& World::lambda() const { return settled_context().lambda; }
 const std::vector<double>& World::lambda_second() const { return ctx_->lambda_second; }
 
 void World::set_def(const WorldDef& def) {
@@ -174,6 +178,10 @@ void World::step() {
     push_mode_ = def_.push;
   }
   ctx.solves_this_step = 0;
+  if (ctx.lambda_pending) {  // the last step's, unwritten: this step writes its own
+    ctx.lambda_pending = false;
+    ctx.lambda.clear();
+  }
   ctx.update_workers();
   {
     StageTimer timer(ctx, &StageTimes::collide);
@@ -185,6 +193,7 @@ void World::step() {
       if (ctx.deferred_rows.pending) {
         ctx.deferred_rows.pending = false;
         ctx.rows.clear();
+        ctx.lambda.clear();
       }
       throw;
     }
@@ -504,10 +513,10 @@ void World::build_rows() {
   }
   for (const DistanceConstraint& d : distances_) append_distance_row(d, bodies_, params, rows);
   ctx.counters.rows += static_cast<std::int64_t>(rows.size());
-  if (warm) {
+  // Box3D's warm start is the method's own (WarmStartRule::manifold).
+  if (warm && push_->warm_start_rule(def_) == WarmStartRule::sustained) {
     ctx.warm_start->initial_guesses(ctx.manifolds, rows, distances_.size(), def_.warm_start,
-                                    def_.friction_model, ctx.initial, ctx.initial_second,
-                                    push_->warm_start_rule(def_), workers);
+                                    def_.friction_model, ctx.initial, ctx.initial_second, workers);
   }
 }
 

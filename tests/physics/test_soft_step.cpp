@@ -288,3 +288,48 @@ TEST_CASE("the soft step's rows, written when asked for, are the rows its step b
     }
   }
 }
+
+TEST_CASE("the soft step's lambda, written when asked for, holds boxes at rest on a slope", "[soft]") {
+  // Two boxes resting one on the other on the ground under gravity tilted 20 degrees from the
+  // normal (a slope), friction 0.6 > tan 20 degrees, warm started as Box3D always is: at rest
+  // (still to round-off: each substep's impulses are the last's) the rows' forces J^T lambda on
+  // each box (the last substep's impulses over h, written from the soft step's impulses when
+  // World::lambda asks for them) balance its weight. (Their torques balance it only to about
+  // 1e-6: a manifold's friction, solved at its centre, is shared out among its points.)
+  const double slope = 20.0 * std::numbers::pi / 180.0;
+  WorldDef def;
+  def.push = PushMode::soft;
+  def.warm_start = 1.0;
+  def.friction = 0.6;
+  def.friction_model = FrictionModel::coupled;  // Box3D's (the fixed limit counts one box's weight)
+  def.gravity = kG * Vec3(std::sin(slope), -std::cos(slope), 0.0);
+  World world(def);
+  scenes::add_ground(world);
+  const Vec3 half(0.6, 0.3, 0.4);
+  for (int i = 0; i < 2; ++i) {
+    BodyDef box;
+    box.shape = Shape::box(half);
+    box.mass = 5.0 + 3.0 * i;
+    box.position = Vec3(0.1 * i, half.y() * (1 + 2 * i), -0.05 * i);
+    box.orientation = Quat(Eigen::AngleAxisd(0.2 * i, Vec3::UnitY()));
+    world.add_body(box);
+  }
+  while (world.time() < 5.0) world.step();
+  const std::vector<ConstraintRow>& rows = world.rows();
+  const std::vector<double>& lambda = world.lambda();
+  REQUIRE(lambda.size() == rows.size());
+  for (int b = 1; b <= 2; ++b) {
+    CAPTURE(b);
+    const Body& body = world.bodies()[static_cast<std::size_t>(b)];
+    Vec3 force = body.mass * def.gravity;
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const ConstraintRow& row = rows[r];
+      if (row.body_a == b) force += lambda[r] * row.j.segment<3>(0);
+      if (row.body_b == b) force += lambda[r] * row.j.segment<3>(6);
+    }
+    const double weight = body.mass * kG;
+    INFO("speed " << body.velocity().norm() << " m/s; force left " << force.transpose() << " N");
+    CHECK(body.velocity().norm() < 1e-12);
+    CHECK(force.norm() < 1e-12 * weight);
+  }
+}

@@ -149,8 +149,9 @@ class World {
   const std::vector<Manifold>& manifolds() const;
   /// Rows built by the last step (c of them) and lambda of its first solve (c, N). Under a push
   /// method that does not read its contact and friction rows (the soft step), those are written
-  /// at the first call after the step, from the bodies as they were at its start: the same rows.
-  /// Not to be called from two threads at once.
+  /// at the first call after the step, from the bodies as they were at its start: the same rows;
+  /// the soft step's lambda likewise, from its impulses. Not to be called from two threads at
+  /// once.
   const std::vector<ConstraintRow>& rows() const;
   const std::vector<double>& lambda() const;
   /// lambda of the last step's second solve (c, N; Sec. 8.1, push split only; empty otherwise).
@@ -190,8 +191,9 @@ class World {
   void build_rows();
   void write_contact_rows(const std::vector<Body>& bodies, const RowParams& params, bool warm,
                           Workers* workers) const;
-  // The context with the last step's rows all written (StepContext::DeferredRows).
-  const StepContext& context_with_rows() const;
+  // The context with the last step's rows and lambda all written (StepContext::DeferredRows,
+  // StepContext::lambda_pending).
+  const StepContext& settled_context() const;
 
   WorldDef def_;
   std::vector<Body> bodies_;

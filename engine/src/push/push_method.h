@@ -58,6 +58,12 @@ class PushMethod {
     return true;
   }
 
+  /// Writes ctx.lambda (c, N) of the step just made, for a method whose step() left it to be
+  /// written when asked for (ctx.lambda_pending), from what the method kept of that step; the
+  /// paper's methods write it in step(). Called at most once after a step, before the next, on
+  /// the calling thread. No errors.
+  virtual void write_lambda(StepContext& /*ctx*/) const {}
+
   /// The solve and integrate stages: solves with ctx's rows and prepared solver, leaves the
   /// step's lambda (and lambda_second, or clears it) in ctx, stores the warm start, and moves the
   /// bodies over ctx.def->dt. No errors.

@@ -22,9 +22,12 @@
 //     of each of its rows, its separation at the start of the step and its approach speed (for
 //     restitution); each rod's anchors and axial mass; each body's I^-1 (as in b3PrepareContacts:
 //     the bodies' inverse inertias of the start of the step serve every substep). The impulses
-//     start from the warm-start cache (WorldDef::warm_start times the last step's, Sec. 6.2.3,
-//     WarmStartRule::last; Box3D always warm starts with factor 1; the restart variant below
-//     takes the sustained rule of the other methods) or from 0.
+//     start from the warm-start cache (WorldDef::warm_start times the last step's, Sec. 6.2.3;
+//     Box3D always warm starts with factor 1) or from 0: as Box3D keeps them on its contacts
+//     (WarmStartRule::manifold; b3UpdateContact, b3PrepareContacts), each point's normal impulse
+//     found by its feature id, and the friction impulse (a vector, projected onto this step's
+//     tangents) and twist of the manifold of the same body pair, whichever points it has. The
+//     restart variant below takes the sustained rule of the other methods, by row.
 //   each substep:
 //     1. integrate velocities: v += h m^-1 f, w += h I^-1 tau (f_ext, Sec. 6.1);
 //     2. warm start: every row's accumulated impulse applied to the velocities;
@@ -53,9 +56,11 @@
 //     6. restitution: each contact point with a restitution target v_r (Eq. 8.2.1, its
 //        contact row's, restitution_target) that took an impulse in the step gets
 //        dP = -m (J v - v_r), the accumulated impulse clamped at 0 (b3ApplyRestitution);
-//     7. store impulses: lambda = P / h per row (N) for the warm-start cache and ctx.lambda (a
-//        manifold's friction as forces at its points' friction rows, store()); the bodies'
-//        momenta p = m v, l = I w with the I of the start of the step.
+//     7. store impulses (b3StoreImpulses): the points' normal impulses and each manifold's
+//        friction vector and twist, over h, into the warm-start cache; the bodies' momenta
+//        p = m v, l = I w with the I of the start of the step. ctx.lambda (lambda = P / h per
+//        row, N; a manifold's friction as forces at its points' friction rows) is written when
+//        asked for (write_lambda()).
 // Stiffness: the contact's is capped at an eighth of the substep rate (b3World_Step), a rod's at
 // a quarter (b3PrepareJoint). A rod (distance constraint) is Box3D's rigid distance joint: its
 // axis and anchors follow the bodies within the step (the current anchors, dq r), its effective
@@ -84,8 +89,7 @@
 // Differences from Box3D: double precision (its lanes are floats); the manifolds as the collide stage
 // makes them (WorldDef::manifold_points and contact_recycle_distance choose Box3D's 4 points and
 // its recycling; Box3D's recycled anchors stay as they were, a cps point is midway between the
-// bodies' material points); the twist warm starts only when a manifold has the same points as
-// the step before; no rolling resistance, no gyroscopic term (Box3D integrates one; for the
+// bodies' material points); no rolling resistance, no gyroscopic term (Box3D integrates one; for the
 // spheres and cubes of the scenes it is zero), no speed caps on the bodies (Box3D clamps at
 // 400 m/s and a quarter turn a step).
 // The solvers of A lambda = b (--solver, --assembly) play no part: the rows are swept as the
@@ -225,10 +229,10 @@ void set_axis_row(AxisRow& row, const Vec3& axis, const Vec3& r_a, const Vec3& r
 
 class SoftStep final : public PushMethod {
  public:
-  // Box3D's warm start (the last step's impulses), or for the restart variant the sustained
-  // rule of the other methods (warm_start.h).
+  // Box3D's warm start (the last step's impulses, kept by point and by manifold), or for the
+  // restart variant the sustained rule of the other methods (warm_start.h).
   WarmStartRule warm_start_rule(const WorldDef& def) const override {
-    return def.soft_relax == SoftRelax::restart ? WarmStartRule::sustained : WarmStartRule::last;
+    return def.soft_relax == SoftRelax::restart ? WarmStartRule::sustained : WarmStartRule::manifold;
   }
 
   // Prepared from the manifolds; only the sustained rule of the warm start reads the rows' limits.
@@ -244,24 +248,37 @@ class SoftStep final : public PushMethod {
     }
     auto substeps = [this, &ctx, h](int t) { run_substeps(ctx, h, t); };
     workers_->run(substeps);
-    {
-      StageTimer timer(ctx, &StageTimes::store);
-      apply_restitution(ctx.layout);
-      store(ctx, h);
+    StageTimer timer(ctx, &StageTimes::store);
+    apply_restitution(ctx.layout);
+    store_momenta(ctx);
+    ctx.lambda_second.clear();
+    if (def.soft_relax == SoftRelax::continue_solve) {
+      if (ctx.warm()) store_warm_start(ctx, 1.0 / h);
+      inv_h_ = 1.0 / h;
+      ctx.lambda_pending = true;  // write_lambda()
+    } else {
+      write_lambda(ctx, 1.0 / h, workers_);
+      ctx.store_warm_start();  // from ctx.lambda
     }
-    ctx.store_warm_start();
   }
+
+  void write_lambda(StepContext& ctx) const override { write_lambda(ctx, inv_h_, nullptr); }
 
  private:
   // Stage "prepare": solver bodies, contact points and rods from ctx's bodies, manifolds and the
-  // rods' rows, with the warm-start impulses by row (contact rows in the manifolds' point order,
-  // then two friction rows per point when the world has friction, then one row per rod:
-  // World::build_rows, which leaves the contact and friction rows unwritten: reads_contact_rows).
+  // rods' rows, with the warm-start impulses: Box3D's from the cache, or for the restart variant
+  // by row (contact rows in the manifolds' point order, then two friction rows per point when the
+  // world has friction, then one row per rod: World::build_rows, which leaves the contact and
+  // friction rows unwritten: reads_contact_rows).
   void prepare(StepContext& ctx, double h) {
     const WorldDef& def = *ctx.def;
     const std::vector<Body>& bodies = *ctx.bodies;
     const std::vector<ConstraintRow>& rows = ctx.rows;
-    const std::vector<double>* warm = ctx.warm_guess();
+    // The warm start: by row (ctx's initial guesses) under the sustained rule, else Box3D's
+    // impulses from the cache itself.
+    const bool by_row = warm_start_rule(def) == WarmStartRule::sustained;
+    const std::vector<double>* warm = by_row ? ctx.warm_guess() : nullptr;
+    const WarmStartCache* last = !by_row && ctx.warm() ? ctx.warm_start.get() : nullptr;
     const auto guess = [&](std::size_t r) { return warm != nullptr ? (*warm)[r] * h : 0.0; };
 
     const std::size_t n = bodies.size();
@@ -303,7 +320,7 @@ class SoftStep final : public PushMethod {
     // speculative distance (m).
     const double inv_tau = 1.0 / std::max(def.contact_margin, 1e-9);
     // The points' friction tangents as World::build_rows gave them to the friction rows, so that
-    // the warm start and store() need not read the rows back (tangents()).
+    // the warm start and write_lambda() need not read the rows back (tangents()).
     cached_tangents_ =
         friction && def.warm_start > 0.0 && ctx.warm_start != nullptr ? ctx.warm_start->tangents(0) : nullptr;
     const std::vector<DistanceConstraint>& distances = *ctx.distances;
@@ -340,6 +357,8 @@ class SoftStep final : public PushMethod {
                            ctx.manifolds,
                            ctx.layout,
                            warm,
+                           last,
+                           def.warm_start,
                            ctx.warm_start.get(),
                            may_bounce ? restitution_targets_.data() : nullptr,
                            h,
@@ -412,7 +431,7 @@ class SoftStep final : public PushMethod {
       set_axis_row(axial, rod.axis0, rod.r_a, rod.r_b, solver_bodies_[index(d.body_a)],
                    solver_bodies_[index(d.body_b)], 0.0);
       rod.mass = axial.mass;
-      rod.impulse = guess(first_rod + r);
+      rod.impulse = last != nullptr ? def.warm_start * last->last_rod(r) * h : guess(first_rod + r);
     }
     if (def.soft_relax == SoftRelax::restart) {  // save()'s buffers
       detail::resize_with_headroom(saved_velocities_, solver_bodies_.size());
@@ -429,6 +448,8 @@ class SoftStep final : public PushMethod {
     const std::vector<Manifold>& manifolds;
     const RowLayout& layout;
     const std::vector<double>* warm;  // the rows' initial lambdas (N), or null
+    const WarmStartCache* last;       // or Box3D's warm start from the cache itself, or null
+    double factor;                    // its factor (WorldDef::warm_start)
     const WarmStartCache* cache;
     double* restitution_targets;  // m/s by contact row, or null where no pair may bounce
     double h;
@@ -455,7 +476,10 @@ class SoftStep final : public PushMethod {
                         ContactPoint* points) const {
     const Manifold& m = in.manifolds[k];
     const double h = in.h;
-    const auto guess = [&](std::size_t r) { return in.warm != nullptr ? (*in.warm)[r] * h : 0.0; };
+    const auto guess = [&](std::size_t r) {
+      if (in.last != nullptr) return in.factor * in.last->last_normal(r) * h;
+      return in.warm != nullptr ? (*in.warm)[r] * h : 0.0;
+    };
     std::size_t g = first_row_[k];  // the point's index over the step: its contact row
     const Body& body_a = in.bodies[static_cast<std::size_t>(m.body_a)];
     const Body& body_b = in.bodies[static_cast<std::size_t>(m.body_b)];
@@ -522,9 +546,17 @@ class SoftStep final : public PushMethod {
     f.tangent_mass = K.determinant() != 0.0 ? Eigen::Matrix2d(K.inverse()) : Eigen::Matrix2d::Zero();
     const double k_twist = f.normal.dot((a.inv_I + b.inv_I) * f.normal);
     f.twist_mass = k_twist > 0.0 ? 1.0 / k_twist : 0.0;
-    // The warm start: the friction rows' initial lambdas (N, store() below) summed back into
-    // the force at the centre and its twist about the normal, as impulses over h. store()
-    // writes each point's force as an equal share of the centre's plus the twist's
+    if (in.last != nullptr) {  // Box3D's: the pair's friction and twist of the last step
+      Vec3 F;
+      double twist = 0.0;
+      in.last->last_friction(k, F, twist);
+      f.impulse = (in.factor * h) * Eigen::Vector2d(F.dot(f.t1), F.dot(f.t2));
+      f.twist_impulse = in.factor * h * twist;
+      return restitution;
+    }
+    // The warm start by row (the restart variant): the friction rows' initial lambdas (N)
+    // summed back into the force at the centre and its twist about the normal, as impulses over
+    // h. write_lambda() writes each point's force as an equal share of the centre's plus the twist's
     // tangential force tau (n x d_i), so with the same points the twist is
     // sum n . (d_i x (F_i - share)). Only then: from other points, or some of them, that
     // moment is not the twist they carried, and warm starting it spun large_pyramid's bottom
@@ -667,8 +699,9 @@ class SoftStep final : public PushMethod {
     at(group.fixed_limit, l) = f.fixed_limit;
   }
 
-  // Lane l of group g, manifold k of ctx, as the scalar manifold and points the restitution and store() read: f
-  // (its bodies, friction at the centre and impulses; its points numbered from 0) and points
+  // Lane l of group g, manifold k of ctx, as the scalar manifold and points the restitution and
+  // write_lambda() read: f (its bodies, friction at the centre and impulses; its points numbered
+  // from 0) and points
   // [points, points + count) with their rows, anchors, normals, impulses and the step's totals
   // when kept (their I^-1 (r x n) and masses are not kept in lanes: set_axis_row forms them),
   // and their restitution targets where prepare() kept them.
@@ -1058,9 +1091,8 @@ class SoftStep final : public PushMethod {
     }
   }
 
-  // Stage "store impulses": lambda = P / h per row into ctx (for the warm-start cache) and the
-  // bodies' momenta.
-  void store(StepContext& ctx, double h) {
+  // Stage "store impulses": the bodies' momenta.
+  void store_momenta(StepContext& ctx) {
     std::vector<Body>& bodies = *ctx.bodies;
     parallel_for(workers_, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
@@ -1071,12 +1103,56 @@ class SoftStep final : public PushMethod {
         body.l = inertia_[i] * s.w;
       }
     });
+  }
+
+  // Stage "store impulses", Box3D's warm start (b3StoreImpulses): each manifold's points' normal
+  // impulses, its friction impulse as a vector and its twist, over the substep (inv_h = 1 / h,
+  // 1/s), into the cache; and the rods'.
+  void store_warm_start(StepContext& ctx, double inv_h) {
+    WarmStartCache& cache = *ctx.warm_start;
+    cache.begin_store(ctx.manifolds);
+    parallel_for(workers_, manifolds_.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+      std::array<double, kMaxManifoldPoints> normal{};
+      for (std::size_t k = begin; k < end; ++k) {
+        Vec3 friction = Vec3::Zero();
+        double twist = 0.0;
+        if (lanes_ && manifold_colour_[k] != ConstraintGraph::kOverflow) {
+          const auto [g, l] = lane_of(k);
+          const LaneGroup& group = groups_[g];
+          const LanePoint* q = lane_points_.data() + group.first_point;
+          const auto count = static_cast<std::size_t>(group.count[l]);
+          for (std::size_t i = 0; i < count; ++i) normal[i] = q[i].impulse[l] * inv_h;
+          if (sweep_.friction) {
+            friction = (group.impulse1[l] * inv_h) * Vec3(group.t1.x[l], group.t1.y[l], group.t1.z[l]) +
+                       (group.impulse2[l] * inv_h) * Vec3(group.t2.x[l], group.t2.y[l], group.t2.z[l]);
+            twist = group.twist_impulse[l] * inv_h;
+          }
+        } else {
+          const ManifoldFriction& f = manifolds_[slot_[k]];
+          const ContactPoint* points = contacts_.data() + f.begin;
+          for (std::size_t i = 0; i < f.end - f.begin; ++i) normal[i] = points[i].normal.impulse * inv_h;
+          if (f.first_friction_row >= 0) {
+            friction = (f.impulse.x() * inv_h) * f.t1 + (f.impulse.y() * inv_h) * f.t2;
+            twist = f.twist_impulse * inv_h;
+          }
+        }
+        cache.store_manifold(k, ctx.manifolds[k], normal.data(), friction, twist);
+      }
+    });
+    detail::resize_with_headroom(rod_lambda_, rods_.size());
+    const std::size_t first_rod = ctx.layout.first_rod();
+    for (const Rod& rod : rods_) rod_lambda_[static_cast<std::size_t>(rod.row) - first_rod] = rod.impulse * inv_h;
+    cache.end_store(rod_lambda_.data(), rod_lambda_.size());
+  }
+
+  // ctx.lambda (c, N): lambda = P / h per row (inv_h = 1 / h, 1/s), a manifold's friction as
+  // forces at its points' friction rows (store_manifold()); shared among `workers` (or null).
+  void write_lambda(StepContext& ctx, double inv_h, Workers* workers) const {
     // Every row is written below: the contact rows by their points, the friction rows (when the
     // world has friction, every manifold has them) by their manifolds, the rods' by the rods.
     detail::resize_with_headroom(ctx.lambda, ctx.rows.size());
-    const double inv_h = 1.0 / h;
     // In ctx's order, which writes the rows and reads the warm-start cache's tangents in order.
-    parallel_for(workers_, manifolds_.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    parallel_for(workers, manifolds_.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
       ManifoldFriction f;
       std::array<ContactPoint, kMaxManifoldPoints> scratch;
       for (std::size_t k = begin; k < end; ++k) {
@@ -1091,7 +1167,6 @@ class SoftStep final : public PushMethod {
       }
     });
     for (const Rod& rod : rods_) ctx.lambda[static_cast<std::size_t>(rod.row)] = rod.impulse * inv_h;
-    ctx.lambda_second.clear();
   }
 
   // Manifold f's rows of `lambda` (N) from its points [points, points + count) and impulses over
@@ -1127,6 +1202,8 @@ class SoftStep final : public PushMethod {
   }
 
   Workers* workers_ = nullptr;             // the step's threads (StepContext::workers) or one_thread_
+  double inv_h_ = 0.0;                     // 1/s: 1 / the last step's substep, for write_lambda()
+  std::vector<double> rod_lambda_;         // N: the rods' lambdas in the world's order (store_warm_start())
   Workers one_thread_{1};                  // the calling thread alone
   std::size_t bodies_ = 0;                 // n: the step's bodies
   std::vector<SolverBody> solver_bodies_;  // n + threads: the bodies, then each thread's static stand-in

@@ -77,7 +77,7 @@ struct StepContext {
   std::vector<Manifold> manifolds;    ///< Sec. 4: the manifolds of this step's collide stage
   std::vector<ConstraintRow> rows;    ///< Sec. 5: c rows: contacts, friction, rods
   RowLayout layout;                   ///< where each kind of row sits in `rows`
-  std::vector<double> lambda;         ///< c, N: the solve that sets the step's result
+  std::vector<double> lambda;         ///< c, N: the solve that sets the step's result (see lambda_pending)
   std::vector<double> lambda_second;  ///< c, N: the second solve of Sec. 8.1 (split only)
   Eigen::VectorXd f_ext;              ///< 6n: f_ext = [m g, 0] per movable body (Sec. 6.1)
   Eigen::VectorXd f_cv;               ///< 6n: f_ext + J^T lambda, the force that moves positions

@@ -556,8 +556,8 @@ class SoftStep final : public PushMethod {
     }
     // The warm start by row (the restart variant): the friction rows' initial lambdas (N)
     // summed back into the force at the centre and its twist about the normal, as impulses over
-    // h. write_lambda() writes each point's force as an equal share of the centre's plus the twist's
-    // tangential force tau (n x d_i), so with the same points the twist is
+    // h. write_lambda() writes each point's force as an equal share of the centre's plus the
+    // twist's tangential force tau (n x d_i), so with the same points the twist is
     // sum n . (d_i x (F_i - share)). Only then: from other points, or some of them, that
     // moment is not the twist they carried, and warm starting it spun large_pyramid's bottom
     // boxes about their normals at up to 11 rad/s within 1 s.
@@ -701,10 +701,9 @@ class SoftStep final : public PushMethod {
 
   // Lane l of group g, manifold k of ctx, as the scalar manifold and points the restitution and
   // write_lambda() read: f (its bodies, friction at the centre and impulses; its points numbered
-  // from 0) and points
-  // [points, points + count) with their rows, anchors, normals, impulses and the step's totals
-  // when kept (their I^-1 (r x n) and masses are not kept in lanes: set_axis_row forms them),
-  // and their restitution targets where prepare() kept them.
+  // from 0) and points [points, points + count) with their rows, anchors, normals, impulses and
+  // the step's totals when kept (their I^-1 (r x n) and masses are not kept in lanes:
+  // set_axis_row forms them), and their restitution targets where prepare() kept them.
   void lane_manifold(const RowLayout& layout, std::size_t k,
                      std::size_t g, int l, ManifoldFriction& f, ContactPoint* points) const {
     const LaneGroup& group = groups_[g];

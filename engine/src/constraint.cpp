@@ -105,7 +105,7 @@ void write_normal_rows(const Manifold& m, const std::vector<Body>& bodies,
     contact.kind = RowKind::contact;
     contact.body_a = m.body_a;
     contact.body_b = m.body_b;
-    write_axis_row(contact.j, c.normal, c.point - a.x, c.point - b.x);
+    write_axis_row(contact.j, c.normal, c.point - a.x, point_on_b(m, c) - b.x);
     if (c.depth >= 0.0) {
       // Eq. 5.3.1 (docs/conventions.md, Sec. 3): C = -d, v = -beta C / dt = beta d / dt > 0 opens
       // it; with a penetration slop s, C = -max(d - s, 0) (s = 0: the paper's push).
@@ -152,7 +152,7 @@ void write_friction_rows(const Manifold& m, const std::vector<Body>& bodies,
   for (int i = 0; i < m.count; ++i) {
     const Contact& c = m.contacts[static_cast<std::size_t>(i)];
     const Vec3 r_a = c.point - a.x;
-    const Vec3 r_b = c.point - b.x;
+    const Vec3 r_b = point_on_b(m, c) - b.x;
     const double limit = friction_limit(mu, a, b, m.count, params.gravity, c.normal);
     Vec3 t[2];
     if (tangents != nullptr) {

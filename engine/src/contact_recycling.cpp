@@ -60,13 +60,15 @@ bool ContactRecycler::recycle(int a, int b, const std::vector<Body>& bodies, dou
   const double radius = std::max(bounding_radius(body_a), bounding_radius(body_b));
   if (moved + 2.0 * turn.vec().norm() * radius >= distance) return false;
   // The points, fixed to the bodies since caching: their separation along the cached normal
-  // changes by n . (motion of b's point - motion of a's point); the point lies midway between
-  // the two bodies' points.
+  // changes by n . (motion of b's point - motion of a's point). The anchors used to apply
+  // impulses stay as cached (world vectors from each centre), as Box3D keeps them
+  // (b3CollideTask); so a point is a's anchor and b's lies anchor_shift from it.
   const Mat3 dR_a = (body_a.o * c.o_a.conjugate()).toRotationMatrix();
   const Mat3 dR_b = (body_b.o * c.o_b.conjugate()).toRotationMatrix();
   out.body_a = a;
   out.body_b = b;
   out.count = c.count;
+  out.anchor_shift = (body_b.x - c.x_b) - (body_a.x - c.x_a);
   for (int i = 0; i < c.count; ++i) {
     const CachedPoint& p = c.points[static_cast<std::size_t>(i)];
     const Vec3 r_a = dR_a * p.r_a;
@@ -74,7 +76,7 @@ bool ContactRecycler::recycle(int a, int b, const std::vector<Body>& bodies, dou
     const Vec3 moved_a = (body_a.x - c.x_a) + (r_a - p.r_a);
     const Vec3 moved_b = (body_b.x - c.x_b) + (r_b - p.r_b);
     Contact& contact = out.contacts[static_cast<std::size_t>(i)];
-    contact.point = 0.5 * ((body_a.x + r_a) + (body_b.x + r_b));
+    contact.point = body_a.x + p.r_a;
     contact.normal = c.normal;
     contact.depth = p.depth - c.normal.dot(moved_b - moved_a);
     contact.feature = p.feature;
@@ -126,7 +128,7 @@ void ContactRecycler::keep_at(std::size_t at, const Manifold& m, const std::vect
     const Contact& contact = m.contacts[static_cast<std::size_t>(i)];
     CachedPoint& p = c.points[static_cast<std::size_t>(i)];
     p.r_a = contact.point - body_a.x;
-    p.r_b = contact.point - body_b.x;
+    p.r_b = point_on_b(m, contact) - body_b.x;
     p.depth = contact.depth;
     p.feature = contact.feature;
   }

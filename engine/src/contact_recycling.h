@@ -2,9 +2,10 @@
 // Contact recycling (WorldDef::contact_recycle_distance), after Box3D (erincatto/box3d
 // src/physics_world.c, b3CollideTask: "contact recycling optimization", and Box2D v3.2): while
 // two bodies have barely moved relative to each other since their manifold was last made by the
-// narrow phase, the collide stage keeps that manifold (its points fixed to the bodies, its
-// normal and feature ids) and only updates each point's depth, as the soft step's substeps do,
-// instead of clipping again. The clipped points of resting boxes whose faces are exactly aligned
+// narrow phase, the collide stage keeps that manifold (its normal, feature ids and anchors: the
+// world vectors from each body's centre to its points when it was made, which do not turn with
+// the bodies) and only updates each point's depth, as the soft step's substeps do, instead of
+// clipping again. The clipped points of resting boxes whose faces are exactly aligned
 // otherwise change their feature ids from step to step (a vertex on a side plane is kept or clipped
 // by round-off), and each change starts the point's warm start from 0.
 

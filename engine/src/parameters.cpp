@@ -286,7 +286,8 @@ const std::array kParameters = {
               .type = ParameterType::real,
               .min = 0.0,
               .max = 1.0e6,
-              .help = "contact recycling: a manifold is kept, its depths updated, while its "
+              .help = "contact recycling: a manifold is kept, its anchors as made and its depths "
+                      "updated, while its "
                       "bodies move relative to each other by less than this since it was made "
                       "(and turn less than 10 degrees); 0 = clip every step, as the paper; "
                       "Box3D's 0.05",

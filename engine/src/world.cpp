@@ -236,11 +236,13 @@ void World::collide() {
 }
 
 namespace {
-// Copies a manifold's pair, count and its `count` contacts (the slots past them are never read).
+// Copies a manifold's pair, count, anchor shift and its `count` contacts (the slots past them are
+// never read).
 void copy_used_contacts(const Manifold& from, Manifold& to) {
   to.body_a = from.body_a;
   to.body_b = from.body_b;
   to.count = from.count;
+  to.anchor_shift = from.anchor_shift;
   std::copy_n(from.contacts.begin(), from.count, to.contacts.begin());
 }
 }  // namespace
@@ -295,6 +297,7 @@ void World::collide_pairs(Workers* workers) {
         per_body ? def_.contact_margin + margins_[ia] + margins_[ib] : def_.contact_margin;
     if (recycler != nullptr && recycler->recycle(a, b, bodies_, recycle, m, cursor)) return true;
     cursor.found = ContactRecycler::kNone;
+    m.anchor_shift = Vec3::Zero();
     if (cps::collide(bodies_[ia], rotations_[ia], bodies_[ib], rotations_[ib], m, margin) == 0) return false;
     if (def_.manifold_points == ManifoldPoints::four) reduce_manifold(m, def_.contact_margin);
     return true;

@@ -488,10 +488,11 @@ TEST_CASE("reducing a manifold to 4 points keeps clipped points that hold the co
 TEST_CASE("contact recycling keeps a manifold while the bodies barely move, with the depths a "
           "new clip gives", "[collision][recycling]") {
   // A box of 1 m resting 1 cm deep on the ground. Moved rigidly by less than the recycling
-  // distance, its manifold is kept: the same feature ids, each point midway between where the
-  // ground and the box have carried it (half the box's motion), its depth changed by the box's
-  // motion along the normal, exactly what clipping again gives for a
-  // move along the normal and a slide within the face. Moved further than the distance, or
+  // distance, its manifold is kept: the same feature ids, each body's anchor (world vector from
+  // its centre) as made, so a point stays where the ground holds it and the box holds it the
+  // box's motion further on (anchor_shift), its depth changed by the box's motion along the
+  // normal, exactly what clipping again gives for a move along the normal and a slide within the
+  // face. Turned, the box keeps its anchors unturned (Box3D's recycling). Moved further than the distance, or
   // turned by more than 10 degrees, it is not kept (the bound of contact_recycling.h: the
   // relative motion plus 2 sin(turn / 2) times the bounding radius, 0.866 m).
   std::vector<Body> bodies;
@@ -536,7 +537,8 @@ TEST_CASE("contact recycling keeps a manifold while the bodies barely move, with
       const Contact& o = first.contacts[static_cast<std::size_t>(i)];
       CHECK(k.feature == o.feature);
       CHECK(k.normal == o.normal);
-      CHECK((k.point - (o.point + 0.5 * Vec3(0.01, -0.003, 0.02))).norm() < 1e-12);
+      CHECK((k.point - o.point).norm() < 1e-12);  // the ground did not move
+      CHECK((point_on_b(kept, k) - (o.point + Vec3(0.01, -0.003, 0.02))).norm() < 1e-12);
       CHECK(k.depth == Approx(o.depth + 0.003).margin(1e-12));
       bool same = false;  // the new clip's point of the same feature: the same depth
       for (int j = 0; j < 4; ++j) {
@@ -564,6 +566,13 @@ TEST_CASE("contact recycling keeps a manifold while the bodies barely move, with
   recycler.begin_step();
   Manifold kept;
   CHECK(recycler.recycle(0, 1, moved(Vec3::Zero(), 3.0), 0.05, kept, fresh_cursor));
+  for (int i = 0; i < kept.count; ++i) {  // a turn about the normal: the same anchors and depths
+    const Contact& k = kept.contacts[static_cast<std::size_t>(i)];
+    const Contact& o = first.contacts[static_cast<std::size_t>(i)];
+    CHECK((k.point - o.point).norm() < 1e-12);
+    CHECK((point_on_b(kept, k) - o.point).norm() < 1e-12);
+    CHECK(k.depth == Approx(o.depth).margin(1e-12));
+  }
   recycler.begin_step();
   CHECK_FALSE(recycler.recycle(0, 1, moved(Vec3::Zero(), 3.0), 0.04, kept, fresh_cursor));
   recycler.begin_step();

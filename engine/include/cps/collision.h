@@ -52,7 +52,8 @@ constexpr ContactFeatureKind contact_feature_kind(std::uint32_t feature) {
 /// One contact point. normal: unit 3-vector from body a to body b (the direction along which
 /// b must move to separate). depth: penetration along the normal (m); negative for a
 /// speculative contact, where -depth is the gap (less than the collision margin). point: world
-/// position (m), midway between the two surfaces. feature: which features of the two shapes it
+/// position (m), midway between the two surfaces; in a recycled manifold, body a's anchor
+/// (Manifold::anchor_shift). feature: which features of the two shapes it
 /// comes from (ContactFeatureKind); a contact of the next step with the same body pair and the
 /// same feature is the same contact.
 struct Contact {
@@ -61,6 +62,11 @@ struct Contact {
   double depth = 0.0;
   std::uint32_t feature = 0;
 };
+
+struct Manifold;
+
+/// Contact c of manifold m as body b holds it: world position (m). No errors.
+inline Vec3 point_on_b(const Manifold& m, const Contact& c);
 
 /// Most points a manifold holds: clipping a quadrilateral against four planes leaves at most 8.
 inline constexpr int kMaxManifoldPoints = 8;
@@ -72,11 +78,17 @@ struct Manifold {
   int body_b = -1;
   int count = 0;
   std::array<Contact, kMaxManifoldPoints> contacts{};
+  /// m: where body b holds the points, relative to `point`: 0 for a manifold the narrow phase
+  /// made; in a recycled one (contact_recycling.h) both bodies keep the anchors of its making
+  /// (world vectors from their centres) while their centres move apart by this.
+  Vec3 anchor_shift = Vec3::Zero();
 
   void add(const Contact& c) {
     if (count < kMaxManifoldPoints) contacts[static_cast<std::size_t>(count++)] = c;
   }
 };
+
+inline Vec3 point_on_b(const Manifold& m, const Contact& c) { return c.point + m.anchor_shift; }
 
 /// Tests bodies a and b and writes their contacts into `out` (out.count = 0 when they are
 /// further apart than `margin`). Normals point from a to b. Returns out.count. margin (m, >= 0):

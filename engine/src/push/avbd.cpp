@@ -224,7 +224,7 @@ class Avbd final : public PushMethod {
       s.feature = c.feature;
       s.mu = pair_friction(def.friction, a.friction, b.friction);
       s.local_a = Ra_t * (c.point + 0.5 * c.depth * c.normal - a.x);
-      s.local_b = Rb_t * (c.point - 0.5 * c.depth * c.normal - b.x);
+      s.local_b = Rb_t * (point_on_b(m, c) - 0.5 * c.depth * c.normal - b.x);
       s.lambda = {0.0, 0.0, 0.0};
       s.k = {0.0, 0.0, 0.0};
       const auto found = std::lower_bound(

@@ -508,7 +508,7 @@ class SoftStep final : public PushMethod {
       p.b = f.b;
       p.row = static_cast<int>(g);
       p.r_a = c.point - body_a.x;
-      p.r_b = c.point - body_b.x;
+      p.r_b = point_on_b(m, c) - body_b.x;
       p.base_separation = -c.depth - c.normal.dot(p.r_b - p.r_a);
       if (bouncy) {
         p.restitution = restitution_target(axis_row(c.normal, p.r_a, p.r_b), c, vel_a, vel_b, eps,

@@ -112,10 +112,10 @@ class TemporalGaussSeidel final : public PushMethod {
   void begin(const std::vector<Manifold>& manifolds, const std::vector<Body>& bodies) {
     contacts_.clear();
     detail::reserve_with_headroom(contacts_, contact_point_count(manifolds));
-    for_each_contact_point(manifolds, bodies, [this](const Manifold&, const Contact& c,
+    for_each_contact_point(manifolds, bodies, [this](const Manifold& m, const Contact& c,
                                                      const Body& a, const Body& b,
                                                      const Mat3& Ra_t, const Mat3& Rb_t) {
-      contacts_.push_back({Ra_t * (c.point - a.x), Rb_t * (c.point - b.x), c.normal, c.depth});
+      contacts_.push_back({Ra_t * (c.point - a.x), Rb_t * (point_on_b(m, c) - b.x), c.normal, c.depth});
     });
     detail::resize_with_headroom(momenta_, bodies.size());
     for (std::size_t i = 0; i < bodies.size(); ++i) momenta_[i] = {bodies[i].p, bodies[i].l};

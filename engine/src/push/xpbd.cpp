@@ -202,7 +202,7 @@ class Xpbd final : public PushMethod {
       p.body_b = m.body_b;
       p.normal = c.normal;
       p.local_a = Ra_t * (c.point + 0.5 * c.depth * c.normal - a.x);
-      p.local_b = Rb_t * (c.point - 0.5 * c.depth * c.normal - b.x);
+      p.local_b = Rb_t * (point_on_b(m, c) - 0.5 * c.depth * c.normal - b.x);
       p.target = std::max(c.depth - cap, def.penetration_slop);
       p.allowed = def.penetration_slop;
     });

@@ -44,8 +44,8 @@ class ContactRecycler {
   /// when the last step had a manifold for it and the bodies have moved relative to its cached
   /// poses by less than `distance` (m, > 0) at every point within their bounding radius, and
   /// neither has turned by more than about 10 degrees, writes the recycled manifold into `out`
-  /// (each point midway between where the two bodies have carried it, its depth changed by their
-  /// relative motion along the cached normal), sets cursor.found and returns true; else returns
+  /// (each body's anchors as cached: a point is a's anchor, b's lies out.anchor_shift from it;
+  /// its depth changed by their relative motion along the cached normal), sets cursor.found and returns true; else returns
   /// false with cursor.found = kNone and `out` untouched. Reads only the last step's cache, so
   /// threads may look up at once. No errors.
   bool recycle(int a, int b, const std::vector<Body>& bodies, double distance, Manifold& out,

@@ -12,7 +12,8 @@
 // correction; the velocities are not touched):
 //   contact point: its two witness points move with their bodies (fixed in each body's frame
 //     from the point and depth the collision gave at the start of the step; Contact::point is
-//     midway, so p_a = point + n d/2 and p_b = point - n d/2); the normal n keeps its world
+//     midway, so p_a = point + n d/2 and p_b = point_on_b - n d/2, point_on_b = point but in a
+//     recycled manifold); the normal n keeps its world
 //     direction (as Jolt's; Box2D 2.4 rotates it with the reference body). Separation
 //     s = n . (p_b - p_a) (< 0: overlap), and
 //       C = clamp(beta (s + slop), -max_correction, 0)

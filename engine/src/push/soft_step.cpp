@@ -86,12 +86,11 @@
 // result is the same bit for bit; the overflow, the rods and the restart variant are swept one
 // at a time.
 //
-// Differences from Box3D: double precision (its lanes are floats); the manifolds as the collide stage
-// makes them (WorldDef::manifold_points and contact_recycle_distance choose Box3D's 4 points and
-// its recycling; Box3D's recycled anchors stay as they were, a cps point is midway between the
-// bodies' material points); no rolling resistance, no gyroscopic term (Box3D integrates one; for the
-// spheres and cubes of the scenes it is zero), no speed caps on the bodies (Box3D clamps at
-// 400 m/s and a quarter turn a step).
+// Differences from Box3D: double precision (its lanes are floats); the manifolds as the collide
+// stage makes them (WorldDef::manifold_points and contact_recycle_distance choose Box3D's 4
+// points and its recycling, whose anchors stay as they were made, as Box3D's); no rolling
+// resistance, no gyroscopic term (Box3D integrates one; for the spheres and cubes of the scenes
+// it is zero), no speed caps on the bodies (Box3D clamps at 400 m/s and a quarter turn a step).
 // The solvers of A lambda = b (--solver, --assembly) play no part: the rows are swept as the
 // source sweeps them, Gauss-Seidel over body velocities.
 

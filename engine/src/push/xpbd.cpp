@@ -24,7 +24,7 @@
 //        x_b += m_b^-1 P, o_b turned by I_b^-1 (r_b x P); x_a -= m_a^-1 P, o_a by -I_a^-1 (r_a x P)
 //      (the turn as Eq. 3.2.4's linear update, then normalised).
 //        contact: its two witness points fixed in the bodies' frames (Contact::point is midway:
-//          p_a = point + n d/2, p_b = point - n d/2, as ngs.cpp), n its normal of the start of
+//          p_a = point + n d/2, p_b = point_on_b - n d/2, as ngs.cpp), n its normal of the start of
 //          the step (a to b, kept in the world frame), C = n . (p_b - p_a) + allowed, acted on
 //          when C < 0 (rigid: alpha = 0, as the paper's contacts), `allowed` the slop (or the
 //          overlap the pre-stabilisation below left);

@@ -114,6 +114,12 @@ constexpr std::array kSoftRelaxChoices = {
     Choice{"restart", static_cast<int>(SoftRelax::restart), "Sec. 8.1",
            "relax from the substep's start and the last relax's impulses"},
 };
+constexpr std::array kXpbdFrictionOrderChoices = {
+    Choice{"point", static_cast<int>(XpbdFrictionOrder::point), "Mueller et al. 2020",
+           "each point's friction right after its normal"},
+    Choice{"manifold", static_cast<int>(XpbdFrictionOrder::manifold), "Solver2D",
+           "a manifold's friction after all of its normals"},
+};
 constexpr std::array kRotationChoices = {
     Choice{"linear", static_cast<int>(RotationUpdate::linear), "Eq. 3.2.4", "linear orientation update"},
     Choice{"exact", static_cast<int>(RotationUpdate::exact), "Eq. 12.4.1", "axis-angle orientation update"},
@@ -476,6 +482,16 @@ const std::array kParameters = {
                       "and a velocity pass; typical 20",
               .get = &get_member<&WorldDef::xpbd_substeps>,
               .set = &set_member<&WorldDef::xpbd_substeps>},
+    Parameter{.name = "xpbd_friction_order",
+              .flag = "xpbd-friction-order",
+              .json_key = "xpbd_friction_order",
+              .type = ParameterType::choice,
+              .choices = kXpbdFrictionOrderChoices,
+              .help = "push xpbd: where a contact point's static and dynamic friction are taken; "
+                      "point: right after its own normal; manifold: after all of its manifold's "
+                      "normals (E. Catto's Solver2D)",
+              .get = &get_member<&WorldDef::xpbd_friction_order>,
+              .set = &set_member<&WorldDef::xpbd_friction_order>},
     Parameter{.name = "xpbd_compliance",
               .flag = "xpbd-compliance",
               .json_key = "xpbd_compliance_m_per_n",

@@ -406,9 +406,11 @@ namespace {
 
 // A 1 kg cube of 0.5 m half side resting on a floor (world friction 0.5, gravity 10 m/s^2),
 // sliding along +x at 5 m/s from the start, under `push`, with the cube's own friction `cube`
-// and the floor's own `floor` ("" for none): how far it slides in 3 s (m).
-double slide_distance(const std::string& push, const std::string& cube, const std::string& floor) {
-  std::string text = R"({"world": {"friction": 0.5, "push": ")" + push + R"("}, "bodies": [
+// and the floor's own `floor` ("" for none), and `world` more world parameters ("" or JSON
+// members each with a leading comma): how far it slides in 3 s (m).
+double slide_distance(const std::string& push, const std::string& cube, const std::string& floor,
+                      const std::string& world = "") {
+  std::string text = R"({"world": {"friction": 0.5, "push": ")" + push + R"(")" + world + R"(}, "bodies": [
     {"shape": "plane", "static": true, "normal": [0, 1, 0], "offset_m": 0)";
   if (!floor.empty()) text += R"(, "friction": )" + floor;
   text += R"(},
@@ -451,6 +453,12 @@ TEST_CASE("a body's own friction: a contact takes the geometric mean of its two 
       // stopping distances in the ratio 0.5 / 0.4.
       CHECK(mixed / world == Approx(0.5 / 0.4).epsilon(0.03));
       CHECK(world == Approx(2.5).epsilon(0.15));
+      // With each manifold's friction after all of its normals (Solver2D's order), the normal
+      // impulses of the position pass carry all the support, and the cube stops where Coulomb
+      // friction stops it.
+      const std::string manifold = R"(, "xpbd_friction_order": "manifold")";
+      CHECK(slide_distance(push, "", "", manifold) == Approx(2.5).margin(tol + 0.05));
+      CHECK(slide_distance(push, "0.2", "0.8", manifold) == Approx(3.125).margin(tol + 0.06));
     } else {
       CHECK(world == Approx(2.5).margin(tol + 0.05));
       CHECK(mixed == Approx(3.125).margin(tol + 0.06));

@@ -124,6 +124,13 @@ enum class SoftRelax {
   restart,         ///< from the velocities before the soft solve and the last relax's impulses
 };
 
+/// Where XPBD (push xpbd, engine/src/push/xpbd.cpp) takes a contact point's friction, in the
+/// position pass (static) and the velocity pass (dynamic) alike (WorldDef::xpbd_friction_order).
+enum class XpbdFrictionOrder {
+  point,     ///< right after the point's own normal, point by point
+  manifold,  ///< after the normals of all of its manifold's points, as E. Catto's Solver2D
+};
+
 /// How A lambda = b is represented while it is solved.
 enum class Assembly {
   explicit_matrices,  ///< sparse J, M^-1 and A = J M^-1 J^T built every step (Sec. 6), as the
@@ -233,6 +240,10 @@ struct WorldDef {
   /// XPBD only: the rods' compliance alpha (m/N, >= 0), the inverse of their stiffness; 0 (the
   /// default) is a rigid rod, as the source's joints; contacts are always rigid.
   double xpbd_compliance = 0.0;
+  /// XPBD only: where a contact point's static and dynamic friction are taken (choice): point
+  /// (the default) right after its own normal; manifold after all of its manifold's normals
+  /// (Solver2D's reading of Mueller et al. 2020, Secs. 3.5 and 3.6).
+  XpbdFrictionOrder xpbd_friction_order = XpbdFrictionOrder::point;
   /// AVBD (push avbd) only: the penalty ramp beta (N/m per m of error, >= 0): after each sweep a
   /// row inside its force limits stiffens by beta |C|. The authors' 2D demo: 1e5.
   double avbd_beta = 1.0e5;

@@ -14,8 +14,9 @@
 // and v, w their velocities (m^-1 p, I^-1 l):
 //   1. x_prev = x, o_prev = o; the momenta take f_ext h and the bodies move over h with them
 //      (semi-implicit Euler, Eqs. 3.2.1-3.2.4: the paper's integration of Algorithm 2);
-//   2. one Gauss-Seidel sweep over the contacts in the collide stage's order, then the rods (Sec.
-//      3.3). A constraint C between points at offsets r_a, r_b from the centres of mass, along
+//   2. one Gauss-Seidel sweep over the contacts in the collide stage's order (each point's static
+//      friction right after its normal correction, or after those of all of its manifold's
+//      points: WorldDef::xpbd_friction_order, below), then the rods (Sec. 3.3). A constraint C between points at offsets r_a, r_b from the centres of mass, along
 //      the unit axis k (the gradient of C at body b), with the generalised inverse masses
 //        w_i = m_i^-1 + (r_i x k)^T I_i^-1 (r_i x k)   (1/kg; 0 for a static body or the world)
 //      and the compliance alpha (m/N) as alpha~ = alpha / h^2, gets
@@ -37,12 +38,19 @@
 //      momenta p = m v, l = I w with I of the new orientation;
 //   4. the velocity pass (Sec. 3.6) over every contact that acted in 2 (lambda_n > 0), with v_n
 //      = n . (u_b - u_a) the points' normal velocity (> 0: separating) and u_t their tangential
-//      one: dynamic friction applies the impulse -u_t / |u_t| min(mu lambda_n / h, |u_t| / w_t)
-//      (N s; the paper's velocity change min(h mu |f_n|, |u_t|), f_n = lambda_n / h^2, written
-//      as an impulse so that its units agree), and the normal velocity is set to
-//      max(-eps v~_n, 0), v~_n its pre-solve value (after step 1; eps = WorldDef::restitution
-//      when -v~_n exceeds the restitution threshold, else 0; the paper uses 2 |g| h there), each
-//      as a velocity impulse (N s) Delta v / (w_a + w_b) along its direction.
+//      one: the normal velocity is set to max(-eps v~_n, 0), v~_n its pre-solve value (after
+//      step 1; eps = WorldDef::restitution when -v~_n exceeds the restitution threshold, else
+//      0; the paper uses 2 |g| h there), and dynamic friction applies the impulse -u_t / |u_t|
+//      min(mu lambda_n / h, |u_t| / w_t) (N s; the paper's velocity change min(h mu |f_n|,
+//      |u_t|), f_n = lambda_n / h^2, written as an impulse so that its units agree); each a
+//      velocity impulse (N s) Delta v / (w_a + w_b) along its direction.
+//   Friction order (WorldDef::xpbd_friction_order). point: in 2 each point's static friction
+//   right after its normal correction, in 4 both impulses of a point from the same velocities.
+//   manifold, E. Catto's reading of the paper (Solver2D, solve_xpbd.c): a manifold's normal
+//   corrections first, then their friction, in 2 and in 4. Under point, the turn a point's
+//   friction gives the body is taken back by the next points' normal corrections, which in 4
+//   carry support outside lambda_n: a cube sliding on the ground stops 11 % late, against 0.3 %
+//   under manifold (docs/findings.md, "TGS and XPBD").
 //
 // Contacts. As the paper's Sec. 3.5, the contacts are collected once per step and followed
 // through the substeps: their points stay fixed in the bodies' frames and each substep measures
@@ -166,6 +174,7 @@ class Xpbd final : public PushMethod {
     // This substep's results: the normal positional impulse (kg m), the static friction one on b
     // (kg m), the velocity pass's impulse on b (N s).
     double lambda_n = 0.0;
+    bool first = false;  // the first point of its manifold
     Vec3 friction = Vec3::Zero();
     Vec3 velocity_impulse = Vec3::Zero();
   };
@@ -201,6 +210,7 @@ class Xpbd final : public PushMethod {
       p.body_a = m.body_a;
       p.body_b = m.body_b;
       p.normal = c.normal;
+      p.first = &c == m.contacts.data();
       p.local_a = Ra_t * (c.point + 0.5 * c.depth * c.normal - a.x);
       p.local_b = Rb_t * (point_on_b(m, c) - 0.5 * c.depth * c.normal - b.x);
       p.target = std::max(c.depth - cap, def.penetration_slop);
@@ -352,45 +362,74 @@ class Xpbd final : public PushMethod {
     for (Point& p : points_) p.allowed = std::max(overlap(bodies, p), def.penetration_slop);
   }
 
-  // Step 2: one sweep over the contacts (with static friction), then the rods.
+  // Step 2: one sweep over the contacts, manifold by manifold (its points' normals, then their
+  // static friction), then the rods.
   void solve_positions(std::vector<Body>& bodies, const std::vector<DistanceConstraint>& distances,
                        const WorldDef& def, double h) {
     for (Point& p : points_) {
       p.lambda_n = 0.0;
       p.friction.setZero();
       p.velocity_impulse.setZero();
-      const auto ia = static_cast<std::size_t>(p.body_a);
-      const auto ib = static_cast<std::size_t>(p.body_b);
-      Body& a = bodies[ia];
-      Body& b = bodies[ib];
-      const Vec3 pa = world_point(a, p.local_a);
-      const Vec3 pb = world_point(b, p.local_b);
-      const double C = p.normal.dot(pb - pa) + p.allowed;
-      if (!(C < 0.0)) continue;
-      p.lambda_n = correct(&a, ia, &b, ib, pa, pb, p.normal, C, 0.0);
-      const double mu = pair_friction(def.friction, a.friction, b.friction);
-      if (!(mu > 0.0)) continue;
-      // Static friction (Sec. 3.5): the points' tangential motion over the substep, undone when
-      // the impulse it takes stays within mu lambda_n. Gauss-Seidel reads the points after the
-      // normal correction; Jacobi the state of the sweep.
-      const Vec3 qa = world_point(a, p.local_a);
-      const Vec3 qb = world_point(b, p.local_b);
-      const Vec3 pa_prev = state_[ia].x + state_[ia].R * p.local_a;
-      const Vec3 pb_prev = state_[ib].x + state_[ib].R * p.local_b;
-      const Vec3 dp = (qa - pa_prev) - (qb - pb_prev);
-      const Vec3 dp_t = dp - p.normal.dot(dp) * p.normal;
-      const double slip = dp_t.norm();
-      if (!(slip > 0.0)) continue;
-      const Vec3 t = dp_t / slip;  // a's motion relative to b
-      const double w = inverse_mass(&a, qa - a.x, t) + inverse_mass(&b, qb - b.x, t);
-      if (!(w > 0.0) || !(slip / w < mu * p.lambda_n)) continue;
-      // -C along t moves b by +slip/w t and a by -slip/w t: the relative motion cancelled.
-      correct(&a, ia, &b, ib, qa, qb, t, -slip, 0.0);
-      p.friction = (slip / w) * t;
+    }
+    for (std::size_t begin = 0; begin < points_.size();) {
+      const std::size_t end = friction_run_end(begin, def);
+      for (std::size_t i = begin; i < end; ++i) apply_normal(bodies, points_[i]);
+      for (std::size_t i = begin; i < end; ++i) apply_static_friction(bodies, def, points_[i]);
+      begin = end;
     }
     flush(bodies, false);
     detail::resize_with_headroom(rod_lambda_, distances.size());
     sweep_rods(bodies, distances, nullptr, def.xpbd_compliance / (h * h), &rod_lambda_);
+  }
+
+  // One past the last point whose normal comes before the friction of the point at `begin`:
+  // that point alone, or the rest of its manifold (WorldDef::xpbd_friction_order).
+  std::size_t friction_run_end(std::size_t begin, const WorldDef& def) const {
+    std::size_t end = begin + 1;
+    if (def.xpbd_friction_order == XpbdFrictionOrder::point) return end;
+    while (end < points_.size() && !points_[end].first) ++end;
+    return end;
+  }
+
+  // Contact (Sec. 3.5): moves a point that overlaps by more than it may keep out to that
+  // overlap, and sets lambda_n.
+  void apply_normal(std::vector<Body>& bodies, Point& p) {
+    const auto ia = static_cast<std::size_t>(p.body_a);
+    const auto ib = static_cast<std::size_t>(p.body_b);
+    Body& a = bodies[ia];
+    Body& b = bodies[ib];
+    const Vec3 pa = world_point(a, p.local_a);
+    const Vec3 pb = world_point(b, p.local_b);
+    const double C = p.normal.dot(pb - pa) + p.allowed;
+    if (!(C < 0.0)) return;
+    p.lambda_n = correct(&a, ia, &b, ib, pa, pb, p.normal, C, 0.0);
+  }
+
+  // Static friction (Sec. 3.5) of a point that acted: the points' tangential motion over the
+  // substep, undone when the impulse it takes stays within mu lambda_n. Gauss-Seidel reads the
+  // points after their manifold's normal corrections; Jacobi the state of the sweep.
+  void apply_static_friction(std::vector<Body>& bodies, const WorldDef& def, Point& p) {
+    if (!(p.lambda_n > 0.0)) return;
+    const auto ia = static_cast<std::size_t>(p.body_a);
+    const auto ib = static_cast<std::size_t>(p.body_b);
+    Body& a = bodies[ia];
+    Body& b = bodies[ib];
+    const double mu = pair_friction(def.friction, a.friction, b.friction);
+    if (!(mu > 0.0)) return;
+    const Vec3 qa = world_point(a, p.local_a);
+    const Vec3 qb = world_point(b, p.local_b);
+    const Vec3 pa_prev = state_[ia].x + state_[ia].R * p.local_a;
+    const Vec3 pb_prev = state_[ib].x + state_[ib].R * p.local_b;
+    const Vec3 dp = (qa - pa_prev) - (qb - pb_prev);
+    const Vec3 dp_t = dp - p.normal.dot(dp) * p.normal;
+    const double slip = dp_t.norm();
+    if (!(slip > 0.0)) return;
+    const Vec3 t = dp_t / slip;  // a's motion relative to b
+    const double w = inverse_mass(&a, qa - a.x, t) + inverse_mass(&b, qb - b.x, t);
+    if (!(w > 0.0) || !(slip / w < mu * p.lambda_n)) return;
+    // -C along t moves b by +slip/w t and a by -slip/w t: the relative motion cancelled.
+    correct(&a, ia, &b, ib, qa, qb, t, -slip, 0.0);
+    p.friction = (slip / w) * t;
   }
 
   // Step 3: velocities from the change of position and orientation over the substep.
@@ -406,28 +445,57 @@ class Xpbd final : public PushMethod {
     }
   }
 
-  // Step 4: dynamic friction and restitution on the contacts that acted.
+  // Step 4: restitution and dynamic friction on the contacts that acted. Point order: both from
+  // the velocities before the point's impulse, applied together. Manifold order: each
+  // manifold's restitution, then its friction from the velocities that leaves (Jacobi: all
+  // restitution, then all friction).
   void solve_velocities(std::vector<Body>& bodies, const WorldDef& def, double h) {
-    for (Point& p : points_) {
-      if (!(p.lambda_n > 0.0)) continue;
-      const auto ia = static_cast<std::size_t>(p.body_a);
-      const auto ib = static_cast<std::size_t>(p.body_b);
-      Body& a = bodies[ia];
-      Body& b = bodies[ib];
-      const Vec3 ra = world_point(a, p.local_a) - a.x;
-      const Vec3 rb = world_point(b, p.local_b) - b.x;
-      const Vec3 u = (b.velocity() + b.angular_velocity().cross(rb)) -
-                     (a.velocity() + a.angular_velocity().cross(ra));
-      const double vn = p.normal.dot(u);
-      const Vec3 ut = u - vn * p.normal;
-      Vec3 impulse = Vec3::Zero();  // on b (N s)
-      const double slide = ut.norm();
-      const double mu = pair_friction(def.friction, a.friction, b.friction);
-      if (mu > 0.0 && slide > 0.0) {
-        const Vec3 t = ut / slide;
-        const double w = inverse_mass(&a, ra, t) + inverse_mass(&b, rb, t);
-        if (w > 0.0) impulse -= std::min(mu * p.lambda_n / h, slide / w) * t;
-      }
+    for (Point& p : points_) p.velocity_impulse.setZero();
+    if (def.xpbd_friction_order == XpbdFrictionOrder::point) {
+      for (Point& p : points_) apply_velocity_impulse(bodies, def, h, p, true, true);
+      flush(bodies, true);
+      return;
+    }
+    if (jacobi_) {
+      for (Point& p : points_) apply_velocity_impulse(bodies, def, h, p, true, false);
+      flush(bodies, true);
+      for (Point& p : points_) apply_velocity_impulse(bodies, def, h, p, false, true);
+      flush(bodies, true);
+      return;
+    }
+    for (std::size_t begin = 0; begin < points_.size();) {
+      const std::size_t end = friction_run_end(begin, def);
+      for (std::size_t i = begin; i < end; ++i) apply_velocity_impulse(bodies, def, h, points_[i], true, false);
+      for (std::size_t i = begin; i < end; ++i) apply_velocity_impulse(bodies, def, h, points_[i], false, true);
+      begin = end;
+    }
+  }
+
+  // The velocity pass's impulse on b (N s) at a point that acted, from the bodies' momenta now
+  // (Sec. 3.6): with `normal`, the one that sets the normal velocity to max(-eps v~_n, 0); with
+  // `friction`, dynamic friction's -u_t / |u_t| min(mu lambda_n / h, |u_t| / w_t).
+  void apply_velocity_impulse(std::vector<Body>& bodies, const WorldDef& def, double h, Point& p,
+                              bool normal, bool friction) {
+    if (!(p.lambda_n > 0.0)) return;
+    const auto ia = static_cast<std::size_t>(p.body_a);
+    const auto ib = static_cast<std::size_t>(p.body_b);
+    Body& a = bodies[ia];
+    Body& b = bodies[ib];
+    const Vec3 ra = world_point(a, p.local_a) - a.x;
+    const Vec3 rb = world_point(b, p.local_b) - b.x;
+    const Vec3 u = (b.velocity() + b.angular_velocity().cross(rb)) -
+                   (a.velocity() + a.angular_velocity().cross(ra));
+    const double vn = p.normal.dot(u);
+    Vec3 impulse = Vec3::Zero();
+    const double mu = pair_friction(def.friction, a.friction, b.friction);
+    const Vec3 ut = u - vn * p.normal;
+    const double slide = ut.norm();
+    if (friction && mu > 0.0 && slide > 0.0) {
+      const Vec3 t = ut / slide;
+      const double w = inverse_mass(&a, ra, t) + inverse_mass(&b, rb, t);
+      if (w > 0.0) impulse -= std::min(mu * p.lambda_n / h, slide / w) * t;
+    }
+    if (normal) {
       const Vec3 u_before = (state_[ib].v + state_[ib].w.cross(rb)) - (state_[ia].v + state_[ia].w.cross(ra));
       const double vn_before = p.normal.dot(u_before);
       const double eps = -vn_before > def.restitution_threshold
@@ -436,11 +504,10 @@ class Xpbd final : public PushMethod {
       const double target = std::max(-eps * vn_before, 0.0);
       const double wn = inverse_mass(&a, ra, p.normal) + inverse_mass(&b, rb, p.normal);
       if (wn > 0.0) impulse += (target - vn) / wn * p.normal;
-      push(&b, ib, rb, impulse);
-      push(&a, ia, ra, -impulse);
-      p.velocity_impulse = impulse;
     }
-    flush(bodies, true);
+    push(&b, ib, rb, impulse);
+    push(&a, ia, ra, -impulse);
+    p.velocity_impulse += impulse;
   }
 
   // Adds this substep's share of each row's mean force over the step (N) to `lambda` (c) at the

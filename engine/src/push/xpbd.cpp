@@ -16,8 +16,9 @@
 //      (semi-implicit Euler, Eqs. 3.2.1-3.2.4: the paper's integration of Algorithm 2);
 //   2. one Gauss-Seidel sweep over the contacts in the collide stage's order (each point's static
 //      friction right after its normal correction, or after those of all of its manifold's
-//      points: WorldDef::xpbd_friction_order, below), then the rods (Sec. 3.3). A constraint C between points at offsets r_a, r_b from the centres of mass, along
-//      the unit axis k (the gradient of C at body b), with the generalised inverse masses
+//      points: the friction order below), then the rods (Sec. 3.3). A constraint C between
+//      points at offsets r_a, r_b from the centres of mass, along the unit axis k (the gradient
+//      of C at body b), with the generalised inverse masses
 //        w_i = m_i^-1 + (r_i x k)^T I_i^-1 (r_i x k)   (1/kg; 0 for a static body or the world)
 //      and the compliance alpha (m/N) as alpha~ = alpha / h^2, gets
 //        Delta lambda = (-C - alpha~ lambda) / (w_a + w_b + alpha~)   (kg m; lambda = 0 at the
@@ -362,8 +363,8 @@ class Xpbd final : public PushMethod {
     for (Point& p : points_) p.allowed = std::max(overlap(bodies, p), def.penetration_slop);
   }
 
-  // Step 2: one sweep over the contacts, manifold by manifold (its points' normals, then their
-  // static friction), then the rods.
+  // Step 2: one sweep over the contacts, in runs of WorldDef::xpbd_friction_order (a point, or
+  // a manifold: the run's normals, then its static friction), then the rods.
   void solve_positions(std::vector<Body>& bodies, const std::vector<DistanceConstraint>& distances,
                        const WorldDef& def, double h) {
     for (Point& p : points_) {
@@ -465,8 +466,12 @@ class Xpbd final : public PushMethod {
     }
     for (std::size_t begin = 0; begin < points_.size();) {
       const std::size_t end = friction_run_end(begin, def);
-      for (std::size_t i = begin; i < end; ++i) apply_velocity_impulse(bodies, def, h, points_[i], true, false);
-      for (std::size_t i = begin; i < end; ++i) apply_velocity_impulse(bodies, def, h, points_[i], false, true);
+      for (std::size_t i = begin; i < end; ++i) {
+        apply_velocity_impulse(bodies, def, h, points_[i], true, false);
+      }
+      for (std::size_t i = begin; i < end; ++i) {
+        apply_velocity_impulse(bodies, def, h, points_[i], false, true);
+      }
       begin = end;
     }
   }

@@ -115,10 +115,16 @@ constexpr std::array kSoftRelaxChoices = {
            "relax from the substep's start and the last relax's impulses"},
 };
 constexpr std::array kXpbdFrictionOrderChoices = {
-    Choice{"point", static_cast<int>(XpbdFrictionOrder::point), "Mueller et al. 2020",
-           "each point's friction right after its normal"},
     Choice{"manifold", static_cast<int>(XpbdFrictionOrder::manifold), "Solver2D",
            "a manifold's friction after all of its normals"},
+    Choice{"point", static_cast<int>(XpbdFrictionOrder::point), "Mueller et al. 2020",
+           "each point's friction right after its normal"},
+};
+constexpr std::array kXpbdFrictionAnchorChoices = {
+    Choice{"step", static_cast<int>(XpbdFrictionAnchor::step), "Solver2D",
+           "the slip since the start of the step"},
+    Choice{"substep", static_cast<int>(XpbdFrictionAnchor::substep), "Mueller et al. 2020",
+           "the slip since the start of the substep"},
 };
 constexpr std::array kRotationChoices = {
     Choice{"linear", static_cast<int>(RotationUpdate::linear), "Eq. 3.2.4", "linear orientation update"},
@@ -488,10 +494,20 @@ const std::array kParameters = {
               .type = ParameterType::choice,
               .choices = kXpbdFrictionOrderChoices,
               .help = "push xpbd: where a contact point's static and dynamic friction are taken; "
-                      "point: right after its own normal; manifold: after all of its manifold's "
-                      "normals (E. Catto's Solver2D)",
+                      "manifold: after all of its manifold's normals (E. Catto's Solver2D); "
+                      "point: right after its own normal",
               .get = &get_member<&WorldDef::xpbd_friction_order>,
               .set = &set_member<&WorldDef::xpbd_friction_order>},
+    Parameter{.name = "xpbd_friction_anchor",
+              .flag = "xpbd-friction-anchor",
+              .json_key = "xpbd_friction_anchor",
+              .type = ParameterType::choice,
+              .choices = kXpbdFrictionAnchorChoices,
+              .help = "push xpbd: where static friction measures a contact point's slip from; "
+                      "step: its place at the start of the step (E. Catto's Solver2D); substep: "
+                      "at the start of the substep",
+              .get = &get_member<&WorldDef::xpbd_friction_anchor>,
+              .set = &set_member<&WorldDef::xpbd_friction_anchor>},
     Parameter{.name = "xpbd_compliance",
               .flag = "xpbd-compliance",
               .json_key = "xpbd_compliance_m_per_n",

@@ -131,6 +131,12 @@ enum class XpbdFrictionOrder {
   manifold,  ///< after the normals of all of its manifold's points, as E. Catto's Solver2D
 };
 
+/// Where XPBD's static friction measures a contact point's slip from (WorldDef::xpbd_friction_anchor).
+enum class XpbdFrictionAnchor {
+  step,     ///< the points' places at the start of the step, as E. Catto's Solver2D
+  substep,  ///< their places at the start of the substep
+};
+
 /// How A lambda = b is represented while it is solved.
 enum class Assembly {
   explicit_matrices,  ///< sparse J, M^-1 and A = J M^-1 J^T built every step (Sec. 6), as the
@@ -240,10 +246,14 @@ struct WorldDef {
   /// XPBD only: the rods' compliance alpha (m/N, >= 0), the inverse of their stiffness; 0 (the
   /// default) is a rigid rod, as the source's joints; contacts are always rigid.
   double xpbd_compliance = 0.0;
-  /// XPBD only: where a contact point's static and dynamic friction are taken (choice): point
-  /// (the default) right after its own normal; manifold after all of its manifold's normals
-  /// (Solver2D's reading of Mueller et al. 2020, Secs. 3.5 and 3.6).
-  XpbdFrictionOrder xpbd_friction_order = XpbdFrictionOrder::point;
+  /// XPBD only: where a contact point's static and dynamic friction are taken (choice): manifold
+  /// (the default) after all of its manifold's normals (E. Catto's Solver2D reading of Mueller et
+  /// al. 2020, Secs. 3.5 and 3.6); point right after its own normal.
+  XpbdFrictionOrder xpbd_friction_order = XpbdFrictionOrder::manifold;
+  /// XPBD only: where static friction measures a point's tangential slip from (choice): step
+  /// (the default) its place at the start of the step, so that a substep undoes what earlier
+  /// substeps left (Solver2D); substep its place at the start of the substep.
+  XpbdFrictionAnchor xpbd_friction_anchor = XpbdFrictionAnchor::step;
   /// AVBD (push avbd) only: the penalty ramp beta (N/m per m of error, >= 0): after each sweep a
   /// row inside its force limits stiffens by beta |C|. The authors' 2D demo: 1e5.
   double avbd_beta = 1.0e5;

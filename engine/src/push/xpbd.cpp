@@ -14,9 +14,9 @@
 // and v, w their velocities (m^-1 p, I^-1 l):
 //   1. x_prev = x, o_prev = o; the momenta take f_ext h and the bodies move over h with them
 //      (semi-implicit Euler, Eqs. 3.2.1-3.2.4: the paper's integration of Algorithm 2);
-//   2. one Gauss-Seidel sweep over the contacts in the collide stage's order (each point's static
-//      friction right after its normal correction, or after those of all of its manifold's
-//      points: the friction order below), then the rods (Sec. 3.3). A constraint C between
+//   2. one Gauss-Seidel sweep over the contacts in the collide stage's order (a manifold's normal
+//      corrections, then its points' static friction; or each point's static friction right
+//      after its normal: the friction order below), then the rods (Sec. 3.3). A constraint C between
 //      points at offsets r_a, r_b from the centres of mass, along the unit axis k (the gradient
 //      of C at body b), with the generalised inverse masses
 //        w_i = m_i^-1 + (r_i x k)^T I_i^-1 (r_i x k)   (1/kg; 0 for a static body or the world)
@@ -30,10 +30,11 @@
 //          the step (a to b, kept in the world frame), C = n . (p_b - p_a) + allowed, acted on
 //          when C < 0 (rigid: alpha = 0, as the paper's contacts), `allowed` the slop (or the
 //          overlap the pre-stabilisation below left);
-//        static friction: the tangential part Delta p_t of the points' relative motion over the
-//          substep, (p_a - p_a,prev) - (p_b - p_b,prev) less its normal part, is undone (C =
-//          |Delta p_t|) if the impulse it takes is below mu lambda_n (mu: WorldDef::friction for
-//          both the static and the dynamic coefficient; lambda_n this substep's normal one);
+//        static friction: the tangential part Delta p_t of the points' relative motion since
+//          the anchor below, (p_a - p_a,start) - (p_b - p_b,start) less its normal part, is
+//          undone (C = |Delta p_t|) if the impulse it takes is below mu lambda_n (mu:
+//          WorldDef::friction for both the static and the dynamic coefficient; lambda_n this
+//          substep's normal one);
 //        rod: u = (p_b - p_a) / |p_b - p_a|, C = |p_b - p_a| - l, alpha = xpbd_compliance;
 //   3. v = (x - x_prev) / h; w = 2 vec(o o_prev^-1) / h (negated when its real part is < 0); the
 //      momenta p = m v, l = I w with I of the new orientation;
@@ -45,13 +46,18 @@
 //      min(mu lambda_n / h, |u_t| / w_t) (N s; the paper's velocity change min(h mu |f_n|,
 //      |u_t|), f_n = lambda_n / h^2, written as an impulse so that its units agree); each a
 //      velocity impulse (N s) Delta v / (w_a + w_b) along its direction.
-//   Friction order (WorldDef::xpbd_friction_order). point: in 2 each point's static friction
-//   right after its normal correction, in 4 both impulses of a point from the same velocities.
-//   manifold, E. Catto's reading of the paper (Solver2D, solve_xpbd.c): a manifold's normal
-//   corrections first, then their friction, in 2 and in 4. Under point, the turn a point's
-//   friction gives the body is taken back by the next points' normal corrections, which in 4
-//   carry support outside lambda_n: a cube sliding on the ground stops 11 % late, against 0.3 %
-//   under manifold (docs/findings.md, "TGS and XPBD").
+//   Friction order (WorldDef::xpbd_friction_order). manifold, E. Catto's reading of the paper
+//   (Solver2D, solve_xpbd.c): a manifold's normal corrections first, then their friction, in 2
+//   and in 4. point: in 2 each point's static friction right after its normal correction, in 4
+//   both impulses of a point from the same velocities. Under point, the turn a point's friction
+//   gives the body is taken back by the next points' normal corrections, which in 4 carry
+//   support outside lambda_n: a cube sliding on the ground stops 11 % late, against 0.3 % under
+//   manifold (docs/findings.md, "TGS and XPBD").
+//   Friction anchor (WorldDef::xpbd_friction_anchor). step, Solver2D's reading: p_start is the
+//   point's place at the start of the step (before the pre-stabilisation below), so each
+//   substep's static friction also undoes the slip that earlier substeps' later corrections
+//   left. substep: its place at the start of the substep, so that slip stays. With one sweep a
+//   substep, the substep anchor lets the paper's stack walk off its column (docs/findings.md).
 //
 // Contacts. As the paper's Sec. 3.5, the contacts are collected once per step and followed
 // through the substeps: their points stay fixed in the bodies' frames and each substep measures
@@ -143,6 +149,11 @@ class Xpbd final : public PushMethod {
     capture(ctx.manifolds, bodies, def);
     detail::resize_with_headroom(state_, bodies.size());
     detail::resize_with_headroom(delta_, bodies.size());
+    detail::resize_with_headroom(step_start_, bodies.size());
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      step_start_[i].x = bodies[i].x;
+      step_start_[i].R = bodies[i].rotation();
+    }
     prestabilise(bodies, *ctx.distances, def, substeps);
     for (int k = 0; k < substeps; ++k) {
       for (std::size_t i = 0; i < bodies.size(); ++i) {
@@ -406,9 +417,10 @@ class Xpbd final : public PushMethod {
     p.lambda_n = correct(&a, ia, &b, ib, pa, pb, p.normal, C, 0.0);
   }
 
-  // Static friction (Sec. 3.5) of a point that acted: the points' tangential motion over the
-  // substep, undone when the impulse it takes stays within mu lambda_n. Gauss-Seidel reads the
-  // points after their manifold's normal corrections; Jacobi the state of the sweep.
+  // Static friction (Sec. 3.5) of a point that acted: the points' tangential motion since the
+  // start of the step or of the substep (WorldDef::xpbd_friction_anchor), undone when the
+  // impulse it takes stays within mu lambda_n. Gauss-Seidel reads the points after the normal
+  // corrections before it (friction_run_end); Jacobi the state of the sweep.
   void apply_static_friction(std::vector<Body>& bodies, const WorldDef& def, Point& p) {
     if (!(p.lambda_n > 0.0)) return;
     const auto ia = static_cast<std::size_t>(p.body_a);
@@ -419,8 +431,10 @@ class Xpbd final : public PushMethod {
     if (!(mu > 0.0)) return;
     const Vec3 qa = world_point(a, p.local_a);
     const Vec3 qb = world_point(b, p.local_b);
-    const Vec3 pa_prev = state_[ia].x + state_[ia].R * p.local_a;
-    const Vec3 pb_prev = state_[ib].x + state_[ib].R * p.local_b;
+    const std::vector<Saved>& start =
+        def.xpbd_friction_anchor == XpbdFrictionAnchor::step ? step_start_ : state_;
+    const Vec3 pa_prev = start[ia].x + start[ia].R * p.local_a;
+    const Vec3 pb_prev = start[ib].x + start[ib].R * p.local_b;
     const Vec3 dp = (qa - pa_prev) - (qb - pb_prev);
     const Vec3 dp_t = dp - p.normal.dot(dp) * p.normal;
     const double slip = dp_t.norm();
@@ -535,6 +549,7 @@ class Xpbd final : public PushMethod {
 
   std::vector<Point> points_;
   std::vector<Saved> state_;        // n: each body at the start of the substep
+  std::vector<Saved> step_start_;   // n: each body's x and R at the start of the step
   std::vector<Delta> delta_;        // n: Jacobi's pending changes
   std::vector<double> rod_lambda_;  // one per rod: this substep's Delta lambda (kg m)
   std::vector<double> rod_lengths_; // one per rod: its length at the start of the step (m)

@@ -381,7 +381,6 @@ class Xpbd final : public PushMethod {
     for (Point& p : points_) {
       p.lambda_n = 0.0;
       p.friction.setZero();
-      p.velocity_impulse.setZero();
     }
     for (std::size_t begin = 0; begin < points_.size();) {
       const std::size_t end = friction_run_end(begin, def);

@@ -379,19 +379,28 @@ template <bool kBias>
   scatter(B);
 }
 
-// Asks for the cache lines of a group's bodies ahead of its sweep: the groups stream in order,
-// their bodies do not.
-[[gnu::always_inline]] inline void prefetch_bodies(const LaneGroup& g, const LaneSweep& s) {
-  for (int l = 0; l < kLanes; ++l) {
-    for (const int index : {g.a[l], g.b[l]}) {
-      if (index < 0) continue;
-      const char* p = reinterpret_cast<const char*>(s.bodies + index);
-      for (std::size_t off = 0; off < sizeof(SolverBody); off += 64) __builtin_prefetch(p + off, 1, 3);
-    }
-  }
+inline constexpr std::size_t kPrefetchAhead = 2;  // groups
+
+// Asks for the cache lines of [start, start + bytes) (prefetch()).
+[[gnu::always_inline]] inline void prefetch_lines(const void* start, std::size_t bytes) {
+  const char* p = static_cast<const char*>(start);
+  for (std::size_t off = 0; off < bytes; off += 64) __builtin_prefetch(p + off, 1, 3);
 }
 
-inline constexpr std::size_t kPrefetchAhead = 2;  // groups
+// Asks for the cache lines of group i + kPrefetchAhead of [groups, groups + count) ahead of its
+// sweep: its bodies, and the group and its points. The groups and points are streamed in order,
+// but the hardware's own prefetching fell behind them (docs/benchmarks.md).
+[[gnu::always_inline]] inline void prefetch(const LaneGroup* groups, std::size_t i, std::size_t count,
+                                            const LaneSweep& s) {
+  if (i + kPrefetchAhead >= count) return;
+  const LaneGroup& g = groups[i + kPrefetchAhead];
+  for (int l = 0; l < kLanes; ++l) {
+    if (g.a[l] >= 0) prefetch_lines(s.bodies + g.a[l], sizeof(SolverBody));
+    if (g.b[l] >= 0) prefetch_lines(s.bodies + g.b[l], sizeof(SolverBody));
+  }
+  prefetch_lines(&g, sizeof(LaneGroup));
+  prefetch_lines(s.points + g.first_point, static_cast<std::size_t>(g.points) * sizeof(LanePoint));
+}
 
 }  // namespace lanes
 
@@ -399,7 +408,7 @@ inline constexpr std::size_t kPrefetchAhead = 2;  // groups
 /// and each manifold's friction and twist applied to the bodies (soft_step.cpp's warm_start()).
 CPS_LANES_CLONES inline void warm_start_lanes(const LaneGroup* groups, std::size_t count, const LaneSweep& s) {
   for (std::size_t i = 0; i < count; ++i) {
-    if (i + lanes::kPrefetchAhead < count) lanes::prefetch_bodies(groups[i + lanes::kPrefetchAhead], s);
+    lanes::prefetch(groups, i, count, s);
     lanes::warm_start_group(groups[i], s);
   }
 }
@@ -409,12 +418,12 @@ CPS_LANES_CLONES inline void warm_start_lanes(const LaneGroup* groups, std::size
 CPS_LANES_CLONES inline void solve_lanes(LaneGroup* groups, std::size_t count, const LaneSweep& s, bool use_bias) {
   if (use_bias) {
     for (std::size_t i = 0; i < count; ++i) {
-      if (i + lanes::kPrefetchAhead < count) lanes::prefetch_bodies(groups[i + lanes::kPrefetchAhead], s);
+      lanes::prefetch(groups, i, count, s);
       lanes::solve_group<true>(groups[i], s);
     }
   } else {
     for (std::size_t i = 0; i < count; ++i) {
-      if (i + lanes::kPrefetchAhead < count) lanes::prefetch_bodies(groups[i + lanes::kPrefetchAhead], s);
+      lanes::prefetch(groups, i, count, s);
       lanes::solve_group<false>(groups[i], s);
     }
   }

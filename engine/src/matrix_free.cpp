@@ -149,6 +149,19 @@ template <bool kCoupled>
   }
 }
 
+// Asks for the cache lines of a run's packed rows and coupling ahead of its sweep. The sweeps
+// stream the rows in order, but the hardware's own prefetching fell behind them
+// (docs/benchmarks.md).
+inline void prefetch_run(const SweepData& d, const MatrixFreeSystem::Run& run) {
+  const char* p = reinterpret_cast<const char*>(d.rows + run.begin);
+  const std::size_t bytes = static_cast<std::size_t>(run.count) * sizeof(PackedRow);
+  for (std::size_t off = 0; off < bytes; off += 64) __builtin_prefetch(p + off, 0, 3);
+  if (run.offset >= 0) __builtin_prefetch(d.coupling + run.offset, 0, 3);
+}
+
+// Runs ahead of the one being swept whose rows prefetch_run() asks for.
+inline constexpr std::size_t kPrefetchRuns = 4;
+
 // PGS over the runs (see MatrixFreeSystem::Run), in the order of s.runs. In a run of m rows on
 // bodies a and b, row k's value after rows i < k have changed by delta_i is
 //   lambda_k + (b_k - j_k . w_start) / A_kk - sum_{i < k} (A_ki / A_kk) delta_i,
@@ -158,7 +171,11 @@ template <bool kCoupled>
 void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
   const SweepData d = sweep_data(s, lambda);
   for (int it = 0; it < iterations; ++it) {
-    for (const MatrixFreeSystem::Run& run : s.runs) sweep_run<kCoupled>(d, run, lambda);
+    const std::size_t count = s.runs.size();
+    for (std::size_t i = 0; i < count; ++i) {
+      if (i + kPrefetchRuns < count) prefetch_run(d, s.runs[i + kPrefetchRuns]);
+      sweep_run<kCoupled>(d, s.runs[i], lambda);
+    }
   }
 }
 
@@ -186,7 +203,10 @@ void coloured_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& l
         first = count * k_t / threads;
         last = count * (k_t + 1) / threads;
       }
-      for (std::size_t i = first; i < last; ++i) sweep_run<kCoupled>(d, s.runs[begin + i], lambda);
+      for (std::size_t i = first; i < last; ++i) {
+        if (i + kPrefetchRuns < last) prefetch_run(d, s.runs[begin + i + kPrefetchRuns]);
+        sweep_run<kCoupled>(d, s.runs[begin + i], lambda);
+      }
       if (workers != nullptr) workers->sync();
     }
   }

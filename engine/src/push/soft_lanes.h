@@ -113,11 +113,16 @@ struct LaneGroup {
   Lanes touches_static{};  // 1 where the manifold has a static body, else 0
 };
 
+/// Lane points (bytes) from which the sweeps prefetch: fewer stay in a core's cache (its L2
+/// holds 1 MiB on the machines measured), and asking for them again only costs instructions.
+inline constexpr std::size_t kPrefetchFrom = std::size_t{1} << 20;
+
 /// What a sweep of lanes reads besides the groups (soft_step.cpp's members of the same names).
 struct LaneSweep {
   SolverBody* bodies = nullptr;   // the solver bodies, indexed by LaneGroup::a and b
   SolverBody* stand_in = nullptr;  // a zero body for index -1 (read, never written)
   LanePoint* points = nullptr;
+  bool prefetch = false;           // the sweeps prefetch (kPrefetchFrom)
   LaneTotal* totals = nullptr;     // per point of `points`: the step's sum of its impulses, or null
   bool friction = false;           // the manifolds have friction rows
   double inv_h = 0.0;              // 1/s
@@ -388,11 +393,11 @@ inline constexpr std::size_t kPrefetchAhead = 2;  // groups
 }
 
 // Asks for the cache lines of group i + kPrefetchAhead of [groups, groups + count) ahead of its
-// sweep: its bodies, and the group and its points. The groups and points are streamed in order,
-// but the hardware's own prefetching fell behind them (docs/benchmarks.md).
+// sweep, where s.prefetch: its bodies, and the group and its points. The groups and points are
+// streamed in order, but the hardware's own prefetching fell behind them (docs/benchmarks.md).
 [[gnu::always_inline]] inline void prefetch(const LaneGroup* groups, std::size_t i, std::size_t count,
                                             const LaneSweep& s) {
-  if (i + kPrefetchAhead >= count) return;
+  if (!s.prefetch || i + kPrefetchAhead >= count) return;
   const LaneGroup& g = groups[i + kPrefetchAhead];
   for (int l = 0; l < kLanes; ++l) {
     if (g.a[l] >= 0) prefetch_lines(s.bodies + g.a[l], sizeof(SolverBody));

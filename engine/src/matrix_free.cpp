@@ -171,8 +171,8 @@ inline constexpr std::size_t kPrefetchFrom = std::size_t{1} << 20;
 inline bool prefetching(const MatrixFreeSystem& s) { return s.rows.size() * sizeof(PackedRow) >= kPrefetchFrom; }
 
 // The runs [first, the result) of [first, last) that ask for the run kPrefetchRuns after them.
-// (A bound in one loop: with a second loop without prefetching, the compiler called Eigen's
-// operators instead of inlining them, and small scenes took 20 % longer.)
+// A bound in the one loop, not a second loop: with two copies of the sweep the compiler stopped
+// inlining Eigen's operators (docs/benchmarks.md).
 inline std::size_t prefetch_end(bool prefetch, std::size_t first, std::size_t last) {
   return prefetch && last > first + kPrefetchRuns ? last - kPrefetchRuns : first;
 }

@@ -1,5 +1,6 @@
 #pragma once
-// Step buffers that keep their storage (internal to the engine).
+// Step buffers that keep their storage, and asking for them ahead of a sweep (internal to the
+// engine).
 
 #include <cstddef>
 #include <vector>
@@ -26,6 +27,19 @@ template <class T, class A>
 void assign_with_headroom(std::vector<T, A>& v, std::size_t n, const T& value) {
   reserve_with_headroom(v, n);
   v.assign(n, value);
+}
+
+/// Bytes of a sweep's stream from which it prefetches (1 MiB): fewer stay in a core's cache from
+/// sweep to sweep (its L2 cache holds 1 MiB on the machines measured), and asking for them again
+/// only costs instructions (docs/benchmarks.md, "Prefetching the sweeps' streams").
+inline constexpr std::size_t kPrefetchFrom = std::size_t{1} << 20;
+
+/// Asks for the cache lines (64 bytes) of [start, start + bytes), to be read or, with kWrite,
+/// written: a hint, which changes no result.
+template <bool kWrite>
+[[gnu::always_inline]] inline void prefetch_lines(const void* start, std::size_t bytes) {
+  const char* p = static_cast<const char*>(start);
+  for (std::size_t off = 0; off < bytes; off += 64) __builtin_prefetch(p + off, kWrite ? 1 : 0, 3);
 }
 
 }  // namespace cps::detail

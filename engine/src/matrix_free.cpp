@@ -153,22 +153,17 @@ template <bool kCoupled>
 // stream the rows in order, but the hardware's own prefetching fell behind them
 // (docs/benchmarks.md).
 inline void prefetch_run(const SweepData& d, const MatrixFreeSystem::Run& run) {
-  const char* p = reinterpret_cast<const char*>(d.rows + run.begin);
-  const std::size_t bytes = static_cast<std::size_t>(run.count) * sizeof(PackedRow);
-  for (std::size_t off = 0; off < bytes; off += 64) __builtin_prefetch(p + off, 0, 3);
+  detail::prefetch_lines<false>(d.rows + run.begin, static_cast<std::size_t>(run.count) * sizeof(PackedRow));
   if (run.offset >= 0) __builtin_prefetch(d.coupling + run.offset, 0, 3);
 }
 
 // Runs ahead of the one being swept whose rows prefetch_run() asks for.
 inline constexpr std::size_t kPrefetchRuns = 4;
 
-// Packed rows (bytes) from which the sweeps prefetch: fewer stay in a core's cache from sweep to
-// sweep (its L2 cache holds 1 MiB on the machines measured), and asking for them again only
-// costs instructions.
-inline constexpr std::size_t kPrefetchFrom = std::size_t{1} << 20;
-
 // Whether the sweeps over s prefetch its rows.
-inline bool prefetching(const MatrixFreeSystem& s) { return s.rows.size() * sizeof(PackedRow) >= kPrefetchFrom; }
+inline bool prefetching(const MatrixFreeSystem& s) {
+  return s.rows.size() * sizeof(PackedRow) >= detail::kPrefetchFrom;
+}
 
 // The runs [first, the result) of [first, last) that ask for the run kPrefetchRuns after them.
 // A bound in the one loop, not a second loop: with two copies of the sweep the compiler stopped

@@ -16,6 +16,7 @@
 #ifndef CPS_ENGINE_PUSH_SOFT_LANES_H
 #define CPS_ENGINE_PUSH_SOFT_LANES_H
 
+#include "../buffers.h"
 #include "cps/math.h"
 
 #include <cmath>
@@ -113,16 +114,12 @@ struct LaneGroup {
   Lanes touches_static{};  // 1 where the manifold has a static body, else 0
 };
 
-/// Lane points (bytes) from which the sweeps prefetch: fewer stay in a core's cache (its L2
-/// holds 1 MiB on the machines measured), and asking for them again only costs instructions.
-inline constexpr std::size_t kPrefetchFrom = std::size_t{1} << 20;
-
 /// What a sweep of lanes reads besides the groups (soft_step.cpp's members of the same names).
 struct LaneSweep {
   SolverBody* bodies = nullptr;   // the solver bodies, indexed by LaneGroup::a and b
   SolverBody* stand_in = nullptr;  // a zero body for index -1 (read, never written)
   LanePoint* points = nullptr;
-  bool prefetch = false;           // the sweeps prefetch (kPrefetchFrom)
+  bool prefetch = false;           // the sweeps prefetch (from detail::kPrefetchFrom bytes of points)
   LaneTotal* totals = nullptr;     // per point of `points`: the step's sum of its impulses, or null
   bool friction = false;           // the manifolds have friction rows
   double inv_h = 0.0;              // 1/s
@@ -386,12 +383,6 @@ template <bool kBias>
 
 inline constexpr std::size_t kPrefetchAhead = 2;  // groups
 
-// Asks for the cache lines of [start, start + bytes) (prefetch()).
-[[gnu::always_inline]] inline void prefetch_lines(const void* start, std::size_t bytes) {
-  const char* p = static_cast<const char*>(start);
-  for (std::size_t off = 0; off < bytes; off += 64) __builtin_prefetch(p + off, 1, 3);
-}
-
 // Asks for the cache lines of group i + kPrefetchAhead of [groups, groups + count) ahead of its
 // sweep, where s.prefetch: its bodies, and the group and its points. The groups and points are
 // streamed in order, but the hardware's own prefetching fell behind them (docs/benchmarks.md).
@@ -400,11 +391,11 @@ inline constexpr std::size_t kPrefetchAhead = 2;  // groups
   if (!s.prefetch || i + kPrefetchAhead >= count) return;
   const LaneGroup& g = groups[i + kPrefetchAhead];
   for (int l = 0; l < kLanes; ++l) {
-    if (g.a[l] >= 0) prefetch_lines(s.bodies + g.a[l], sizeof(SolverBody));
-    if (g.b[l] >= 0) prefetch_lines(s.bodies + g.b[l], sizeof(SolverBody));
+    if (g.a[l] >= 0) detail::prefetch_lines<true>(s.bodies + g.a[l], sizeof(SolverBody));
+    if (g.b[l] >= 0) detail::prefetch_lines<true>(s.bodies + g.b[l], sizeof(SolverBody));
   }
-  prefetch_lines(&g, sizeof(LaneGroup));
-  prefetch_lines(s.points + g.first_point, static_cast<std::size_t>(g.points) * sizeof(LanePoint));
+  detail::prefetch_lines<true>(&g, sizeof(LaneGroup));
+  detail::prefetch_lines<true>(s.points + g.first_point, static_cast<std::size_t>(g.points) * sizeof(LanePoint));
 }
 
 }  // namespace lanes

@@ -398,7 +398,7 @@ class SoftStep final : public PushMethod {
       sweep_.bodies = solver_bodies_.data();
       sweep_.stand_in = &lane_stand_in_;
       sweep_.points = lane_points_.data();
-      sweep_.prefetch = lane_points_.size() * sizeof(soft::LanePoint) >= soft::kPrefetchFrom;
+      sweep_.prefetch = lane_points_.size() * sizeof(soft::LanePoint) >= detail::kPrefetchFrom;
       sweep_.totals = restitution ? lane_totals_.data() : nullptr;
       sweep_.friction = friction;
       sweep_.inv_h = 1.0 / h;

@@ -181,11 +181,6 @@ struct ManifoldFriction {
 };
 
 
-// The defaults a manifold and a point start from in prepare, copied from memory: assigning a
-// value-initialised temporary built it on the stack and read it back across its stores.
-inline const ManifoldFriction kNoFriction{};
-inline const ContactPoint kNoPoint{};
-
 struct Rod {
   int a = 0;
   int b = 0;
@@ -490,7 +485,7 @@ class SoftStep final : public PushMethod {
     const Body& body_b = in.bodies[static_cast<std::size_t>(m.body_b)];
     const SolverBody& a = solver_bodies_[static_cast<std::size_t>(m.body_a)];
     const SolverBody& b = solver_bodies_[static_cast<std::size_t>(m.body_b)];
-    f = kNoFriction;
+    f = ManifoldFriction{};
     f.a = moving_index(in.bodies, m.body_a);
     f.b = moving_index(in.bodies, m.body_b);
     f.begin = first;
@@ -508,7 +503,7 @@ class SoftStep final : public PushMethod {
     for (std::size_t i = 0; i < count; ++i, ++g) {
       const Contact& c = m.contacts[i];
       ContactPoint& p = points[i];
-      p = kNoPoint;
+      p = ContactPoint{};
       p.a = f.a;
       p.b = f.b;
       p.row = static_cast<int>(g);
@@ -714,13 +709,13 @@ class SoftStep final : public PushMethod {
     const LaneGroup& group = groups_[g];
     const LanePoint* q = lane_points_.data() + group.first_point;
     const soft::LaneTotal* totals = lane_totals_.empty() ? nullptr : lane_totals_.data() + group.first_point;
-    f = kNoFriction;
+    f = ManifoldFriction{};
     f.a = group.a[l];
     f.b = group.b[l];
     f.end = static_cast<std::size_t>(group.count[l]);
     for (std::size_t i = 0; i < f.end; ++i) {
       ContactPoint& p = points[i];
-      p = kNoPoint;
+      p = ContactPoint{};
       p.a = f.a;
       p.b = f.b;
       p.row = static_cast<int>(first_row_[k] + i);

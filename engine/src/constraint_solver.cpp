@@ -111,6 +111,13 @@ class MatrixFreeSolver final : public ConstraintSolver {
     if (last_kind_ == SolverKind::coloured_pgs) order = system_.perm;
   }
 
+  bool constraint_forces(const std::vector<Body>& bodies, const Eigen::VectorXd& f_ext, Eigen::VectorXd& f,
+                         Workers* workers) const override {
+    if (last_kind_ != SolverKind::coloured_pgs) return false;
+    cps::constraint_forces(system_, bodies, f_ext, f, workers);
+    return true;
+  }
+
  private:
   MatrixFreeSystem system_;
   SolverKind last_kind_ = SolverKind::pgs;

@@ -73,6 +73,19 @@ class ConstraintSolver {
   /// The order the last solve() swept the rows in, into order: c row indices for
   /// SolverKind::coloured_pgs, empty for the methods that sweep in row order. No errors.
   virtual void sweep_order(std::vector<int>& order) const = 0;
+
+  /// f = f_ext + J^T lambda (6n, N and N m) for the lambda the last solve() returned, formed per
+  /// body from what that solve kept, without another pass over the rows, where the solver can:
+  /// the matrix-free coloured PGS from w = M^-1 J^T lambda (f_c = M w, Eq. 6.2.1; its bodies'
+  /// entries equal add_constraint_forces()'s to round-off, and a static body's hold f_ext alone,
+  /// as nothing moves it), shared among `workers`' threads with the same result for every count.
+  /// Returns false and leaves f untouched where it cannot (the explicit path, PGS and Jacobi,
+  /// which keep the state hashes of add_constraint_forces()). bodies: those of the solve; f_ext:
+  /// 6n. No errors.
+  virtual bool constraint_forces(const std::vector<Body>& /*bodies*/, const Eigen::VectorXd& /*f_ext*/,
+                                 Eigen::VectorXd& /*f*/, Workers* /*workers*/) const {
+    return false;
+  }
 };
 
 /// The implementation for `assembly`: Assembly::explicit_matrices or Assembly::matrix_free.

@@ -502,11 +502,29 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
       workers->run(task);
     }
     detail::resize_with_headroom(lambda, rows.size());
-    for (std::size_t j = 0; j < rows.size(); ++j) lambda[static_cast<std::size_t>(s.perm[j])] = l[j];
+    parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+      for (std::size_t j = begin; j < end; ++j) lambda[static_cast<std::size_t>(s.perm[j])] = l[j];
+    });
   } else {
     if (!s.runs_ready) build_runs(s);
     coupled ? pgs_sweeps<true>(s, iterations, l) : pgs_sweeps<false>(s, iterations, l);
   }
+}
+
+void constraint_forces(const MatrixFreeSystem& s, const std::vector<Body>& bodies,
+                       const Eigen::VectorXd& f_ext, Eigen::VectorXd& f, Workers* workers) {
+  f.resize(f_ext.size());  // same size every step: no allocation
+  parallel_for(workers, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const auto k = static_cast<Eigen::Index>(6 * i);
+      f.segment<6>(k) = f_ext.segment<6>(k);
+      const Body& body = bodies[i];
+      if (body.is_static()) continue;
+      const Vec6& w = s.w[i];
+      f.segment<3>(k) += body.mass * w.head<3>();
+      f.segment<3>(k + 3) += s.inv_inertia[i].inverse() * w.tail<3>();
+    }
+  });
 }
 
 void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,

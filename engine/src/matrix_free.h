@@ -106,6 +106,15 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
            SolverKind kind, int iterations, std::vector<double>& lambda,
            const std::vector<double>* initial = nullptr, Workers* workers = nullptr);
 
+/// f = f_ext + J^T lambda (6n, N and N m) for the lambda of the last solve(), per body from its
+/// w = M^-1 J^T lambda: f_c = M w (Eq. 6.2.1), with m and the world inertia of prepare() (the
+/// inverse of its I^-1), equal to the sum over the rows to round-off. A static body's entries
+/// hold f_ext alone (its w is the fixed slot's 0). bodies: n, as given to prepare(); f_ext: 6n;
+/// f resized to 6n (no allocation once it has it). Shared among `workers`' threads, the same
+/// result for every count. No errors.
+void constraint_forces(const MatrixFreeSystem& s, const std::vector<Body>& bodies,
+                       const Eigen::VectorXd& f_ext, Eigen::VectorXd& f, Workers* workers = nullptr);
+
 /// The natural-map residual of lcp_residual for the lambda that solve() left (using its w),
 /// per row: the largest value and the sum of squares (N, N^2).
 void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,

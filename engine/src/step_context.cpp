@@ -71,7 +71,10 @@ void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<d
     residual.sum_squares += sum_squares;
     residual.rows += static_cast<std::int64_t>(rows.size());
   }
-  add_constraint_forces(rows, out, f_ext, f);
+  // A lambda replaced by override_solve is not the one the solver kept: f from the rows then.
+  if (override_solve || !solver->constraint_forces(*bodies, f_ext, f, workers())) {
+    add_constraint_forces(rows, out, f_ext, f);
+  }
 }
 
 void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,

@@ -3,6 +3,7 @@
 // bodies), its solve reaches the solution of the same LCP as PGS, the engine's sweeps on a
 // captured system give back the engine's lambda, and every thread count gives the same state.
 #include "capture.h"
+#include "constraint_solver.h"
 #include "matrix_free.h"
 #include "row_colours.h"
 #include "scene.h"
@@ -117,6 +118,64 @@ TEST_CASE("coloured PGS solves the same LCP as PGS: the engine's sweeps on the c
   StepSystem plain = capture("stack", 180, SolverKind::pgs);
   CHECK(plain.order.empty());
   CHECK_THROWS_AS(solve_sweeps(plain, SolverKind::coloured_pgs, 1), std::invalid_argument);
+}
+
+TEST_CASE("coloured PGS forms f = f_ext + J^T lambda from w, the sum over the rows to round-off",
+          "[coloured]") {
+  // pyramid_100 after 30 steps, one solve with the paper's 25 sweeps. The coloured sweeps keep
+  // w = M^-1 J^T lambda per body, so f_c = M w (Eq. 6.2.1) is formed per body, not summed over
+  // the rows again. The two differ by the round-off of w's additions: each of the 25 sweeps adds
+  // a row's change to w once per half, a few eps of the entry's magnitude each, so an entry is
+  // within 1e-10 of the sum of |lambda_r j_r| and |f_ext| that makes it (about 1e5 times that
+  // round-off). A wrong mass or inertia, or a missing row, is off by the force itself.
+  scenes::Run run = scenes::make_run(*scenes::find_scene("pyramid_100"));
+  for (int k = 0; k < 30; ++k) run.step();
+  const std::vector<ConstraintRow>& rows = run.world.rows();
+  const std::vector<Body>& bodies = run.world.bodies();
+  REQUIRE(rows.size() > 1000);
+  const auto n = static_cast<Eigen::Index>(bodies.size());
+  Eigen::VectorXd f_ext = Eigen::VectorXd::Zero(6 * n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Body& body = bodies[static_cast<std::size_t>(i)];
+    if (!body.is_static()) f_ext.segment<3>(6 * i) = body.mass * run.world.def().gravity;
+  }
+  // The scale of each entry: |f_ext| plus the magnitudes of the terms of J^T lambda.
+  const auto scale = [&](const std::vector<double>& lambda) {
+    Eigen::VectorXd out = f_ext.cwiseAbs();
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const ConstraintRow& row = rows[r];
+      if (row.body_a != kWorldBody) out.segment<6>(6 * row.body_a) += std::abs(lambda[r]) * row.j.head<6>().cwiseAbs();
+      if (row.body_b != kWorldBody) out.segment<6>(6 * row.body_b) += std::abs(lambda[r]) * row.j.tail<6>().cwiseAbs();
+    }
+    return out;
+  };
+  Workers two(2);
+  for (Workers* workers : {static_cast<Workers*>(nullptr), &two}) {
+    CAPTURE(workers != nullptr ? workers->count() : 1);
+    MatrixFreeSystem s;
+    prepare(s, rows, bodies, SolverKind::coloured_pgs, workers);
+    rhs(s, rows, bodies, f_ext, run.world.def().dt, TargetTerms::push_and_bias, workers);
+    std::vector<double> lambda;
+    solve(s, rows, FrictionModel::fixed, SolverKind::coloured_pgs, 25, lambda, nullptr, workers);
+    Eigen::VectorXd from_rows;
+    add_constraint_forces(rows, lambda, f_ext, from_rows);
+    Eigen::VectorXd from_w;
+    constraint_forces(s, bodies, f_ext, from_w, workers);
+    REQUIRE(from_w.size() == from_rows.size());
+    const Eigen::VectorXd bound = 1e-10 * scale(lambda);
+    std::size_t pushed = 0;  // movable bodies that rows push
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Body& body = bodies[static_cast<std::size_t>(i)];
+      CAPTURE(i);
+      if (body.is_static()) {  // nothing moves it: f_ext alone
+        CHECK(from_w.segment<6>(6 * i) == f_ext.segment<6>(6 * i));
+        continue;
+      }
+      if ((from_rows.segment<6>(6 * i) - f_ext.segment<6>(6 * i)).norm() > 0.1 * body.mass) ++pushed;
+      for (Eigen::Index e = 6 * i; e < 6 * i + 6; ++e) CHECK(std::abs(from_w[e] - from_rows[e]) <= bound[e]);
+    }
+    CHECK(pushed > 50);  // the rows carry real forces, so the comparison means something
+  }
 }
 
 TEST_CASE("coloured PGS ends in the same state on 1, 2 and 3 threads", "[coloured][threads]") {

@@ -256,6 +256,12 @@ void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lam
 // (microseconds, tens on a virtual machine) costs about what the work does.
 constexpr std::size_t kMinParallel = 256;
 
+// Coloured PGS reads the paper's rows by position and stores the packed rows at positions, both
+// scattered over tens of MB in a pile's step: rows ahead whose lines are asked for (count; the
+// right-hand side reads one line of each row, the packing writes four; docs/benchmarks.md).
+constexpr std::size_t kReadAhead = 32;
+constexpr std::size_t kWriteAhead = 16;
+
 // Coupling entries reserved per row: sum over runs of m (m - 1) / 2 <= (kMaxRun - 1) / 2 *
 // (sum of m), so this bound holds for any mix of manifolds (8 bytes x 12 = 96 bytes a row).
 constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun / 2;
@@ -403,6 +409,9 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     // less than scattered loads, which the next instructions wait on), built in one place first.
     PackedRow p;
     for (std::size_t i = begin; i < end; ++i) {
+      if (i + kWriteAhead < end) {
+        detail::prefetch_lines<true>(&s.rows[static_cast<std::size_t>(s.position[i + kWriteAhead])], sizeof(PackedRow));
+      }
       const int normal_row = rows[i].normal_row;
       const auto at = static_cast<std::size_t>(s.position[i]);
       s.diagonal[at] = pack(rows[i], normal_row < 0 ? normal_row : s.position[static_cast<std::size_t>(normal_row)], p);
@@ -439,6 +448,7 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
       return;
     }
     for (std::size_t i = begin; i < end; ++i) {
+      if (!s.perm.empty() && i + kReadAhead < end) __builtin_prefetch(&rows[row_at(s, i + kReadAhead)].push, 0, 3);
       s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt - row_times_w(s.rows[i], s.w, fixed_slot);
     }
   });

@@ -14,7 +14,7 @@ namespace {
 class ExplicitSolver final : public ConstraintSolver {
  public:
   void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-               SolverKind kind, Workers* /*workers*/) override {
+               SolverKind kind, RowPrecision /*precision*/, Workers* /*workers*/) override {
     inv_inertia_.resize(bodies.size());
     for (std::size_t i = 0; i < bodies.size(); ++i) inv_inertia_[i] = bodies[i].inv_inertia_world();
     system_ = assemble_matrices(rows, bodies);
@@ -83,8 +83,8 @@ class ExplicitSolver final : public ConstraintSolver {
 class MatrixFreeSolver final : public ConstraintSolver {
  public:
   void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-               SolverKind kind, Workers* workers) override {
-    cps::prepare(system_, rows, bodies, kind, workers);
+               SolverKind kind, RowPrecision precision, Workers* workers) override {
+    cps::prepare(system_, rows, bodies, kind, workers, precision);
   }
 
   void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,

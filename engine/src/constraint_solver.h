@@ -30,6 +30,7 @@ struct SolveSettings {
   SolverKind kind = SolverKind::pgs;
   FrictionModel friction = FrictionModel::fixed;
   Workers* workers = nullptr;
+  RowPrecision precision = RowPrecision::double_precision;  ///< the matrix-free rows' (prepare())
 };
 
 /// A way to solve the step's bounded system A lambda = b.
@@ -42,9 +43,10 @@ class ConstraintSolver {
   /// (explicit), or the packed rows and I^-1 per body (matrix-free); for the sweeps of `kind`
   /// (SolverKind::coloured_pgs: the rows' colours and sweep order too, row_colours.h). The
   /// matrix-free path packs the rows on `workers`' threads (nullptr: the calling thread), with
-  /// the same result for every count.
+  /// the same result for every count. `precision`: how the matrix-free path stores its packed
+  /// rows (RowPrecision); the explicit path assembles in double and ignores it.
   virtual void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-                       SolverKind kind, Workers* workers) = 0;
+                       SolverKind kind, RowPrecision precision, Workers* workers) = 0;
 
   /// Solves A lambda = b with settings.iterations sweeps, b of Eq. 6.2.9 from the bodies'
   /// momenta as they are now (read with the world inverse inertia of prepare(), so that the

@@ -9,12 +9,32 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace cps {
 namespace {
 
-using PackedRow = MatrixFreeSystem::Row;
 using ConstMap6 = Eigen::Map<const Vec6, Eigen::Aligned16>;
+
+// The functions below are templates on the packed row type (MatrixFreeSystem::Row, double, or
+// ::FloatRow, float): s's rows of that type.
+template <class PackedRow>
+std::vector<PackedRow>& packed(MatrixFreeSystem& s) {
+  if constexpr (std::is_same_v<PackedRow, MatrixFreeSystem::Row>) {
+    return s.rows;
+  } else {
+    return s.float_rows;
+  }
+}
+template <class PackedRow>
+const std::vector<PackedRow>& packed(const MatrixFreeSystem& s) {
+  return packed<PackedRow>(const_cast<MatrixFreeSystem&>(s));
+}
+
+// Six numbers of a packed row (half a of j, say) as a double 6-vector: in place for a double
+// row, converted for a float row (every product and sum is then in double).
+inline ConstMap6 half(const double* p) { return ConstMap6(p); }
+inline Vec6 half(const float* p) { return Eigen::Map<const Eigen::Matrix<float, 6, 1>>(p).cast<double>(); }
 
 // The row index packed at position i.
 inline std::size_t row_at(const MatrixFreeSystem& s, std::size_t i) {
@@ -24,27 +44,29 @@ inline std::size_t row_at(const MatrixFreeSystem& s, std::size_t i) {
 // j_j . w over the row's bodies: sum_i A_ji lambda_i. 6-vector dot products (Eigen sums each in
 // pairs, so the additions do not form one long chain); a row on one movable body (its other
 // half, in slot b, is the fixed slot whose w is 0) takes one.
+template <class PackedRow>
 inline double row_times_w(const PackedRow& r, const std::vector<Vec6>& w, int fixed_slot) {
-  const double d = ConstMap6(r.j.data()).dot(w[static_cast<std::size_t>(r.a)]);
+  const double d = half(r.j.data()).dot(w[static_cast<std::size_t>(r.a)]);
   if (r.b == fixed_slot) return d;
-  return d + ConstMap6(r.j.data() + 6).dot(w[static_cast<std::size_t>(r.b)]);
+  return d + half(r.j.data() + 6).dot(w[static_cast<std::size_t>(r.b)]);
 }
 
 // w += M^-1 j^T delta for the row's movable bodies. The fixed slot (static bodies and the world)
 // is never written: M^-1 is 0 there, and rows that share only a static body then do not wait on
 // each other's stores.
+template <class PackedRow>
 inline void add_to_w(const PackedRow& r, double delta, std::vector<Vec6>& w, int fixed_slot) {
-  if (r.a != fixed_slot) w[static_cast<std::size_t>(r.a)] += delta * ConstMap6(r.minv_jt.data());
-  if (r.b != fixed_slot) w[static_cast<std::size_t>(r.b)] += delta * ConstMap6(r.minv_jt.data() + 6);
+  if (r.a != fixed_slot) w[static_cast<std::size_t>(r.a)] += delta * half(r.minv_jt.data());
+  if (r.b != fixed_slot) w[static_cast<std::size_t>(r.b)] += delta * half(r.minv_jt.data() + 6);
 }
 
-template <bool kCoupled>
+template <bool kCoupled, class PackedRow>
 inline void bounds(const PackedRow& r, const std::vector<double>& lambda, double& lo, double& hi) {
   detail::force_limits<kCoupled>(r.c_min, r.c_max, r.mu, r.normal_row, lambda.data(), lo, hi);
 }
 
 // A short run row by row through w (Eq. 7.1.1): rows r[0..m) all on w_a and, when kTwoBodies, w_b.
-template <bool kCoupled, bool kTwoBodies>
+template <bool kCoupled, bool kTwoBodies, class PackedRow>
 [[gnu::always_inline]] inline void sweep_short_run(const PackedRow* r, const double* b, double* l, int m,
                             const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
   for (int i = 0; i < m; ++i) {
@@ -53,12 +75,12 @@ template <bool kCoupled, bool kTwoBodies>
     double lo;
     double hi;
     bounds<kCoupled>(row, lambda, lo, hi);
-    double jw = ConstMap6(row.j.data()).dot(w_a);
-    if constexpr (kTwoBodies) jw += ConstMap6(row.j.data() + 6).dot(w_b);
+    double jw = half(row.j.data()).dot(w_a);
+    if constexpr (kTwoBodies) jw += half(row.j.data() + 6).dot(w_b);
     const double value = std::clamp(l[i] + (b[i] - jw) * row.inv_diagonal, lo, hi);
     const double delta = value - l[i];
-    w_a += delta * ConstMap6(row.minv_jt.data());
-    if constexpr (kTwoBodies) w_b += delta * ConstMap6(row.minv_jt.data() + 6);
+    w_a += delta * half(row.minv_jt.data());
+    if constexpr (kTwoBodies) w_b += delta * half(row.minv_jt.data() + 6);
     l[i] = value;
   }
 }
@@ -66,15 +88,15 @@ template <bool kCoupled, bool kTwoBodies>
 // A run of m rows on w_a and (kTwoBodies) w_b as a block; kM = m when known at compile time (the
 // loops then unroll), 0 otherwise. g: the run's coupling, the strict lower triangle of its m x m
 // block column by column (column i: A_ki / A_kk for k = i+1..m-1).
-template <bool kCoupled, bool kTwoBodies, int kM>
+template <bool kCoupled, bool kTwoBodies, int kM, class PackedRow>
 [[gnu::always_inline]] inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_runtime,
                         const double* g, const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
   const int m = kM > 0 ? kM : m_runtime;
   // Unclamped new values against w at the start of the run: independent of each other.
   double t[MatrixFreeSystem::kMaxRun];
   for (int i = 0; i < m; ++i) {
-    double jw = ConstMap6(r[i].j.data()).dot(w_a);
-    if constexpr (kTwoBodies) jw += ConstMap6(r[i].j.data() + 6).dot(w_b);
+    double jw = half(r[i].j.data()).dot(w_a);
+    if constexpr (kTwoBodies) jw += half(r[i].j.data() + 6).dot(w_b);
     t[i] = l[i] + (b[i] - jw) * r[i].inv_diagonal;
   }
   Vec6 dw_a = Vec6::Zero();
@@ -88,8 +110,8 @@ template <bool kCoupled, bool kTwoBodies, int kM>
     const double delta = value - l[i];
     l[i] = value;
     for (int k = i + 1; k < m; ++k) t[k] -= g[k - i - 1] * delta;
-    dw_a += delta * ConstMap6(r[i].minv_jt.data());
-    if constexpr (kTwoBodies) dw_b += delta * ConstMap6(r[i].minv_jt.data() + 6);
+    dw_a += delta * half(r[i].minv_jt.data());
+    if constexpr (kTwoBodies) dw_b += delta * half(r[i].minv_jt.data() + 6);
   }
   w_a += dw_a;
   if constexpr (kTwoBodies) w_b += dw_b;
@@ -101,6 +123,7 @@ template <bool kCoupled, bool kTwoBodies, int kM>
 // the same number Eq. 7.1.1 gives through w, in the same order; w_a and w_b take the run's
 // sum of M^-1 j_i^T delta_i at its end.
 // What a sweep reads and writes, taken out of s once per solve.
+template <class PackedRow>
 struct SweepData {
   const PackedRow* rows;
   const double* b;
@@ -110,16 +133,17 @@ struct SweepData {
   int fixed_slot;
 };
 
-SweepData sweep_data(MatrixFreeSystem& s, std::vector<double>& lambda) {
-  return {s.rows.data(), s.b.data(), lambda.data(), s.w.data(), s.coupling.data(),
+template <class PackedRow>
+SweepData<PackedRow> sweep_data(MatrixFreeSystem& s, std::vector<double>& lambda) {
+  return {packed<PackedRow>(s).data(), s.b.data(), lambda.data(), s.w.data(), s.coupling.data(),
           static_cast<int>(s.w.size()) - 1};
 }
 
 // One run (see MatrixFreeSystem::Run): a short run row by row through w, a longer one as a block.
 // Inlined into the sweeps' loops: as a call per run it cost the pendulum wave's single-row runs
 // 20 % more instructions.
-template <bool kCoupled>
-[[gnu::always_inline]] inline void sweep_run(const SweepData& d, const MatrixFreeSystem::Run& run,
+template <bool kCoupled, class PackedRow>
+[[gnu::always_inline]] inline void sweep_run(const SweepData<PackedRow>& d, const MatrixFreeSystem::Run& run,
                       const std::vector<double>& lambda) {
   const auto first = static_cast<std::size_t>(run.begin);
   const PackedRow* r = d.rows + first;
@@ -152,7 +176,8 @@ template <bool kCoupled>
 // Asks for the cache lines of a run's packed rows and coupling ahead of its sweep. The sweeps
 // stream the rows in order, but the hardware's own prefetching fell behind them
 // (docs/benchmarks.md).
-inline void prefetch_run(const SweepData& d, const MatrixFreeSystem::Run& run) {
+template <class PackedRow>
+inline void prefetch_run(const SweepData<PackedRow>& d, const MatrixFreeSystem::Run& run) {
   detail::prefetch_lines<false>(d.rows + run.begin, static_cast<std::size_t>(run.count) * sizeof(PackedRow));
   if (run.offset >= 0) __builtin_prefetch(d.coupling + run.offset, 0, 3);
 }
@@ -161,8 +186,9 @@ inline void prefetch_run(const SweepData& d, const MatrixFreeSystem::Run& run) {
 inline constexpr std::size_t kPrefetchRuns = 4;
 
 // Whether the sweeps over s prefetch its rows.
+template <class PackedRow>
 inline bool prefetching(const MatrixFreeSystem& s) {
-  return s.rows.size() * sizeof(PackedRow) >= detail::kPrefetchFrom;
+  return packed<PackedRow>(s).size() * sizeof(PackedRow) >= detail::kPrefetchFrom;
 }
 
 // The runs [first, the result) of [first, last) that ask for the run kPrefetchRuns after them.
@@ -177,12 +203,15 @@ inline std::size_t prefetch_end(bool prefetch, std::size_t first, std::size_t la
 //   lambda_k + (b_k - j_k . w_start) / A_kk - sum_{i < k} (A_ki / A_kk) delta_i,
 // the same number Eq. 7.1.1 gives through w, in the same order; w_a and w_b take the run's
 // sum of M^-1 j_i^T delta_i at its end.
-template <bool kCoupled>
-void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
-  const SweepData d = sweep_data(s, lambda);
+// The three sweeps are [[gnu::flatten]]: built for double and for float rows, they outgrew GCC's
+// inlining budget, and an out-of-line Eigen 6-vector += took 10 % of the funnel's step
+// (docs/benchmarks.md); flatten inlines every call in them.
+template <bool kCoupled, class PackedRow>
+[[gnu::flatten]] void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
+  const SweepData<PackedRow> d = sweep_data<PackedRow>(s, lambda);
   const MatrixFreeSystem::Run* runs = s.runs.data();
   const std::size_t count = s.runs.size();
-  const std::size_t prefetched = prefetch_end(prefetching(s), 0, count);
+  const std::size_t prefetched = prefetch_end(prefetching<PackedRow>(s), 0, count);
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t i = 0; i < count; ++i) {
       if (i < prefetched) prefetch_run(d, runs[i + kPrefetchRuns]);
@@ -196,13 +225,13 @@ void pgs_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda
 // with a barrier after each colour. The runs of a colour share no movable body: each writes only
 // its own lambdas and its bodies' w, and reads a contact row's lambda only from its own run
 // (a manifold's rows are one run or runs of different colours).
-template <bool kCoupled>
-void coloured_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda,
+template <bool kCoupled, class PackedRow>
+[[gnu::flatten]] void coloured_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda,
                      Workers* workers, int t) {
-  const SweepData d = sweep_data(s, lambda);
+  const SweepData<PackedRow> d = sweep_data<PackedRow>(s, lambda);
   const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
   const auto k_t = static_cast<std::size_t>(t);
-  const bool prefetch = prefetching(s);
+  const bool prefetch = prefetching<PackedRow>(s);
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t k = 0; k < ConstraintGraph::kColours; ++k) {
       const std::size_t begin = s.sweep_start[k];
@@ -228,10 +257,10 @@ void coloured_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& l
 }
 
 // Projected Jacobi: every row against the w of the previous sweep, then all of them applied.
-template <bool kCoupled>
-void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
-  const std::size_t c = s.rows.size();
-  const PackedRow* rows = s.rows.data();
+template <bool kCoupled, class PackedRow>
+[[gnu::flatten]] void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda) {
+  const std::size_t c = packed<PackedRow>(s).size();
+  const PackedRow* rows = packed<PackedRow>(s).data();
   const double* b = s.b.data();
   double* l = lambda.data();
   const int fixed_slot = static_cast<int>(s.w.size()) - 1;
@@ -252,6 +281,16 @@ void jacobi_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lam
   }
 }
 
+// Calls f(rows) with s's packed rows of prepare()'s precision (s.rows or s.float_rows).
+template <class System, class F>
+void with_rows(System& s, F&& f) {
+  if (s.precision == RowPrecision::single_precision) {
+    f(s.float_rows);
+  } else {
+    f(s.rows);
+  }
+}
+
 // Fewest items (rows, bodies, runs) a stage shares among threads (count): below it waking them
 // (microseconds, tens on a virtual machine) costs about what the work does.
 constexpr std::size_t kMinParallel = 256;
@@ -268,6 +307,7 @@ constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun / 2;
 
 // The coupling blocks of s.runs (any order), at offsets set here (PGS and coloured PGS), the
 // blocks computed on `workers`' threads.
+template <class PackedRow>
 void build_coupling(MatrixFreeSystem& s, Workers* workers = nullptr) {
   std::size_t coupling_size = 0;
   for (MatrixFreeSystem::Run& run : s.runs) {
@@ -279,19 +319,19 @@ void build_coupling(MatrixFreeSystem& s, Workers* workers = nullptr) {
   // Room for the largest coupling these many rows can need (kCouplingPerRow): it then grows only
   // when the row count does, not whenever more rows happen to sit in blocks than in any earlier
   // step (which a long run meets after warm-up).
-  detail::reserve_with_headroom(s.coupling, std::max(coupling_size, kCouplingPerRow * s.rows.size()));
+  detail::reserve_with_headroom(s.coupling, std::max(coupling_size, kCouplingPerRow * packed<PackedRow>(s).size()));
   detail::resize_with_headroom(s.coupling, coupling_size);
   parallel_for(workers, s.runs.size(), kMinParallel, [&s](int, std::size_t begin, std::size_t end) {
     for (std::size_t n = begin; n < end; ++n) {
       const MatrixFreeSystem::Run& run = s.runs[n];
       if (run.offset < 0) continue;
-      const PackedRow* r = s.rows.data() + run.begin;
+      const PackedRow* r = packed<PackedRow>(s).data() + run.begin;
       double* g = s.coupling.data() + run.offset;
       for (int i = 0; i < run.count; g += run.count - 1 - i, ++i) {
         // Column i: A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
         for (int k = i + 1; k < run.count; ++k) {
-          const double a_ki = ConstMap6(r[k].j.data()).dot(ConstMap6(r[i].minv_jt.data())) +
-                              ConstMap6(r[k].j.data() + 6).dot(ConstMap6(r[i].minv_jt.data() + 6));
+          const double a_ki = half(r[k].j.data()).dot(half(r[i].minv_jt.data())) +
+                              half(r[k].j.data() + 6).dot(half(r[i].minv_jt.data() + 6));
           g[k - i - 1] = a_ki * r[k].inv_diagonal;
         }
       }
@@ -300,25 +340,28 @@ void build_coupling(MatrixFreeSystem& s, Workers* workers = nullptr) {
 }
 
 // Runs of consecutive rows on the same two slots in row order, and their coupling blocks (PGS).
+template <class PackedRow>
 void build_runs(MatrixFreeSystem& s) {
-  const std::size_t c = s.rows.size();
+  const std::vector<PackedRow>& rows = packed<PackedRow>(s);
+  const std::size_t c = rows.size();
   s.runs.clear();
   detail::reserve_with_headroom(s.runs, c);
   for (std::size_t r = 0; r < c;) {
     std::size_t end = r + 1;
     while (end < c && end - r < static_cast<std::size_t>(MatrixFreeSystem::kMaxRun) &&
-           s.rows[end].a == s.rows[r].a && s.rows[end].b == s.rows[r].b) {
+           rows[end].a == rows[r].a && rows[end].b == rows[r].b) {
       ++end;
     }
     s.runs.push_back({static_cast<int>(r), static_cast<int>(end - r), -1});
     r = end;
   }
-  build_coupling(s);
+  build_coupling<PackedRow>(s);
   s.runs_ready = true;
 }
 
 // Coloured PGS: the runs of s.colours at their positions (the rows are packed in sweep order, so
 // a colour's runs are consecutive) and their coupling blocks.
+template <class PackedRow>
 void build_coloured_runs(MatrixFreeSystem& s, Workers* workers) {
   s.runs.clear();
   detail::reserve_with_headroom(s.runs, s.colours.runs.size());
@@ -333,14 +376,15 @@ void build_coloured_runs(MatrixFreeSystem& s, Workers* workers) {
     }
   }
   s.sweep_start.back() = s.runs.size();
-  build_coupling(s, workers);
+  build_coupling<PackedRow>(s, workers);
   s.runs_ready = true;
 }
 
 }  // namespace
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
-             const std::vector<Body>& bodies, SolverKind kind, Workers* workers) {
+             const std::vector<Body>& bodies, SolverKind kind, Workers* workers,
+             RowPrecision precision) {
   const int n = static_cast<int>(bodies.size());
   s.runs_ready = false;  // built below (coloured PGS) or by the first PGS solve (Jacobi: never)
   if (kind == SolverKind::coloured_pgs) {
@@ -356,38 +400,39 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   parallel_for(workers, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) s.inv_inertia[i] = bodies[i].inv_inertia_world();
   });
-  detail::resize_with_headroom(s.rows, rows.size());
   detail::resize_with_headroom(s.diagonal, rows.size());
   detail::resize_with_headroom(s.w, bodies.size() + 1);  // slot n: static bodies and the fixed world, always 0
   // Static bodies and the fixed world share slot n, whose w stays 0 (M^-1 = 0 there).
   const auto slot = [&](int body) {
     return body == kWorldBody || bodies[static_cast<std::size_t>(body)].is_static() ? n : body;
   };
-  // Packs `row` into p, with A_jj; normal_row: the contact row's position.
-  const auto pack = [&](const ConstraintRow& row, int normal_row, PackedRow& p) {
+  // Packs `row` into p, with A_jj of the numbers stored; normal_row: the contact row's position.
+  const auto pack = [&]<class PackedRow>(const ConstraintRow& row, int normal_row, PackedRow& p) {
+    using Scalar = typename decltype(p.j)::value_type;
     p.a = slot(row.body_a);
     p.b = slot(row.body_b);
     p.c_min = row.c_min;
     p.c_max = row.c_max;
     p.mu = row.mu;
     p.normal_row = normal_row;
-    p.minv_jt.fill(0.0);
+    p.minv_jt.fill(Scalar{0});
     double diagonal = 0.0;
     for (int half = 0; half < 2; ++half) {
       const int body = half == 0 ? row.body_a : row.body_b;
       const int o = 6 * half;
-      for (int k = 0; k < 6; ++k) p.j[static_cast<std::size_t>(o + k)] = row.j[o + k];
+      for (int k = 0; k < 6; ++k) p.j[static_cast<std::size_t>(o + k)] = static_cast<Scalar>(row.j[o + k]);
       if (body == kWorldBody) continue;
       const Body& bd = bodies[static_cast<std::size_t>(body)];
       if (bd.is_static()) continue;  // M^-1 = 0: nothing to add
       const Vec3 lin = bd.inv_mass * row.j.segment<3>(o);
       const Vec3 ang = s.inv_inertia[static_cast<std::size_t>(body)] * row.j.segment<3>(o + 3);
       for (int k = 0; k < 3; ++k) {
-        p.minv_jt[static_cast<std::size_t>(o + k)] = lin[k];
-        p.minv_jt[static_cast<std::size_t>(o + 3 + k)] = ang[k];
+        p.minv_jt[static_cast<std::size_t>(o + k)] = static_cast<Scalar>(lin[k]);
+        p.minv_jt[static_cast<std::size_t>(o + 3 + k)] = static_cast<Scalar>(ang[k]);
       }
       for (int k = 0; k < 6; ++k) {
-        diagonal += row.j[o + k] * p.minv_jt[static_cast<std::size_t>(o + k)];
+        const auto e = static_cast<std::size_t>(o + k);
+        diagonal += static_cast<double>(p.j[e]) * static_cast<double>(p.minv_jt[e]);
       }
     }
     if (p.a == n && p.b != n) {
@@ -400,9 +445,12 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     p.inv_diagonal = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
     return diagonal;
   };
+  // Every row packed into out (s.rows or s.float_rows), then the coloured runs' coupling.
+  const auto pack_all = [&]<class PackedRow>(std::vector<PackedRow>& out) {
+  detail::resize_with_headroom(out, rows.size());
   parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
     if (s.perm.empty()) {
-      for (std::size_t i = begin; i < end; ++i) s.diagonal[i] = pack(rows[i], rows[i].normal_row, s.rows[i]);
+      for (std::size_t i = begin; i < end; ++i) s.diagonal[i] = pack(rows[i], rows[i].normal_row, out[i]);
       return;
     }
     // Coloured PGS: read in row order and stored at the row's position (scattered stores cost
@@ -410,15 +458,24 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     PackedRow p;
     for (std::size_t i = begin; i < end; ++i) {
       if (i + kWriteAhead < end) {
-        detail::prefetch_lines<true>(&s.rows[static_cast<std::size_t>(s.position[i + kWriteAhead])], sizeof(PackedRow));
+        detail::prefetch_lines<true>(&out[static_cast<std::size_t>(s.position[i + kWriteAhead])], sizeof(PackedRow));
       }
       const int normal_row = rows[i].normal_row;
       const auto at = static_cast<std::size_t>(s.position[i]);
       s.diagonal[at] = pack(rows[i], normal_row < 0 ? normal_row : s.position[static_cast<std::size_t>(normal_row)], p);
-      s.rows[at] = p;
+      out[at] = p;
     }
   });
-  if (kind == SolverKind::coloured_pgs) build_coloured_runs(s, workers);
+  if (kind == SolverKind::coloured_pgs) build_coloured_runs<PackedRow>(s, workers);
+  };
+  s.precision = precision;
+  if (precision == RowPrecision::single_precision) {
+    s.rows.clear();
+    pack_all(s.float_rows);
+  } else {
+    s.float_rows.clear();
+    pack_all(s.rows);
+  }
 }
 
 void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
@@ -442,15 +499,17 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   });
   s.w.back().setZero();
   const int fixed_slot = static_cast<int>(bodies.size());
-  parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
-    if (terms == TargetTerms::push_from_rest) {  // the bodies at rest, no external force: b = v / dt
-      for (std::size_t i = begin; i < end; ++i) s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt;
-      return;
-    }
-    for (std::size_t i = begin; i < end; ++i) {
-      if (!s.perm.empty() && i + kReadAhead < end) __builtin_prefetch(&rows[row_at(s, i + kReadAhead)].push, 0, 3);
-      s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt - row_times_w(s.rows[i], s.w, fixed_slot);
-    }
+  with_rows(s, [&](const auto& packed_rows) {
+    parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+      if (terms == TargetTerms::push_from_rest) {  // the bodies at rest, no external force: b = v / dt
+        for (std::size_t i = begin; i < end; ++i) s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt;
+        return;
+      }
+      for (std::size_t i = begin; i < end; ++i) {
+        if (!s.perm.empty() && i + kReadAhead < end) __builtin_prefetch(&rows[row_at(s, i + kReadAhead)].push, 0, 3);
+        s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt - row_times_w(packed_rows[i], s.w, fixed_slot);
+      }
+    });
   });
 }
 
@@ -467,6 +526,8 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
   std::vector<double>& l = coloured ? s.swept : lambda;
   detail::assign_with_headroom(l, rows.size(), 0.0);  // initial guess 0 (Sec. 7.2) ...
   for (Vec6& w : s.w) w.setZero();
+  with_rows(s, [&](const auto& packed_rows) {
+  using PackedRow = typename std::decay_t<decltype(packed_rows)>::value_type;
   if (initial != nullptr) {  // ... or the one given, with w = M^-1 J^T lambda to match
     const int fixed_slot = static_cast<int>(s.w.size()) - 1;
     // Consecutive rows on the same two slots (a manifold's contact rows, its friction rows) sum
@@ -483,7 +544,7 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
       sum_b.setZero();
     };
     for (std::size_t j = 0; j < rows.size(); ++j) {
-      const PackedRow& r = s.rows[j];
+      const PackedRow& r = packed_rows[j];
       if (r.inv_diagonal == 0.0) continue;  // touches no movable body: stays 0
       if (r.a != a || r.b != b) {
         flush();
@@ -491,23 +552,23 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
         b = r.b;
       }
       l[j] = (*initial)[row_at(s, j)];
-      sum_a += l[j] * ConstMap6(r.minv_jt.data());
-      sum_b += l[j] * ConstMap6(r.minv_jt.data() + 6);
+      sum_a += l[j] * half(r.minv_jt.data());
+      sum_b += l[j] * half(r.minv_jt.data() + 6);
     }
     flush();
   }
   const bool coupled = friction == FrictionModel::coupled;
   if (kind == SolverKind::jacobi) {
     detail::assign_with_headroom(s.next, rows.size(), 0.0);
-    coupled ? jacobi_sweeps<true>(s, iterations, l) : jacobi_sweeps<false>(s, iterations, l);
+    coupled ? jacobi_sweeps<true, PackedRow>(s, iterations, l) : jacobi_sweeps<false, PackedRow>(s, iterations, l);
   } else if (coloured) {
     if (workers == nullptr || workers->count() == 1) {
-      coupled ? coloured_sweeps<true>(s, iterations, l, nullptr, 0)
-              : coloured_sweeps<false>(s, iterations, l, nullptr, 0);
+      coupled ? coloured_sweeps<true, PackedRow>(s, iterations, l, nullptr, 0)
+              : coloured_sweeps<false, PackedRow>(s, iterations, l, nullptr, 0);
     } else {
       auto task = [&](int t) {
-        coupled ? coloured_sweeps<true>(s, iterations, l, workers, t)
-                : coloured_sweeps<false>(s, iterations, l, workers, t);
+        coupled ? coloured_sweeps<true, PackedRow>(s, iterations, l, workers, t)
+                : coloured_sweeps<false, PackedRow>(s, iterations, l, workers, t);
       };
       workers->run(task);
     }
@@ -516,9 +577,10 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
       for (std::size_t j = begin; j < end; ++j) lambda[static_cast<std::size_t>(s.perm[j])] = l[j];
     });
   } else {
-    if (!s.runs_ready) build_runs(s);
-    coupled ? pgs_sweeps<true>(s, iterations, l) : pgs_sweeps<false>(s, iterations, l);
+    if (!s.runs_ready) build_runs<PackedRow>(s);
+    coupled ? pgs_sweeps<true, PackedRow>(s, iterations, l) : pgs_sweeps<false, PackedRow>(s, iterations, l);
   }
+  });
 }
 
 void constraint_forces(const MatrixFreeSystem& s, const std::vector<Body>& bodies,
@@ -542,10 +604,11 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
               double& sum_squares) {
   max = 0.0;
   sum_squares = 0.0;
+  with_rows(s, [&](const auto& packed_rows) {
   for (std::size_t j = 0; j < rows.size(); ++j) {
     const double diagonal = s.diagonal[j];
     if (!(diagonal > 0.0)) continue;
-    const PackedRow& p = s.rows[j];
+    const auto& p = packed_rows[j];
     // The bounds read lambda by row index: the contact row's index for a friction row.
     const int normal_row = p.normal_row < 0 || s.perm.empty()
                                ? p.normal_row
@@ -560,11 +623,13 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     max = std::max(max, r);
     sum_squares += r * r;
   }
+  });
 }
 
 void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::VectorXd& b,
                      RowLimits& limits) {
-  const auto c = static_cast<Eigen::Index>(s.rows.size());
+  with_rows(s, [&](const auto& packed_rows) {
+  const auto c = static_cast<Eigen::Index>(packed_rows.size());
   const auto slots = 6 * static_cast<Eigen::Index>(s.w.size());  // n bodies and the fixed slot
   // J and (M^-1 J^T)^T over the slots, 12 entries a row; the fixed slot's M^-1 j^T is 0.
   std::vector<Eigen::Triplet<double>> j_entries;
@@ -577,7 +642,7 @@ void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::Vecto
   limits.normal_row.resize(static_cast<std::size_t>(c));
   for (Eigen::Index i = 0; i < c; ++i) {
     // Written at its row index: A, b and the limits in row order, as the explicit path's.
-    const PackedRow& p = s.rows[static_cast<std::size_t>(i)];
+    const auto& p = packed_rows[static_cast<std::size_t>(i)];
     const auto r = static_cast<Eigen::Index>(row_at(s, static_cast<std::size_t>(i)));
     for (int half = 0; half < 2; ++half) {
       const Eigen::Index column = 6 * static_cast<Eigen::Index>(half == 0 ? p.a : p.b);
@@ -600,6 +665,7 @@ void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::Vecto
   A = J * SparseRowMatrix(MJt.transpose());
   b.resize(c);
   for (Eigen::Index i = 0; i < c; ++i) b[static_cast<Eigen::Index>(row_at(s, static_cast<std::size_t>(i)))] = s.b[static_cast<std::size_t>(i)];
+  });
 }
 
 }  // namespace cps

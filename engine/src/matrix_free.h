@@ -18,25 +18,30 @@ namespace cps {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;  ///< per body: linear then angular part
 
+/// One row packed for the sweep, everything the sweep reads in one contiguous block (as the
+/// constraint parts of Box2D v3 and Jolt): its bodies (static bodies and a fixed world point
+/// share the extra slot n, whose w stays 0 and is never written), j (12) and M^-1 j^T (12) in
+/// Scalar (double, or float for RowPrecision::single_precision: 144 bytes a row instead of 240),
+/// 1 / A_jj of those numbers, and its bounds. A row with one movable body keeps it in half a (its
+/// halves are swapped if needed), so b == n marks a one-body row.
+template <class Scalar>
+struct alignas(16) PackedRow {
+  std::array<Scalar, 12> j{};        ///< [j_a (6), j_b (6)]: the row of J
+  std::array<Scalar, 12> minv_jt{};  ///< [M_a^-1 j_a (6), M_b^-1 j_b (6)]
+  double inv_diagonal = 0.0;         ///< 1 / A_jj (kg); 0 for a row that touches no movable body
+  double c_min = 0.0;                ///< lower force limit (N)
+  double c_max = 0.0;                ///< upper force limit (N)
+  double mu = 0.0;                   ///< friction coefficient of a friction row (dimensionless)
+  int normal_row = -1;               ///< a friction row's contact row (its position), for the coupled limit
+  int a = 0;                         ///< body slot of half a
+  int b = 0;                         ///< body slot of half b
+};
+
 /// Buffers of the matrix-free solve, sized by prepare() and reused from step to step, so a step
 /// allocates nothing once they have reached their largest size.
 struct MatrixFreeSystem {
-  /// One row packed for the sweep, everything the sweep reads in one contiguous block (as the
-  /// constraint parts of Box2D v3 and Jolt): its bodies (static bodies and a fixed world point
-  /// share the extra slot n, whose w stays 0 and is never written), j (12) and M^-1 j^T (12),
-  /// 1 / A_jj, and its bounds. A row with one movable body keeps it in half a (its halves are
-  /// swapped if needed), so b == n marks a one-body row.
-  struct alignas(16) Row {
-    std::array<double, 12> j{};        ///< [j_a (6), j_b (6)]: the row of J
-    std::array<double, 12> minv_jt{};  ///< [M_a^-1 j_a (6), M_b^-1 j_b (6)]
-    double inv_diagonal = 0.0;         ///< 1 / A_jj (kg); 0 for a row that touches no movable body
-    double c_min = 0.0;                ///< lower force limit (N)
-    double c_max = 0.0;                ///< upper force limit (N)
-    double mu = 0.0;                   ///< friction coefficient of a friction row (dimensionless)
-    int normal_row = -1;               ///< a friction row's contact row (its position), for the coupled limit
-    int a = 0;                         ///< body slot of half a
-    int b = 0;                         ///< body slot of half b
-  };
+  using Row = PackedRow<double>;
+  using FloatRow = PackedRow<float>;
   /// Consecutive rows on the same two body slots (the rows of one manifold): PGS sweeps them as
   /// a block. Each sees the others' updates through the coupling A_ki / A_kk (k > i) instead of
   /// through w, so the rows of a run do not wait on each other's w stores and the first products
@@ -52,8 +57,11 @@ struct MatrixFreeSystem {
   /// Most rows in a run: the rows of a full manifold (a contact and two friction rows a point).
   static constexpr int kMaxRun = 3 * kMaxManifoldPoints;
   /// The packed rows in sweep order: position i holds row perm[i] (row order when perm is
-  /// empty). A friction row's normal_row is a position too.
+  /// empty). A friction row's normal_row is a position too. `rows` for double precision,
+  /// `float_rows` for single (the other is left empty).
   std::vector<Row> rows;
+  std::vector<FloatRow> float_rows;
+  RowPrecision precision = RowPrecision::double_precision;  ///< prepare()'s: which of the two
   /// Coloured PGS: the row at each position (c), the rows' sweep order by graph colour
   /// (row_colours.h); empty for PGS and Jacobi, which keep row order.
   std::vector<int> perm;
@@ -81,9 +89,12 @@ struct MatrixFreeSystem {
 /// (row_colours.h) and packs them in sweep order, so that the sweeps read them in order. Rows
 /// refer to bodies by index or kWorldBody. The packing and the coupling blocks are shared among
 /// `workers`' threads (nullptr: the calling thread; the same numbers for every count; the
-/// colouring stays on one). Source: Eq. 6.2.9, A_jj = j M^-1 j^T. No errors.
+/// colouring stays on one). `precision`: j and M^-1 j^T stored in double or rounded to float,
+/// A_jj and the coupling then formed from the stored numbers (so the sweeps solve that system
+/// consistently). Source: Eq. 6.2.9, A_jj = j M^-1 j^T. No errors.
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
-             const std::vector<Body>& bodies, SolverKind kind, Workers* workers = nullptr);
+             const std::vector<Body>& bodies, SolverKind kind, Workers* workers = nullptr,
+             RowPrecision precision = RowPrecision::double_precision);
 
 /// Fills s.b (c): b_j = v_j / dt - j_j . (v1 / dt + M^-1 f_ext) (Eq. 6.2.9) with f_ext (6n:
 /// force and torque per body, N and N m; the explicit path reads the same vector), v1 from the

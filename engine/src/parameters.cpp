@@ -134,6 +134,10 @@ constexpr std::array kAssemblyChoices = {
     Choice{"matrix-free", static_cast<int>(Assembly::matrix_free), "", "matrix-free"},
     Choice{"explicit", static_cast<int>(Assembly::explicit_matrices), "Sec. 6", "explicit J, M^-1 and A"},
 };
+constexpr std::array kRowPrecisionChoices = {
+    Choice{"double", static_cast<int>(RowPrecision::double_precision), "", "rows in double"},
+    Choice{"float", static_cast<int>(RowPrecision::single_precision), "Box3D", "rows in float"},
+};
 
 // Every WorldDef member, in its order. Reals and integers are finite and in [min, max].
 const std::array kParameters = {
@@ -269,6 +273,18 @@ const std::array kParameters = {
                       "J, M^-1 and A = J M^-1 J^T as in Sec. 6; the same lambda to round-off",
               .get = &get_member<&WorldDef::assembly>,
               .set = &set_member<&WorldDef::assembly>},
+    Parameter{.name = "row_precision",
+              .flag = "row-precision",
+              .json_key = "row_precision",
+              .type = ParameterType::choice,
+              .choices = kRowPrecisionChoices,
+              .help = "how the matrix-free solve stores the rows it sweeps: double (the paper's "
+                      "numbers) or float (j and M^-1 j^T rounded to float, half the bytes a "
+                      "sweep reads; lambda and every sum stay double); --assembly explicit takes "
+                      "double only",
+              .title = "row precision",
+              .get = &get_member<&WorldDef::row_precision>,
+              .set = &set_member<&WorldDef::row_precision>},
     Parameter{.name = "contact_margin",
               .flag = "contact-margin",
               .json_key = "contact_margin_m",
@@ -868,6 +884,9 @@ std::string_view name_of(SoftRelax v) {
   return parameter("soft_relax").choice_name(static_cast<int>(v));
 }
 std::string_view name_of(Assembly v) { return parameter("assembly").choice_name(static_cast<int>(v)); }
+std::string_view name_of(RowPrecision v) {
+  return parameter("row_precision").choice_name(static_cast<int>(v));
+}
 
 void WorldDef::validate() const {
   for (const Parameter& p : kParameters) {
@@ -876,6 +895,11 @@ void WorldDef::validate() const {
       throw std::invalid_argument("world parameter " + std::string(p.name) + " = " + p.format(v) +
                                   " is not allowed: " + *why);
     }
+  }
+  if (assembly == Assembly::explicit_matrices && row_precision != RowPrecision::double_precision) {
+    throw std::invalid_argument("world parameter row_precision = " + std::string(name_of(row_precision)) +
+                                " is not allowed with assembly = explicit, which assembles J in "
+                                "double; give row_precision double, or assembly matrix-free");
   }
 }
 

@@ -26,7 +26,7 @@ StepContext::StepContext(const StepContext& other)
 StepContext::~StepContext() = default;
 
 SolveSettings StepContext::settings(double dt) const {
-  return SolveSettings{dt, def->iterations, def->solver, def->friction_model, workers()};
+  return SolveSettings{dt, def->iterations, def->solver, def->friction_model, workers(), def->row_precision};
 }
 
 void StepContext::update_workers() {
@@ -45,7 +45,7 @@ void StepContext::prepare() {
     solver_assembly = def->assembly;
   }
   StageTimer timer(*this, &StageTimes::prepare);
-  solver->prepare(rows, *bodies, def->solver, workers());
+  solver->prepare(rows, *bodies, def->solver, def->row_precision, workers());
 }
 
 void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<double>& out,

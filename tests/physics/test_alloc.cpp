@@ -102,6 +102,7 @@ TEST_CASE("after warm-up a step of every paper scene allocates nothing", "[alloc
     PushMode push;
     double warm_start;  // the cache and the initial guesses keep their storage too
     int threads = 1;
+    RowPrecision precision = RowPrecision::double_precision;
   };
   for (const scenes::Scene& scene : scenes::paper_scenes()) {
     for (const Variant& v : {Variant{"pgs baumgarte", SolverKind::pgs, PushMode::baumgarte, 0.0},
@@ -115,13 +116,16 @@ TEST_CASE("after warm-up a step of every paper scene allocates nothing", "[alloc
                              Variant{"jacobi soft", SolverKind::jacobi, PushMode::soft, 0.0},
                              Variant{"pgs ngs", SolverKind::pgs, PushMode::ngs, 0.0},
                              Variant{"coloured-pgs baumgarte, 2 threads", SolverKind::coloured_pgs,
-                                     PushMode::baumgarte, 0.0, 2}}) {
+                                     PushMode::baumgarte, 0.0, 2},
+                             Variant{"pgs split warm 1, float rows", SolverKind::pgs, PushMode::split, 1.0, 1,
+                                     RowPrecision::single_precision}}) {
       scenes::Overrides o;
       o.set("solver", v.solver);
       o.set("push", v.push);
       o.set("warm_start", v.warm_start);
       o.set("assembly", Assembly::matrix_free);
       o.set("threads", v.threads);
+      o.set("row_precision", v.precision);
       scenes::Run run = scenes::make_run(scene, o);
       // Under the soft step the pendulum grid's shapes settle later: its rows grow from at most
       // 142 in the first 3 s to 169 by 11 s, past the headroom of the step's own buffers (World's

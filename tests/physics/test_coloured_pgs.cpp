@@ -31,14 +31,19 @@ StepSystem capture(const char* scene, std::int64_t step, SolverKind solver) {
   return test::capture(scene, step, o);
 }
 
+// pyramid_100 after 30 steps: boxes on boxes and on the ground (static), 4 to 8 points a
+// manifold, friction rows that read their contact row's lambda.
+scenes::Run settled_pile() {
+  scenes::Run run = scenes::make_run(*scenes::find_scene("pyramid_100"));
+  for (int k = 0; k < 30; ++k) run.step();
+  return run;
+}
+
 }  // namespace
 
 TEST_CASE("coloured PGS sweeps every row once, and a colour's runs share no movable body",
           "[coloured]") {
-  // pyramid_100 after 30 steps: boxes on boxes and on the ground (static), 4 to 8 points a
-  // manifold, friction rows that read their contact row's lambda.
-  scenes::Run run = scenes::make_run(*scenes::find_scene("pyramid_100"));
-  for (int k = 0; k < 30; ++k) run.step();
+  scenes::Run run = settled_pile();
   const std::vector<ConstraintRow>& rows = run.world.rows();
   REQUIRE(rows.size() > 1000);
   RowColours colours;
@@ -122,14 +127,13 @@ TEST_CASE("coloured PGS solves the same LCP as PGS: the engine's sweeps on the c
 
 TEST_CASE("coloured PGS forms f = f_ext + J^T lambda from w, the sum over the rows to round-off",
           "[coloured]") {
-  // pyramid_100 after 30 steps, one solve with the paper's 25 sweeps. The coloured sweeps keep
+  // The pile, one solve with the paper's 25 sweeps. The coloured sweeps keep
   // w = M^-1 J^T lambda per body, so f_c = M w (Eq. 6.2.1) is formed per body, not summed over
   // the rows again. The two differ by the round-off of w's additions: each of the 25 sweeps adds
   // a row's change to w once per half, a few eps of the entry's magnitude each, so an entry is
   // within 1e-10 of the sum of |lambda_r j_r| and |f_ext| that makes it (about 1e5 times that
   // round-off). A wrong mass or inertia, or a missing row, is off by the force itself.
-  scenes::Run run = scenes::make_run(*scenes::find_scene("pyramid_100"));
-  for (int k = 0; k < 30; ++k) run.step();
+  scenes::Run run = settled_pile();
   const std::vector<ConstraintRow>& rows = run.world.rows();
   const std::vector<Body>& bodies = run.world.bodies();
   REQUIRE(rows.size() > 1000);
@@ -176,6 +180,72 @@ TEST_CASE("coloured PGS forms f = f_ext + J^T lambda from w, the sum over the ro
     }
     CHECK(pushed > 50);  // the rows carry real forces, so the comparison means something
   }
+}
+
+TEST_CASE("rows stored in float: j and M^-1 j^T rounded to the nearest float, the system they "
+          "make solved consistently, the same state on every thread count",
+          "[coloured][float]") {
+  // The pile packed for coloured PGS in double and in float.
+  scenes::Run run = settled_pile();
+  const std::vector<ConstraintRow>& rows = run.world.rows();
+  const std::vector<Body>& bodies = run.world.bodies();
+  REQUIRE(rows.size() > 1000);
+  MatrixFreeSystem d;
+  MatrixFreeSystem f;
+  prepare(d, rows, bodies, SolverKind::coloured_pgs, nullptr, RowPrecision::double_precision);
+  prepare(f, rows, bodies, SolverKind::coloured_pgs, nullptr, RowPrecision::single_precision);
+  REQUIRE(f.rows.empty());
+  REQUIRE(d.float_rows.empty());
+  REQUIRE(f.float_rows.size() == d.rows.size());
+  // Round to nearest: each number within half a float ulp, 2^-24 of itself (IEEE 754).
+  const double half_ulp = std::ldexp(1.0, -24);
+  for (std::size_t i = 0; i < d.rows.size(); ++i) {
+    const MatrixFreeSystem::Row& x = d.rows[i];
+    const MatrixFreeSystem::FloatRow& y = f.float_rows[i];
+    CAPTURE(i);
+    REQUIRE((x.a == y.a && x.b == y.b && x.normal_row == y.normal_row));
+    REQUIRE((x.c_min == y.c_min && x.c_max == y.c_max && x.mu == y.mu));
+    double terms = 0.0;  // sum of |j_k (M^-1 j^T)_k|: A_jj's terms
+    for (std::size_t e = 0; e < 12; ++e) {
+      CHECK(std::abs(static_cast<double>(y.j[e]) - x.j[e]) <= half_ulp * std::abs(x.j[e]));
+      CHECK(std::abs(static_cast<double>(y.minv_jt[e]) - x.minv_jt[e]) <= half_ulp * std::abs(x.minv_jt[e]));
+      terms += std::abs(x.j[e] * x.minv_jt[e]);
+    }
+    // A_jj of the stored numbers: each product off by at most two roundings of 2^-24.
+    if (x.inv_diagonal > 0.0) {
+      CHECK(std::abs(1.0 / y.inv_diagonal - 1.0 / x.inv_diagonal) <= 3.0 * half_ulp * terms);
+    }
+  }
+  // The engine's float sweeps on the captured system (A from the stored floats) give its lambda
+  // back to round-off: the rows, A_jj and the coupling all come from the same numbers.
+  {
+    scenes::Overrides o;
+    o.set("solver", SolverKind::coloured_pgs);
+    o.set("row_precision", RowPrecision::single_precision);
+    const StepSystem s = test::capture("funnel", 180, o);
+    REQUIRE(s.rows() > 0);
+    const Eigen::VectorXd again = solve_sweeps(s, SolverKind::coloured_pgs, s.iterations, &s.initial);
+    CHECK((again - s.lambda).cwiseAbs().maxCoeff() <= 1e-9 * s.lambda.cwiseAbs().maxCoeff());
+  }
+  // The same state on 1, 2 and 3 threads, and not double's.
+  std::uint64_t hashes[4] = {};
+  for (int threads = 0; threads <= 3; ++threads) {
+    scenes::Overrides o;
+    o.set("solver", SolverKind::coloured_pgs);
+    o.set("row_precision", threads == 0 ? RowPrecision::double_precision : RowPrecision::single_precision);
+    o.set("threads", std::max(threads, 1));
+    scenes::Run r = scenes::make_run(*scenes::find_scene("pyramid_100"), o);
+    for (int k = 0; k < 60; ++k) r.world.step();
+    hashes[threads] = scenes::state_hash(r.world);
+  }
+  CHECK(hashes[1] != hashes[0]);
+  CHECK(hashes[2] == hashes[1]);
+  CHECK(hashes[3] == hashes[1]);
+  // The explicit path assembles J in double: float rows are refused there, naming both.
+  WorldDef def;
+  def.assembly = Assembly::explicit_matrices;
+  def.row_precision = RowPrecision::single_precision;
+  CHECK_THROWS_WITH(def.validate(), Catch::Contains("row_precision = float") && Catch::Contains("explicit"));
 }
 
 TEST_CASE("coloured PGS ends in the same state on 1, 2 and 3 threads", "[coloured][threads]") {

@@ -75,6 +75,8 @@ StepCost step_cost(const scenes::Scene& scene, const scenes::Overrides& override
   scenes::Run run = scenes::make_run(scene, overrides);
   WorldDef def = run.world.def();
   def.assembly = assembly;
+  // The explicit column assembles J in double whatever --row-precision says (it packs no rows).
+  if (assembly == Assembly::explicit_matrices) def.row_precision = RowPrecision::double_precision;
   if (warm_start) def.warm_start = *warm_start;
   run.world.set_def(def);
   while (scenes::short_of(run.world, start_s)) run.world.step();

@@ -144,6 +144,14 @@ enum class Assembly {
   matrix_free,        ///< per body w = M^-1 J^T lambda, O(12) a row update (matrix_free.h)
 };
 
+/// How the matrix-free solve stores the rows it sweeps (WorldDef::row_precision): j and M^-1 j^T
+/// in double, or rounded to float, halving the bytes each sweep reads; lambda, w, b and every sum
+/// stay in double either way.
+enum class RowPrecision {
+  double_precision,  ///< 8-byte j and M^-1 j^T: the paper's numbers (the default)
+  single_precision,  ///< 4-byte j and M^-1 j^T (Box3D's solver is float throughout)
+};
+
 /// World parameters, each with its unit and a typical value; the table below gives each one's
 /// allowed values. Validate with validate().
 struct WorldDef {
@@ -159,6 +167,10 @@ struct WorldDef {
   FrictionModel friction_model = FrictionModel::fixed;  ///< Sec. 5.4 fixed, or coupled
   RotationUpdate rotation = RotationUpdate::linear;     ///< Eq. 3.2.4, or Eq. 12.4.1
   Assembly assembly = Assembly::matrix_free;  ///< same lambda to round-off; matrix-free is faster
+  /// The matrix-free path's rows in double (the default) or float (RowPrecision); float solves a
+  /// system whose j is rounded to float (relative 6e-8), so the state differs from double's. The
+  /// explicit path has no packed rows: it takes double only (validate()).
+  RowPrecision row_precision = RowPrecision::double_precision;
   /// Speculative contact distance (m) >= 0: features closer than this already get a contact row
   /// that lets them close the gap within a step and no further, so resting contacts do not
   /// break and re-form each step. 0 gives the paper's contacts, made only on overlap. Typical:
@@ -376,5 +388,6 @@ std::string_view name_of(RotationUpdate v);
 std::string_view name_of(ManifoldPoints v);
 std::string_view name_of(SoftRelax v);
 std::string_view name_of(Assembly v);
+std::string_view name_of(RowPrecision v);
 
 }  // namespace cps

@@ -279,9 +279,9 @@ const std::array kParameters = {
               .type = ParameterType::choice,
               .choices = kRowPrecisionChoices,
               .help = "how the matrix-free solve stores the rows it sweeps: double (the paper's "
-                      "numbers) or float (j and M^-1 j^T rounded to float, half the bytes a "
-                      "sweep reads; lambda and every sum stay double); --assembly explicit takes "
-                      "double only",
+                      "numbers) or float (j and M^-1 j^T rounded to float, in half their bytes; "
+                      "lambda and every sum stay double; another state); --assembly explicit "
+                      "takes double only",
               .title = "row precision",
               .get = &get_member<&WorldDef::row_precision>,
               .set = &set_member<&WorldDef::row_precision>},

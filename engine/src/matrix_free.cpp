@@ -447,26 +447,27 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   };
   // Every row packed into out (s.rows or s.float_rows), then the coloured runs' coupling.
   const auto pack_all = [&]<class PackedRow>(std::vector<PackedRow>& out) {
-  detail::resize_with_headroom(out, rows.size());
-  parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
-    if (s.perm.empty()) {
-      for (std::size_t i = begin; i < end; ++i) s.diagonal[i] = pack(rows[i], rows[i].normal_row, out[i]);
-      return;
-    }
-    // Coloured PGS: read in row order and stored at the row's position (scattered stores cost
-    // less than scattered loads, which the next instructions wait on), built in one place first.
-    PackedRow p;
-    for (std::size_t i = begin; i < end; ++i) {
-      if (i + kWriteAhead < end) {
-        detail::prefetch_lines<true>(&out[static_cast<std::size_t>(s.position[i + kWriteAhead])], sizeof(PackedRow));
+    detail::resize_with_headroom(out, rows.size());
+    parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+      if (s.perm.empty()) {
+        for (std::size_t i = begin; i < end; ++i) s.diagonal[i] = pack(rows[i], rows[i].normal_row, out[i]);
+        return;
       }
-      const int normal_row = rows[i].normal_row;
-      const auto at = static_cast<std::size_t>(s.position[i]);
-      s.diagonal[at] = pack(rows[i], normal_row < 0 ? normal_row : s.position[static_cast<std::size_t>(normal_row)], p);
-      out[at] = p;
-    }
-  });
-  if (kind == SolverKind::coloured_pgs) build_coloured_runs<PackedRow>(s, workers);
+      // Coloured PGS: read in row order and stored at the row's position (scattered stores cost
+      // less than scattered loads, which the next instructions wait on), built in one place first.
+      PackedRow p;
+      for (std::size_t i = begin; i < end; ++i) {
+        if (i + kWriteAhead < end) {
+          const auto ahead = static_cast<std::size_t>(s.position[i + kWriteAhead]);
+          detail::prefetch_lines<true>(&out[ahead], sizeof(PackedRow));
+        }
+        const int normal_row = rows[i].normal_row;
+        const auto at = static_cast<std::size_t>(s.position[i]);
+        s.diagonal[at] = pack(rows[i], normal_row < 0 ? normal_row : s.position[static_cast<std::size_t>(normal_row)], p);
+        out[at] = p;
+      }
+    });
+    if (kind == SolverKind::coloured_pgs) build_coloured_runs<PackedRow>(s, workers);
   };
   s.precision = precision;
   if (precision == RowPrecision::single_precision) {
@@ -527,59 +528,61 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
   detail::assign_with_headroom(l, rows.size(), 0.0);  // initial guess 0 (Sec. 7.2) ...
   for (Vec6& w : s.w) w.setZero();
   with_rows(s, [&](const auto& packed_rows) {
-  using PackedRow = typename std::decay_t<decltype(packed_rows)>::value_type;
-  if (initial != nullptr) {  // ... or the one given, with w = M^-1 J^T lambda to match
-    const int fixed_slot = static_cast<int>(s.w.size()) - 1;
-    // Consecutive rows on the same two slots (a manifold's contact rows, its friction rows) sum
-    // their M^-1 j^T lambda in registers and add it to w once, so the rows do not wait on each
-    // other's w stores.
-    Vec6 sum_a = Vec6::Zero();
-    Vec6 sum_b = Vec6::Zero();
-    int a = fixed_slot;
-    int b = fixed_slot;
-    const auto flush = [&] {
-      if (a != fixed_slot) s.w[static_cast<std::size_t>(a)] += sum_a;
-      if (b != fixed_slot) s.w[static_cast<std::size_t>(b)] += sum_b;
-      sum_a.setZero();
-      sum_b.setZero();
-    };
-    for (std::size_t j = 0; j < rows.size(); ++j) {
-      const PackedRow& r = packed_rows[j];
-      if (r.inv_diagonal == 0.0) continue;  // touches no movable body: stays 0
-      if (r.a != a || r.b != b) {
-        flush();
-        a = r.a;
-        b = r.b;
-      }
-      l[j] = (*initial)[row_at(s, j)];
-      sum_a += l[j] * half(r.minv_jt.data());
-      sum_b += l[j] * half(r.minv_jt.data() + 6);
-    }
-    flush();
-  }
-  const bool coupled = friction == FrictionModel::coupled;
-  if (kind == SolverKind::jacobi) {
-    detail::assign_with_headroom(s.next, rows.size(), 0.0);
-    coupled ? jacobi_sweeps<true, PackedRow>(s, iterations, l) : jacobi_sweeps<false, PackedRow>(s, iterations, l);
-  } else if (coloured) {
-    if (workers == nullptr || workers->count() == 1) {
-      coupled ? coloured_sweeps<true, PackedRow>(s, iterations, l, nullptr, 0)
-              : coloured_sweeps<false, PackedRow>(s, iterations, l, nullptr, 0);
-    } else {
-      auto task = [&](int t) {
-        coupled ? coloured_sweeps<true, PackedRow>(s, iterations, l, workers, t)
-                : coloured_sweeps<false, PackedRow>(s, iterations, l, workers, t);
+    using PackedRow = typename std::decay_t<decltype(packed_rows)>::value_type;
+    if (initial != nullptr) {  // ... or the one given, with w = M^-1 J^T lambda to match
+      const int fixed_slot = static_cast<int>(s.w.size()) - 1;
+      // Consecutive rows on the same two slots (a manifold's contact rows, its friction rows) sum
+      // their M^-1 j^T lambda in registers and add it to w once, so the rows do not wait on each
+      // other's w stores.
+      Vec6 sum_a = Vec6::Zero();
+      Vec6 sum_b = Vec6::Zero();
+      int a = fixed_slot;
+      int b = fixed_slot;
+      const auto flush = [&] {
+        if (a != fixed_slot) s.w[static_cast<std::size_t>(a)] += sum_a;
+        if (b != fixed_slot) s.w[static_cast<std::size_t>(b)] += sum_b;
+        sum_a.setZero();
+        sum_b.setZero();
       };
-      workers->run(task);
+      for (std::size_t j = 0; j < rows.size(); ++j) {
+        const PackedRow& r = packed_rows[j];
+        if (r.inv_diagonal == 0.0) continue;  // touches no movable body: stays 0
+        if (r.a != a || r.b != b) {
+          flush();
+          a = r.a;
+          b = r.b;
+        }
+        l[j] = (*initial)[row_at(s, j)];
+        sum_a += l[j] * half(r.minv_jt.data());
+        sum_b += l[j] * half(r.minv_jt.data() + 6);
+      }
+      flush();
     }
-    detail::resize_with_headroom(lambda, rows.size());
-    parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
-      for (std::size_t j = begin; j < end; ++j) lambda[static_cast<std::size_t>(s.perm[j])] = l[j];
-    });
-  } else {
-    if (!s.runs_ready) build_runs<PackedRow>(s);
-    coupled ? pgs_sweeps<true, PackedRow>(s, iterations, l) : pgs_sweeps<false, PackedRow>(s, iterations, l);
-  }
+    const bool coupled = friction == FrictionModel::coupled;
+    if (kind == SolverKind::jacobi) {
+      detail::assign_with_headroom(s.next, rows.size(), 0.0);
+      coupled ? jacobi_sweeps<true, PackedRow>(s, iterations, l)
+              : jacobi_sweeps<false, PackedRow>(s, iterations, l);
+    } else if (coloured) {
+      if (workers == nullptr || workers->count() == 1) {
+        coupled ? coloured_sweeps<true, PackedRow>(s, iterations, l, nullptr, 0)
+                : coloured_sweeps<false, PackedRow>(s, iterations, l, nullptr, 0);
+      } else {
+        auto task = [&](int t) {
+          coupled ? coloured_sweeps<true, PackedRow>(s, iterations, l, workers, t)
+                  : coloured_sweeps<false, PackedRow>(s, iterations, l, workers, t);
+        };
+        workers->run(task);
+      }
+      detail::resize_with_headroom(lambda, rows.size());
+      parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+        for (std::size_t j = begin; j < end; ++j) lambda[static_cast<std::size_t>(s.perm[j])] = l[j];
+      });
+    } else {
+      if (!s.runs_ready) build_runs<PackedRow>(s);
+      coupled ? pgs_sweeps<true, PackedRow>(s, iterations, l)
+              : pgs_sweeps<false, PackedRow>(s, iterations, l);
+    }
   });
 }
 
@@ -605,66 +608,66 @@ void residual(const MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   max = 0.0;
   sum_squares = 0.0;
   with_rows(s, [&](const auto& packed_rows) {
-  for (std::size_t j = 0; j < rows.size(); ++j) {
-    const double diagonal = s.diagonal[j];
-    if (!(diagonal > 0.0)) continue;
-    const auto& p = packed_rows[j];
-    // The bounds read lambda by row index: the contact row's index for a friction row.
-    const int normal_row = p.normal_row < 0 || s.perm.empty()
-                               ? p.normal_row
-                               : s.perm[static_cast<std::size_t>(p.normal_row)];
-    double lo;
-    double hi;
-    detail::force_limits(friction == FrictionModel::coupled, p.c_min, p.c_max, p.mu, normal_row,
-                         lambda.data(), lo, hi);
-    const double Ax = row_times_w(p, s.w, static_cast<int>(s.w.size()) - 1);
-    const double r =
-        detail::natural_map_residual(lambda[row_at(s, j)], Ax - s.b[j], diagonal, lo, hi);
-    max = std::max(max, r);
-    sum_squares += r * r;
-  }
+    for (std::size_t j = 0; j < rows.size(); ++j) {
+      const double diagonal = s.diagonal[j];
+      if (!(diagonal > 0.0)) continue;
+      const auto& p = packed_rows[j];
+      // The bounds read lambda by row index: the contact row's index for a friction row.
+      const int normal_row = p.normal_row < 0 || s.perm.empty()
+                                 ? p.normal_row
+                                 : s.perm[static_cast<std::size_t>(p.normal_row)];
+      double lo;
+      double hi;
+      detail::force_limits(friction == FrictionModel::coupled, p.c_min, p.c_max, p.mu, normal_row,
+                           lambda.data(), lo, hi);
+      const double Ax = row_times_w(p, s.w, static_cast<int>(s.w.size()) - 1);
+      const double r =
+          detail::natural_map_residual(lambda[row_at(s, j)], Ax - s.b[j], diagonal, lo, hi);
+      max = std::max(max, r);
+      sum_squares += r * r;
+    }
   });
 }
 
 void explicit_system(const MatrixFreeSystem& s, SparseRowMatrix& A, Eigen::VectorXd& b,
                      RowLimits& limits) {
   with_rows(s, [&](const auto& packed_rows) {
-  const auto c = static_cast<Eigen::Index>(packed_rows.size());
-  const auto slots = 6 * static_cast<Eigen::Index>(s.w.size());  // n bodies and the fixed slot
-  // J and (M^-1 J^T)^T over the slots, 12 entries a row; the fixed slot's M^-1 j^T is 0.
-  std::vector<Eigen::Triplet<double>> j_entries;
-  std::vector<Eigen::Triplet<double>> m_entries;
-  j_entries.reserve(static_cast<std::size_t>(12 * c));
-  m_entries.reserve(static_cast<std::size_t>(12 * c));
-  limits.c_min.resize(c);
-  limits.c_max.resize(c);
-  limits.mu.resize(c);
-  limits.normal_row.resize(static_cast<std::size_t>(c));
-  for (Eigen::Index i = 0; i < c; ++i) {
-    // Written at its row index: A, b and the limits in row order, as the explicit path's.
-    const auto& p = packed_rows[static_cast<std::size_t>(i)];
-    const auto r = static_cast<Eigen::Index>(row_at(s, static_cast<std::size_t>(i)));
-    for (int half = 0; half < 2; ++half) {
-      const Eigen::Index column = 6 * static_cast<Eigen::Index>(half == 0 ? p.a : p.b);
-      for (int k = 0; k < 6; ++k) {
-        const auto e = static_cast<std::size_t>(6 * half + k);
-        j_entries.emplace_back(r, column + k, p.j[e]);
-        m_entries.emplace_back(r, column + k, p.minv_jt[e]);
+    const auto c = static_cast<Eigen::Index>(packed_rows.size());
+    const auto slots = 6 * static_cast<Eigen::Index>(s.w.size());  // n bodies and the fixed slot
+    // J and (M^-1 J^T)^T over the slots, 12 entries a row; the fixed slot's M^-1 j^T is 0.
+    std::vector<Eigen::Triplet<double>> j_entries;
+    std::vector<Eigen::Triplet<double>> m_entries;
+    j_entries.reserve(static_cast<std::size_t>(12 * c));
+    m_entries.reserve(static_cast<std::size_t>(12 * c));
+    limits.c_min.resize(c);
+    limits.c_max.resize(c);
+    limits.mu.resize(c);
+    limits.normal_row.resize(static_cast<std::size_t>(c));
+    for (Eigen::Index i = 0; i < c; ++i) {
+      // Written at its row index: A, b and the limits in row order, as the explicit path's.
+      const auto& p = packed_rows[static_cast<std::size_t>(i)];
+      const auto r = static_cast<Eigen::Index>(row_at(s, static_cast<std::size_t>(i)));
+      for (int half = 0; half < 2; ++half) {
+        const Eigen::Index column = 6 * static_cast<Eigen::Index>(half == 0 ? p.a : p.b);
+        for (int k = 0; k < 6; ++k) {
+          const auto e = static_cast<std::size_t>(6 * half + k);
+          j_entries.emplace_back(r, column + k, p.j[e]);
+          m_entries.emplace_back(r, column + k, p.minv_jt[e]);
+        }
       }
+      limits.c_min[r] = p.c_min;
+      limits.c_max[r] = p.c_max;
+      limits.mu[r] = p.mu;
+      limits.normal_row[static_cast<std::size_t>(r)] =
+          p.normal_row < 0 || s.perm.empty() ? p.normal_row : s.perm[static_cast<std::size_t>(p.normal_row)];
     }
-    limits.c_min[r] = p.c_min;
-    limits.c_max[r] = p.c_max;
-    limits.mu[r] = p.mu;
-    limits.normal_row[static_cast<std::size_t>(r)] =
-        p.normal_row < 0 || s.perm.empty() ? p.normal_row : s.perm[static_cast<std::size_t>(p.normal_row)];
-  }
-  SparseRowMatrix J(c, slots);
-  SparseRowMatrix MJt(c, slots);
-  J.setFromTriplets(j_entries.begin(), j_entries.end());
-  MJt.setFromTriplets(m_entries.begin(), m_entries.end());
-  A = J * SparseRowMatrix(MJt.transpose());
-  b.resize(c);
-  for (Eigen::Index i = 0; i < c; ++i) b[static_cast<Eigen::Index>(row_at(s, static_cast<std::size_t>(i)))] = s.b[static_cast<std::size_t>(i)];
+    SparseRowMatrix J(c, slots);
+    SparseRowMatrix MJt(c, slots);
+    J.setFromTriplets(j_entries.begin(), j_entries.end());
+    MJt.setFromTriplets(m_entries.begin(), m_entries.end());
+    A = J * SparseRowMatrix(MJt.transpose());
+    b.resize(c);
+    for (Eigen::Index i = 0; i < c; ++i) b[static_cast<Eigen::Index>(row_at(s, static_cast<std::size_t>(i)))] = s.b[static_cast<std::size_t>(i)];
   });
 }
 

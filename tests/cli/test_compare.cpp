@@ -139,11 +139,16 @@ TEST_CASE("a bad compare spec is a usage error naming the parameter, the value a
   CHECK(contains(usage_error("solver", avbd), "push avbd does not read --solver"));
   CHECK(contains(usage_error("friction-model", avbd), "does not read --friction-model"));
   CHECK(contains(usage_error("warm-start=0,0.8", avbd), "does not read --warm-start"));
+  CHECK(contains(usage_error("row-precision", avbd), "does not read --row-precision"));
   scenes::Overrides xpbd;
   xpbd.set("push", PushMode::xpbd);
   CHECK(contains(usage_error("warm-start=0,0.8", xpbd), "push xpbd does not read --warm-start"));
   CHECK_NOTHROW(parse_comparison("solver", xpbd));  // xpbd's Jacobi averages its corrections
   CHECK_NOTHROW(parse_comparison("solver", push));  // split solves A lambda = b
+  CHECK_NOTHROW(parse_comparison("row-precision", push));
+  scenes::Overrides soft;
+  soft.set("push", PushMode::soft);
+  CHECK(contains(usage_error("row-precision", soft), "push soft does not read --row-precision"));
 }
 
 TEST_CASE("compared variants are laid out so that panels stay large", "[compare]") {

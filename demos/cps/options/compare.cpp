@@ -75,9 +75,11 @@ Comparison parse_comparison(const std::string& spec, const scenes::Overrides& ba
   if (const ParameterValue* push = base.find("push"); push != nullptr && std::holds_alternative<int>(*push)) {
     const auto mode = static_cast<PushMode>(std::get<int>(*push));
     const PushReads reads = push_reads(mode);
+    // The packed rows' precision matters only where the step's solver solves A lambda = b.
     const bool unread = (p->name == "solver" && !reads.solver) ||
                         (p->name == "friction_model" && !reads.friction_model) ||
-                        (p->name == "warm_start" && !reads.warm_start);
+                        (p->name == "warm_start" && !reads.warm_start) ||
+                        (p->name == "row_precision" && !push_traits(mode).solves_system);
     if (unread) {
       throw UsageError(what + "push " + std::string(name_of(mode)) + " does not read --" + name +
                        ", so every variant would be the same run; compare another parameter, or " +

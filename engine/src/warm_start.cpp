@@ -159,21 +159,25 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
             if (friction_rows) out[points + 2 * k] = out[points + 2 * k + 1] = 0.0;
             continue;
           }
-          const CachedPoint& p = points_[static_cast<std::size_t>(match_[k])];
-          const double* cached = solve == 0 ? p.first : p.second;
-          const double older = p.older[solve];
+          const auto cached_index = static_cast<std::size_t>(match_[k]);
+          const CachedPoint& p = points_[cached_index];
+          const CachedRows* more = has_rows_ ? &rows_[cached_index] : nullptr;
+          // Its contact row's last lambda and the one before (0 where not kept).
+          const double last = solve == 0 ? p.normal : (more != nullptr ? more->second[0] : 0.0);
+          const double older = more != nullptr ? more->older[solve] : 0.0;
           // Contact row k: the smaller of its last two lambdas (see the class comment).
-          const double sustained = std::max(0.0, std::min(cached[0], older));
+          const double sustained = std::max(0.0, std::min(last, older));
           out[k] = factor * sustained;
           if (!friction_rows) continue;
-          if (!has_friction_) {
+          if (!has_friction_ || more == nullptr) {
             out[points + 2 * k] = out[points + 2 * k + 1] = 0.0;
             continue;
           }
           // The cached friction force, scaled as the contact's, along this step's directions (t1
           // is the cached t1 in the new plane, so this is close to a copy), within the row's limits.
-          const double scale = cached[0] > 0.0 ? sustained / cached[0] : 0.0;
-          const Vec3 force = scale * (cached[1] * p.t1 + cached[2] * p.t2);
+          const double* tangential = solve == 0 ? more->first : more->second + 1;
+          const double scale = last > 0.0 ? sustained / last : 0.0;
+          const Vec3 force = scale * (tangential[0] * p.t1 + tangential[1] * more->t2);
           const Vec3& t1 = tangents_[k];
           const Vec3 t2 = m.contacts[static_cast<std::size_t>(i)].normal.cross(t1);
           for (int r = 0; r < 2; ++r) {
@@ -218,6 +222,7 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
   const bool own_tangents = tangents_fresh_ && tangents_.size() >= points;
   detail::resize_with_headroom(manifolds_, manifolds.size());
   detail::resize_with_headroom(next_points_, points);
+  detail::resize_with_headroom(next_rows_, points);
   // Each manifold writes only its own entry and points.
   parallel_for(workers, manifolds.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
     for (std::size_t index = begin; index < end; ++index) {
@@ -226,34 +231,35 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
       manifolds_[index] = {m.body_a, m.body_b, static_cast<int>(k), m.count, Vec3::Zero(), 0.0};
       for (int i = 0; i < m.count; ++i, ++k) {
         CachedPoint& p = next_points_[k];
+        CachedRows& more = next_rows_[k];
         const bool matched = k < match_.size() && match_[k] >= 0;
-        const CachedPoint* before = matched ? &points_[static_cast<std::size_t>(match_[k])] : nullptr;
-        p.older[0] = before != nullptr ? before->first[0] : 0.0;
-        p.older[1] = before != nullptr ? before->second[0] : 0.0;
+        const auto before = matched ? static_cast<std::size_t>(match_[k]) : 0;
+        more.older[0] = matched ? points_[before].normal : 0.0;
+        more.older[1] = matched && has_rows_ ? rows_[before].second[0] : 0.0;
         const Contact& contact = m.contacts[static_cast<std::size_t>(i)];
         p.feature = contact.feature;
-        for (int s = 0; s < 2; ++s) {
-          const std::vector<double>& lambda = s == 0 ? first : second;
-          double* out = s == 0 ? p.first : p.second;
-          const bool have = s == 0 || has_second_;
-          out[0] = have && k < lambda.size() ? lambda[k] : 0.0;
-          out[1] = have && has_friction_ ? lambda[points + 2 * k] : 0.0;
-          out[2] = have && has_friction_ ? lambda[points + 2 * k + 1] : 0.0;
-        }
+        p.normal = k < first.size() ? first[k] : 0.0;
+        more.first[0] = has_friction_ ? first[points + 2 * k] : 0.0;
+        more.first[1] = has_friction_ ? first[points + 2 * k + 1] : 0.0;
+        more.second[0] = has_second_ && k < second.size() ? second[k] : 0.0;
+        more.second[1] = has_second_ && has_friction_ ? second[points + 2 * k] : 0.0;
+        more.second[2] = has_second_ && has_friction_ ? second[points + 2 * k + 1] : 0.0;
         if (has_friction_ && own_tangents) {
           p.t1 = tangents_[k];
-          p.t2 = contact.normal.cross(p.t1);
+          more.t2 = contact.normal.cross(p.t1);
         } else if (has_friction_) {
           // The directions of its friction rows: the linear part of body b's half of j is t.
           p.t1 = rows[points + 2 * k].j.segment<3>(6);
-          p.t2 = rows[points + 2 * k + 1].j.segment<3>(6);
+          more.t2 = rows[points + 2 * k + 1].j.segment<3>(6);
         } else {
-          tangent_basis(contact.normal, p.t1, p.t2);
+          tangent_basis(contact.normal, p.t1, more.t2);
         }
       }
     }
   });
   points_.swap(next_points_);
+  rows_.swap(next_rows_);
+  has_rows_ = true;
   tangents_fresh_ = false;
   const std::size_t had_rods = rods_first_.size();
   rods_older_first_.swap(rods_first_);
@@ -288,19 +294,17 @@ void WarmStartCache::store_manifold(std::size_t m, const Manifold& manifold, con
     p.feature = contact.feature;
     if (own_tangents) {
       p.t1 = tangents_[k];
-      p.t2 = contact.normal.cross(p.t1);
     } else {
-      tangent_basis(contact.normal, p.t1, p.t2);
+      Vec3 t2;
+      tangent_basis(contact.normal, p.t1, t2);
     }
-    p.first[0] = normal[i];
-    p.first[1] = p.first[2] = 0.0;
-    p.second[0] = p.second[1] = p.second[2] = 0.0;
-    p.older[0] = p.older[1] = 0.0;
+    p.normal = normal[i];
   }
 }
 
 void WarmStartCache::end_store(const double* rods, std::size_t count) {
   points_.swap(next_points_);
+  has_rows_ = false;  // the sustained rule's parts read as 0
   tangents_fresh_ = false;
   detail::resize_with_headroom(rods_first_, count);
   std::copy_n(rods, count, rods_first_.begin());
@@ -312,6 +316,8 @@ void WarmStartCache::end_store(const double* rods, std::size_t count) {
 void WarmStartCache::clear() {
   manifolds_.clear();
   points_.clear();
+  rows_.clear();
+  has_rows_ = false;
   rods_first_.clear();
   rods_second_.clear();
   rods_older_first_.clear();

@@ -89,7 +89,7 @@ class WarmStartCache {
   /// WarmStartRule::manifold, after match(): the contact row's lambda (N) of the cached point
   /// that this step's point k (its contact row) matched, 0 for a new point.
   double last_normal(std::size_t k) const {
-    return k < match_.size() && match_[k] >= 0 ? points_[static_cast<std::size_t>(match_[k])].first[0] : 0.0;
+    return k < match_.size() && match_[k] >= 0 ? points_[static_cast<std::size_t>(match_[k])].normal : 0.0;
   }
   /// WarmStartRule::manifold, after match(): the friction force (N, a world vector; its last
   /// contact plane's) and twist (N m about its last normal) of the cached manifold with the body
@@ -137,18 +137,28 @@ class WarmStartCache {
     Vec3 friction;  // N: the manifold's friction force (WarmStartRule::manifold; else 0)
     double twist;   // N m: its twist about the normal (the same)
   };
+  // A cached point in two parts: what match() and WarmStartRule::manifold read (40 bytes, which
+  // every step streams through), and the rest, which only the sustained rule reads.
   struct CachedPoint {
     std::uint32_t feature;
-    Vec3 t1;           // friction directions of its rows (unit)
-    Vec3 t2;
-    double first[3];   // lambda (N) of its contact, t1 and t2 rows, first solve
-    double second[3];  // the same, second solve (Sec. 8.1)
-    double older[2];   // its contact row's lambda (N) one step earlier (first, second solve);
-                       // 0 if it is new
+    Vec3 t1;        // friction direction of its first friction row (unit)
+    double normal;  // lambda (N) of its contact row, first solve
+  };
+  struct CachedRows {
+    Vec3 t2;            // friction direction of its second friction row (unit)
+    double first[2];    // lambda (N) of its t1 and t2 rows, first solve
+    double second[3];   // lambda (N) of its contact, t1 and t2 rows, second solve (Sec. 8.1)
+    double older[2];    // its contact row's lambda (N) one step earlier (first, second solve);
+                        // 0 if it is new
   };
   std::vector<CachedManifold> manifolds_;
   std::vector<CachedPoint> points_;
   std::vector<CachedPoint> next_points_;  // store() builds here, then swaps with points_
+  // Per cached point, its CachedRows when store() kept them (has_rows_); after begin_store()
+  // they are not kept and read as 0 (has_second_ and has_friction_ are false then).
+  std::vector<CachedRows> rows_;
+  std::vector<CachedRows> next_rows_;
+  bool has_rows_ = false;
   std::vector<double> rods_first_;
   std::vector<double> rods_second_;
   std::vector<double> rods_older_first_;   // the rods' lambdas one step earlier (N)

@@ -117,7 +117,8 @@ namespace {
 // (microseconds, tens on a virtual machine) costs about what the work does.
 constexpr std::size_t kMinParallel = 256;
 
-// Manifolds ahead whose lines the prepare stage asks for (count; prefetch_manifold()).
+// Manifolds ahead whose bodies and lanes the prepare stage asks for (count; twice as far for the
+// manifolds themselves; prefetch_manifold()).
 constexpr std::size_t kManifoldsAhead = 4;
 
 using soft::LaneGroup;
@@ -378,7 +379,8 @@ class SoftStep final : public PushMethod {
       ManifoldFriction f;
       std::array<ContactPoint, kMaxManifoldPoints> scratch;
       for (std::size_t k = begin; k < end; ++k) {
-        if (k + kManifoldsAhead < end) prefetch_manifold(ctx.manifolds, k + kManifoldsAhead);
+        if (k + 2 * kManifoldsAhead < end) prefetch_manifold(ctx.manifolds[k + 2 * kManifoldsAhead]);
+        if (k + kManifoldsAhead < end) prefetch_bodies_and_lanes(in, k + kManifoldsAhead);
         const std::size_t j = slot_[k];
         if (lanes_ && manifold_colour_[k] != ConstraintGraph::kOverflow) {
           restitution = prepare_manifold(in, k, 0, f, scratch.data()) || restitution;
@@ -462,18 +464,30 @@ class SoftStep final : public PushMethod {
     double inv_tau;
   };
 
-  // Asks for the lines of manifold k of `manifolds` (ctx's) that prepare_manifold() reads,
-  // through its first four points, and of its lane's group and points, which put_lane() writes.
-  // The prepare stage goes through the manifolds in ctx's order and the lanes lie in colour
-  // order, so each manifold's lanes are elsewhere; without this the stores to them held up the
-  // next manifold (docs/benchmarks.md). Always inlined: as a call, GCC took it for a function
-  // without effects and dropped it.
-  [[gnu::always_inline]] void prefetch_manifold(const std::vector<Manifold>& manifolds, std::size_t k) const {
-    const Manifold& m = manifolds[k];
+  // The prepare stage's prefetching, kManifoldsAhead manifolds ahead: the lines of a manifold
+  // that prepare_manifold() reads (through its first four points; twice as far ahead, so that
+  // its bodies can be found), then its bodies' (Body and SolverBody) and its lane's group and
+  // points, which put_lane() writes. The stage goes through the manifolds in ctx's order and the
+  // lanes lie in colour order, so each manifold's lanes are elsewhere; without this the stores to
+  // them held up the next manifold (docs/benchmarks.md). Always inlined: as calls, GCC took them
+  // for functions without effects and dropped them.
+  [[gnu::always_inline]] static void prefetch_manifold(const Manifold& m) {
     const auto* start = reinterpret_cast<const char*>(&m);
     const auto* past = reinterpret_cast<const char*>(m.contacts.data() + 4);
     detail::prefetch_lines<false>(start, static_cast<std::size_t>(past - start));
     __builtin_prefetch(&m.anchor_shift, 0, 3);
+  }
+  [[gnu::always_inline]] void prefetch_bodies_and_lanes(const ManifoldInput& in, std::size_t k) const {
+    const Manifold& m = in.manifolds[k];
+    for (const int i : {m.body_a, m.body_b}) {
+      const Body& body = in.bodies[static_cast<std::size_t>(i)];
+      __builtin_prefetch(&body.x, 0, 3);
+      __builtin_prefetch(&body.inv_mass, 0, 3);
+      __builtin_prefetch(&body.friction, 0, 3);
+      const SolverBody& sb = solver_bodies_[static_cast<std::size_t>(i)];
+      __builtin_prefetch(&sb.inv_I, 0, 3);
+      __builtin_prefetch(&sb.inv_mass, 0, 3);
+    }
     if (!lanes_ || manifold_colour_[k] == ConstraintGraph::kOverflow) return;
     const LaneGroup& group = groups_[lane_of(k).first];
     detail::prefetch_lines<true>(&group, sizeof(LaneGroup));

@@ -466,8 +466,8 @@ class SoftStep final : public PushMethod {
 
   // The prepare stage's prefetching, kManifoldsAhead manifolds ahead: the lines of a manifold
   // that prepare_manifold() reads (through its first four points; twice as far ahead, so that
-  // its bodies can be found), then its bodies' (Body and SolverBody) and its lane's group and
-  // points, which put_lane() writes. The stage goes through the manifolds in ctx's order and the
+  // its bodies can be found; the store stage asks for them too), then its bodies' (Body and
+  // SolverBody) and its lane's group and points, which put_lane() writes. The stage goes through the manifolds in ctx's order and the
   // lanes lie in colour order, so each manifold's lanes are elsewhere; without this the stores to
   // them held up the next manifold (docs/benchmarks.md). Always inlined: as calls, GCC took them
   // for functions without effects and dropped them.
@@ -1150,6 +1150,7 @@ class SoftStep final : public PushMethod {
     parallel_for(workers_, manifolds_.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
       std::array<double, kMaxManifoldPoints> normal{};
       for (std::size_t k = begin; k < end; ++k) {
+        if (k + 2 * kManifoldsAhead < end) prefetch_manifold(ctx.manifolds[k + 2 * kManifoldsAhead]);
         Vec3 friction = Vec3::Zero();
         double twist = 0.0;
         if (lanes_ && manifold_colour_[k] != ConstraintGraph::kOverflow) {

@@ -495,6 +495,18 @@ class SoftStep final : public PushMethod {
                                    static_cast<std::size_t>(group.points) * sizeof(LanePoint));
   }
 
+  // The store stage's prefetching: the lines of manifold k's lane that store_warm_start() reads
+  // (its group's t1, t2, impulses and count, and its points' impulses).
+  [[gnu::always_inline]] void prefetch_stored_lanes(const std::vector<Manifold>& manifolds, std::size_t k) const {
+    if (!lanes_ || manifold_colour_[k] == ConstraintGraph::kOverflow) return;
+    const LaneGroup& group = groups_[lane_of(k).first];
+    detail::prefetch_lines<false>(&group.t1, 2 * sizeof(soft::LaneVec3));
+    detail::prefetch_lines<false>(&group.impulse1, 4 * sizeof(soft::Lanes));
+    __builtin_prefetch(&group.count, 0, 3);
+    const LanePoint* q = lane_points_.data() + group.first_point;
+    for (int i = 0; i < manifolds[k].count; ++i) __builtin_prefetch(&q[i].impulse, 0, 3);
+  }
+
   // Whether a contact of the step has a restitution target (prepare's per-thread flags).
   bool any_restitution() const {
     return std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) != restitution_by_thread_.end();
@@ -1151,6 +1163,7 @@ class SoftStep final : public PushMethod {
       std::array<double, kMaxManifoldPoints> normal{};
       for (std::size_t k = begin; k < end; ++k) {
         if (k + 2 * kManifoldsAhead < end) prefetch_manifold(ctx.manifolds[k + 2 * kManifoldsAhead]);
+        if (k + kManifoldsAhead < end) prefetch_stored_lanes(ctx.manifolds, k + kManifoldsAhead);
         Vec3 friction = Vec3::Zero();
         double twist = 0.0;
         if (lanes_ && manifold_colour_[k] != ConstraintGraph::kOverflow) {

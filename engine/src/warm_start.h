@@ -154,8 +154,9 @@ class WarmStartCache {
   std::vector<CachedManifold> manifolds_;
   std::vector<CachedPoint> points_;
   std::vector<CachedPoint> next_points_;  // store() builds here, then swaps with points_
-  // Per cached point, its CachedRows when store() kept them (has_rows_); after begin_store()
-  // they are not kept and read as 0 (has_second_ and has_friction_ are false then).
+  // Per cached point, its CachedRows when store() kept them (has_rows_); after a store by the
+  // manifold rule (end_store()) they are not kept and read as 0 (has_second_ and has_friction_
+  // are false then).
   std::vector<CachedRows> rows_;
   std::vector<CachedRows> next_rows_;
   bool has_rows_ = false;

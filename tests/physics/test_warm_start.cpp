@@ -1,6 +1,7 @@
 // Warm starting (WorldDef::warm_start, Sec. 6.2.3): a persisting contact's or rod's rows start
 // from the factor times their cached lambda (engine/src/warm_start.h).
 #include "scene.h"
+#include "warm_start.h"  // engine/src
 
 #include <catch2/catch.hpp>
 
@@ -131,6 +132,60 @@ TEST_CASE("a copied world carries its warm start cache and steps on as the origi
     differs = differs || cold.bodies()[i].x != run.world.bodies()[i].x;
   }
   CHECK(differs);
+}
+
+TEST_CASE("after the soft step's store the sustained rule finds no older lambda, then keeps its normal one",
+          "[warm_start]") {
+  // A world may change its push method between steps (set_def). One manifold of two points
+  // (features 1 and 2) and its two contact rows, no friction rows. The sustained rule guesses
+  // the factor times the smaller of a contact row's last two lambdas. Two of its stores at 3 N
+  // leave both lambdas at 3 N; a store by the manifold rule (the soft step's: normal lambdas 5
+  // and 7 N) replaces them by the normal lambda alone, so the next guesses are 0, as for a
+  // contact in its first step; the sustained store after it keeps 5 and 7 N as the older lambdas.
+  Manifold m;
+  m.body_a = 0;
+  m.body_b = 1;
+  Contact contact;
+  contact.normal = Vec3::UnitY();
+  contact.depth = 0.01;
+  contact.feature = 1;
+  contact.point = Vec3(-0.5, 0.0, 0.0);
+  m.add(contact);
+  contact.feature = 2;
+  contact.point = Vec3(0.5, 0.0, 0.0);
+  m.add(contact);
+  const std::vector<Manifold> manifolds{m};
+  std::vector<ConstraintRow> rows(2);
+  for (ConstraintRow& row : rows) row.c_min = 0.0;
+  WarmStartCache cache;
+  std::vector<double> first;
+  std::vector<double> second;
+  for (int k = 0; k < 2; ++k) {
+    cache.match(manifolds);
+    cache.store(manifolds, rows, 0, {3.0, 3.0}, {});
+  }
+  cache.match(manifolds);
+  cache.initial_guesses(manifolds, rows, 0, 1.0, FrictionModel::fixed, first, second);
+  REQUIRE(first.size() == 2);
+  CHECK(first[0] == 3.0);  // the sustained rule at work
+  cache.begin_store(manifolds);
+  const double normal[2] = {5.0, 7.0};
+  cache.store_manifold(0, m, normal, Vec3::Zero(), 0.0);
+  cache.end_store(nullptr, 0);
+  cache.match(manifolds);
+  CHECK(cache.matched_points() == 2);
+  CHECK(cache.last_normal(0) == 5.0);
+  CHECK(cache.last_normal(1) == 7.0);
+  cache.initial_guesses(manifolds, rows, 0, 1.0, FrictionModel::fixed, first, second);
+  REQUIRE(first.size() == 2);
+  CHECK(first[0] == 0.0);
+  CHECK(first[1] == 0.0);
+  CHECK(second.empty());
+  cache.store(manifolds, rows, 0, {6.0, 4.0}, {});
+  cache.match(manifolds);
+  cache.initial_guesses(manifolds, rows, 0, 0.5, FrictionModel::fixed, first, second);
+  CHECK(first[0] == 0.5 * 5.0);  // the smaller of 6 and 5 N
+  CHECK(first[1] == 0.5 * 4.0);  // of 4 and 7 N
 }
 
 TEST_CASE("warm_start is a world parameter in [0, 1] with the flag --warm-start",

@@ -467,10 +467,10 @@ class SoftStep final : public PushMethod {
   // The prepare stage's prefetching, kManifoldsAhead manifolds ahead: the lines of a manifold
   // that prepare_manifold() reads (through its first four points; twice as far ahead, so that
   // its bodies can be found; the store stage asks for them too), then its bodies' (Body and
-  // SolverBody) and its lane's group and points, which put_lane() writes. The stage goes through the manifolds in ctx's order and the
-  // lanes lie in colour order, so each manifold's lanes are elsewhere; without this the stores to
-  // them held up the next manifold (docs/benchmarks.md). Always inlined: as calls, GCC took them
-  // for functions without effects and dropped them.
+  // SolverBody) and its lane's group and points, which put_lane() writes. The stage goes through
+  // the manifolds in ctx's order and the lanes lie in colour order, so each manifold's lanes are
+  // elsewhere; without this the stores to them held up the next manifold (docs/benchmarks.md).
+  // Always inlined: as calls, GCC took them for functions without effects and dropped them.
   [[gnu::always_inline]] static void prefetch_manifold(const Manifold& m) {
     const auto* start = reinterpret_cast<const char*>(&m);
     const auto* past = reinterpret_cast<const char*>(m.contacts.data() + 4);

@@ -65,6 +65,19 @@ inline void bounds(const PackedRow& r, const std::vector<double>& lambda, double
   detail::force_limits<kCoupled>(r.c_min, r.c_max, r.mu, r.normal_row, lambda.data(), lo, hi);
 }
 
+// A block run's coupling g (m (m - 1) / 2 entries) from its m packed rows r: column i holds
+// A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
+template <class PackedRow>
+[[gnu::always_inline]] inline void couple_run(const PackedRow* r, int m, double* g) {
+  for (int i = 0; i < m; g += m - 1 - i, ++i) {
+    for (int k = i + 1; k < m; ++k) {
+      const double a_ki = half(r[k].j.data()).dot(half(r[i].minv_jt.data())) +
+                          half(r[k].j.data() + 6).dot(half(r[i].minv_jt.data() + 6));
+      g[k - i - 1] = a_ki * r[k].inv_diagonal;
+    }
+  }
+}
+
 // A short run row by row through w (Eq. 7.1.1): rows r[0..m) all on w_a and, when kTwoBodies, w_b.
 template <bool kCoupled, bool kTwoBodies, class PackedRow>
 [[gnu::always_inline]] inline void sweep_short_run(const PackedRow* r, const double* b, double* l, int m,
@@ -101,15 +114,22 @@ template <bool kCoupled, bool kTwoBodies, int kM, class PackedRow>
   }
   Vec6 dw_a = Vec6::Zero();
   Vec6 dw_b = Vec6::Zero();
+  // The next row's t is carried in a register (t_i), so the chain of clamps waits on one product
+  // and one difference a row, not on a store and load of t (the same numbers in the same order).
+  double t_i = t[0];
   for (int i = 0; i < m; g += m - 1 - i, ++i) {
-    if (r[i].inv_diagonal == 0.0) continue;  // lambda_i stays 0
+    if (r[i].inv_diagonal == 0.0) {  // lambda_i stays 0
+      if (i + 1 < m) t_i = t[i + 1];
+      continue;
+    }
     double lo;
     double hi;
     bounds<kCoupled>(r[i], lambda, lo, hi);
-    const double value = std::clamp(t[i], lo, hi);
+    const double value = std::clamp(t_i, lo, hi);
     const double delta = value - l[i];
     l[i] = value;
-    for (int k = i + 1; k < m; ++k) t[k] -= g[k - i - 1] * delta;
+    if (i + 1 < m) t_i = t[i + 1] - g[0] * delta;
+    for (int k = i + 2; k < m; ++k) t[k] -= g[k - i - 1] * delta;
     dw_a += delta * half(r[i].minv_jt.data());
     if constexpr (kTwoBodies) dw_b += delta * half(r[i].minv_jt.data() + 6);
   }
@@ -129,7 +149,7 @@ struct SweepData {
   const double* b;
   double* l;  // lambda by position
   Vec6* w;
-  const double* coupling;
+  double* coupling;
   int fixed_slot;
 };
 
@@ -144,12 +164,15 @@ SweepData<PackedRow> sweep_data(MatrixFreeSystem& s, std::vector<double>& lambda
 // 20 % more instructions.
 template <bool kCoupled, class PackedRow>
 [[gnu::always_inline]] inline void sweep_run(const SweepData<PackedRow>& d, const MatrixFreeSystem::Run& run,
-                      const std::vector<double>& lambda) {
+                      const std::vector<double>& lambda, bool couple) {
   const auto first = static_cast<std::size_t>(run.begin);
   const PackedRow* r = d.rows + first;
   const double* b = d.b + first;
   double* l = d.l + first;
   if (r->a == d.fixed_slot) return;  // no movable body: every lambda stays 0
+  // The first sweep of a solve forms the coupling of each block run as it reaches it (the rows are
+  // then in the cache), not in a pass of its own.
+  if (couple && run.offset >= 0) couple_run(r, run.count, d.coupling + run.offset);
   Vec6& w_a = d.w[static_cast<std::size_t>(r->a)];
   const bool two = r->b != d.fixed_slot;
   if (run.offset < 0) {  // a short run: row by row, through w
@@ -212,11 +235,13 @@ template <bool kCoupled, class PackedRow>
   const MatrixFreeSystem::Run* runs = s.runs.data();
   const std::size_t count = s.runs.size();
   const std::size_t prefetched = prefetch_end(prefetching<PackedRow>(s), 0, count);
+  bool couple = !s.coupling_ready;
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t i = 0; i < count; ++i) {
       if (i < prefetched) prefetch_run(d, runs[i + kPrefetchRuns]);
-      sweep_run<kCoupled>(d, runs[i], lambda);
+      sweep_run<kCoupled>(d, runs[i], lambda, couple);
     }
+    couple = false;
   }
 }
 
@@ -232,6 +257,7 @@ template <bool kCoupled, class PackedRow>
   const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
   const auto k_t = static_cast<std::size_t>(t);
   const bool prefetch = prefetching<PackedRow>(s);
+  bool couple = !s.coupling_ready;
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t k = 0; k < ConstraintGraph::kColours; ++k) {
       const std::size_t begin = s.sweep_start[k];
@@ -249,10 +275,11 @@ template <bool kCoupled, class PackedRow>
       const std::size_t prefetched = prefetch_end(prefetch, first, last);
       for (std::size_t i = first; i < last; ++i) {
         if (i < prefetched) prefetch_run(d, runs[i + kPrefetchRuns]);
-        sweep_run<kCoupled>(d, runs[i], lambda);
+        sweep_run<kCoupled>(d, runs[i], lambda, couple);
       }
       if (workers != nullptr) workers->sync();
     }
+    couple = false;
   }
 }
 
@@ -305,10 +332,10 @@ constexpr std::size_t kWriteAhead = 16;
 // (sum of m), so this bound holds for any mix of manifolds (8 bytes x 12 = 96 bytes a row).
 constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun / 2;
 
-// The coupling blocks of s.runs (any order), at offsets set here (PGS and coloured PGS), the
-// blocks computed on `workers`' threads.
+// The offsets of the coupling blocks of s.runs (any order), and room for them (PGS and coloured
+// PGS). The first sweep of the next solve forms the blocks (couple_run).
 template <class PackedRow>
-void build_coupling(MatrixFreeSystem& s, Workers* workers = nullptr) {
+void place_coupling(MatrixFreeSystem& s) {
   std::size_t coupling_size = 0;
   for (MatrixFreeSystem::Run& run : s.runs) {
     const int m = run.count;
@@ -321,25 +348,11 @@ void build_coupling(MatrixFreeSystem& s, Workers* workers = nullptr) {
   // step (which a long run meets after warm-up).
   detail::reserve_with_headroom(s.coupling, std::max(coupling_size, kCouplingPerRow * packed<PackedRow>(s).size()));
   detail::resize_with_headroom(s.coupling, coupling_size);
-  parallel_for(workers, s.runs.size(), kMinParallel, [&s](int, std::size_t begin, std::size_t end) {
-    for (std::size_t n = begin; n < end; ++n) {
-      const MatrixFreeSystem::Run& run = s.runs[n];
-      if (run.offset < 0) continue;
-      const PackedRow* r = packed<PackedRow>(s).data() + run.begin;
-      double* g = s.coupling.data() + run.offset;
-      for (int i = 0; i < run.count; g += run.count - 1 - i, ++i) {
-        // Column i: A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
-        for (int k = i + 1; k < run.count; ++k) {
-          const double a_ki = half(r[k].j.data()).dot(half(r[i].minv_jt.data())) +
-                              half(r[k].j.data() + 6).dot(half(r[i].minv_jt.data() + 6));
-          g[k - i - 1] = a_ki * r[k].inv_diagonal;
-        }
-      }
-    }
-  });
+  s.coupling_ready = false;
 }
 
-// Runs of consecutive rows on the same two slots in row order, and their coupling blocks (PGS).
+// Runs of consecutive rows on the same two slots in row order, and their coupling blocks' places
+// (PGS).
 template <class PackedRow>
 void build_runs(MatrixFreeSystem& s) {
   const std::vector<PackedRow>& rows = packed<PackedRow>(s);
@@ -355,14 +368,14 @@ void build_runs(MatrixFreeSystem& s) {
     s.runs.push_back({static_cast<int>(r), static_cast<int>(end - r), -1});
     r = end;
   }
-  build_coupling<PackedRow>(s);
+  place_coupling<PackedRow>(s);
   s.runs_ready = true;
 }
 
 // Coloured PGS: the runs of s.colours at their positions (the rows are packed in sweep order, so
-// a colour's runs are consecutive) and their coupling blocks.
+// a colour's runs are consecutive) and their coupling blocks' places.
 template <class PackedRow>
-void build_coloured_runs(MatrixFreeSystem& s, Workers* workers) {
+void build_coloured_runs(MatrixFreeSystem& s) {
   s.runs.clear();
   detail::reserve_with_headroom(s.runs, s.colours.runs.size());
   int position = 0;
@@ -376,7 +389,7 @@ void build_coloured_runs(MatrixFreeSystem& s, Workers* workers) {
     }
   }
   s.sweep_start.back() = s.runs.size();
-  build_coupling<PackedRow>(s, workers);
+  place_coupling<PackedRow>(s);
   s.runs_ready = true;
 }
 
@@ -467,7 +480,7 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
         out[at] = p;
       }
     });
-    if (kind == SolverKind::coloured_pgs) build_coloured_runs<PackedRow>(s, workers);
+    if (kind == SolverKind::coloured_pgs) build_coloured_runs<PackedRow>(s);
   };
   s.precision = precision;
   if (precision == RowPrecision::single_precision) {
@@ -583,6 +596,7 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
       coupled ? pgs_sweeps<true, PackedRow>(s, iterations, l)
               : pgs_sweeps<false, PackedRow>(s, iterations, l);
     }
+    if (kind != SolverKind::jacobi && iterations > 0) s.coupling_ready = true;  // formed by the first sweep
   });
 }
 

@@ -71,7 +71,8 @@ struct MatrixFreeSystem {
   std::vector<Run> runs;
   ColourStarts sweep_start{};
   RowColours colours;            ///< coloured PGS: the rows' runs and colours
-  bool runs_ready = false;       ///< runs and coupling built for these rows (prepare or first PGS solve)
+  bool runs_ready = false;       ///< runs and coupling's places built for these rows (prepare or first PGS solve)
+  bool coupling_ready = false;   ///< coupling blocks formed (by the first sweep of a solve after the runs)
   /// Per block run of m rows: the strict lower triangle of its m x m coupling, column by column
   /// (column i: A_ki / A_kk for k = i+1..m-1; dimensionless).
   std::vector<double> coupling;

@@ -6,10 +6,17 @@
 #include "lcp.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+
+// The 32-byte vectors of the coloured sweeps (Wide) pass by value only between always-inlined
+// functions, so no call uses the ABI that -Wpsabi warns of (it warns at the end of the file, where
+// the templates are instantiated, so for the whole file).
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace cps {
 namespace {
@@ -98,6 +105,31 @@ template <bool kCoupled, bool kTwoBodies, class PackedRow>
   }
 }
 
+// Row i of a block run's chain of clamps (sweep_block, sweep_block_wide): t_i, row i's unclamped
+// value, clamped into its bounds gives lambda_i (into l_i); t_i then becomes row i + 1's and the
+// later t[k] take the change (g: column i of the run's coupling). Returns false, changing only
+// t_i, for a row that touches no movable body (lambda_i stays 0); else delta, lambda_i's change.
+// The next row's t is carried in a register, so the chain waits on one product and one
+// difference a row, not on a store and load of t (the same numbers in the same order).
+template <bool kCoupled, class PackedRow>
+[[gnu::always_inline]] inline bool chain_row(const PackedRow& row, int i, int m, const double* g,
+                                             const std::vector<double>& lambda, double* t, double& t_i,
+                                             double& l_i, double& delta) {
+  if (row.inv_diagonal == 0.0) {
+    if (i + 1 < m) t_i = t[i + 1];
+    return false;
+  }
+  double lo;
+  double hi;
+  bounds<kCoupled>(row, lambda, lo, hi);
+  const double value = std::clamp(t_i, lo, hi);
+  delta = value - l_i;
+  l_i = value;
+  if (i + 1 < m) t_i = t[i + 1] - g[0] * delta;
+  for (int k = i + 2; k < m; ++k) t[k] -= g[k - i - 1] * delta;
+  return true;
+}
+
 // A run of m rows on w_a and (kTwoBodies) w_b as a block; kM = m when known at compile time (the
 // loops then unroll), 0 otherwise. g: the run's coupling, the strict lower triangle of its m x m
 // block column by column (column i: A_ki / A_kk for k = i+1..m-1).
@@ -114,27 +146,84 @@ template <bool kCoupled, bool kTwoBodies, int kM, class PackedRow>
   }
   Vec6 dw_a = Vec6::Zero();
   Vec6 dw_b = Vec6::Zero();
-  // The next row's t is carried in a register (t_i), so the chain of clamps waits on one product
-  // and one difference a row, not on a store and load of t (the same numbers in the same order).
   double t_i = t[0];
   for (int i = 0; i < m; g += m - 1 - i, ++i) {
-    if (r[i].inv_diagonal == 0.0) {  // lambda_i stays 0
-      if (i + 1 < m) t_i = t[i + 1];
-      continue;
-    }
-    double lo;
-    double hi;
-    bounds<kCoupled>(r[i], lambda, lo, hi);
-    const double value = std::clamp(t_i, lo, hi);
-    const double delta = value - l[i];
-    l[i] = value;
-    if (i + 1 < m) t_i = t[i + 1] - g[0] * delta;
-    for (int k = i + 2; k < m; ++k) t[k] -= g[k - i - 1] * delta;
+    double delta;
+    if (!chain_row<kCoupled>(r[i], i, m, g, lambda, t, t_i, l[i], delta)) continue;
     dw_a += delta * half(r[i].minv_jt.data());
     if constexpr (kTwoBodies) dw_b += delta * half(r[i].minv_jt.data() + 6);
   }
   w_a += dw_a;
   if constexpr (kTwoBodies) w_b += dw_b;
+}
+
+// Coloured PGS's block sweep on 4-wide vectors (GCC vector extensions): a row's j and M^-1 j^T
+// as three vectors of 4 over the 12 numbers [half a, half b], its body pair's w likewise. Built for
+// SSE2 each vector is two registers, built with AVX2 (coloured_sweeps_avx2) one; every lane's
+// operation is the same IEEE operation either way, and the horizontal sum has a fixed order, so
+// both builds give the same numbers (a test). The same equations as sweep_block, with j . w summed
+// in another order (so another state than sweep_block's, by round-off).
+using Wide = double __attribute__((vector_size(32)));
+
+// Four numbers of a packed row from p as a Wide (converted from float for a float row, number by
+// number: a vector conversion here would be split in halves before it is inlined into the AVX2
+// build).
+struct WideLoad {
+  [[gnu::always_inline]] static Wide load(const double* p) {
+    Wide v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  }
+  [[gnu::always_inline]] static Wide load(const float* p) {
+    return Wide{static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]),
+                static_cast<double>(p[3])};
+  }
+};
+
+// a . b over 12 numbers held as three Wides: (a0 b0 + a1 b1) + a2 b2 lane by lane, then the lanes
+// summed as (x0 + x2) + (x1 + x3).
+[[gnu::always_inline]] inline double wide_dot(Wide a0, Wide a1, Wide a2, Wide b0, Wide b1, Wide b2) {
+  const Wide x = (a0 * b0 + a1 * b1) + a2 * b2;
+  return (x[0] + x[2]) + (x[1] + x[3]);
+}
+
+template <bool kCoupled, bool kTwoBodies, class PackedRow>
+[[gnu::always_inline]] inline void sweep_block_wide(const PackedRow* r, const double* b, double* l, int m,
+                                                    const double* g, const std::vector<double>& lambda,
+                                                    Vec6& w_a, Vec6& w_b) {
+  // w of the two bodies as 12 numbers in three Wides (a one-body run's half b is the fixed slot's 0).
+  const Wide w0 = WideLoad::load(w_a.data());
+  const Wide w1 = {w_a[4], w_a[5], w_b[0], w_b[1]};
+  const Wide w2 = WideLoad::load(w_b.data() + 2);
+  double t[MatrixFreeSystem::kMaxRun];
+  for (int i = 0; i < m; ++i) {
+    const auto* j = r[i].j.data();
+    const double jw = wide_dot(WideLoad::load(j), WideLoad::load(j + 4), WideLoad::load(j + 8), w0, w1, w2);
+    t[i] = l[i] + (b[i] - jw) * r[i].inv_diagonal;
+  }
+  Wide d0 = {0.0, 0.0, 0.0, 0.0};
+  Wide d1 = d0;
+  Wide d2 = d0;
+  double t_i = t[0];
+  for (int i = 0; i < m; g += m - 1 - i, ++i) {
+    double delta;
+    if (!chain_row<kCoupled>(r[i], i, m, g, lambda, t, t_i, l[i], delta)) continue;
+    const auto* minv_jt = r[i].minv_jt.data();
+    d0 += delta * WideLoad::load(minv_jt);
+    d1 += delta * WideLoad::load(minv_jt + 4);
+    if constexpr (kTwoBodies) d2 += delta * WideLoad::load(minv_jt + 8);
+  }
+  const Wide n0 = w0 + d0;
+  const Wide n1 = w1 + d1;
+  std::memcpy(w_a.data(), &n0, sizeof n0);
+  w_a[4] = n1[0];
+  w_a[5] = n1[1];
+  if constexpr (kTwoBodies) {
+    const Wide n2 = w2 + d2;
+    w_b[0] = n1[2];
+    w_b[1] = n1[3];
+    std::memcpy(w_b.data() + 2, &n2, sizeof n2);
+  }
 }
 
 // PGS over the runs (see MatrixFreeSystem::Run). In a run of m rows on bodies a and b, row k's
@@ -162,7 +251,8 @@ SweepData<PackedRow> sweep_data(MatrixFreeSystem& s, std::vector<double>& lambda
 // One run (see MatrixFreeSystem::Run): a short run row by row through w, a longer one as a block.
 // Inlined into the sweeps' loops: as a call per run it cost the pendulum wave's single-row runs
 // 20 % more instructions.
-template <bool kCoupled, class PackedRow>
+// kWide: a block by sweep_block_wide (coloured PGS), else by sweep_block (PGS).
+template <bool kCoupled, bool kWide, class PackedRow>
 [[gnu::always_inline]] inline void sweep_run(const SweepData<PackedRow>& d, const MatrixFreeSystem::Run& run,
                       const std::vector<double>& lambda, bool couple) {
   const auto first = static_cast<std::size_t>(run.begin);
@@ -186,6 +276,11 @@ template <bool kCoupled, class PackedRow>
   }
   Vec6& w_b = d.w[static_cast<std::size_t>(r->b)];
   const double* g = d.coupling + run.offset;
+  if constexpr (kWide) {
+    two ? sweep_block_wide<kCoupled, true>(r, b, l, run.count, g, lambda, w_a, w_b)
+        : sweep_block_wide<kCoupled, false>(r, b, l, run.count, g, lambda, w_a, w_b);
+    return;
+  }
   // Two contact points (a contact and two friction rows each), or any other size.
   if (run.count == 6) {
     two ? sweep_block<kCoupled, true, 6>(r, b, l, 6, g, lambda, w_a, w_b)
@@ -239,7 +334,7 @@ template <bool kCoupled, class PackedRow>
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t i = 0; i < count; ++i) {
       if (i < prefetched) prefetch_run(d, runs[i + kPrefetchRuns]);
-      sweep_run<kCoupled>(d, runs[i], lambda, couple);
+      sweep_run<kCoupled, false>(d, runs[i], lambda, couple);
     }
     couple = false;
   }
@@ -251,7 +346,7 @@ template <bool kCoupled, class PackedRow>
 // its own lambdas and its bodies' w, and reads a contact row's lambda only from its own run
 // (a manifold's rows are one run or runs of different colours).
 template <bool kCoupled, class PackedRow>
-[[gnu::flatten]] void coloured_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda,
+[[gnu::always_inline]] inline void coloured_sweeps_body(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda,
                      Workers* workers, int t) {
   const SweepData<PackedRow> d = sweep_data<PackedRow>(s, lambda);
   const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
@@ -275,12 +370,37 @@ template <bool kCoupled, class PackedRow>
       const std::size_t prefetched = prefetch_end(prefetch, first, last);
       for (std::size_t i = first; i < last; ++i) {
         if (i < prefetched) prefetch_run(d, runs[i + kPrefetchRuns]);
-        sweep_run<kCoupled>(d, runs[i], lambda, couple);
+        sweep_run<kCoupled, true>(d, runs[i], lambda, couple);
       }
       if (workers != nullptr) workers->sync();
     }
     couple = false;
   }
+}
+
+// coloured_sweeps_body built for the baseline (SSE2 on x86-64) and, on x86-64, with AVX2: the
+// same numbers (sweep_block_wide); solve() takes the AVX2 build where the CPU has it.
+template <bool kCoupled, class PackedRow>
+[[gnu::flatten]] void coloured_sweeps(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda,
+                                      Workers* workers, int t) {
+  coloured_sweeps_body<kCoupled, PackedRow>(s, iterations, lambda, workers, t);
+}
+#if defined(__x86_64__)
+template <bool kCoupled, class PackedRow>
+[[gnu::flatten, gnu::target("avx2")]] void coloured_sweeps_avx2(MatrixFreeSystem& s, int iterations,
+                                                               std::vector<double>& lambda, Workers* workers, int t) {
+  coloured_sweeps_body<kCoupled, PackedRow>(s, iterations, lambda, workers, t);
+}
+#endif
+
+// Whether this solve's coloured sweeps take the AVX2 build.
+bool wide_avx2() {
+#if defined(__x86_64__)
+  static const bool has_avx2 = __builtin_cpu_supports("avx2");
+  return has_avx2 && detail::coloured_avx2_allowed();
+#else
+  return false;
+#endif
 }
 
 // Projected Jacobi: every row against the w of the previous sweep, then all of them applied.
@@ -394,6 +514,14 @@ void build_coloured_runs(MatrixFreeSystem& s) {
 }
 
 }  // namespace
+
+namespace detail {
+namespace {
+std::atomic<bool> avx2_allowed{true};
+}  // namespace
+void allow_coloured_avx2(bool allowed) { avx2_allowed.store(allowed); }
+bool coloured_avx2_allowed() { return avx2_allowed.load(); }
+}  // namespace detail
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
              const std::vector<Body>& bodies, SolverKind kind, Workers* workers,
@@ -577,14 +705,22 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
       coupled ? jacobi_sweeps<true, PackedRow>(s, iterations, l)
               : jacobi_sweeps<false, PackedRow>(s, iterations, l);
     } else if (coloured) {
+      const bool avx2 = wide_avx2();
+      auto sweeps = [&](Workers* on, int t) {
+#if defined(__x86_64__)
+        if (avx2) {
+          coupled ? coloured_sweeps_avx2<true, PackedRow>(s, iterations, l, on, t)
+                  : coloured_sweeps_avx2<false, PackedRow>(s, iterations, l, on, t);
+          return;
+        }
+#endif
+        coupled ? coloured_sweeps<true, PackedRow>(s, iterations, l, on, t)
+                : coloured_sweeps<false, PackedRow>(s, iterations, l, on, t);
+      };
       if (workers == nullptr || workers->count() == 1) {
-        coupled ? coloured_sweeps<true, PackedRow>(s, iterations, l, nullptr, 0)
-                : coloured_sweeps<false, PackedRow>(s, iterations, l, nullptr, 0);
+        sweeps(nullptr, 0);
       } else {
-        auto task = [&](int t) {
-          coupled ? coloured_sweeps<true, PackedRow>(s, iterations, l, workers, t)
-                  : coloured_sweeps<false, PackedRow>(s, iterations, l, workers, t);
-        };
+        auto task = [&](int t) { sweeps(workers, t); };
         workers->run(task);
       }
       detail::resize_with_headroom(lambda, rows.size());

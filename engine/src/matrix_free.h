@@ -108,7 +108,8 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
 
 /// Solves the bounded system with `iterations` sweeps of PGS, coloured PGS (in the sweep order of
 /// prepare(), a colour's runs shared among `workers`' threads; nullptr: one thread; the same
-/// lambda for every thread count) or Jacobi, the bounds of solve_lcp
+/// lambda for every thread count; its blocks on 4-wide vectors, in AVX2 where the CPU has it and
+/// SSE2 otherwise, the same numbers both ways) or Jacobi, the bounds of solve_lcp
 /// (c_min, c_max from the rows, or the coupled friction limit), into lambda (resized to c, N).
 /// It starts from `initial` (c values, N; warm starting, Sec. 6.2.3) when given, with
 /// w = M^-1 J^T initial, else from lambda = 0 and w = 0; a row that touches no movable body
@@ -126,6 +127,14 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
 /// result for every count. No errors.
 void constraint_forces(const MatrixFreeSystem& s, const std::vector<Body>& bodies,
                        const Eigen::VectorXd& f_ext, Eigen::VectorXd& f, Workers* workers = nullptr);
+
+namespace detail {
+/// Whether coloured PGS's sweeps may take their AVX2 build where the CPU has it (true by
+/// default). Both builds give the same numbers; false runs the baseline build, for the test that
+/// checks it. No errors.
+void allow_coloured_avx2(bool allowed);
+bool coloured_avx2_allowed();
+}  // namespace detail
 
 /// The natural-map residual of lcp_residual for the lambda that solve() left (using its w),
 /// per row: the largest value and the sum of squares (N, N^2).

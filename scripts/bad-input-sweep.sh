@@ -10,7 +10,8 @@
 # Options whose --help shows a choice list {a, b} are classified as choices automatically.
 #
 # Each command line (nproc of them at a time, or SWEEP_JOBS; SWEEP_TIMEOUT, SWEEP_VERBOSE=1 to
-# list every verdict) runs in a fresh temporary folder (its cwd, with a few fixture files:
+# list every verdict) runs in a temporary folder (its cwd, with a few fixture files, made again
+# after any line changed them:
 # `file`, `file.png` and `file.hdf5` regular files, `adir`, `adir.json` and `dir.png` folders,
 # `fifo.png` (a FIFO), `loop.png` (a link to itself) and `bomb.png` (a size bomb), scene files
 # `bad.json` (a box without half_extents_m) and `notjson.json`, valid ones `a/x.json` and
@@ -418,13 +419,16 @@ choose_cap() {
   MEM_NOTE="no rlimit (--as and --data broke a valid run: $why); ASan limits 1 GiB if ASan"
 }
 
-# Runs "$@" as cps's arguments in a fresh folder; sets RC, OUT, ERR, WROTE (what was written).
+# Runs "$@" as cps's arguments in the case folder; sets RC, OUT, ERR, WROTE (what was written).
+# The fixture is made once per folder and made again only after a command line changed it (a
+# failure, or a control that wrote its output), so every line starts from the same fixture.
 CASE_DIR=$root/case
+FIXTURE_DIR='' FIXTURE_SNAP=''  # the folder whose fixture is intact, and its snapshot
 BOMB_PNG='\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x01\x86\xa0\x00\x01\x86\xa0'
 BOMB_PNG+='\x08\x02\x00\x00\x00\x27\x30\x9c\x9f\x00\x00\x00\x08\x49\x44\x41\x54\x78\x9c\x03\x00\x00\x00'
 BOMB_PNG+='\x00\x01\x48\x06\x89\xd2\x00\x00\x00\x00\x49\x45\x4e\x44\xae\x42\x60\x82'
-run_cps() {
-  local d=$CASE_DIR
+make_fixture() {  # DIR: a fresh cwd and tmp with the fixture files
+  local d=$1
   rm -rf "$d"
   mkdir -p "$d/cwd/adir" "$d/cwd/dir.png" "$d/cwd/adir.json" "$d/tmp"
   printf '{"bodies": [{"shape": "box", "mass_kg": 1}]}\n' > "$d/cwd/bad.json"  # no half_extents_m
@@ -445,90 +449,108 @@ run_cps() {
   mkdir -p "$d/cwd/names"
   printf '{"bodies": [], "name": "ab\\u202ecd"}\n' > "$d/cwd/names/bidi.json"
   printf '{"bodies": []}\n' > "$d/cwd/names/run.json"
-  local before
-  before=$(snapshot "$d")
-  (cd "$d/cwd" && TMPDIR="$d/tmp" exec timeout -k 5 "$TIMEOUT" "${CAP[@]}" "$CPS" "$@" \
-    > "$d/out" 2> "$d/err")
-  RC=$?
-  OUT=$(head -c 4000 "$d/out")
-  ERR=$(head -c 4000 "$d/err")
-  WROTE=
-  local after
-  after=$(snapshot "$d")
-  if [[ $after != "$before" ]]; then
-    local line
-    while IFS= read -r line; do
-      [[ $NL$before$NL == *"$NL$line$NL"* ]] || WROTE+="${WROTE:+, }${line%%|*}"
-    done <<< "$after"
-    [[ -n $WROTE ]] || WROTE="(a fixture file changed)"
-    local -a paths
-    IFS=, read -ra paths <<< "$WROTE"
-    ((${#paths[@]} > 3)) && WROTE="${paths[0]},${paths[1]},${paths[2]} and $((${#paths[@]} - 3)) more"
-  fi
+  FIXTURE_DIR=$d
+  snapshot "$d"
+  FIXTURE_SNAP=$SNAP
 }
-snapshot() {  # every path below cwd and tmp; size and time of the fixture files
-  (
-    cd "$1" || exit
-    shopt -s globstar dotglob nullglob
-    printf '%s\n' cwd/** tmp/**
-    stat -c '%n|%s|%y' cwd/file cwd/file.png cwd/file.hdf5
-  )
+# Each command line costs one process besides cps's own (the snapshot's find): a fork costs
+# milliseconds here, and the sweep runs thousands of lines, so no $(...) on the way.
+run_cps() {
+  local d=$CASE_DIR
+  [[ $FIXTURE_DIR == "$d" ]] || make_fixture "$d"
+  local back=$PWD
+  cd "$d/cwd" || exit 3
+  TMPDIR="$d/tmp" timeout -k 5 "$TIMEOUT" "${CAP[@]}" "$CPS" "$@" > "$d/out" 2> "$d/err"
+  RC=$?
+  cd "$back" || exit 3
+  OUT='' ERR=''
+  IFS= read -r -d '' -N 4000 OUT < "$d/out"
+  IFS= read -r -d '' -N 4000 ERR < "$d/err"
+  WROTE=
+  snapshot "$d"
+  [[ $SNAP == "$FIXTURE_SNAP" ]] && return
+  # Something changed: what is new or changed (by path), or else what is gone.
+  local line gone=
+  while IFS= read -r line; do
+    [[ $NL$FIXTURE_SNAP$NL == *"$NL$line$NL"* ]] || WROTE+="${WROTE:+, }${line%%|*}"
+  done <<< "$SNAP"
+  while IFS= read -r line; do
+    [[ $NL$SNAP$NL == *"$NL$line$NL"* ]] || gone+="${gone:+, }${line%%|*}"
+  done <<< "$FIXTURE_SNAP"
+  [[ -n $WROTE$gone ]] || return  # the same paths, listed in another order
+  FIXTURE_DIR=  # made again before the next command line
+  [[ -n $WROTE ]] || WROTE="(removed $gone)"
+  local -a paths
+  IFS=, read -ra paths <<< "$WROTE"
+  ((${#paths[@]} > 3)) && WROTE="${paths[0]},${paths[1]},${paths[2]} and $((${#paths[@]} - 3)) more"
+}
+snapshot() {  # DIR -> SNAP: every path below DIR/cwd and DIR/tmp (as cwd/... and tmp/...), with the
+  # size and time of each that is not a folder
+  local back=$PWD
+  cd "$1" || exit 3
+  find cwd tmp -type d -printf '%p\n' -o -printf '%p|%s|%T@\n' > snap
+  cd "$back" || exit 3
+  SNAP=''
+  IFS= read -r -d '' SNAP < "$1/snap"
 }
 
-# Why the last run (of a bad command line) is not a clean refusal, or nothing if it is.
+# WHY: why the last run (of a bad command line) is not a clean refusal, or empty if it is.
 # $1: what the message must name, alternatives separated by '/' (those under 2 characters ignored).
 verdict_bad() {
   local needles=$1 n named=0
-  if ((RC == 124 || RC == 137)); then echo "timeout: still running after ${TIMEOUT} s"; return; fi
-  if ((RC > 128)); then echo "killed by signal $((RC - 128)) ($(kill -l $((RC - 128)) 2> /dev/null))"; return; fi
+  WHY=
+  if ((RC == 124 || RC == 137)); then WHY="timeout: still running after ${TIMEOUT} s"; return; fi
+  if ((RC > 128)); then WHY="killed by signal $((RC - 128)) ($(kill -l $((RC - 128)) 2> /dev/null))"; return; fi
   if [[ $ERR == *bad_alloc* || $ERR == *"out of memory"* || $ERR == *"Cannot allocate"* ]]; then
-    echo "memory exhausted (exit $RC)"; return
+    WHY="memory exhausted (exit $RC)"; return
   fi
-  if ((RC == 0)); then echo "accepted (exit 0)${WROTE:+; wrote $WROTE}"; return; fi
-  if ((RC != 2)); then echo "exit $RC, not 2${WROTE:+; wrote $WROTE}"; return; fi
-  if [[ -n $WROTE ]]; then echo "exit 2 but wrote $WROTE"; return; fi
+  if ((RC == 0)); then WHY="accepted (exit 0)${WROTE:+; wrote $WROTE}"; return; fi
+  if ((RC != 2)); then WHY="exit $RC, not 2${WROTE:+; wrote $WROTE}"; return; fi
+  if [[ -n $WROTE ]]; then WHY="exit 2 but wrote $WROTE"; return; fi
   local IFS=/
   for n in $needles; do
     ((${#n} >= 2)) && [[ $ERR == *"$n"* ]] && named=1
   done
-  ((named)) || echo "exit 2 but the message does not name ${needles//\// or }"
+  ((named)) || WHY="exit 2 but the message does not name ${needles//\// or }"
 }
 
-message() {  # STDERR -> its first line that starts with "cps", else its last line
+message() {  # STDERR -> MSG: its first line that starts with "cps", else its last line
   local line last=
   while IFS= read -r line; do
-    [[ $line == cps* ]] && { printf '%s' "$line"; return; }
+    [[ $line == cps* ]] && { MSG=$line; return; }
     [[ -n $line ]] && last=$line
   done <<< "$1"
-  printf '%s' "${last:-(nothing on stderr)}"
+  MSG=${last:-(nothing on stderr)}
 }
-quoted() {  # ARGS... -> " ARG1 ARG2 ..." quoted for the shell (eval "args=(...)" reads it back)
-  local s= a q
+quoted() {  # ARGS... -> Q: " ARG1 ARG2 ..." quoted for the shell (eval "args=(...)" reads it back)
+  local a q
+  Q=
   for a in "$@"; do
     printf -v q '%q' "$a"
-    s+=" $q"
+    Q+=" $q"
   done
-  printf '%s' "$s"
 }
-show() { printf 'cps%s' "$(quoted "$@")"; }  # the command line as a shell would take it
+show() { quoted "$@"; printf 'cps%s' "$Q"; }  # the command line as a shell would take it
 
 # bad NEEDLES ARGS...: plans a bad command line (run_sweep runs them).
 CASE_NEEDLES=() CASE_ARGS=()
 bad() {
   CASE_NEEDLES+=("$1")
   shift
-  CASE_ARGS+=("$(quoted "$@")")
+  quoted "$@"
+  CASE_ARGS+=("$Q")
 }
 # Runs the planned command lines, JOBS at a time (worker w takes w, w + JOBS, ...), each
 # verdict into $root/res/I, then prints the failures in plan order and sets N, P, F.
 sweep_worker() {
-  local w=$1 i why args
+  local w=$1 i args
   CASE_DIR=$root/w$w
   for ((i = w; i < ${#CASE_ARGS[@]}; i += JOBS)); do
     eval "args=(${CASE_ARGS[i]})"
     run_cps "${args[@]}"
-    why=$(verdict_bad "${CASE_NEEDLES[i]}")
-    printf '%s\n%s\n' "$why" "$(message "$ERR")" > "$root/res/$i"
+    verdict_bad "${CASE_NEEDLES[i]}"
+    message "$ERR"
+    printf '%s\n%s\n' "$WHY" "$MSG" > "$root/res/$i"
   done
 }
 run_sweep() {
@@ -720,15 +742,21 @@ fi
 # Self-test: the classifier must call these failures.
 SELF_FAILS=()
 run_cps simulate stack --seconds 0.1
-[[ -n $(verdict_bad --seconds) ]] || SELF_FAILS+=("an accepted command line (exit 0) was not a failure")
+verdict_bad --seconds; [[ -n $WHY ]] || SELF_FAILS+=("an accepted command line (exit 0) was not a failure")
 run_cps simulate stack --seconds 0.1 --expect-hash 0000000000000000
-[[ $(verdict_bad --expect-hash) == "exit 1"* ]] || SELF_FAILS+=("exit 1 was not a failure")
+verdict_bad --expect-hash; [[ $WHY == "exit 1"* ]] || SELF_FAILS+=("exit 1 was not a failure")
 RC=2 ERR="cps: something" WROTE=
-[[ -n $(verdict_bad --seconds) ]] || SELF_FAILS+=("a message that names nothing was not a failure")
+verdict_bad --seconds; [[ -n $WHY ]] || SELF_FAILS+=("a message that names nothing was not a failure")
 RC=2 ERR="cps: --seconds: x" WROTE=out
-[[ -n $(verdict_bad --seconds) ]] || SELF_FAILS+=("a written file was not a failure")
+verdict_bad --seconds; [[ -n $WHY ]] || SELF_FAILS+=("a written file was not a failure")
 RC=124 ERR= WROTE=
-[[ -n $(verdict_bad --seconds) ]] || SELF_FAILS+=("a timeout was not a failure")
+verdict_bad --seconds; [[ -n $WHY ]] || SELF_FAILS+=("a timeout was not a failure")
+# A line that overwrites a fixture file is a failure, and the next line gets the fixture again.
+run_cps simulate stack --seconds 0.1 --trace file --force
+[[ $WROTE == *cwd/file* ]] || SELF_FAILS+=("an overwritten fixture file was not seen (wrote: '$WROTE')")
+run_cps list
+[[ -z $WROTE && $(< "$CASE_DIR/cwd/file") == "not written by cps" ]] ||
+  SELF_FAILS+=("the fixture was not made again after a line changed it")
 ((${#SELF_FAILS[@]} == 0)) || printf 'SELF-TEST FAILED: %s\n' "${SELF_FAILS[@]}"
 
 # ---------------------------------------------------------------------------------------------
@@ -799,7 +827,7 @@ for sub in "${COMMANDS[@]}"; do
   done <<< "${PLAN_OPTS[$sub]}"
   # Positionals (the first word after the command).
   while IFS='|' read -r name kind; do
-    [[ -n $name ]] || continue
+    [[ -n $name && $kind != skip ]] || continue  # (diff's frames: covered by reference's values)
     IFS=';' read -ra contexts <<< "$(base_for "$sub" "$name")"
     read -ra words <<< "${contexts[0]}"
     mapfile -t values < <(bad_values "$kind")

@@ -74,13 +74,16 @@ inline void bounds(const PackedRow& r, const std::vector<double>& lambda, double
 
 // A block run's coupling g (m (m - 1) / 2 entries) from its m packed rows r: column i holds
 // A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
-template <class PackedRow>
+// kStride: the rows at r[kStride i], the entries at g[kStride e] (a lane of a lane group).
+template <int kStride = 1, class PackedRow>
 [[gnu::always_inline]] inline void couple_run(const PackedRow* r, int m, double* g) {
-  for (int i = 0; i < m; g += m - 1 - i, ++i) {
+  for (int i = 0; i < m; g += kStride * (m - 1 - i), ++i) {
+    const PackedRow& r_i = r[kStride * i];
     for (int k = i + 1; k < m; ++k) {
-      const double a_ki = half(r[k].j.data()).dot(half(r[i].minv_jt.data())) +
-                          half(r[k].j.data() + 6).dot(half(r[i].minv_jt.data() + 6));
-      g[k - i - 1] = a_ki * r[k].inv_diagonal;
+      const PackedRow& r_k = r[kStride * k];
+      const double a_ki = half(r_k.j.data()).dot(half(r_i.minv_jt.data())) +
+                          half(r_k.j.data() + 6).dot(half(r_i.minv_jt.data() + 6));
+      g[kStride * (k - i - 1)] = a_ki * r_k.inv_diagonal;
     }
   }
 }
@@ -106,14 +109,15 @@ template <bool kCoupled, bool kTwoBodies, class PackedRow>
 }
 
 // Row i of a block run's chain of clamps (sweep_block, sweep_block_wide): t_i, row i's unclamped
-// value, clamped into its bounds gives lambda_i (into l_i); t_i then becomes row i + 1's and the
-// later t[k] take the change (g: column i of the run's coupling). Returns false, changing only
-// t_i, for a row that touches no movable body (lambda_i stays 0); else delta, lambda_i's change.
-// The next row's t is carried in a register, so the chain waits on one product and one
-// difference a row, not on a store and load of t (the same numbers in the same order).
+// value, clamped into its bounds gives lambda_i (into l_i); t_i then becomes row i + 1's (g:
+// column i of the run's coupling). Returns false, changing only t_i, for a row that touches no
+// movable body (lambda_i stays 0); else delta, lambda_i's change, which the caller then takes
+// from the later t[k]. The next row's t is carried in a register, so the chain waits on one
+// product and one difference a row, not on a store and load of t (the same numbers in the same
+// order).
 template <bool kCoupled, class PackedRow>
-[[gnu::always_inline]] inline bool chain_row(const PackedRow& row, int i, int m, const double* g,
-                                             const std::vector<double>& lambda, double* t, double& t_i,
+[[gnu::always_inline]] inline bool clamp_row(const PackedRow& row, int i, int m, const double* g,
+                                             const std::vector<double>& lambda, const double* t, double& t_i,
                                              double& l_i, double& delta) {
   if (row.inv_diagonal == 0.0) {
     if (i + 1 < m) t_i = t[i + 1];
@@ -126,6 +130,15 @@ template <bool kCoupled, class PackedRow>
   delta = value - l_i;
   l_i = value;
   if (i + 1 < m) t_i = t[i + 1] - g[0] * delta;
+  return true;
+}
+
+// clamp_row, then the later t[k] take the change one by one (sweep_block).
+template <bool kCoupled, class PackedRow>
+[[gnu::always_inline]] inline bool chain_row(const PackedRow& row, int i, int m, const double* g,
+                                             const std::vector<double>& lambda, double* t, double& t_i,
+                                             double& l_i, double& delta) {
+  if (!clamp_row<kCoupled>(row, i, m, g, lambda, t, t_i, l_i, delta)) return false;
   for (int k = i + 2; k < m; ++k) t[k] -= g[k - i - 1] * delta;
   return true;
 }
@@ -187,6 +200,28 @@ struct WideLoad {
   return (x[0] + x[2]) + (x[1] + x[3]);
 }
 
+// clamp_row, then (sweep_block_wide) the later t[k] take the change four lanes at a time, in the
+// aligned Wides of t that hold rows i + 2 and later, with g read from column i shifted so that
+// lane k meets A_ki / A_kk. The lanes before i + 2 (rows already clamped) and past m take
+// numbers of no use (their g is a neighbouring column's or the coupling's padding): nothing
+// reads them again. Every later t[k] takes the same t[k] - g delta as in chain_row.
+template <bool kCoupled, class PackedRow>
+[[gnu::always_inline]] inline bool chain_row_wide(const PackedRow& row, int i, int m, const double* g,
+                                                  const std::vector<double>& lambda, double* t, double& t_i,
+                                                  double& l_i, double& delta) {
+  if (!clamp_row<kCoupled>(row, i, m, g, lambda, t, t_i, l_i, delta)) return false;
+  const Wide d = {delta, delta, delta, delta};
+  for (int q = (i + 2) / 4; 4 * q < m; ++q) {
+    Wide t_q;
+    Wide g_q;
+    std::memcpy(&t_q, t + 4 * q, sizeof t_q);
+    std::memcpy(&g_q, g + 4 * q - i - 1, sizeof g_q);
+    t_q -= g_q * d;
+    std::memcpy(t + 4 * q, &t_q, sizeof t_q);
+  }
+  return true;
+}
+
 template <bool kCoupled, bool kTwoBodies, class PackedRow>
 [[gnu::always_inline]] inline void sweep_block_wide(const PackedRow* r, const double* b, double* l, int m,
                                                     const double* g, const std::vector<double>& lambda,
@@ -195,7 +230,8 @@ template <bool kCoupled, bool kTwoBodies, class PackedRow>
   const Wide w0 = WideLoad::load(w_a.data());
   const Wide w1 = {w_a[4], w_a[5], w_b[0], w_b[1]};
   const Wide w2 = WideLoad::load(w_b.data() + 2);
-  double t[MatrixFreeSystem::kMaxRun];
+  alignas(32) double t[MatrixFreeSystem::kMaxRun + 4];
+  for (int i = m; i < m + 4; ++i) t[i] = 0.0;  // lanes past m (see chain_row_wide)
   for (int i = 0; i < m; ++i) {
     const auto* j = r[i].j.data();
     const double jw = wide_dot(WideLoad::load(j), WideLoad::load(j + 4), WideLoad::load(j + 8), w0, w1, w2);
@@ -207,7 +243,7 @@ template <bool kCoupled, bool kTwoBodies, class PackedRow>
   double t_i = t[0];
   for (int i = 0; i < m; g += m - 1 - i, ++i) {
     double delta;
-    if (!chain_row<kCoupled>(r[i], i, m, g, lambda, t, t_i, l[i], delta)) continue;
+    if (!chain_row_wide<kCoupled>(r[i], i, m, g, lambda, t, t_i, l[i], delta)) continue;
     const auto* minv_jt = r[i].minv_jt.data();
     d0 += delta * WideLoad::load(minv_jt);
     d1 += delta * WideLoad::load(minv_jt + 4);
@@ -226,11 +262,6 @@ template <bool kCoupled, bool kTwoBodies, class PackedRow>
   }
 }
 
-// PGS over the runs (see MatrixFreeSystem::Run). In a run of m rows on bodies a and b, row k's
-// value after rows i < k have changed by delta_i is
-//   lambda_k + (b_k - j_k . w_start) / A_kk - sum_{i < k} (A_ki / A_kk) delta_i,
-// the same number Eq. 7.1.1 gives through w, in the same order; w_a and w_b take the run's
-// sum of M^-1 j_i^T delta_i at its end.
 // What a sweep reads and writes, taken out of s once per solve.
 template <class PackedRow>
 struct SweepData {
@@ -248,6 +279,132 @@ SweepData<PackedRow> sweep_data(MatrixFreeSystem& s, std::vector<double>& lambda
           static_cast<int>(s.w.size()) - 1};
 }
 
+// Coloured PGS's lane group (Run::lanes = kLanes): kLanes block runs of m rows, one in each
+// lane, their rows and coupling interleaved. Lane L does what sweep_block_wide does for its run,
+// operation for operation (so the same numbers): the unclamped t of each row against w at the
+// start, then the chain of clamps, where the four runs' chains advance side by side in one
+// vector each step, then each run's w update. A row that touches no movable body (rare) takes
+// the lanes' scalar path for that row.
+template <bool kCoupled, class PackedRow>
+[[gnu::always_inline]] inline void sweep_lanes(const SweepData<PackedRow>& d, const MatrixFreeSystem::Run& run,
+                                               const std::vector<double>& lambda, bool couple) {
+  constexpr int kL = MatrixFreeSystem::kLanes;
+  static_assert(kL == 4, "a lane group fills one Wide");
+  const int m = run.count;
+  const PackedRow* r = d.rows + run.begin;
+  const double* b = d.b + run.begin;
+  double* l = d.l + run.begin;
+  const double* g = d.coupling + run.offset;
+  if (couple) {
+    for (int lane = 0; lane < kL; ++lane) couple_run<kL>(r + lane, m, d.coupling + run.offset + lane);
+  }
+  constexpr int kMax = MatrixFreeSystem::kMaxRun;
+  Wide t[kMax];    // row i's unclamped values, lane by lane
+  Wide lo[kMax];   // row i's bounds (fixed friction)
+  Wide hi[kMax];
+  Wide delta[kMax];
+  unsigned skip[kMax];  // per row: the lanes whose row touches no movable body
+  Wide w[kL][3] = {};  // each lane's w_a and w_b as three Wides (as sweep_block_wide)
+  for (int lane = 0; lane < kL; ++lane) {
+    const Vec6& w_a = d.w[static_cast<std::size_t>(r[lane].a)];
+    const Vec6& w_b = d.w[static_cast<std::size_t>(r[lane].b)];  // the fixed slot's 0 for one body
+    w[lane][0] = WideLoad::load(w_a.data());
+    w[lane][1] = Wide{w_a[4], w_a[5], w_b[0], w_b[1]};
+    w[lane][2] = WideLoad::load(w_b.data() + 2);
+  }
+  for (int i = 0; i < m; ++i) {  // the rows in memory order
+    const PackedRow* r_i = r + kL * i;
+    Wide x[kL];  // wide_dot's lane sums, lane by lane
+    for (int lane = 0; lane < kL; ++lane) {
+      const auto* j = r_i[lane].j.data();
+      x[lane] = (WideLoad::load(j) * w[lane][0] + WideLoad::load(j + 4) * w[lane][1]) +
+                WideLoad::load(j + 8) * w[lane][2];
+    }
+    // The four j . w, one a lane, each summed as wide_dot sums: (x0 + x2) + (x1 + x3).
+    const Wide s01 = __builtin_shufflevector(x[0], x[1], 0, 1, 4, 5) + __builtin_shufflevector(x[0], x[1], 2, 3, 6, 7);
+    const Wide s23 = __builtin_shufflevector(x[2], x[3], 0, 1, 4, 5) + __builtin_shufflevector(x[2], x[3], 2, 3, 6, 7);
+    const Wide jw = __builtin_shufflevector(s01, s23, 0, 2, 4, 6) + __builtin_shufflevector(s01, s23, 1, 3, 5, 7);
+    const Wide inv = {r_i[0].inv_diagonal, r_i[1].inv_diagonal, r_i[2].inv_diagonal, r_i[3].inv_diagonal};
+    t[i] = WideLoad::load(l + kL * i) + (WideLoad::load(b + kL * i) - jw) * inv;
+    if constexpr (!kCoupled) {  // bounds<false>: c_min and c_max
+      lo[i] = Wide{r_i[0].c_min, r_i[1].c_min, r_i[2].c_min, r_i[3].c_min};
+      hi[i] = Wide{r_i[0].c_max, r_i[1].c_max, r_i[2].c_max, r_i[3].c_max};
+    }
+    const auto none = inv == Wide{0.0, 0.0, 0.0, 0.0};  // -1 in the lanes of rows with no movable body
+    skip[i] = static_cast<unsigned>((none[0] & 1) | (none[1] & 2) | (none[2] & 4) | (none[3] & 8));
+  }
+  Wide t_i = t[0];
+  for (int i = 0; i < m; g += kL * (m - 1 - i), ++i) {
+    Wide lo_i;
+    Wide hi_i;
+    if constexpr (kCoupled) {
+      for (int lane = 0; lane < kL; ++lane) {
+        double lo_p;
+        double hi_p;
+        bounds<true>(r[kL * i + lane], lambda, lo_p, hi_p);
+        lo_i[lane] = lo_p;
+        hi_i[lane] = hi_p;
+      }
+    } else {
+      lo_i = lo[i];
+      hi_i = hi[i];
+    }
+    const Wide l_i = WideLoad::load(l + kL * i);
+    if (skip[i] == 0) {
+      // std::clamp lane by lane: (t < lo) ? lo : t, then (hi < x) ? hi : x.
+      const Wide x = t_i < lo_i ? lo_i : t_i;
+      const Wide value = hi_i < x ? hi_i : x;
+      delta[i] = value - l_i;
+      std::memcpy(l + kL * i, &value, sizeof value);
+      if (i + 1 < m) t_i = t[i + 1] - WideLoad::load(g) * delta[i];
+      for (int k = i + 2; k < m; ++k) t[k] -= WideLoad::load(g + kL * (k - i - 1)) * delta[i];
+      continue;
+    }
+    for (int lane = 0; lane < kL; ++lane) {  // as chain_row_wide, lane by lane
+      double& l_p = l[kL * i + lane];
+      const double t_next = i + 1 < m ? t[i + 1][lane] : 0.0;
+      if ((skip[i] >> lane & 1u) != 0) {
+        delta[i][lane] = 0.0;
+        t_i[lane] = t_next;
+        continue;
+      }
+      const double value = std::clamp(t_i[lane], lo_i[lane], hi_i[lane]);
+      const double change = value - l_p;
+      delta[i][lane] = change;
+      l_p = value;
+      if (i + 1 < m) t_i[lane] = t_next - g[lane] * change;
+      for (int k = i + 2; k < m; ++k) t[k][lane] -= g[kL * (k - i - 1) + lane] * change;
+    }
+  }
+  Wide dw[kL][3] = {};
+  for (int i = 0; i < m; ++i) {  // the rows in memory order again
+    for (int lane = 0; lane < kL; ++lane) {
+      if ((skip[i] >> lane & 1u) != 0) continue;
+      const auto* minv_jt = r[kL * i + lane].minv_jt.data();
+      const double change = delta[i][lane];
+      dw[lane][0] += change * WideLoad::load(minv_jt);
+      dw[lane][1] += change * WideLoad::load(minv_jt + 4);
+      dw[lane][2] += change * WideLoad::load(minv_jt + 8);
+    }
+  }
+  for (int lane = 0; lane < kL; ++lane) {
+    const PackedRow& first = r[lane];
+    Vec6& w_a = d.w[static_cast<std::size_t>(first.a)];
+    Vec6& w_b = d.w[static_cast<std::size_t>(first.b)];
+    const Wide n0 = w[lane][0] + dw[lane][0];
+    const Wide n1 = w[lane][1] + dw[lane][1];
+    std::memcpy(w_a.data(), &n0, sizeof n0);
+    w_a[4] = n1[0];
+    w_a[5] = n1[1];
+    if (first.b != d.fixed_slot) {
+      const Wide n2 = w[lane][2] + dw[lane][2];
+      w_b[0] = n1[2];
+      w_b[1] = n1[3];
+      std::memcpy(w_b.data() + 2, &n2, sizeof n2);
+    }
+  }
+}
+
 // One run (see MatrixFreeSystem::Run): a short run row by row through w, a longer one as a block.
 // Inlined into the sweeps' loops: as a call per run it cost the pendulum wave's single-row runs
 // 20 % more instructions.
@@ -255,6 +412,12 @@ SweepData<PackedRow> sweep_data(MatrixFreeSystem& s, std::vector<double>& lambda
 template <bool kCoupled, bool kWide, class PackedRow>
 [[gnu::always_inline]] inline void sweep_run(const SweepData<PackedRow>& d, const MatrixFreeSystem::Run& run,
                       const std::vector<double>& lambda, bool couple) {
+  if constexpr (kWide) {
+    if (run.lanes > 1) {
+      sweep_lanes<kCoupled>(d, run, lambda, couple);
+      return;
+    }
+  }
   const auto first = static_cast<std::size_t>(run.begin);
   const PackedRow* r = d.rows + first;
   const double* b = d.b + first;
@@ -296,7 +459,8 @@ template <bool kCoupled, bool kWide, class PackedRow>
 // (docs/benchmarks.md).
 template <class PackedRow>
 inline void prefetch_run(const SweepData<PackedRow>& d, const MatrixFreeSystem::Run& run) {
-  detail::prefetch_lines<false>(d.rows + run.begin, static_cast<std::size_t>(run.count) * sizeof(PackedRow));
+  detail::prefetch_lines<false>(d.rows + run.begin,
+                                static_cast<std::size_t>(run.count * run.lanes) * sizeof(PackedRow));
   if (run.offset >= 0) __builtin_prefetch(d.coupling + run.offset, 0, 3);
 }
 
@@ -451,23 +615,30 @@ constexpr std::size_t kWriteAhead = 16;
 // Coupling entries reserved per row: sum over runs of m (m - 1) / 2 <= (kMaxRun - 1) / 2 *
 // (sum of m), so this bound holds for any mix of manifolds (8 bytes x 12 = 96 bytes a row).
 constexpr std::size_t kCouplingPerRow = MatrixFreeSystem::kMaxRun / 2;
+// Entries before the first block and after the last (zeros): chain_row_wide reads up to 3
+// entries either side of a column.
+constexpr std::size_t kCouplingPad = 4;
 
 // The offsets of the coupling blocks of s.runs (any order), and room for them (PGS and coloured
 // PGS). The first sweep of the next solve forms the blocks (couple_run).
 template <class PackedRow>
 void place_coupling(MatrixFreeSystem& s) {
-  std::size_t coupling_size = 0;
+  std::size_t coupling_size = kCouplingPad;
   for (MatrixFreeSystem::Run& run : s.runs) {
     const int m = run.count;
     const bool block = m >= MatrixFreeSystem::kMinBlock;
     run.offset = block ? static_cast<int>(coupling_size) : -1;
-    if (block) coupling_size += static_cast<std::size_t>(m * (m - 1) / 2);
+    if (block) coupling_size += static_cast<std::size_t>(run.lanes * m * (m - 1) / 2);
   }
   // Room for the largest coupling these many rows can need (kCouplingPerRow): it then grows only
   // when the row count does, not whenever more rows happen to sit in blocks than in any earlier
   // step (which a long run meets after warm-up).
-  detail::reserve_with_headroom(s.coupling, std::max(coupling_size, kCouplingPerRow * packed<PackedRow>(s).size()));
+  coupling_size += kCouplingPad;
+  detail::reserve_with_headroom(s.coupling,
+                                std::max(coupling_size, kCouplingPerRow * packed<PackedRow>(s).size() + 2 * kCouplingPad));
   detail::resize_with_headroom(s.coupling, coupling_size);
+  std::fill_n(s.coupling.begin(), kCouplingPad, 0.0);
+  std::fill_n(s.coupling.end() - kCouplingPad, kCouplingPad, 0.0);
   s.coupling_ready = false;
 }
 
@@ -492,23 +663,58 @@ void build_runs(MatrixFreeSystem& s) {
   s.runs_ready = true;
 }
 
-// Coloured PGS: the runs of s.colours at their positions (the rows are packed in sweep order, so
-// a colour's runs are consecutive) and their coupling blocks' places.
-template <class PackedRow>
-void build_coloured_runs(MatrixFreeSystem& s) {
+// Coloured PGS's sweep order: s.perm (position -> row) and s.runs with s.sweep_start, colour
+// by colour as sweep_order() takes them. In each colour but the overflow, block runs with a
+// movable body and the same row count go kLanes at a time into a lane group (Run::lanes), as
+// they come in row order; the others, and a count's last runs short of a group, run on their
+// own. The runs of a colour share no movable body, so their order within it changes no number.
+void coloured_order(MatrixFreeSystem& s, bool lanes) {
+  constexpr int kL = MatrixFreeSystem::kLanes;
+  constexpr int kMax = MatrixFreeSystem::kMaxRun;
+  const RowColours& colours = s.colours;
+  s.perm.clear();
   s.runs.clear();
-  detail::reserve_with_headroom(s.runs, s.colours.runs.size());
+  const RowColours::Run* last = colours.runs.empty() ? nullptr : &colours.runs.back();
+  detail::reserve_with_headroom(s.perm, last == nullptr ? 0 : static_cast<std::size_t>(last->begin + last->count));
+  detail::reserve_with_headroom(s.runs, colours.runs.size());
   int position = 0;
+  const auto alone = [&](const RowColours::Run& x) {
+    s.runs.push_back({position, x.count, -1, 1});
+    for (int row = x.begin; row < x.begin + x.count; ++row) s.perm.push_back(row);
+    position += x.count;
+  };
+  std::array<std::array<std::size_t, kL>, kMax + 1> waiting{};  // per row count: runs (indices)
+  std::array<int, kMax + 1> waits{};
   for (int k = 0; k < ConstraintGraph::kColours; ++k) {
     const auto c = static_cast<std::size_t>(sweep_colour(k));
     s.sweep_start[static_cast<std::size_t>(k)] = s.runs.size();
-    for (std::size_t i = s.colours.start[c]; i < s.colours.start[c + 1]; ++i) {
-      const int count = s.colours.runs[s.colours.order[i]].count;
-      s.runs.push_back({position, count, -1});
-      position += count;
+    for (std::size_t i = colours.start[c]; i < colours.start[c + 1]; ++i) {
+      const RowColours::Run& x = colours.runs[colours.order[i]];
+      if (!lanes || k == 0 || x.count < MatrixFreeSystem::kMinBlock || x.a < 0) {
+        alone(x);
+        continue;
+      }
+      const auto m = static_cast<std::size_t>(x.count);
+      waiting[m][static_cast<std::size_t>(waits[m]++)] = colours.order[i];
+      if (waits[m] < kL) continue;
+      waits[m] = 0;
+      s.runs.push_back({position, x.count, -1, kL});
+      for (int row = 0; row < x.count; ++row) {
+        for (std::size_t lane = 0; lane < kL; ++lane) s.perm.push_back(colours.runs[waiting[m][lane]].begin + row);
+      }
+      position += kL * x.count;
+    }
+    for (std::size_t m = 0; m <= kMax; ++m) {
+      for (int w = 0; w < waits[m]; ++w) alone(colours.runs[waiting[m][static_cast<std::size_t>(w)]]);
+      waits[m] = 0;
     }
   }
   s.sweep_start.back() = s.runs.size();
+}
+
+// Coloured PGS: the coupling blocks' places of the runs coloured_order() made.
+template <class PackedRow>
+void build_coloured_runs(MatrixFreeSystem& s) {
   place_coupling<PackedRow>(s);
   s.runs_ready = true;
 }
@@ -518,9 +724,12 @@ void build_coloured_runs(MatrixFreeSystem& s) {
 namespace detail {
 namespace {
 std::atomic<bool> avx2_allowed{true};
+std::atomic<bool> lanes_allowed{true};
 }  // namespace
 void allow_coloured_avx2(bool allowed) { avx2_allowed.store(allowed); }
 bool coloured_avx2_allowed() { return avx2_allowed.load(); }
+void allow_coloured_lanes(bool allowed) { lanes_allowed.store(allowed); }
+bool coloured_lanes_allowed() { return lanes_allowed.load(); }
 }  // namespace detail
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
@@ -530,7 +739,7 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   s.runs_ready = false;  // built below (coloured PGS) or by the first PGS solve (Jacobi: never)
   if (kind == SolverKind::coloured_pgs) {
     colour_rows(rows, bodies, MatrixFreeSystem::kMaxRun, s.colours);
-    sweep_order(s.colours, s.perm);
+    coloured_order(s, detail::coloured_lanes_allowed());
     detail::resize_with_headroom(s.position, rows.size());
     for (std::size_t i = 0; i < s.perm.size(); ++i) s.position[static_cast<std::size_t>(s.perm[i])] = static_cast<int>(i);
   } else {
@@ -685,9 +894,9 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
         sum_a.setZero();
         sum_b.setZero();
       };
-      for (std::size_t j = 0; j < rows.size(); ++j) {
+      const auto add = [&](std::size_t j) {
         const PackedRow& r = packed_rows[j];
-        if (r.inv_diagonal == 0.0) continue;  // touches no movable body: stays 0
+        if (r.inv_diagonal == 0.0) return;  // touches no movable body: stays 0
         if (r.a != a || r.b != b) {
           flush();
           a = r.a;
@@ -696,6 +905,15 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
         l[j] = (*initial)[row_at(s, j)];
         sum_a += l[j] * half(r.minv_jt.data());
         sum_b += l[j] * half(r.minv_jt.data() + 6);
+      };
+      if (coloured) {  // run by run, a lane group's runs one after another
+        for (const MatrixFreeSystem::Run& run : s.runs) {
+          for (int lane = 0; lane < run.lanes; ++lane) {
+            for (int i = 0; i < run.count; ++i) add(static_cast<std::size_t>(run.begin + run.lanes * i + lane));
+          }
+        }
+      } else {
+        for (std::size_t j = 0; j < rows.size(); ++j) add(j);
       }
       flush();
     }

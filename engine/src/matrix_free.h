@@ -46,11 +46,19 @@ struct MatrixFreeSystem {
   /// a block. Each sees the others' updates through the coupling A_ki / A_kk (k > i) instead of
   /// through w, so the rows of a run do not wait on each other's w stores and the first products
   /// j . w of a run are independent.
+  ///
+  /// Coloured PGS also sweeps kLanes runs of one colour with the same row count side by side,
+  /// one run in each lane of 4-wide vectors: such a Run (lanes = kLanes) holds their rows
+  /// interleaved (row i of lane L at position begin + lanes i + L) and their coupling likewise
+  /// (entry e of lane L at offset + lanes e + L).
   struct Run {
     int begin = 0;   ///< first row
-    int count = 0;   ///< rows, 1..kMaxRun
-    int offset = 0;  ///< start of its coupling (m (m - 1) / 2 entries); -1: swept row by row
+    int count = 0;   ///< rows of each run, 1..kMaxRun
+    int offset = 0;  ///< start of its coupling (lanes m (m - 1) / 2 entries); -1: swept row by row
+    int lanes = 1;   ///< runs side by side: 1, or kLanes
   };
+  /// Runs a lane group sweeps side by side.
+  static constexpr int kLanes = 4;
   /// Runs shorter than this (a single contact point: 3 rows) are swept row by row through w: for
   /// them the block measured no faster (funnel scene).
   static constexpr int kMinBlock = 4;
@@ -134,6 +142,11 @@ namespace detail {
 /// checks it. No errors.
 void allow_coloured_avx2(bool allowed);
 bool coloured_avx2_allowed();
+/// Whether coloured PGS's prepare() may put runs side by side in lanes (Run::lanes; true by
+/// default). Both ways give the same numbers; false sweeps every run on its own, for the test
+/// that checks it. No errors.
+void allow_coloured_lanes(bool allowed);
+bool coloured_lanes_allowed();
 }  // namespace detail
 
 /// The natural-map residual of lcp_residual for the lambda that solve() left (using its w),

@@ -193,11 +193,39 @@ struct WideLoad {
   }
 };
 
-// a . b over 12 numbers held as three Wides: (a0 b0 + a1 b1) + a2 b2 lane by lane, then the lanes
-// summed as (x0 + x2) + (x1 + x3).
+// The terms of a . b over 12 numbers held as three Wides, lane by lane: (a0 b0 + a1 b1) + a2 b2.
+[[gnu::always_inline]] inline Wide wide_terms(Wide a0, Wide a1, Wide a2, Wide b0, Wide b1, Wide b2) {
+  return (a0 * b0 + a1 * b1) + a2 * b2;
+}
+
+// a . b over 12 numbers held as three Wides: wide_terms' lanes summed as (x0 + x2) + (x1 + x3).
 [[gnu::always_inline]] inline double wide_dot(Wide a0, Wide a1, Wide a2, Wide b0, Wide b1, Wide b2) {
-  const Wide x = (a0 * b0 + a1 * b1) + a2 * b2;
+  const Wide x = wide_terms(a0, a1, a2, b0, b1, b2);
   return (x[0] + x[2]) + (x[1] + x[3]);
+}
+
+// w of a body pair as 12 numbers [w_a, w_b] in three Wides (a one-body run's w_b is the fixed
+// slot's 0).
+[[gnu::always_inline]] inline void load_pair(const Vec6& w_a, const Vec6& w_b, Wide (&w)[3]) {
+  w[0] = WideLoad::load(w_a.data());
+  w[1] = Wide{w_a[4], w_a[5], w_b[0], w_b[1]};
+  w[2] = WideLoad::load(w_b.data() + 2);
+}
+
+// w_a and (two: a second movable body) w_b set to load_pair's w plus the change dw.
+[[gnu::always_inline]] inline void store_pair(const Wide (&w)[3], const Wide (&dw)[3], bool two, Vec6& w_a,
+                                              Vec6& w_b) {
+  const Wide n0 = w[0] + dw[0];
+  const Wide n1 = w[1] + dw[1];
+  std::memcpy(w_a.data(), &n0, sizeof n0);
+  w_a[4] = n1[0];
+  w_a[5] = n1[1];
+  if (two) {
+    const Wide n2 = w[2] + dw[2];
+    w_b[0] = n1[2];
+    w_b[1] = n1[3];
+    std::memcpy(w_b.data() + 2, &n2, sizeof n2);
+  }
 }
 
 // clamp_row, then (sweep_block_wide) the later t[k] take the change four lanes at a time, in the
@@ -226,40 +254,26 @@ template <bool kCoupled, bool kTwoBodies, class PackedRow>
 [[gnu::always_inline]] inline void sweep_block_wide(const PackedRow* r, const double* b, double* l, int m,
                                                     const double* g, const std::vector<double>& lambda,
                                                     Vec6& w_a, Vec6& w_b) {
-  // w of the two bodies as 12 numbers in three Wides (a one-body run's half b is the fixed slot's 0).
-  const Wide w0 = WideLoad::load(w_a.data());
-  const Wide w1 = {w_a[4], w_a[5], w_b[0], w_b[1]};
-  const Wide w2 = WideLoad::load(w_b.data() + 2);
+  Wide w[3] = {};  // load_pair
+  load_pair(w_a, w_b, w);
   alignas(32) double t[MatrixFreeSystem::kMaxRun + 4];
   for (int i = m; i < m + 4; ++i) t[i] = 0.0;  // lanes past m (see chain_row_wide)
   for (int i = 0; i < m; ++i) {
     const auto* j = r[i].j.data();
-    const double jw = wide_dot(WideLoad::load(j), WideLoad::load(j + 4), WideLoad::load(j + 8), w0, w1, w2);
+    const double jw = wide_dot(WideLoad::load(j), WideLoad::load(j + 4), WideLoad::load(j + 8), w[0], w[1], w[2]);
     t[i] = l[i] + (b[i] - jw) * r[i].inv_diagonal;
   }
-  Wide d0 = {0.0, 0.0, 0.0, 0.0};
-  Wide d1 = d0;
-  Wide d2 = d0;
+  Wide dw[3] = {};
   double t_i = t[0];
   for (int i = 0; i < m; g += m - 1 - i, ++i) {
     double delta;
     if (!chain_row_wide<kCoupled>(r[i], i, m, g, lambda, t, t_i, l[i], delta)) continue;
     const auto* minv_jt = r[i].minv_jt.data();
-    d0 += delta * WideLoad::load(minv_jt);
-    d1 += delta * WideLoad::load(minv_jt + 4);
-    if constexpr (kTwoBodies) d2 += delta * WideLoad::load(minv_jt + 8);
+    dw[0] += delta * WideLoad::load(minv_jt);
+    dw[1] += delta * WideLoad::load(minv_jt + 4);
+    if constexpr (kTwoBodies) dw[2] += delta * WideLoad::load(minv_jt + 8);
   }
-  const Wide n0 = w0 + d0;
-  const Wide n1 = w1 + d1;
-  std::memcpy(w_a.data(), &n0, sizeof n0);
-  w_a[4] = n1[0];
-  w_a[5] = n1[1];
-  if constexpr (kTwoBodies) {
-    const Wide n2 = w2 + d2;
-    w_b[0] = n1[2];
-    w_b[1] = n1[3];
-    std::memcpy(w_b.data() + 2, &n2, sizeof n2);
-  }
+  store_pair(w, dw, kTwoBodies, w_a, w_b);
 }
 
 // What a sweep reads and writes, taken out of s once per solve.
@@ -304,21 +318,17 @@ template <bool kCoupled, class PackedRow>
   Wide hi[kMax];
   Wide delta[kMax];
   unsigned skip[kMax];  // per row: the lanes whose row touches no movable body
-  Wide w[kL][3] = {};  // each lane's w_a and w_b as three Wides (as sweep_block_wide)
+  Wide w[kL][3] = {};  // each lane's w_a and w_b (load_pair)
   for (int lane = 0; lane < kL; ++lane) {
-    const Vec6& w_a = d.w[static_cast<std::size_t>(r[lane].a)];
-    const Vec6& w_b = d.w[static_cast<std::size_t>(r[lane].b)];  // the fixed slot's 0 for one body
-    w[lane][0] = WideLoad::load(w_a.data());
-    w[lane][1] = Wide{w_a[4], w_a[5], w_b[0], w_b[1]};
-    w[lane][2] = WideLoad::load(w_b.data() + 2);
+    load_pair(d.w[static_cast<std::size_t>(r[lane].a)], d.w[static_cast<std::size_t>(r[lane].b)], w[lane]);
   }
   for (int i = 0; i < m; ++i) {  // the rows in memory order
     const PackedRow* r_i = r + kL * i;
-    Wide x[kL];  // wide_dot's lane sums, lane by lane
+    Wide x[kL];  // wide_terms, lane by lane
     for (int lane = 0; lane < kL; ++lane) {
       const auto* j = r_i[lane].j.data();
-      x[lane] = (WideLoad::load(j) * w[lane][0] + WideLoad::load(j + 4) * w[lane][1]) +
-                WideLoad::load(j + 8) * w[lane][2];
+      x[lane] = wide_terms(WideLoad::load(j), WideLoad::load(j + 4), WideLoad::load(j + 8), w[lane][0], w[lane][1],
+                           w[lane][2]);
     }
     // The four j . w, one a lane, each summed as wide_dot sums: (x0 + x2) + (x1 + x3).
     const Wide s01 = __builtin_shufflevector(x[0], x[1], 0, 1, 4, 5) + __builtin_shufflevector(x[0], x[1], 2, 3, 6, 7);
@@ -389,19 +399,8 @@ template <bool kCoupled, class PackedRow>
   }
   for (int lane = 0; lane < kL; ++lane) {
     const PackedRow& first = r[lane];
-    Vec6& w_a = d.w[static_cast<std::size_t>(first.a)];
-    Vec6& w_b = d.w[static_cast<std::size_t>(first.b)];
-    const Wide n0 = w[lane][0] + dw[lane][0];
-    const Wide n1 = w[lane][1] + dw[lane][1];
-    std::memcpy(w_a.data(), &n0, sizeof n0);
-    w_a[4] = n1[0];
-    w_a[5] = n1[1];
-    if (first.b != d.fixed_slot) {
-      const Wide n2 = w[lane][2] + dw[lane][2];
-      w_b[0] = n1[2];
-      w_b[1] = n1[3];
-      std::memcpy(w_b.data() + 2, &n2, sizeof n2);
-    }
+    store_pair(w[lane], dw[lane], first.b != d.fixed_slot, d.w[static_cast<std::size_t>(first.a)],
+               d.w[static_cast<std::size_t>(first.b)]);
   }
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -297,18 +298,18 @@ SweepData<PackedRow> sweep_data(MatrixFreeSystem& s, std::vector<double>& lambda
 // lane, their rows and coupling interleaved. Lane L does what sweep_block_wide does for its run,
 // operation for operation (so the same numbers): the unclamped t of each row against w at the
 // start, then the chain of clamps, where the four runs' chains advance side by side in one
-// vector each step, then each run's w update. A row that touches no movable body (rare) takes
-// the lanes' scalar path for that row.
-template <bool kCoupled, class PackedRow>
+// vector each step, then each run's w update. A group with a row that touches no movable body
+// (rare) takes the lanes' scalar path for that row (kSkips); the others test no lane. kM = m when
+// known at compile time (the loops then unroll), 0 otherwise.
+template <int kM, bool kCoupled, class PackedRow>
 [[gnu::always_inline]] inline void sweep_lanes(const SweepData<PackedRow>& d, const MatrixFreeSystem::Run& run,
                                                const std::vector<double>& lambda, bool couple) {
   constexpr int kL = MatrixFreeSystem::kLanes;
   static_assert(kL == 4, "a lane group fills one Wide");
-  const int m = run.count;
+  const int m = kM > 0 ? kM : run.count;
   const PackedRow* r = d.rows + run.begin;
   const double* b = d.b + run.begin;
   double* l = d.l + run.begin;
-  const double* g = d.coupling + run.offset;
   if (couple) {
     for (int lane = 0; lane < kL; ++lane) couple_run<kL>(r + lane, m, d.coupling + run.offset + lane);
   }
@@ -317,11 +318,12 @@ template <bool kCoupled, class PackedRow>
   Wide lo[kMax];   // row i's bounds (fixed friction)
   Wide hi[kMax];
   Wide delta[kMax];
-  unsigned skip[kMax];  // per row: the lanes whose row touches no movable body
   Wide w[kL][3] = {};  // each lane's w_a and w_b (load_pair)
   for (int lane = 0; lane < kL; ++lane) {
     load_pair(d.w[static_cast<std::size_t>(r[lane].a)], d.w[static_cast<std::size_t>(r[lane].b)], w[lane]);
   }
+  using Mask = long long __attribute__((vector_size(32)));
+  Mask none = {};  // -1 in the lanes with a row that touches no movable body
   for (int i = 0; i < m; ++i) {  // the rows in memory order
     const PackedRow* r_i = r + kL * i;
     Wide x[kL];  // wide_terms, lane by lane
@@ -340,68 +342,82 @@ template <bool kCoupled, class PackedRow>
       lo[i] = Wide{r_i[0].c_min, r_i[1].c_min, r_i[2].c_min, r_i[3].c_min};
       hi[i] = Wide{r_i[0].c_max, r_i[1].c_max, r_i[2].c_max, r_i[3].c_max};
     }
-    const auto none = inv == Wide{0.0, 0.0, 0.0, 0.0};  // -1 in the lanes of rows with no movable body
-    skip[i] = static_cast<unsigned>((none[0] & 1) | (none[1] & 2) | (none[2] & 4) | (none[3] & 8));
+    none |= inv == Wide{0.0, 0.0, 0.0, 0.0};
   }
-  Wide t_i = t[0];
-  for (int i = 0; i < m; g += kL * (m - 1 - i), ++i) {
-    Wide lo_i;
-    Wide hi_i;
-    if constexpr (kCoupled) {
-      for (int lane = 0; lane < kL; ++lane) {
-        double lo_p;
-        double hi_p;
-        bounds<true>(r[kL * i + lane], lambda, lo_p, hi_p);
-        lo_i[lane] = lo_p;
-        hi_i[lane] = hi_p;
+  // The chain of clamps, then each lane's w update. kSkips: some rows touch no movable body, and
+  // skip says which (per row, a bit a lane).
+  const auto chain = [&]<bool kSkips>(const unsigned* skip) {
+    const auto* g = d.coupling + run.offset;
+    Wide t_i = t[0];
+    for (int i = 0; i < m; g += kL * (m - 1 - i), ++i) {
+      Wide lo_i;
+      Wide hi_i;
+      if constexpr (kCoupled) {
+        for (int lane = 0; lane < kL; ++lane) {
+          double lo_p;
+          double hi_p;
+          bounds<true>(r[kL * i + lane], lambda, lo_p, hi_p);
+          lo_i[lane] = lo_p;
+          hi_i[lane] = hi_p;
+        }
+      } else {
+        lo_i = lo[i];
+        hi_i = hi[i];
       }
-    } else {
-      lo_i = lo[i];
-      hi_i = hi[i];
-    }
-    const Wide l_i = WideLoad::load(l + kL * i);
-    if (skip[i] == 0) {
-      // std::clamp lane by lane: (t < lo) ? lo : t, then (hi < x) ? hi : x.
-      const Wide x = t_i < lo_i ? lo_i : t_i;
-      const Wide value = hi_i < x ? hi_i : x;
-      delta[i] = value - l_i;
-      std::memcpy(l + kL * i, &value, sizeof value);
-      if (i + 1 < m) t_i = t[i + 1] - WideLoad::load(g) * delta[i];
-      for (int k = i + 2; k < m; ++k) t[k] -= WideLoad::load(g + kL * (k - i - 1)) * delta[i];
-      continue;
-    }
-    for (int lane = 0; lane < kL; ++lane) {  // as chain_row_wide, lane by lane
-      double& l_p = l[kL * i + lane];
-      const double t_next = i + 1 < m ? t[i + 1][lane] : 0.0;
-      if ((skip[i] >> lane & 1u) != 0) {
-        delta[i][lane] = 0.0;
-        t_i[lane] = t_next;
+      const Wide l_i = WideLoad::load(l + kL * i);
+      if (!kSkips || skip[i] == 0) {
+        // std::clamp lane by lane: (t < lo) ? lo : t, then (hi < x) ? hi : x.
+        const Wide x = t_i < lo_i ? lo_i : t_i;
+        const Wide value = hi_i < x ? hi_i : x;
+        delta[i] = value - l_i;
+        std::memcpy(l + kL * i, &value, sizeof value);
+        if (i + 1 < m) t_i = t[i + 1] - WideLoad::load(g) * delta[i];
+        for (int k = i + 2; k < m; ++k) t[k] -= WideLoad::load(g + kL * (k - i - 1)) * delta[i];
         continue;
       }
-      const double value = std::clamp(t_i[lane], lo_i[lane], hi_i[lane]);
-      const double change = value - l_p;
-      delta[i][lane] = change;
-      l_p = value;
-      if (i + 1 < m) t_i[lane] = t_next - g[lane] * change;
-      for (int k = i + 2; k < m; ++k) t[k][lane] -= g[kL * (k - i - 1) + lane] * change;
+      for (int lane = 0; lane < kL; ++lane) {  // as chain_row_wide, lane by lane
+        double& l_p = l[kL * i + lane];
+        const double t_next = i + 1 < m ? t[i + 1][lane] : 0.0;
+        if ((skip[i] >> lane & 1u) != 0) {
+          delta[i][lane] = 0.0;
+          t_i[lane] = t_next;
+          continue;
+        }
+        const double value = std::clamp(t_i[lane], lo_i[lane], hi_i[lane]);
+        const double change = value - l_p;
+        delta[i][lane] = change;
+        l_p = value;
+        if (i + 1 < m) t_i[lane] = t_next - g[lane] * change;
+        for (int k = i + 2; k < m; ++k) t[k][lane] -= g[kL * (k - i - 1) + lane] * change;
+      }
     }
-  }
-  Wide dw[kL][3] = {};
-  for (int i = 0; i < m; ++i) {  // the rows in memory order again
+    Wide dw[kL][3] = {};
+    for (int i = 0; i < m; ++i) {  // the rows in memory order again
+      for (int lane = 0; lane < kL; ++lane) {
+        if (kSkips && (skip[i] >> lane & 1u) != 0) continue;
+        const auto* minv_jt = r[kL * i + lane].minv_jt.data();
+        const double change = delta[i][lane];
+        dw[lane][0] += change * WideLoad::load(minv_jt);
+        dw[lane][1] += change * WideLoad::load(minv_jt + 4);
+        dw[lane][2] += change * WideLoad::load(minv_jt + 8);
+      }
+    }
     for (int lane = 0; lane < kL; ++lane) {
-      if ((skip[i] >> lane & 1u) != 0) continue;
-      const auto* minv_jt = r[kL * i + lane].minv_jt.data();
-      const double change = delta[i][lane];
-      dw[lane][0] += change * WideLoad::load(minv_jt);
-      dw[lane][1] += change * WideLoad::load(minv_jt + 4);
-      dw[lane][2] += change * WideLoad::load(minv_jt + 8);
+      const PackedRow& first = r[lane];
+      store_pair(w[lane], dw[lane], first.b != d.fixed_slot, d.w[static_cast<std::size_t>(first.a)],
+                 d.w[static_cast<std::size_t>(first.b)]);
     }
+  };
+  if ((none[0] | none[1] | none[2] | none[3]) == 0) {
+    chain.template operator()<false>(nullptr);
+    return;
   }
-  for (int lane = 0; lane < kL; ++lane) {
-    const PackedRow& first = r[lane];
-    store_pair(w[lane], dw[lane], first.b != d.fixed_slot, d.w[static_cast<std::size_t>(first.a)],
-               d.w[static_cast<std::size_t>(first.b)]);
+  unsigned skip[kMax];
+  for (int i = 0; i < m; ++i) {
+    skip[i] = 0;
+    for (int lane = 0; lane < kL; ++lane) skip[i] |= (r[kL * i + lane].inv_diagonal == 0.0 ? 1u : 0u) << lane;
   }
+  chain.template operator()<true>(skip);
 }
 
 // One run (see MatrixFreeSystem::Run): a short run row by row through w, a longer one as a block.
@@ -413,8 +429,14 @@ template <bool kCoupled, bool kWide, class PackedRow>
                       const std::vector<double>& lambda, bool couple) {
   if constexpr (kWide) {
     if (run.lanes > 1) {
-      sweep_lanes<kCoupled>(d, run, lambda, couple);
-      return;
+      // The common sizes unrolled (four contact points with a contact row and one or two friction
+      // rows each, or four contact rows alone), any other size as it comes.
+      switch (run.count) {
+        case 4: sweep_lanes<4, kCoupled>(d, run, lambda, couple); return;
+        case 8: sweep_lanes<8, kCoupled>(d, run, lambda, couple); return;
+        case 12: sweep_lanes<12, kCoupled>(d, run, lambda, couple); return;
+        default: sweep_lanes<0, kCoupled>(d, run, lambda, couple); return;
+      }
     }
   }
   const auto first = static_cast<std::size_t>(run.begin);
@@ -437,7 +459,7 @@ template <bool kCoupled, bool kWide, class PackedRow>
     return;
   }
   Vec6& w_b = d.w[static_cast<std::size_t>(r->b)];
-  const double* g = d.coupling + run.offset;
+  const auto* g = d.coupling + run.offset;
   if constexpr (kWide) {
     two ? sweep_block_wide<kCoupled, true>(r, b, l, run.count, g, lambda, w_a, w_b)
         : sweep_block_wide<kCoupled, false>(r, b, l, run.count, g, lambda, w_a, w_b);
@@ -503,6 +525,24 @@ template <bool kCoupled, class PackedRow>
   }
 }
 
+// A stream read in order (a sweep's packed rows, or its coupling) whose lines up to kAhead bytes
+// past the read are asked for, each line once: the asks spread evenly over the sweep, where
+// asking for whole runs ahead sent a lane group's hundred lines at once.
+struct PrefetchStream {
+  static constexpr std::ptrdiff_t kAhead = 8192;  // bytes (docs/benchmarks.md)
+  const char* next = nullptr;  // the first line not asked for yet
+  const char* end = nullptr;   // the stream's end
+  PrefetchStream(const void* from, const void* stream_end)
+      : next(reinterpret_cast<const char*>(reinterpret_cast<std::uintptr_t>(from) & ~std::uintptr_t{63})),
+        end(static_cast<const char*>(stream_end)) {}
+  // Asks for the lines up to kAhead bytes past p (p: the end of what the sweep reads next).
+  [[gnu::always_inline]] void upto(const void* p) {
+    const char* stop = static_cast<const char*>(p) + kAhead;
+    if (stop > end) stop = end;
+    for (; next < stop; next += 64) __builtin_prefetch(next, 0, 3);
+  }
+};
+
 // Coloured PGS, thread t of `workers` (every thread runs this with its own t): per sweep, the
 // overflow's runs on thread 0 in order, then each colour's runs split evenly among the threads,
 // with a barrier after each colour. The runs of a colour share no movable body: each writes only
@@ -515,6 +555,8 @@ template <bool kCoupled, class PackedRow>
   const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
   const auto k_t = static_cast<std::size_t>(t);
   const bool prefetch = prefetching<PackedRow>(s);
+  const std::size_t row_count = packed<PackedRow>(s).size();
+  const std::size_t coupling_size = s.coupling.size();
   bool couple = !s.coupling_ready;
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t k = 0; k < ConstraintGraph::kColours; ++k) {
@@ -530,10 +572,17 @@ template <bool kCoupled, class PackedRow>
         last = count * (k_t + 1) / threads;
       }
       const MatrixFreeSystem::Run* runs = s.runs.data() + begin;
-      const std::size_t prefetched = prefetch_end(prefetch, first, last);
-      for (std::size_t i = first; i < last; ++i) {
-        if (i < prefetched) prefetch_run(d, runs[i + kPrefetchRuns]);
-        sweep_run<kCoupled, true>(d, runs[i], lambda, couple);
+      if (first < last) {
+        PrefetchStream row_stream(d.rows + runs[first].begin, d.rows + row_count);
+        PrefetchStream coupling_stream(d.coupling + std::max(runs[first].offset, 0), d.coupling + coupling_size);
+        for (std::size_t i = first; i < last; ++i) {
+          const MatrixFreeSystem::Run& run = runs[i];
+          if (prefetch) {
+            row_stream.upto(d.rows + run.begin + run.count * run.lanes);
+            if (run.offset >= 0) coupling_stream.upto(d.coupling + run.offset + run.lanes * run.count * (run.count - 1) / 2);
+          }
+          sweep_run<kCoupled, true>(d, run, lambda, couple);
+        }
       }
       if (workers != nullptr) workers->sync();
     }

@@ -458,3 +458,68 @@ TEST_CASE("coloured PGS gives the same state with block runs side by side in lan
     CHECK(hashes[0] == hashes[1]);
   }
 }
+
+TEST_CASE("coloured PGS's lane groups keep a row that touches no movable body at 0, and give the "
+          "others the numbers of the runs swept one by one",
+          "[coloured][simd]") {
+  // Eight boxes on a static ground, each with a run of rows on (box, ground): four runs of 4 rows
+  // and four of 5, so that coloured PGS sweeps them in two lane groups (the runs share no movable
+  // body). In one run of each group one row's j is 0 on the box: A_jj = 0, a row that touches no
+  // movable body, whose lambda stays 0 (as solve_lcp) while its lane's other rows and the other
+  // lanes go on. So the lambda must be the same bit for bit with lanes and without, with 0 there.
+  std::vector<Body> bodies;
+  for (int k = 0; k < 8; ++k) {
+    BodyDef def{Shape::box(Vec3(0.5, 0.5, 0.5)), false, 1.0 + k, Vec3(3.0 * k, 0.5, 0.0)};
+    bodies.push_back(make_body(def));
+  }
+  bodies.push_back(make_body({Shape::plane(Vec3::UnitY(), 0.0), true}));
+  const int ground = 8;
+  std::vector<ConstraintRow> rows;
+  std::vector<std::size_t> empty;  // the rows with j = 0 on the box
+  for (int k = 0; k < 8; ++k) {
+    const int count = k < 4 ? 4 : 5;
+    for (int p = 0; p < count; ++p) {
+      ConstraintRow row;
+      row.body_a = k;
+      row.body_b = ground;
+      // A contact row along the ground's normal at a corner of the box's base, a friction-like
+      // row along x at the last one.
+      const Vec3 r_a(p % 2 == 0 ? -0.5 : 0.5, -0.5, p < 2 ? -0.5 : 0.5);
+      const Vec3 n = p == 4 ? Vec3::UnitX() : Vec3::UnitY();
+      row.j = axis_row(n, r_a, Vec3(3.0 * k, 0.0, 0.0) + r_a);
+      row.c_min = p == 4 ? -2.0 : 0.0;
+      row.c_max = p == 4 ? 2.0 : kInfinity;
+      row.bias = 0.01 * (p + 1);
+      if ((k == 2 || k == 5) && p == 1) {
+        row.j.head<6>().setZero();
+        row.c_min = 1.0;  // bounds without 0: clamped, lambda would move off 0
+        row.c_max = 2.0;
+        empty.push_back(rows.size());
+      }
+      rows.push_back(row);
+    }
+  }
+  Eigen::VectorXd f_ext = Eigen::VectorXd::Zero(6 * static_cast<Eigen::Index>(bodies.size()));
+  for (int k = 0; k < 8; ++k) f_ext[6 * k + 1] = -9.81 * bodies[static_cast<std::size_t>(k)].mass;
+  for (const RowPrecision precision : {RowPrecision::double_precision, RowPrecision::single_precision}) {
+    for (const FrictionModel friction : {FrictionModel::fixed, FrictionModel::coupled}) {
+      CAPTURE(static_cast<int>(precision), static_cast<int>(friction));
+      std::vector<double> lambda[2];
+      for (int lanes = 0; lanes < 2; ++lanes) {
+        detail::allow_coloured_lanes(lanes == 1);
+        MatrixFreeSystem s;
+        prepare(s, rows, bodies, SolverKind::coloured_pgs, nullptr, precision);
+        rhs(s, rows, bodies, f_ext, 1.0 / 60.0, TargetTerms::push_and_bias);
+        int grouped = 0;  // runs in lane groups
+        for (const MatrixFreeSystem::Run& run : s.runs) grouped += run.lanes > 1 ? run.lanes : 0;
+        CHECK(grouped == (lanes == 1 ? 8 : 0));
+        solve(s, rows, friction, SolverKind::coloured_pgs, 10, lambda[lanes]);
+      }
+      detail::allow_coloured_lanes(true);
+      CHECK(lambda[1] == lambda[0]);
+      for (const std::size_t e : empty) CHECK(lambda[1][e] == 0.0);
+      // The rows carry the boxes' weight, so the comparison means something.
+      CHECK(*std::max_element(lambda[1].begin(), lambda[1].end()) > 1.0);
+    }
+  }
+}

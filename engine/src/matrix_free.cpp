@@ -39,6 +39,20 @@ const std::vector<PackedRow>& packed(const MatrixFreeSystem& s) {
   return packed<PackedRow>(const_cast<MatrixFreeSystem&>(s));
 }
 
+// The number type of a packed row's j (double or float), which its run's coupling shares.
+template <class PackedRow>
+using ScalarOf = typename decltype(PackedRow::j)::value_type;
+
+// The coupling blocks for the rows of PackedRow: s.coupling (double rows) or s.float_coupling.
+template <class PackedRow>
+std::vector<ScalarOf<PackedRow>>& coupling_of(MatrixFreeSystem& s) {
+  if constexpr (std::is_same_v<ScalarOf<PackedRow>, float>) {
+    return s.float_coupling;
+  } else {
+    return s.coupling;
+  }
+}
+
 // Six numbers of a packed row (half a of j, say) as a double 6-vector: in place for a double
 // row, converted for a float row (every product and sum is then in double).
 inline ConstMap6 half(const double* p) { return ConstMap6(p); }
@@ -77,14 +91,14 @@ inline void bounds(const PackedRow& r, const std::vector<double>& lambda, double
 // A_ki / A_kk = (j_k . M^-1 j_i^T) / A_kk for the rows k after i.
 // kStride: the rows at r[kStride i], the entries at g[kStride e] (a lane of a lane group).
 template <int kStride = 1, class PackedRow>
-[[gnu::always_inline]] inline void couple_run(const PackedRow* r, int m, double* g) {
+[[gnu::always_inline]] inline void couple_run(const PackedRow* r, int m, ScalarOf<PackedRow>* g) {
   for (int i = 0; i < m; g += kStride * (m - 1 - i), ++i) {
     const PackedRow& r_i = r[kStride * i];
     for (int k = i + 1; k < m; ++k) {
       const PackedRow& r_k = r[kStride * k];
       const double a_ki = half(r_k.j.data()).dot(half(r_i.minv_jt.data())) +
                           half(r_k.j.data() + 6).dot(half(r_i.minv_jt.data() + 6));
-      g[kStride * (k - i - 1)] = a_ki * r_k.inv_diagonal;
+      g[kStride * (k - i - 1)] = static_cast<ScalarOf<PackedRow>>(a_ki * r_k.inv_diagonal);
     }
   }
 }
@@ -117,7 +131,7 @@ template <bool kCoupled, bool kTwoBodies, class PackedRow>
 // product and one difference a row, not on a store and load of t (the same numbers in the same
 // order).
 template <bool kCoupled, class PackedRow>
-[[gnu::always_inline]] inline bool clamp_row(const PackedRow& row, int i, int m, const double* g,
+[[gnu::always_inline]] inline bool clamp_row(const PackedRow& row, int i, int m, const ScalarOf<PackedRow>* g,
                                              const std::vector<double>& lambda, const double* t, double& t_i,
                                              double& l_i, double& delta) {
   if (row.inv_diagonal == 0.0) {
@@ -136,7 +150,7 @@ template <bool kCoupled, class PackedRow>
 
 // clamp_row, then the later t[k] take the change one by one (sweep_block).
 template <bool kCoupled, class PackedRow>
-[[gnu::always_inline]] inline bool chain_row(const PackedRow& row, int i, int m, const double* g,
+[[gnu::always_inline]] inline bool chain_row(const PackedRow& row, int i, int m, const ScalarOf<PackedRow>* g,
                                              const std::vector<double>& lambda, double* t, double& t_i,
                                              double& l_i, double& delta) {
   if (!clamp_row<kCoupled>(row, i, m, g, lambda, t, t_i, l_i, delta)) return false;
@@ -149,7 +163,7 @@ template <bool kCoupled, class PackedRow>
 // block column by column (column i: A_ki / A_kk for k = i+1..m-1).
 template <bool kCoupled, bool kTwoBodies, int kM, class PackedRow>
 [[gnu::always_inline]] inline void sweep_block(const PackedRow* r, const double* b, double* l, int m_runtime,
-                        const double* g, const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
+                        const ScalarOf<PackedRow>* g, const std::vector<double>& lambda, Vec6& w_a, Vec6& w_b) {
   const int m = kM > 0 ? kM : m_runtime;
   // Unclamped new values against w at the start of the run: independent of each other.
   double t[MatrixFreeSystem::kMaxRun];
@@ -235,17 +249,15 @@ struct WideLoad {
 // numbers of no use (their g is a neighbouring column's or the coupling's padding): nothing
 // reads them again. Every later t[k] takes the same t[k] - g delta as in chain_row.
 template <bool kCoupled, class PackedRow>
-[[gnu::always_inline]] inline bool chain_row_wide(const PackedRow& row, int i, int m, const double* g,
+[[gnu::always_inline]] inline bool chain_row_wide(const PackedRow& row, int i, int m, const ScalarOf<PackedRow>* g,
                                                   const std::vector<double>& lambda, double* t, double& t_i,
                                                   double& l_i, double& delta) {
   if (!clamp_row<kCoupled>(row, i, m, g, lambda, t, t_i, l_i, delta)) return false;
   const Wide d = {delta, delta, delta, delta};
   for (int q = (i + 2) / 4; 4 * q < m; ++q) {
     Wide t_q;
-    Wide g_q;
     std::memcpy(&t_q, t + 4 * q, sizeof t_q);
-    std::memcpy(&g_q, g + 4 * q - i - 1, sizeof g_q);
-    t_q -= g_q * d;
+    t_q -= WideLoad::load(g + 4 * q - i - 1) * d;
     std::memcpy(t + 4 * q, &t_q, sizeof t_q);
   }
   return true;
@@ -253,7 +265,7 @@ template <bool kCoupled, class PackedRow>
 
 template <bool kCoupled, bool kTwoBodies, class PackedRow>
 [[gnu::always_inline]] inline void sweep_block_wide(const PackedRow* r, const double* b, double* l, int m,
-                                                    const double* g, const std::vector<double>& lambda,
+                                                    const ScalarOf<PackedRow>* g, const std::vector<double>& lambda,
                                                     Vec6& w_a, Vec6& w_b) {
   Wide w[3] = {};  // load_pair
   load_pair(w_a, w_b, w);
@@ -284,13 +296,13 @@ struct SweepData {
   const double* b;
   double* l;  // lambda by position
   Vec6* w;
-  double* coupling;
+  ScalarOf<PackedRow>* coupling;
   int fixed_slot;
 };
 
 template <class PackedRow>
 SweepData<PackedRow> sweep_data(MatrixFreeSystem& s, std::vector<double>& lambda) {
-  return {packed<PackedRow>(s).data(), s.b.data(), lambda.data(), s.w.data(), s.coupling.data(),
+  return {packed<PackedRow>(s).data(), s.b.data(), lambda.data(), s.w.data(), coupling_of<PackedRow>(s).data(),
           static_cast<int>(s.w.size()) - 1};
 }
 
@@ -339,8 +351,10 @@ template <int kM, bool kCoupled, class PackedRow>
     const Wide inv = {r_i[0].inv_diagonal, r_i[1].inv_diagonal, r_i[2].inv_diagonal, r_i[3].inv_diagonal};
     t[i] = WideLoad::load(l + kL * i) + (WideLoad::load(b + kL * i) - jw) * inv;
     if constexpr (!kCoupled) {  // bounds<false>: c_min and c_max
-      lo[i] = Wide{r_i[0].c_min, r_i[1].c_min, r_i[2].c_min, r_i[3].c_min};
-      hi[i] = Wide{r_i[0].c_max, r_i[1].c_max, r_i[2].c_max, r_i[3].c_max};
+      lo[i] = Wide{static_cast<double>(r_i[0].c_min), static_cast<double>(r_i[1].c_min),
+                   static_cast<double>(r_i[2].c_min), static_cast<double>(r_i[3].c_min)};
+      hi[i] = Wide{static_cast<double>(r_i[0].c_max), static_cast<double>(r_i[1].c_max),
+                   static_cast<double>(r_i[2].c_max), static_cast<double>(r_i[3].c_max)};
     }
     none |= inv == Wide{0.0, 0.0, 0.0, 0.0};
   }
@@ -556,7 +570,7 @@ template <bool kCoupled, class PackedRow>
   const auto k_t = static_cast<std::size_t>(t);
   const bool prefetch = prefetching<PackedRow>(s);
   const std::size_t row_count = packed<PackedRow>(s).size();
-  const std::size_t coupling_size = s.coupling.size();
+  const std::size_t coupling_size = coupling_of<PackedRow>(s).size();
   bool couple = !s.coupling_ready;
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t k = 0; k < ConstraintGraph::kColours; ++k) {
@@ -682,11 +696,12 @@ void place_coupling(MatrixFreeSystem& s) {
   // when the row count does, not whenever more rows happen to sit in blocks than in any earlier
   // step (which a long run meets after warm-up).
   coupling_size += kCouplingPad;
-  detail::reserve_with_headroom(s.coupling,
+  auto& coupling = coupling_of<PackedRow>(s);
+  detail::reserve_with_headroom(coupling,
                                 std::max(coupling_size, kCouplingPerRow * packed<PackedRow>(s).size() + 2 * kCouplingPad));
-  detail::resize_with_headroom(s.coupling, coupling_size);
-  std::fill_n(s.coupling.begin(), kCouplingPad, 0.0);
-  std::fill_n(s.coupling.end() - kCouplingPad, kCouplingPad, 0.0);
+  detail::resize_with_headroom(coupling, coupling_size);
+  std::fill_n(coupling.begin(), kCouplingPad, 0);
+  std::fill_n(coupling.end() - kCouplingPad, kCouplingPad, 0);
   s.coupling_ready = false;
 }
 
@@ -809,9 +824,9 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     using Scalar = typename decltype(p.j)::value_type;
     p.a = slot(row.body_a);
     p.b = slot(row.body_b);
-    p.c_min = row.c_min;
-    p.c_max = row.c_max;
-    p.mu = row.mu;
+    p.c_min = static_cast<Scalar>(row.c_min);
+    p.c_max = static_cast<Scalar>(row.c_max);
+    p.mu = static_cast<Scalar>(row.mu);
     p.normal_row = normal_row;
     p.minv_jt.fill(Scalar{0});
     double diagonal = 0.0;
@@ -870,9 +885,11 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   s.precision = precision;
   if (precision == RowPrecision::single_precision) {
     s.rows.clear();
+    s.coupling.clear();
     pack_all(s.float_rows);
   } else {
     s.float_rows.clear();
+    s.float_coupling.clear();
     pack_all(s.rows);
   }
 }

@@ -279,7 +279,7 @@ const std::array kParameters = {
               .type = ParameterType::choice,
               .choices = kRowPrecisionChoices,
               .help = "how the matrix-free solve stores the rows it sweeps: double (the paper's "
-                      "numbers) or float (j and M^-1 j^T rounded to float, in half their bytes; "
+                      "numbers) or float (j, M^-1 j^T and the limits rounded to float, in half their bytes; "
                       "lambda and every sum stay double; another state); --assembly explicit "
                       "takes double only",
               .title = "row precision",

@@ -144,12 +144,12 @@ enum class Assembly {
   matrix_free,        ///< per body w = M^-1 J^T lambda, O(12) a row update (matrix_free.h)
 };
 
-/// How the matrix-free solve stores the rows it sweeps (WorldDef::row_precision): j and M^-1 j^T
-/// in double, or rounded to float, halving the bytes each sweep reads; lambda, w, b and every sum
-/// stay in double either way.
+/// How the matrix-free solve stores the rows it sweeps (WorldDef::row_precision): j, M^-1 j^T,
+/// the force limits, mu and the coupling of a block run in double, or rounded to float, halving
+/// the bytes each sweep reads; lambda, w, b, 1 / A_jj and every sum stay in double either way.
 enum class RowPrecision {
   double_precision,  ///< 8-byte j and M^-1 j^T: the paper's numbers (the default)
-  single_precision,  ///< 4-byte j and M^-1 j^T (Box3D's solver is float throughout)
+  single_precision,  ///< 4-byte j, M^-1 j^T, limits and coupling (Box3D's solver is float throughout)
 };
 
 /// World parameters, each with its unit and a typical value; the table below gives each one's
@@ -168,7 +168,7 @@ struct WorldDef {
   RotationUpdate rotation = RotationUpdate::linear;     ///< Eq. 3.2.4, or Eq. 12.4.1
   Assembly assembly = Assembly::matrix_free;  ///< same lambda to round-off; matrix-free is faster
   /// The matrix-free path's rows in double (the default) or float (RowPrecision); float solves a
-  /// system whose j is rounded to float (relative 6e-8), so the state differs from double's. The
+  /// system whose j and limits are rounded to float (relative 6e-8), so the state differs from double's. The
   /// explicit path has no packed rows: it takes double only (validate()).
   RowPrecision row_precision = RowPrecision::double_precision;
   /// Speculative contact distance (m) >= 0: features closer than this already get a contact row

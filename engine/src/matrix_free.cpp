@@ -540,20 +540,20 @@ template <bool kCoupled, class PackedRow>
 }
 
 // A stream read in order (a sweep's packed rows, or its coupling) whose lines up to kAhead bytes
-// past the read are asked for, each line once: the asks spread evenly over the sweep, where
-// asking for whole runs ahead sent a lane group's hundred lines at once.
+// past the read are asked for, each line once, so the asks spread evenly over the sweep
+// (docs/benchmarks.md, "Rows on whole cache lines, asked for evenly"). Addresses as integers: the
+// lines may start before the stream and end past it.
 struct PrefetchStream {
-  static constexpr std::ptrdiff_t kAhead = 8192;  // bytes (docs/benchmarks.md)
-  const char* next = nullptr;  // the first line not asked for yet
-  const char* end = nullptr;   // the stream's end
+  static constexpr std::uintptr_t kAhead = 8192;  // bytes
+  std::uintptr_t next;  // the first line not asked for yet
+  std::uintptr_t end;   // the stream's end
   PrefetchStream(const void* from, const void* stream_end)
-      : next(reinterpret_cast<const char*>(reinterpret_cast<std::uintptr_t>(from) & ~std::uintptr_t{63})),
-        end(static_cast<const char*>(stream_end)) {}
+      : next(reinterpret_cast<std::uintptr_t>(from) & ~std::uintptr_t{63}),
+        end(reinterpret_cast<std::uintptr_t>(stream_end)) {}
   // Asks for the lines up to kAhead bytes past p (p: the end of what the sweep reads next).
   [[gnu::always_inline]] void upto(const void* p) {
-    const char* stop = static_cast<const char*>(p) + kAhead;
-    if (stop > end) stop = end;
-    for (; next < stop; next += 64) __builtin_prefetch(next, 0, 3);
+    const std::uintptr_t stop = std::min(reinterpret_cast<std::uintptr_t>(p) + kAhead, end);
+    for (; next < stop; next += 64) __builtin_prefetch(reinterpret_cast<const void*>(next), 0, 3);
   }
 };
 

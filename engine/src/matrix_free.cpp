@@ -545,14 +545,14 @@ template <bool kCoupled, class PackedRow>
 // lines may start before the stream and end past it.
 struct PrefetchStream {
   static constexpr std::uintptr_t kAhead = 8192;  // bytes
-  std::uintptr_t next;  // the first line not asked for yet
-  std::uintptr_t end;   // the stream's end
-  PrefetchStream(const void* from, const void* stream_end)
-      : next(reinterpret_cast<std::uintptr_t>(from) & ~std::uintptr_t{63}),
-        end(reinterpret_cast<std::uintptr_t>(stream_end)) {}
-  // Asks for the lines up to kAhead bytes past p (p: the end of what the sweep reads next).
-  [[gnu::always_inline]] void upto(const void* p) {
-    const std::uintptr_t stop = std::min(reinterpret_cast<std::uintptr_t>(p) + kAhead, end);
+  std::uintptr_t next = 0;  // the first line not asked for yet
+  std::uintptr_t end;       // the stream's end
+  explicit PrefetchStream(const void* stream_end) : end(reinterpret_cast<std::uintptr_t>(stream_end)) {}
+  // Asks for the lines from the one holding `from` (the start of what the sweep reads next; the
+  // lines before it are not asked for now) to kAhead bytes past `to` (its end).
+  [[gnu::always_inline]] void upto(const void* from, const void* to) {
+    next = std::max(next, reinterpret_cast<std::uintptr_t>(from) & ~std::uintptr_t{63});
+    const std::uintptr_t stop = std::min(reinterpret_cast<std::uintptr_t>(to) + kAhead, end);
     for (; next < stop; next += 64) __builtin_prefetch(reinterpret_cast<const void*>(next), 0, 3);
   }
 };
@@ -586,17 +586,19 @@ template <bool kCoupled, class PackedRow>
         last = count * (k_t + 1) / threads;
       }
       const MatrixFreeSystem::Run* runs = s.runs.data() + begin;
-      if (first < last) {
-        PrefetchStream row_stream(d.rows + runs[first].begin, d.rows + row_count);
-        PrefetchStream coupling_stream(d.coupling + std::max(runs[first].offset, 0), d.coupling + coupling_size);
-        for (std::size_t i = first; i < last; ++i) {
-          const MatrixFreeSystem::Run& run = runs[i];
-          if (prefetch) {
-            row_stream.upto(d.rows + run.begin + run.count * run.lanes);
-            if (run.offset >= 0) coupling_stream.upto(d.coupling + run.offset + run.lanes * run.count * (run.count - 1) / 2);
+      PrefetchStream row_stream(d.rows + row_count);
+      PrefetchStream coupling_stream(d.coupling + coupling_size);
+      for (std::size_t i = first; i < last; ++i) {
+        const MatrixFreeSystem::Run& run = runs[i];
+        if (prefetch) {
+          const PackedRow* r = d.rows + run.begin;
+          row_stream.upto(r, r + run.count * run.lanes);
+          if (run.offset >= 0) {
+            const auto* g = d.coupling + run.offset;
+            coupling_stream.upto(g, g + run.lanes * run.count * (run.count - 1) / 2);
           }
-          sweep_run<kCoupled, true>(d, run, lambda, couple);
         }
+        sweep_run<kCoupled, true>(d, run, lambda, couple);
       }
       if (workers != nullptr) workers->sync();
     }

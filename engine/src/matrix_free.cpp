@@ -39,6 +39,9 @@ const std::vector<PackedRow>& packed(const MatrixFreeSystem& s) {
   return packed<PackedRow>(const_cast<MatrixFreeSystem&>(s));
 }
 
+// A float row fills two whole cache lines (matrix_free.h).
+static_assert(sizeof(PackedRow<float>) == 128 && alignof(PackedRow<float>) == 64);
+
 // The number type of a packed row's j (double or float), which its run's coupling shares.
 template <class PackedRow>
 using ScalarOf = typename decltype(PackedRow::j)::value_type;

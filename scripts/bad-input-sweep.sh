@@ -17,7 +17,7 @@
 # `bad.json` (a box without half_extents_m) and `notjson.json`, valid ones `a/x.json` and
 # `b/x.json` of one stem, and `prior/`, a/x.json's render and figure made in another folder)
 # under `timeout 20` and a
-# 1 GiB address-space cap (prlimit --as; see choose_cap below), stdout and stderr captured.
+# 1 GiB address-space cap (ulimit -v; see choose_cap below), stdout and stderr captured.
 # A bad command line PASSES when cps exits 2 with a message on stderr that names the option or
 # the value, and wrote nothing (no new file in the cwd or in its TMPDIR, fixture files
 # unchanged). Anything else FAILS: exit 0, another exit code, a timeout, a signal, bad_alloc,
@@ -27,7 +27,8 @@
 # Prints each failure with its command line, then
 #   N command lines: P refused cleanly, F failures
 # and exits 1 when F > 0 (or a control or self-test failed), 3 on an unclassified option.
-# Needs only bash, coreutils (timeout, mktemp, stat, ...) and util-linux (prlimit).
+# Needs only bash (5.1 or later: -nt to the nanosecond), coreutils (timeout, sleep, ...) and
+# findutils.
 set -u
 shopt -s extglob
 
@@ -352,9 +353,8 @@ CONTROLS=(
   "simulate stack --seconds 0.1 --dt 1/60 --beta 1e-320 --friction 0 --iterations 10000"
   "report --list-runs --out out"
   "report intersecting_stack --run intersecting_stack.pgs.baumgarte.fixed.it1.ss1.ws0.8 --out out"
-  # Every push method on every case, the hard cases' 600 steps among them (about 40 s of CPU):
-  # a "long|" control gets the fixture's bound (SWEEP_FIXTURE_TIMEOUT) instead of TIMEOUT.
-  "long|report push --quick --out out"
+  # (The push table's base line, report push --quick --out DIR, a minute or two of CPU, exits 0
+  # in the ctest case "cps report push --quick compares every push method ...": not again here.)
   "render stack --seconds 0.1 --fps 10 --size 16x16 --out out"
   "render ./b/../a/x.json --seconds 0.1 --fps 10 --size 16x16 --out out"  # '..' in a scene path
   "render $PRIOR/a/x.json --seconds 0.1 --fps 10 --size 16x16 --out out"  # an absolute one
@@ -383,40 +383,46 @@ CONTROLS=(
 
 # The memory cap: 1 GiB of address space, unless that breaks a valid command line (a sanitizer
 # build maps terabytes of shadow memory; a GL driver may reserve large areas); then 1 GiB of data
-# segment (prlimit --data: heap and private writable mappings); if that breaks it too, no rlimit
-# but, for a sanitizer build, ASan's own limits (hard_rss_limit_mb, malloc_limit_mb).
-CAP=(prlimit "--as=$MEM" --)
-cap_works() {  # runs the first control (and a render if there is one) under "${CAP[@]}"
+# segment (ulimit -d: heap and private writable mappings); if that breaks it too, no rlimit
+# but, for a sanitizer build, ASan's own limits (hard_rss_limit_mb, malloc_limit_mb). CAP holds
+# bash's ulimit arguments (KiB), set in the subshell that then becomes cps's `timeout`: a
+# prlimit process a line would cost an exec more.
+CAP=(-v $((MEM / 1024)))
+capped() {  # ARGS...: exec timeout ARGS... under the cap (in a subshell: the cap stays there)
+  ((${#CAP[@]} == 0)) || ulimit "${CAP[@]}" || exit 126
+  exec timeout "$@"
+}
+cap_works() {  # runs the first control (and a render if there is one) under the cap
   local d=$root/probe line
   for line in "list" "render stack --seconds 0.05 --fps 10 --size 16x16 --out out"; do
     [[ $line == render* ]] && ! "$CPS" render --help > /dev/null 2>&1 && continue
     rm -rf "$d" && mkdir -p "$d"
     # shellcheck disable=SC2086
-    { (cd "$d" && exec timeout "$TIMEOUT" "${CAP[@]}" "$CPS" $line > /dev/null 2> "$d.err"); } \
+    { (cd "$d" && capped "$TIMEOUT" "$CPS" $line > /dev/null 2> "$d.err"); } \
       2> /dev/null || return 1
   done
 }
 choose_cap() {
   if cap_works; then
-    MEM_NOTE="address space <= 1 GiB (prlimit --as)"
+    MEM_NOTE="address space <= 1 GiB (ulimit -v)"
     return
   fi
   local why
   why=$(head -c 300 "$root/probe.err")
   CAP=()
   if ! cap_works; then  # not the cap's doing: keep it, the controls will show the failure
-    CAP=(prlimit "--as=$MEM" --)
-    MEM_NOTE="address space <= 1 GiB (prlimit --as; a valid run fails even without it: $why)"
+    CAP=(-v $((MEM / 1024)))
+    MEM_NOTE="address space <= 1 GiB (ulimit -v; a valid run fails even without it: $why)"
     return
   fi
-  CAP=(prlimit "--data=$MEM" --)
+  CAP=(-d $((MEM / 1024)))
   if cap_works; then
-    MEM_NOTE="data segment <= 1 GiB (prlimit --data: --as=1GiB broke a valid run: $why)"
+    MEM_NOTE="data segment <= 1 GiB (ulimit -d: -v of 1 GiB broke a valid run: $why)"
     return
   fi
   CAP=()
   export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}hard_rss_limit_mb=1024:malloc_limit_mb=1024"
-  MEM_NOTE="no rlimit (--as and --data broke a valid run: $why); ASan limits 1 GiB if ASan"
+  MEM_NOTE="no rlimit (-v and -d broke a valid run: $why); ASan limits 1 GiB if ASan"
 }
 
 # Runs "$@" as cps's arguments in the case folder; sets RC, OUT, ERR, WROTE (what was written).
@@ -452,23 +458,43 @@ make_fixture() {  # DIR: a fresh cwd and tmp with the fixture files
   FIXTURE_DIR=$d
   snapshot "$d"
   FIXTURE_SNAP=$SNAP
+  stamp "$d"
 }
-# Each command line costs one process besides cps's own (the snapshot's find): a fork costs
-# milliseconds here, and the sweep runs thousands of lines, so no $(...) on the way.
+# DIR: FIXTURE_PATHS (every path of FIXTURE_SNAP) and DIR/stamp, whose time every later write
+# passes. A new, removed or renamed path changes its folder's time, a written file its own, so a
+# line changed the fixture only if one of these paths is newer than the stamp (bash's -nt, to the
+# nanosecond): the test forks nothing. File times come from a clock that moves in ticks of a few
+# ms, so the stamp is followed by a wait, after which a write's time is later than the stamp's.
+stamp() {
+  local line
+  FIXTURE_PATHS=()
+  while IFS= read -r line; do FIXTURE_PATHS+=("$1/${line%%|*}"); done <<< "$FIXTURE_SNAP"
+  : > "$1/stamp"
+  sleep 0.05
+}
+changed() {  # DIR -> true if a path of FIXTURE_PATHS is newer than DIR/stamp
+  local p
+  for p in "${FIXTURE_PATHS[@]}"; do [[ $p -nt $1/stamp ]] && return 0; done
+  return 1
+}
+# A command line costs only cps's processes (the subshell that becomes timeout, and cps): a fork
+# costs milliseconds here, and the sweep runs thousands of lines, so no $(...) on the way, and
+# the snapshot's find runs only when a path of the fixture is newer than its stamp.
 run_cps() {
   local d=$CASE_DIR
   [[ $FIXTURE_DIR == "$d" ]] || make_fixture "$d"
   local back=$PWD
   cd "$d/cwd" || exit 3
-  TMPDIR="$d/tmp" timeout -k 5 "$TIMEOUT" "${CAP[@]}" "$CPS" "$@" > "$d/out" 2> "$d/err"
+  (export TMPDIR="$d/tmp"; capped -k 5 "$TIMEOUT" "$CPS" "$@") > "$d/out" 2> "$d/err"
   RC=$?
   cd "$back" || exit 3
   OUT='' ERR=''
   IFS= read -r -d '' -N 4000 OUT < "$d/out"
   IFS= read -r -d '' -N 4000 ERR < "$d/err"
   WROTE=
+  changed "$d" || return
   snapshot "$d"
-  [[ $SNAP == "$FIXTURE_SNAP" ]] && return
+  if [[ $SNAP == "$FIXTURE_SNAP" ]]; then stamp "$d"; return; fi
   # Something changed: what is new or changed (by path), or else what is gone.
   local line gone=
   while IFS= read -r line; do
@@ -477,7 +503,7 @@ run_cps() {
   while IFS= read -r line; do
     [[ $NL$SNAP$NL == *"$NL$line$NL"* ]] || gone+="${gone:+, }${line%%|*}"
   done <<< "$FIXTURE_SNAP"
-  [[ -n $WROTE$gone ]] || return  # the same paths, listed in another order
+  if [[ -z $WROTE$gone ]]; then stamp "$d"; return; fi  # the same paths, in another order
   FIXTURE_DIR=  # made again before the next command line
   [[ -n $WROTE ]] || WROTE="(removed $gone)"
   local -a paths
@@ -720,14 +746,9 @@ printf '%s\n' "$DROP" > "$PRIOR/a/x.json"
 has_fclib=1
 "$CPS" export --help 2>&1 | grep -q 'left out of this build' && has_fclib=0
 for line in "${CONTROLS[@]}"; do
-  bound=$TIMEOUT
-  if [[ $line == long\|* ]]; then
-    line=${line#long|}
-    bound=${SWEEP_FIXTURE_TIMEOUT:-300}
-  fi
   read -ra words <<< "$line"
   [[ $has_fclib == 0 && " $line " == *" --fclib "* ]] && continue
-  has_command "${words[0]}" && TIMEOUT=$bound control "${words[@]}"
+  has_command "${words[0]}" && control "${words[@]}"
 done
 control report --merge "$MERGE_SRC" --out merged
 # An expected hash: the one simulate prints, and the same in capitals with 0X.
@@ -757,6 +778,9 @@ run_cps simulate stack --seconds 0.1 --trace file --force
 run_cps list
 [[ -z $WROTE && $(< "$CASE_DIR/cwd/file") == "not written by cps" ]] ||
   SELF_FAILS+=("the fixture was not made again after a line changed it")
+# A new file in a fixture folder is seen (through the folder's time).
+run_cps simulate stack --seconds 0.1 --trace adir/t.csv
+[[ $WROTE == *cwd/adir/t.csv* ]] || SELF_FAILS+=("a file written into a fixture folder was not seen (wrote: '$WROTE')")
 ((${#SELF_FAILS[@]} == 0)) || printf 'SELF-TEST FAILED: %s\n' "${SELF_FAILS[@]}"
 
 # ---------------------------------------------------------------------------------------------

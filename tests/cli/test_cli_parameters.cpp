@@ -72,6 +72,27 @@ TEST_CASE("cps parameters --format json lists every world parameter of the table
   int in_paper = 0;
   for (const json& c : push->at("choices")) in_paper += c.at("in_paper").get<bool>() ? 1 : 0;
   CHECK(in_paper == 2);  // Sec. 5.3 and Sec. 8.1
+  // Each push method's `reads` is its row of the engine's table (PushTraits), by parameter name.
+  for (const json& c : push->at("choices")) {
+    CAPTURE(c.dump());
+    const cps::Choice* choice = cps::parameter("push").find_choice(c.at("name").get<std::string>());
+    REQUIRE(choice != nullptr);
+    REQUIRE(choice->push != nullptr);
+    const cps::PushTraits& traits = *choice->push;
+    const json& reads = c.at("reads");
+    CHECK(reads.size() == 5);
+    CHECK(reads.at("solver").get<bool>() == traits.reads.solver);
+    CHECK(reads.at("assembly").get<bool>() == traits.solves_system);
+    CHECK(reads.at("row_precision").get<bool>() == traits.solves_system);
+    CHECK(reads.at("friction_model").get<bool>() == traits.reads.friction_model);
+    CHECK(reads.at("warm_start").get<bool>() == traits.reads.warm_start);
+    for (const auto& [name, read] : reads.items()) CHECK(cps::find_parameter(name) != nullptr);
+  }
+  // No other parameter's choices carry one.
+  for (const json& row : table) {
+    if (row.at("name") == "push" || !row.contains("choices")) continue;
+    for (const json& c : row.at("choices")) CHECK(!c.contains("reads"));
+  }
 }
 
 TEST_CASE("the scene schema's world section is the parameter table's", "[cli][parameters]") {

@@ -59,7 +59,19 @@ std::string default_text(const Parameter& p) {
   return p.format(v);
 }
 
-// Every parameter with its name, flag, JSON key, unit, type, range, default, help and choices.
+// Which settings of the solve a push method reads (PushTraits: reads, and solves_system for the
+// assembly and the row precision, which only the solve of A lambda = b uses), by parameter name.
+// A setting it does not read leaves its runs bit for bit the same.
+json push_reads_json(const PushTraits& traits) {
+  return {{"solver", traits.reads.solver},
+          {"assembly", traits.solves_system},
+          {"row_precision", traits.solves_system},
+          {"friction_model", traits.reads.friction_model},
+          {"warm_start", traits.reads.warm_start}};
+}
+
+// Every parameter with its name, flag, JSON key, unit, type, range, default, help and choices
+// (a push method's with the settings it reads).
 json table_json() {
   json out = json::array();
   for (const Parameter& p : world_parameters()) {
@@ -81,10 +93,9 @@ json table_json() {
     if (p.type == ParameterType::choice) {
       json choices = json::array();
       for (const Choice& c : p.choices) {
-        choices.push_back({{"name", c.name},
-                           {"source", c.source},
-                           {"title", c.title},
-                           {"in_paper", c.in_paper}});
+        json choice = {{"name", c.name}, {"source", c.source}, {"title", c.title}, {"in_paper", c.in_paper}};
+        if (c.push != nullptr) choice["reads"] = push_reads_json(*c.push);
+        choices.push_back(choice);
       }
       row["choices"] = choices;
     }

@@ -4,7 +4,8 @@
 // index and they meet at barriers between the stages. Between tasks the workers spin a while
 // before they sleep, as Box2D v3's and enkiTS's workers do: a step runs a dozen short tasks
 // with a little serial work between them, and waking a sleeping thread costs tens of
-// microseconds on a virtual machine.
+// microseconds on a virtual machine. With more threads than the processor runs at once, none
+// spins: a spinning thread would hold a core that the thread it waits for needs.
 
 #include <atomic>
 #include <cstddef>
@@ -15,7 +16,8 @@
 namespace cps {
 
 /// `count` threads (>= 1; less is taken as 1): the calling thread and count - 1 kept workers,
-/// which sleep between tasks. Not copyable. Errors: the constructor throws std::system_error
+/// which sleep between tasks (after kIdleSpins pauses; at once when count exceeds
+/// std::thread::hardware_concurrency()). Not copyable. Errors: the constructor throws std::system_error
 /// when a thread cannot be started (or std::bad_alloc), after joining those it started.
 class Workers {
  public:
@@ -67,6 +69,10 @@ class Workers {
   static void wait_while(const std::atomic<T>& value, T old, int spins);
 
   int count_ = 1;
+  // kSpins and kIdleSpins, or 0 when there are more threads than the processor runs at once: a
+  // thread that spins then holds a core the thread it waits for may need (set once).
+  int spins_ = kSpins;
+  int idle_spins_ = kIdleSpins;
   std::atomic<int> arrived_{0};               // threads at the current barrier
   std::atomic<std::uint32_t> phase_{0};       // barriers passed
   std::atomic<std::uint32_t> generation_{0};  // tasks started (and the stop)
@@ -118,6 +124,8 @@ void parallel_chunks(Workers* workers, std::size_t chunks, Fn&& fn) {
 }
 
 inline Workers::Workers(int count) : count_(count < 1 ? 1 : count) {
+  const unsigned cores = std::thread::hardware_concurrency();  // 0: unknown
+  if (cores != 0 && static_cast<unsigned>(count_) > cores) spins_ = idle_spins_ = 0;
   try {
     threads_.reserve(static_cast<std::size_t>(count_ - 1));
     for (int t = 1; t < count_; ++t) threads_.emplace_back([this, t] { loop(t); });
@@ -150,7 +158,7 @@ inline void Workers::sync() {
     phase_.notify_all();
     return;
   }
-  wait_while(phase_, phase, kSpins);
+  wait_while(phase_, phase, spins_);
 }
 
 inline void Workers::stop_and_join() {
@@ -172,14 +180,14 @@ inline void Workers::start() {
 inline void Workers::finish() {
   for (int left = running_.load(std::memory_order_acquire); left != 0;
        left = running_.load(std::memory_order_acquire)) {
-    wait_while(running_, left, kSpins);
+    wait_while(running_, left, spins_);
   }
 }
 
 inline void Workers::loop(int t) {
   std::uint32_t seen = 0;
   for (;;) {
-    wait_while(generation_, seen, kIdleSpins);
+    wait_while(generation_, seen, idle_spins_);
     seen = generation_.load(std::memory_order_acquire);
     if (stop_.load(std::memory_order_acquire)) return;
     call_(task_, t);

@@ -17,8 +17,9 @@ namespace cps {
 
 /// `count` threads (>= 1; less is taken as 1): the calling thread and count - 1 kept workers,
 /// which sleep between tasks (after kIdleSpins pauses; at once when count exceeds
-/// std::thread::hardware_concurrency()). Not copyable. Errors: the constructor throws std::system_error
-/// when a thread cannot be started (or std::bad_alloc), after joining those it started.
+/// std::thread::hardware_concurrency()). Not copyable. Errors: the constructor throws
+/// std::system_error when a thread cannot be started (or std::bad_alloc), after joining those
+/// it started.
 class Workers {
  public:
   explicit Workers(int count);

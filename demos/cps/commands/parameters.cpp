@@ -93,7 +93,10 @@ json table_json() {
     if (p.type == ParameterType::choice) {
       json choices = json::array();
       for (const Choice& c : p.choices) {
-        json choice = {{"name", c.name}, {"source", c.source}, {"title", c.title}, {"in_paper", c.in_paper}};
+        json choice = {{"name", c.name},
+                       {"source", c.source},
+                       {"title", c.title},
+                       {"in_paper", c.in_paper}};
         if (c.push != nullptr) choice["reads"] = push_reads_json(*c.push);
         choices.push_back(choice);
       }

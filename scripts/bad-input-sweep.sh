@@ -8,6 +8,9 @@
 # range matter: -1 is bad for --fps, not for --orbit). An option (or command) the table does not
 # classify stops the sweep with exit 3 before anything runs, so coverage cannot shrink silently.
 # Options whose --help shows a choice list {a, b} are classified as choices automatically.
+# The world parameters' options, registered for every stepping command by one function, get
+# their full lists on simulate and, on the other commands, the few values that show each
+# command checks them (empty, not a number, trailing text, past each end of the range).
 #
 # Each command line (nproc of them at a time, or SWEEP_JOBS; SWEEP_TIMEOUT, SWEEP_VERBOSE=1 to
 # list every verdict) runs in a temporary folder (its cwd, with a few fixture files, made again
@@ -80,8 +83,14 @@ declare -A KIND=(
 # The world parameters' kinds come from the parameter table itself (`cps parameters --format
 # tsv`: flag, type, min, max, min excluded, unit), as param:TYPE:MIN:MAX:EXCL:UNIT; their bad
 # values are made from the range in bad_values below. Choices and flags are classified from --help.
+# Every stepping command registers these options through one function and one set of checks
+# (add_world_options), so their full lists of bad values run on one command (WORLD_FULL); every
+# other command that has them gets the values that show it routes them through those checks
+# (bad_values' "routed" kind): empty, not a number, trailing text, and past each end of the range.
+WORLD_FULL=simulate
+declare -A WORLD=()
 while IFS=$'\t' read -r flag type min max excl unit; do
-  case $type in real | integer) KIND["*:$flag"]="param:$type:$min:$max:$excl:$unit" ;; esac
+  case $type in real | integer) KIND["*:$flag"]="param:$type:$min:$max:$excl:$unit" WORLD[$flag]=1 ;; esac
 done < <("$CPS" parameters --format tsv)
 if [[ -z ${KIND['*:--dt']:-} ]]; then
   echo "bad-input-sweep: '$CPS parameters --format tsv' gave no --dt row" >&2
@@ -151,13 +160,7 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
       # (the avbd penalties): left out there.
       printf '%s\n' "$NUM_COMMON" -1 | awk -v hi="$hi" '
         !(($0 == "1e12" || $0 == "4294967297") && (hi == "inf" || $0 + 0 <= hi + 0))'
-      # Just outside each end: below min (min itself when it is excluded), above max.
-      awk -v lo="$lo" -v hi="$hi" -v excl="$excl" 'BEGIN {
-        if (excl == 1) { print lo; print "-0"; print "1e-400" }
-        else if (lo == 0) print "-1e-9"
-        else printf "%.17g\n", lo - (lo < 0 ? -lo : lo) / 10
-        if (hi != "inf") { printf "%.17g\n", hi + 1; printf "%.17g\n", hi * 2 }
-      }'
+      range_ends "$lo" "$hi" "$excl"
       case $type in
         integer) printf '%s\n' 1.5 "$lo.0" 1e3 1/2 1e-320 5e-324 2147483648 99999999999999999999 ;;
         real)
@@ -166,6 +169,15 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
           else
             printf '%s\n' 1/2
           fi ;;
+      esac ;;
+    routed:*)  # a world parameter on a command other than WORLD_FULL: routed:TYPE:MIN:MAX:EXCL:UNIT
+      local type lo hi excl unit
+      IFS=: read -r _ type lo hi excl unit <<< "$kind"
+      printf '%s\n' "" nan 1x
+      range_ends "$lo" "$hi" "$excl"
+      case $type in
+        integer) printf '%s\n' 1.5 ;;
+        real) [[ $unit == s ]] && printf '%s\n' 1/0 ;;
       esac ;;
     choice)  # the choices from --help
       printf '%s\n' "" nosuch "${1^^}" "$1 " " $1" "$1,$1" 1 ;;
@@ -241,6 +253,15 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
       esac ;;
     *) echo "bad-input-sweep: no bad values for kind '$kind'" >&2; exit 3 ;;
   esac
+}
+range_ends() {  # MIN MAX EXCL -> just outside each end: below MIN (MIN itself when it is
+  # excluded), above MAX
+  awk -v lo="$1" -v hi="$2" -v excl="$3" 'BEGIN {
+    if (excl == 1) { print lo; print "-0"; print "1e-400" }
+    else if (lo == 0) print "-1e-9"
+    else printf "%.17g\n", lo - (lo < 0 ? -lo : lo) / 10
+    if (hi != "inf") { printf "%.17g\n", hi + 1; printf "%.17g\n", hi * 2 }
+  }'
 }
 seq_csv() {  # N -> 0,1,...,N-1
   local i s=0
@@ -695,6 +716,8 @@ for sub in "${COMMANDS[@]}"; do
     PLAN_POS[$sub]+="$name|$kind$NL"
   done
 done
+[[ ${#WORLD[@]} == 0 || " ${COMMANDS[*]} " == *" $WORLD_FULL "* ]] ||
+  unclassified+=("the world parameters' full lists run on $WORLD_FULL, which cps does not have (WORLD_FULL)")
 if ((${#unclassified[@]})); then
   echo "bad-input-sweep: --help shows what this sweep does not know how to classify;" \
     "add it to KIND (and BASE) in $0:" >&2
@@ -786,6 +809,16 @@ run_cps simulate stack --seconds 0.1 --trace adir/t.csv
 # ---------------------------------------------------------------------------------------------
 # The sweep.
 
+unique_values() {  # values: each value once, in the order of its first appearance
+  local -A seen=()
+  local v kept=()
+  for v in "${values[@]}"; do
+    [[ -n ${seen["x$v"]:-} ]] && continue
+    seen["x$v"]=1
+    kept+=("$v")
+  done
+  values=("${kept[@]}")
+}
 # base_for SUB KEY -> the contexts (';' separated) for an option or positional
 base_for() { printf '%s' "${BASE["$1:$2"]:-${BASE[$1]}}"; }
 # without OPT VALUED WORDS... -> WORDS with OPT (and its value when VALUED) removed, into W
@@ -841,9 +874,12 @@ for sub in "${COMMANDS[@]}"; do
       # Bad values.
       if [[ $kind == choice ]]; then
         mapfile -t values < <(bad_values choice $(choices_of "$type"))
+      elif [[ -n ${WORLD[$long]:-} && $sub != "$WORLD_FULL" && $kind == param:* ]]; then
+        mapfile -t values < <(bad_values "routed:${kind#param:}")
       else
         mapfile -t values < <(bad_values "$kind")
       fi
+      unique_values
       for v in "${values[@]}"; do
         bad "$needles/$v" "${W[@]}" "$long" "$v"
       done
@@ -855,6 +891,7 @@ for sub in "${COMMANDS[@]}"; do
     IFS=';' read -ra contexts <<< "$(base_for "$sub" "$name")"
     read -ra words <<< "${contexts[0]}"
     mapfile -t values < <(bad_values "$kind")
+    unique_values
     for v in "${values[@]}"; do
       bad "$name/$v" "${words[0]}" "$v" "${words[@]:2}"
     done

@@ -5,6 +5,7 @@
 #include <cairo-pdf.h>
 #include <cairo-svg.h>
 #include <cairo.h>
+#include <dlfcn.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +17,95 @@
 
 namespace cps::cli {
 namespace {
+
+// cairo (libcairo.so.2, Debian's libcairo2) is opened with dlopen when a page is first measured or
+// drawn, not linked: the commands that draw no page, and the Python module, then start without
+// loading it and the libraries it pulls in (fontconfig, freetype, pixman, X11's; the time this
+// saves a start: docs/benchmarks.md). Its functions are called through this table.
+struct CairoLib {
+  decltype(&::cairo_clip) clip;
+  decltype(&::cairo_create) create;
+  decltype(&::cairo_destroy) destroy;
+  decltype(&::cairo_fill) fill;
+  decltype(&::cairo_font_extents) font_extents;
+  decltype(&::cairo_image_surface_create) image_surface_create;
+  decltype(&::cairo_image_surface_get_data) image_surface_get_data;
+  decltype(&::cairo_image_surface_get_stride) image_surface_get_stride;
+  decltype(&::cairo_move_to) move_to;
+  decltype(&::cairo_paint) paint;
+  decltype(&::cairo_pdf_surface_create_for_stream) pdf_surface_create_for_stream;
+  decltype(&::cairo_pdf_surface_set_metadata) pdf_surface_set_metadata;
+  decltype(&::cairo_rectangle) rectangle;
+  decltype(&::cairo_restore) restore;
+  decltype(&::cairo_save) save;
+  decltype(&::cairo_select_font_face) select_font_face;
+  decltype(&::cairo_set_font_size) set_font_size;
+  decltype(&::cairo_set_source_rgb) set_source_rgb;
+  decltype(&::cairo_set_source_surface) set_source_surface;
+  decltype(&::cairo_show_text) show_text;
+  decltype(&::cairo_status) status;
+  decltype(&::cairo_status_to_string) status_to_string;
+  decltype(&::cairo_surface_destroy) surface_destroy;
+  decltype(&::cairo_surface_finish) surface_finish;
+  decltype(&::cairo_surface_flush) surface_flush;
+  decltype(&::cairo_surface_mark_dirty) surface_mark_dirty;
+  decltype(&::cairo_surface_status) surface_status;
+  decltype(&::cairo_svg_surface_create_for_stream) svg_surface_create_for_stream;
+  decltype(&::cairo_text_extents) text_extents;
+
+  CairoLib() {
+    void* lib = dlopen("libcairo.so.2", RTLD_NOW | RTLD_LOCAL);
+    if (lib == nullptr) {
+      const char* why = dlerror();
+      throw std::runtime_error(
+          std::string("cairo: libcairo.so.2 (Debian: libcairo2), which draws the figure page, "
+                      "could not be opened: ") +
+          (why != nullptr ? why : "unknown error"));
+    }
+    load(lib, "cairo_clip", clip);
+    load(lib, "cairo_create", create);
+    load(lib, "cairo_destroy", destroy);
+    load(lib, "cairo_fill", fill);
+    load(lib, "cairo_font_extents", font_extents);
+    load(lib, "cairo_image_surface_create", image_surface_create);
+    load(lib, "cairo_image_surface_get_data", image_surface_get_data);
+    load(lib, "cairo_image_surface_get_stride", image_surface_get_stride);
+    load(lib, "cairo_move_to", move_to);
+    load(lib, "cairo_paint", paint);
+    load(lib, "cairo_pdf_surface_create_for_stream", pdf_surface_create_for_stream);
+    load(lib, "cairo_pdf_surface_set_metadata", pdf_surface_set_metadata);
+    load(lib, "cairo_rectangle", rectangle);
+    load(lib, "cairo_restore", restore);
+    load(lib, "cairo_save", save);
+    load(lib, "cairo_select_font_face", select_font_face);
+    load(lib, "cairo_set_font_size", set_font_size);
+    load(lib, "cairo_set_source_rgb", set_source_rgb);
+    load(lib, "cairo_set_source_surface", set_source_surface);
+    load(lib, "cairo_show_text", show_text);
+    load(lib, "cairo_status", status);
+    load(lib, "cairo_status_to_string", status_to_string);
+    load(lib, "cairo_surface_destroy", surface_destroy);
+    load(lib, "cairo_surface_finish", surface_finish);
+    load(lib, "cairo_surface_flush", surface_flush);
+    load(lib, "cairo_surface_mark_dirty", surface_mark_dirty);
+    load(lib, "cairo_surface_status", surface_status);
+    load(lib, "cairo_svg_surface_create_for_stream", svg_surface_create_for_stream);
+    load(lib, "cairo_text_extents", text_extents);
+  }
+
+  template <class F>
+  static void load(void* lib, const char* name, F& f) {
+    f = reinterpret_cast<F>(dlsym(lib, name));
+    if (f == nullptr) throw std::runtime_error(std::string("cairo: libcairo.so.2 has no ") + name);
+  }
+};
+
+// The table, opened on the first call (thread-safe; a failed open throws and is tried again on
+// the next call). Throws std::runtime_error if libcairo.so.2 or one of its functions is missing.
+const CairoLib& cairo() {
+  static const CairoLib lib;
+  return lib;
+}
 
 constexpr const char* kFont = "DejaVu Sans";
 // Text colour (sRGB): near black, as a journal's captions.
@@ -41,14 +131,14 @@ using CairoPtr = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
 using SurfacePtr = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
 
 void set_font(cairo_t* cr, double size, bool bold) {
-  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL,
+  cairo().select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL,
                          bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
+  cairo().set_font_size(cr, size);
 }
 
 double advance(cairo_t* cr, const std::string& text) {
   cairo_text_extents_t e;
-  cairo_text_extents(cr, text.c_str(), &e);
+  cairo().text_extents(cr, text.c_str(), &e);
   return e.x_advance;
 }
 
@@ -114,8 +204,9 @@ CaptionLines caption_lines(cairo_t* cr, const PagePanel& panel, const Metrics& m
 }
 
 CairoPtr measuring_context(SurfacePtr& surface) {
-  surface = SurfacePtr(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 1, 1), cairo_surface_destroy);
-  return CairoPtr(cairo_create(surface.get()), cairo_destroy);
+  surface = SurfacePtr(cairo().image_surface_create(CAIRO_FORMAT_ARGB32, 1, 1),
+                       cairo().surface_destroy);
+  return CairoPtr(cairo().create(surface.get()), cairo().destroy);
 }
 
 // The height of every caption strip: the longest caption of `page` wrapped to panels `width`
@@ -143,18 +234,18 @@ int legend_height(const FigurePage& page, const Metrics& m) {
 
 // Draws `text` with its first baseline at y (px).
 void show(cairo_t* cr, double x, double y, const std::string& text) {
-  cairo_move_to(cr, x, y);
-  cairo_show_text(cr, text.c_str());
+  cairo().move_to(cr, x, y);
+  cairo().show_text(cr, text.c_str());
 }
 
 // The one drawing routine of every format.
 void draw_page(cairo_t* cr, const FigurePage& page, const PageLayout& layout) {
   const Metrics m = metrics_of(page);
-  cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
-  cairo_paint(cr);
+  cairo().set_source_rgb(cr, 1.0, 1.0, 1.0);
+  cairo().paint(cr);
   set_font(cr, m.font, false);
   cairo_font_extents_t fe;
-  cairo_font_extents(cr, &fe);
+  cairo().font_extents(cr, &fe);
   const double ascent = fe.ascent;
   const double text_width = page.panel_width - 2.0 * m.pad;
 
@@ -162,11 +253,11 @@ void draw_page(cairo_t* cr, const FigurePage& page, const PageLayout& layout) {
   for (std::size_t k = 0; k < page.panels.size(); ++k) {
     if (page.panels[k].image == nullptr) continue;  // an empty cell stays white
     const render::Image& im = *page.panels[k].image;
-    SurfacePtr img(cairo_image_surface_create(CAIRO_FORMAT_RGB24, im.width, im.height),
-                   cairo_surface_destroy);
-    cairo_surface_flush(img.get());
-    unsigned char* data = cairo_image_surface_get_data(img.get());
-    const int stride = cairo_image_surface_get_stride(img.get());
+    SurfacePtr img(cairo().image_surface_create(CAIRO_FORMAT_RGB24, im.width, im.height),
+                   cairo().surface_destroy);
+    cairo().surface_flush(img.get());
+    unsigned char* data = cairo().image_surface_get_data(img.get());
+    const int stride = cairo().image_surface_get_stride(img.get());
     for (int y = 0; y < im.height; ++y) {
       auto* row = reinterpret_cast<std::uint32_t*>(data + static_cast<std::ptrdiff_t>(y) * stride);
       for (int x = 0; x < im.width; ++x) {
@@ -176,19 +267,19 @@ void draw_page(cairo_t* cr, const FigurePage& page, const PageLayout& layout) {
                  std::uint32_t{im.pixels[i + 2]};
       }
     }
-    cairo_surface_mark_dirty(img.get());
+    cairo().surface_mark_dirty(img.get());
     const PageLayout::Rect& r = layout.panels[k];
-    cairo_save(cr);
-    cairo_set_source_surface(cr, img.get(), r.x, r.y);
-    cairo_rectangle(cr, r.x, r.y, r.width, r.height);
-    cairo_fill(cr);
-    cairo_restore(cr);
+    cairo().save(cr);
+    cairo().set_source_surface(cr, img.get(), r.x, r.y);
+    cairo().rectangle(cr, r.x, r.y, r.width, r.height);
+    cairo().fill(cr);
+    cairo().restore(cr);
   }
-  if (cairo_status(cr) != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error(std::string("cairo: ") + cairo_status_to_string(cairo_status(cr)));
+  if (cairo().status(cr) != CAIRO_STATUS_SUCCESS) {
+    throw std::runtime_error(std::string("cairo: ") + cairo().status_to_string(cairo().status(cr)));
   }
 
-  cairo_set_source_rgb(cr, kInk, kInk, kInk);
+  cairo().set_source_rgb(cr, kInk, kInk, kInk);
   if (page.labels) {
     // Title strip above the grid.
     if (!page.title.empty()) {
@@ -203,9 +294,9 @@ void draw_page(cairo_t* cr, const FigurePage& page, const PageLayout& layout) {
     for (std::size_t k = 0; k < page.panels.size(); ++k) {
       const PageLayout::Rect& r = layout.panels[k];
       const CaptionLines c = caption_lines(cr, page.panels[k], m, text_width);
-      cairo_save(cr);
-      cairo_rectangle(cr, r.x, r.y + r.height, r.width, layout.caption_height);
-      cairo_clip(cr);
+      cairo().save(cr);
+      cairo().rectangle(cr, r.x, r.y + r.height, r.width, layout.caption_height);
+      cairo().clip(cr);
       double y = r.y + r.height + m.pad + ascent;
       const double x = r.x + m.pad;
       if (!c.letter.empty()) {
@@ -217,7 +308,7 @@ void draw_page(cairo_t* cr, const FigurePage& page, const PageLayout& layout) {
         show(cr, i == 0 ? x + c.letter_advance : x, y, c.lines[i]);
         y += m.line;
       }
-      cairo_restore(cr);
+      cairo().restore(cr);
     }
   }
   // The legend strip below the grid: heading, then a swatch and the text per entry.
@@ -230,15 +321,15 @@ void draw_page(cairo_t* cr, const FigurePage& page, const PageLayout& layout) {
     set_font(cr, m.font, false);
     for (const PageLegendEntry& e : page.legend) {
       y += m.line;
-      cairo_set_source_rgb(cr, e.srgb[0], e.srgb[1], e.srgb[2]);
-      cairo_rectangle(cr, x, y - 0.8 * m.font, 0.8 * m.font, 0.8 * m.font);
-      cairo_fill(cr);
-      cairo_set_source_rgb(cr, kInk, kInk, kInk);
+      cairo().set_source_rgb(cr, e.srgb[0], e.srgb[1], e.srgb[2]);
+      cairo().rectangle(cr, x, y - 0.8 * m.font, 0.8 * m.font, 0.8 * m.font);
+      cairo().fill(cr);
+      cairo().set_source_rgb(cr, kInk, kInk, kInk);
       show(cr, x + 1.3 * m.font, y, e.text);
     }
   }
-  if (cairo_status(cr) != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error(std::string("cairo: ") + cairo_status_to_string(cairo_status(cr)));
+  if (cairo().status(cr) != CAIRO_STATUS_SUCCESS) {
+    throw std::runtime_error(std::string("cairo: ") + cairo().status_to_string(cairo().status(cr)));
   }
 }
 
@@ -289,7 +380,7 @@ PageLayout layout_page(const FigurePage& page) {
     }
   }
   const Metrics m = metrics_of(page);
-  SurfacePtr surface(nullptr, cairo_surface_destroy);
+  SurfacePtr surface(nullptr, cairo().surface_destroy);
   CairoPtr cr = measuring_context(surface);
   PageLayout layout;
   layout.font_size = m.font;
@@ -322,7 +413,7 @@ std::pair<int, int> fit_panels(const FigurePage& page, int width, int height) {
                                 ") and rows and columns >= 1");
   }
   const Metrics m = metrics_of(page);
-  SurfacePtr surface(nullptr, cairo_surface_destroy);
+  SurfacePtr surface(nullptr, cairo().surface_destroy);
   CairoPtr cr = measuring_context(surface);
   // layout_page's sums, solved for the panel size.
   const int panel_width = (width - (page.columns + 1) * m.gutter) / page.columns;
@@ -335,22 +426,23 @@ std::pair<int, int> fit_panels(const FigurePage& page, int width, int height) {
 }
 
 render::Image compose_page_pixels(const FigurePage& page, const PageLayout& layout) {
-  SurfacePtr surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, layout.width, layout.height),
-                     cairo_surface_destroy);
+  SurfacePtr surface(cairo().image_surface_create(CAIRO_FORMAT_RGB24, layout.width, layout.height),
+                     cairo().surface_destroy);
   {
-    CairoPtr cr(cairo_create(surface.get()), cairo_destroy);
+    CairoPtr cr(cairo().create(surface.get()), cairo().destroy);
     draw_page(cr.get(), page, layout);
   }
-  cairo_surface_flush(surface.get());
-  if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error(std::string("cairo: ") + cairo_status_to_string(cairo_surface_status(surface.get())));
+  cairo().surface_flush(surface.get());
+  if (cairo().surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) {
+    throw std::runtime_error(std::string("cairo: ") +
+                             cairo().status_to_string(cairo().surface_status(surface.get())));
   }
   render::Image out;
   out.width = layout.width;
   out.height = layout.height;
   out.pixels.resize(3u * static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height));
-  const unsigned char* data = cairo_image_surface_get_data(surface.get());
-  const int stride = cairo_image_surface_get_stride(surface.get());
+  const unsigned char* data = cairo().image_surface_get_data(surface.get());
+  const int stride = cairo().image_surface_get_stride(surface.get());
   for (int y = 0; y < out.height; ++y) {
     const auto* row = reinterpret_cast<const std::uint32_t*>(data + static_cast<std::ptrdiff_t>(y) * stride);
     for (int x = 0; x < out.width; ++x) {
@@ -371,22 +463,25 @@ std::string compose_page(const FigurePage& page, FigureFormat format, const Page
   }
   std::string bytes;
   SurfacePtr surface(format == FigureFormat::pdf
-                         ? cairo_pdf_surface_create_for_stream(append, &bytes, layout.width, layout.height)
-                         : cairo_svg_surface_create_for_stream(append, &bytes, layout.width, layout.height),
-                     cairo_surface_destroy);
+                         ? cairo().pdf_surface_create_for_stream(append, &bytes, layout.width,
+                                                                 layout.height)
+                         : cairo().svg_surface_create_for_stream(append, &bytes, layout.width,
+                                                                 layout.height),
+                     cairo().surface_destroy);
   if (format == FigureFormat::pdf) {
-    cairo_pdf_surface_set_metadata(surface.get(), CAIRO_PDF_METADATA_CREATOR, "cps figure");
+    cairo().pdf_surface_set_metadata(surface.get(), CAIRO_PDF_METADATA_CREATOR, "cps figure");
     if (!page.title.empty()) {
-      cairo_pdf_surface_set_metadata(surface.get(), CAIRO_PDF_METADATA_TITLE, page.title.c_str());
+      cairo().pdf_surface_set_metadata(surface.get(), CAIRO_PDF_METADATA_TITLE, page.title.c_str());
     }
   }
   {
-    CairoPtr cr(cairo_create(surface.get()), cairo_destroy);
+    CairoPtr cr(cairo().create(surface.get()), cairo().destroy);
     draw_page(cr.get(), page, layout);
   }
-  cairo_surface_finish(surface.get());
-  if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error(std::string("cairo: ") + cairo_status_to_string(cairo_surface_status(surface.get())));
+  cairo().surface_finish(surface.get());
+  if (cairo().surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) {
+    throw std::runtime_error(std::string("cairo: ") +
+                             cairo().status_to_string(cairo().surface_status(surface.get())));
   }
   return bytes;
 }

@@ -177,7 +177,7 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
       range_ends "$lo" "$hi" "$excl"
       case $type in
         integer) printf '%s\n' 1.5 ;;
-        real) [[ $unit == s ]] && printf '%s\n' 1/0 ;;
+        real) if [[ $unit == s ]]; then printf '%s\n' 1/0; fi ;;
       esac ;;
     choice)  # the choices from --help
       printf '%s\n' "" nosuch "${1^^}" "$1 " " $1" "$1,$1" 1 ;;

@@ -10,7 +10,8 @@
 # Options whose --help shows a choice list {a, b} are classified as choices automatically.
 # The world parameters' options, registered for every stepping command by one function, get
 # their full lists on simulate and, on the other commands, the few values that show each
-# command checks them (empty, not a number, trailing text, past each end of the range).
+# command checks them (empty, not a number, trailing text, a leading +, past each end of the
+# range).
 #
 # Each command line (nproc of them at a time, or SWEEP_JOBS; SWEEP_TIMEOUT, SWEEP_VERBOSE=1 to
 # list every verdict) runs in a temporary folder (its cwd, with a few fixture files, made again
@@ -86,7 +87,8 @@ declare -A KIND=(
 # Every stepping command registers these options through one function and one set of checks
 # (add_world_options), so their full lists of bad values run on one command (WORLD_FULL); every
 # other command that has them gets the values that show it routes them through those checks
-# (bad_values' "routed" kind): empty, not a number, trailing text, and past each end of the range.
+# (bad_values' "routed" kind): empty, not a number, trailing text, a leading +, and past each end
+# of the range.
 WORLD_FULL=simulate
 declare -A WORLD=()
 while IFS=$'\t' read -r flag type min max excl unit; do
@@ -173,10 +175,11 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     routed:*)  # a world parameter on a command other than WORLD_FULL: routed:TYPE:MIN:MAX:EXCL:UNIT
       local type lo hi excl unit
       IFS=: read -r _ type lo hi excl unit <<< "$kind"
-      printf '%s\n' "" nan 1x
+      # +1 is in every range and refused only by cps's own number parser.
+      printf '%s\n' "" nan 1x +1
       range_ends "$lo" "$hi" "$excl"
       case $type in
-        integer) printf '%s\n' 1.5 ;;
+        integer) printf '%s\n' 1.5 "$((lo - 1))" ;;  # (range_ends' values are not whole numbers)
         real) if [[ $unit == s ]]; then printf '%s\n' 1/0; fi ;;
       esac ;;
     choice)  # the choices from --help
@@ -716,11 +719,14 @@ for sub in "${COMMANDS[@]}"; do
     PLAN_POS[$sub]+="$name|$kind$NL"
   done
 done
-[[ ${#WORLD[@]} == 0 || " ${COMMANDS[*]} " == *" $WORLD_FULL "* ]] ||
-  unclassified+=("the world parameters' full lists run on $WORLD_FULL, which cps does not have (WORLD_FULL)")
+# The world parameters' full lists run on WORLD_FULL: it must have every one of them.
+for flag in "${!WORLD[@]}"; do
+  [[ "$NL${PLAN_OPTS[$WORLD_FULL]:-}" == *"$NL$flag|"* || "${PLAN_OPTS[$WORLD_FULL]:-}" == *",$flag|"* ]] ||
+    unclassified+=("world parameter $flag: not an option of cps $WORLD_FULL, where its full list runs")
+done
 if ((${#unclassified[@]})); then
   echo "bad-input-sweep: --help shows what this sweep does not know how to classify;" \
-    "add it to KIND (and BASE) in $0:" >&2
+    "add it to KIND (and BASE), or set WORLD_FULL, in $0:" >&2
   printf '  %s\n' "${unclassified[@]}" >&2
   exit 3
 fi

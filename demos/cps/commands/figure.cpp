@@ -487,6 +487,7 @@ FigurePlan plan_figure(const FigureOptions& o, int argc, char** argv) {
 // std::runtime_error from the renderer or a write.
 int execute_figure(const FigureOptions& o, const FigurePlan& plan, int argc, char** argv) {
   render::Renderer renderer(plan.size.width, plan.size.height, *render::parse_backend(o.backend));
+  open_cairo();  // before any output: the page's captions and its PDF or SVG need it
   nlohmann::json info = plan.info;
   info["parameters"]["renderer"] = {{"backend", render::backend_name(renderer.backend())},
                                     {"context", renderer.context_description()}};

@@ -62,35 +62,40 @@ struct CairoLib {
                       "could not be opened: ") +
           (why != nullptr ? why : "unknown error"));
     }
-    load(lib, "cairo_clip", clip);
-    load(lib, "cairo_create", create);
-    load(lib, "cairo_destroy", destroy);
-    load(lib, "cairo_fill", fill);
-    load(lib, "cairo_font_extents", font_extents);
-    load(lib, "cairo_image_surface_create", image_surface_create);
-    load(lib, "cairo_image_surface_get_data", image_surface_get_data);
-    load(lib, "cairo_image_surface_get_stride", image_surface_get_stride);
-    load(lib, "cairo_move_to", move_to);
-    load(lib, "cairo_paint", paint);
-    load(lib, "cairo_pdf_surface_create_for_stream", pdf_surface_create_for_stream);
-    load(lib, "cairo_pdf_surface_set_metadata", pdf_surface_set_metadata);
-    load(lib, "cairo_rectangle", rectangle);
-    load(lib, "cairo_restore", restore);
-    load(lib, "cairo_save", save);
-    load(lib, "cairo_select_font_face", select_font_face);
-    load(lib, "cairo_set_font_size", set_font_size);
-    load(lib, "cairo_set_source_rgb", set_source_rgb);
-    load(lib, "cairo_set_source_surface", set_source_surface);
-    load(lib, "cairo_show_text", show_text);
-    load(lib, "cairo_status", status);
-    load(lib, "cairo_status_to_string", status_to_string);
-    load(lib, "cairo_surface_destroy", surface_destroy);
-    load(lib, "cairo_surface_finish", surface_finish);
-    load(lib, "cairo_surface_flush", surface_flush);
-    load(lib, "cairo_surface_mark_dirty", surface_mark_dirty);
-    load(lib, "cairo_surface_status", surface_status);
-    load(lib, "cairo_svg_surface_create_for_stream", svg_surface_create_for_stream);
-    load(lib, "cairo_text_extents", text_extents);
+    try {
+      load(lib, "cairo_clip", clip);
+      load(lib, "cairo_create", create);
+      load(lib, "cairo_destroy", destroy);
+      load(lib, "cairo_fill", fill);
+      load(lib, "cairo_font_extents", font_extents);
+      load(lib, "cairo_image_surface_create", image_surface_create);
+      load(lib, "cairo_image_surface_get_data", image_surface_get_data);
+      load(lib, "cairo_image_surface_get_stride", image_surface_get_stride);
+      load(lib, "cairo_move_to", move_to);
+      load(lib, "cairo_paint", paint);
+      load(lib, "cairo_pdf_surface_create_for_stream", pdf_surface_create_for_stream);
+      load(lib, "cairo_pdf_surface_set_metadata", pdf_surface_set_metadata);
+      load(lib, "cairo_rectangle", rectangle);
+      load(lib, "cairo_restore", restore);
+      load(lib, "cairo_save", save);
+      load(lib, "cairo_select_font_face", select_font_face);
+      load(lib, "cairo_set_font_size", set_font_size);
+      load(lib, "cairo_set_source_rgb", set_source_rgb);
+      load(lib, "cairo_set_source_surface", set_source_surface);
+      load(lib, "cairo_show_text", show_text);
+      load(lib, "cairo_status", status);
+      load(lib, "cairo_status_to_string", status_to_string);
+      load(lib, "cairo_surface_destroy", surface_destroy);
+      load(lib, "cairo_surface_finish", surface_finish);
+      load(lib, "cairo_surface_flush", surface_flush);
+      load(lib, "cairo_surface_mark_dirty", surface_mark_dirty);
+      load(lib, "cairo_surface_status", surface_status);
+      load(lib, "cairo_svg_surface_create_for_stream", svg_surface_create_for_stream);
+      load(lib, "cairo_text_extents", text_extents);
+    } catch (...) {
+      dlclose(lib);  // opened again by the next call
+      throw;
+    }
   }
 
   template <class F>
@@ -424,6 +429,8 @@ std::pair<int, int> fit_panels(const FigurePage& page, int width, int height) {
       (height - (page.rows + 1) * m.gutter - title - legend_height(page, m) - page.rows * caption) / page.rows;
   return {panel_width, panel_height};
 }
+
+void open_cairo() { cairo(); }
 
 render::Image compose_page_pixels(const FigurePage& page, const PageLayout& layout) {
   SurfacePtr surface(cairo().image_surface_create(CAIRO_FORMAT_RGB24, layout.width, layout.height),

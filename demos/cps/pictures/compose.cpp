@@ -1,11 +1,11 @@
 #include "pictures/compose.h"
 
+#include "shared_library.h"
 #include "usage_error.h"
 
 #include <cairo-pdf.h>
 #include <cairo-svg.h>
 #include <cairo.h>
-#include <dlfcn.h>
 
 #include <algorithm>
 #include <cmath>
@@ -54,59 +54,48 @@ struct CairoLib {
   decltype(&::cairo_text_extents) text_extents;
 
   CairoLib() {
-    void* lib = dlopen("libcairo.so.2", RTLD_NOW | RTLD_LOCAL);
-    if (lib == nullptr) {
-      const char* why = dlerror();
-      throw std::runtime_error(
-          std::string("cairo: libcairo.so.2 (Debian: libcairo2), which draws the figure page, "
-                      "could not be opened: ") +
-          (why != nullptr ? why : "unknown error"));
-    }
-    try {
-      load(lib, "cairo_clip", clip);
-      load(lib, "cairo_create", create);
-      load(lib, "cairo_destroy", destroy);
-      load(lib, "cairo_fill", fill);
-      load(lib, "cairo_font_extents", font_extents);
-      load(lib, "cairo_image_surface_create", image_surface_create);
-      load(lib, "cairo_image_surface_get_data", image_surface_get_data);
-      load(lib, "cairo_image_surface_get_stride", image_surface_get_stride);
-      load(lib, "cairo_move_to", move_to);
-      load(lib, "cairo_paint", paint);
-      load(lib, "cairo_pdf_surface_create_for_stream", pdf_surface_create_for_stream);
-      load(lib, "cairo_pdf_surface_set_metadata", pdf_surface_set_metadata);
-      load(lib, "cairo_rectangle", rectangle);
-      load(lib, "cairo_restore", restore);
-      load(lib, "cairo_save", save);
-      load(lib, "cairo_select_font_face", select_font_face);
-      load(lib, "cairo_set_font_size", set_font_size);
-      load(lib, "cairo_set_source_rgb", set_source_rgb);
-      load(lib, "cairo_set_source_surface", set_source_surface);
-      load(lib, "cairo_show_text", show_text);
-      load(lib, "cairo_status", status);
-      load(lib, "cairo_status_to_string", status_to_string);
-      load(lib, "cairo_surface_destroy", surface_destroy);
-      load(lib, "cairo_surface_finish", surface_finish);
-      load(lib, "cairo_surface_flush", surface_flush);
-      load(lib, "cairo_surface_mark_dirty", surface_mark_dirty);
-      load(lib, "cairo_surface_status", surface_status);
-      load(lib, "cairo_svg_surface_create_for_stream", svg_surface_create_for_stream);
-      load(lib, "cairo_text_extents", text_extents);
-    } catch (...) {
-      dlclose(lib);  // opened again by the next call
-      throw;
-    }
-  }
-
-  template <class F>
-  static void load(void* lib, const char* name, F& f) {
-    f = reinterpret_cast<F>(dlsym(lib, name));
-    if (f == nullptr) throw std::runtime_error(std::string("cairo: libcairo.so.2 has no ") + name);
+    const std::string what = "cairo";
+    const std::string hint = " (Debian: libcairo2; it draws the figure page)";
+    const analysis::detail::SharedLibrary lib =
+        analysis::detail::open_shared_library("CPS_CAIRO_LIBRARY", "libcairo.so.2", what, hint);
+    const auto load = [&](const char* name, auto& f) {
+      analysis::detail::resolve_symbol(lib, name, what, hint, f);
+    };
+    load("cairo_clip", clip);
+    load("cairo_create", create);
+    load("cairo_destroy", destroy);
+    load("cairo_fill", fill);
+    load("cairo_font_extents", font_extents);
+    load("cairo_image_surface_create", image_surface_create);
+    load("cairo_image_surface_get_data", image_surface_get_data);
+    load("cairo_image_surface_get_stride", image_surface_get_stride);
+    load("cairo_move_to", move_to);
+    load("cairo_paint", paint);
+    load("cairo_pdf_surface_create_for_stream", pdf_surface_create_for_stream);
+    load("cairo_pdf_surface_set_metadata", pdf_surface_set_metadata);
+    load("cairo_rectangle", rectangle);
+    load("cairo_restore", restore);
+    load("cairo_save", save);
+    load("cairo_select_font_face", select_font_face);
+    load("cairo_set_font_size", set_font_size);
+    load("cairo_set_source_rgb", set_source_rgb);
+    load("cairo_set_source_surface", set_source_surface);
+    load("cairo_show_text", show_text);
+    load("cairo_status", status);
+    load("cairo_status_to_string", status_to_string);
+    load("cairo_surface_destroy", surface_destroy);
+    load("cairo_surface_finish", surface_finish);
+    load("cairo_surface_flush", surface_flush);
+    load("cairo_surface_mark_dirty", surface_mark_dirty);
+    load("cairo_surface_status", surface_status);
+    load("cairo_svg_surface_create_for_stream", svg_surface_create_for_stream);
+    load("cairo_text_extents", text_extents);
   }
 };
 
 // The table, opened on the first call (thread-safe; a failed open throws and is tried again on
-// the next call). Throws std::runtime_error if libcairo.so.2 or one of its functions is missing.
+// the next call): libcairo.so.2, or the file CPS_CAIRO_LIBRARY names. Throws std::runtime_error
+// naming the library if it cannot be opened or lacks one of the functions.
 const CairoLib& cairo() {
   static const CairoLib lib;
   return lib;

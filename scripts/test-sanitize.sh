@@ -8,7 +8,8 @@
 #
 # What runs here: the binaries that never start the cps command (ctest label in-process: the
 # engine, the scenes and scene files, the exact reference, the output rule, image differences,
-# the renderer and the caption page), built alone. Every test, these included, runs in the
+# the renderer and the caption page), built alone. The tests' own files are not instrumented
+# (docs/testing.md: the code they call is). Every test, these included, runs in the
 # Release build of the test command (scripts/test.sh); the command-line tests, which start cps
 # hundreds of times, run only there, so that .ci/run stays under 25 minutes on 2 cores.
 set -euo pipefail

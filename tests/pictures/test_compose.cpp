@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(__SANITIZE_ADDRESS__) || defined(CPS_SANITIZER_RUNTIME)
 // cairo loads fontconfig to find DejaVu Sans, whose pattern cache (about 1 kB) is never freed
 // before exit. The renderer's OSMesa context tells LeakSanitizer so for the cps command; this
 // test does not link that file, so it says it itself (one suppression list per process).

@@ -115,10 +115,10 @@ std::pair<int, int> fit_panels(const FigurePage& page, int width, int height);
 /// text. Throws std::runtime_error if cairo fails.
 std::string compose_page(const FigurePage& page, FigureFormat format, const PageLayout& layout);
 
-/// Opens cairo (libcairo.so.2, with dlopen) if it is not open yet: the functions above open it
-/// when they first need it; a command calls this before it writes anything, so that a machine
-/// without cairo gets the error before any output. Throws std::runtime_error naming the library
-/// when it cannot be opened or lacks a function.
+/// Opens cairo (libcairo.so.2, or the file CPS_CAIRO_LIBRARY names, with dlopen) if it is not
+/// open yet: the functions above open it when they first need it; a command calls this before it
+/// writes anything, so that a machine without cairo gets the error before any output. Throws
+/// std::runtime_error naming the library when it cannot be opened or lacks a function.
 void open_cairo();
 
 /// The page's pixels as composed for PNG (for tests and for the PNG path of compose_page).

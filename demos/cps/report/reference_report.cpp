@@ -224,7 +224,7 @@ std::string references_section(const fs::path& dir, const std::string& scene,
      << 1.05 * std::max(t_used, a->checked_until_s) << "]\n";
   gp << "set title " << gp_text(scene + ": distance between the two references (PGS " +
                                 std::to_string(kReferenceIterations) + " sweeps and the exact "
-                                "solve, both " + std::to_string(kReferenceSubsteps) +
+                                "solve, both " + std::to_string(reference_substeps(studies.quick)) +
                                 " substeps)" + title_note)
      << " font ',11'\nset logscale y\nset format y '1e%T'\nset grid lc rgb '#d8d8d8'\n"
      << "set xlabel 'simulated time (s)'\nset ylabel 'RMS distance of the bodies (m)'\n"
@@ -243,7 +243,7 @@ std::string references_section(const fs::path& dir, const std::string& scene,
 
   std::ostringstream md;
   md << "### Two references and the horizon\n\n"
-     << "Two independent references at the same small dt (" << kReferenceSubsteps
+     << "Two independent references at the same small dt (" << reference_substeps(studies.quick)
      << " substeps per 1/60 s frame, Baumgarte push, fixed friction, cold): PGS at "
      << kReferenceIterations << " sweeps a solve (the trajectory error's reference), and the "
         "exact solve of every step's system in place of the sweeps (World::set_solve_override). "

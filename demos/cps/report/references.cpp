@@ -100,7 +100,7 @@ ReferenceAgreement compare_references(const RunSpec& spec, double until_s, long 
   RunSpec ref = spec;
   ref.solver = SolverKind::pgs;
   ref.iterations = kReferenceIterations;
-  ref.substeps = kReferenceSubsteps;
+  ref.substeps = reference_substeps(spec.quick);
   ref.warm_start = 0.0;
   const scenes::Scene& scene = ref.scene_def();
   scenes::Run pgs = make_run_or_usage_error(scene, ref.overrides());
@@ -122,7 +122,7 @@ ReferenceAgreement compare_references(const RunSpec& spec, double until_s, long 
   });
   std::vector<double> t_all;
   std::vector<double> d_all;
-  const int frame = kReferenceSubsteps;  // steps per 1/60 s
+  const int frame = ref.substeps;  // steps per 1/60 s
   while (scenes::short_of(pgs.world, until_s)) {
     if (a.exact_solves >= max_solves) {
       a.stopped = "the budget of " + std::to_string(max_solves) + " exact solves";
@@ -178,18 +178,19 @@ double local_order(double e_a, int n_a, double e_b, int n_b) {
   return std::log(e_a / e_b) / std::log(static_cast<double>(n_b) / n_a);
 }
 
-const ReferenceAgreement* scene_agreement(const scenes::Scene& scene) {
+const ReferenceAgreement* scene_agreement(const scenes::Scene& scene, bool quick) {
   if (scene.report.has_reference_solution || !is_paper_scene(scene)) return nullptr;
   static OnceCache<ReferenceAgreement> cache;
-  const std::string name(scene.name);
-  return &cache.get(name, [&] {
+  RunSpec paper{std::string(scene.name)};
+  paper.quick = quick;
+  return &cache.get(paper.scene + (quick ? " quick" : ""), [&] {
     const double t = std::min(scene.report_trajectory_time_s(), scene.report_horizon_s());
-    return compare_references(RunSpec{name}, t, kAgreementSolves);
+    return compare_references(paper, t, kAgreementSolves);
   });
 }
 
-double trajectory_time_of(const scenes::Scene& scene) {
-  return trajectory_time_with(scene, scene_agreement(scene));
+double trajectory_time_of(const scenes::Scene& scene, bool quick) {
+  return trajectory_time_with(scene, scene_agreement(scene, quick));
 }
 
 double trajectory_time_with(const scenes::Scene& scene, const ReferenceAgreement* a) {

@@ -85,10 +85,11 @@ inline constexpr long kAgreementSolves = 3000;
 double agreement_horizon(const std::vector<double>& t_s, const std::vector<double>& distance_m,
                          double tolerance_m);
 
-/// Two references of a scene's trajectory at the same small dt (kReferenceSubsteps per 1/60 s
-/// frame, the run's push and friction model, cold): PGS at kReferenceIterations sweeps, and the
-/// exact solve of every step's system (World::set_solve_override with analysis::solve_exact),
-/// stepped side by side and compared every step.
+/// Two references of a scene's trajectory at the same small dt (reference_substeps of the sweep
+/// per 1/60 s frame: those of the trajectory error's reference; the run's push and friction
+/// model, cold): PGS at kReferenceIterations sweeps, and the exact solve of every step's system
+/// (World::set_solve_override with analysis::solve_exact), stepped side by side and compared
+/// every step.
 struct ReferenceAgreement {
   double tolerance_m = 0.0;  ///< kAgreementFraction of the largest movable body (m)
   std::vector<double> t_s;         ///< once a frame (1/60 s) and at the end: the time (s)
@@ -114,12 +115,14 @@ ReferenceAgreement compare_references(const RunSpec& spec, double until_s, long 
 /// (compare_references up to its trajectory time, kAgreementSolves), computed once per process
 /// and kept; nullptr for a scene judged by its own reference solution (has_reference_solution)
 /// or not one of the paper's.
-const ReferenceAgreement* scene_agreement(const scenes::Scene& scene);
+/// `quick`: the quick sweep's (its reference_substeps).
+const ReferenceAgreement* scene_agreement(const scenes::Scene& scene, bool quick);
 
 /// The time (s) at which a run of `scene` measures its trajectory error: its
 /// report_trajectory_time_s (within its horizon), or, when its references part before it
-/// (scene_agreement), their horizon rounded down to a whole 1/60 s frame, at least one frame.
-double trajectory_time_of(const scenes::Scene& scene);
+/// (scene_agreement of the sweep, quick or full), their horizon rounded down to a whole 1/60 s
+/// frame, at least one frame.
+double trajectory_time_of(const scenes::Scene& scene, bool quick);
 /// trajectory_time_of with the references' agreement given (nullptr: none), as a report written
 /// from the studies' CSVs has it. Steps no world. No errors.
 double trajectory_time_with(const scenes::Scene& scene, const ReferenceAgreement* agreement);

@@ -51,7 +51,7 @@ const Reference& reference_of(const RunSpec& spec) {
   ref.warm_start = 0.0;  // one reference for the cold and the warm runs: the paper's start
   // The quick sweep's runs have shorter horizons but the same trajectory time: one reference.
   return cache.get(ref.id(), [&] {
-    const double t = trajectory_time_of(ref.scene_def());
+    const double t = trajectory_time_of(ref.scene_def(), spec.quick);
     Reference r;
     r.positions = positions_at(ref, t);
     RunSpec half = ref;
@@ -239,7 +239,7 @@ MeasuredRun measure_errors(const RunSpec& spec) {
   const scenes::Scene& scene = spec.scene_def();
   const double horizon = spec.horizon_s();
   const bool has_trajectory = !scene.report.has_reference_solution;
-  const double t_traj = trajectory_time_of(scene);
+  const double t_traj = trajectory_time_of(scene, spec.quick);
   scenes::Overrides o = spec.overrides();
   RunResult r = result_of(spec);
   r.dt_s = csv(std::get<double>(*o.find("dt")));

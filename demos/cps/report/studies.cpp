@@ -249,7 +249,7 @@ CsvTable run_study(const StudySpec& spec) {
       s.solver_error = sample_solver_error(paper, s.samples, s.no_solve);
       return solver_error_table(spec.scene, s);
     case StudyKind::references:
-      if (const ReferenceAgreement* a = scene_agreement(paper.scene_def())) s.agreement = *a;
+      if (const ReferenceAgreement* a = scene_agreement(paper.scene_def(), spec.quick)) s.agreement = *a;
       return references_table(spec.scene, s);
     default:
       s.energy = energy_traces(spec.scene, kEnergyPoints, spec.quick);

@@ -398,6 +398,15 @@ TEST_CASE("cps report's quick funnel sweep: trajectory errors where the balls ar
   // Warm-started PGS: the paper's error (trajectory error at 25 it, cold) reached with fewer
   // iterations or not at all, as report.md's table says and the CSV confirms.
   check_warm_table(slurp(dir / "q/report.md"), "funnel", rows, "trajectory_error_m");
+  // The quick sweep checks its two references at its own reference substeps, 8 a frame: at most
+  // one exact solve a step, so at most 3.5 s x 60 x 8 = 1680 to the trajectory time (16 substeps
+  // would take 2350 solves there).
+  CHECK(md.find("Two independent references at the same small dt (8 substeps per 1/60 s frame") !=
+        std::string::npos);
+  const auto agreement = read_table(dir / "q/funnel_references.csv");
+  REQUIRE(!agreement.empty());
+  CHECK(value(agreement.front(), "checked_until_s") == Approx(3.5));
+  CHECK(value(agreement.front(), "exact_solves") <= 3.5 * 60 * 8);
   // Jacobi with the coupled friction model blows the balls apart within 1.3 s, before the
   // trajectory time: it steps on to it, and the blow-up has carried the balls further from the
   // reference pile than a ball's radius.

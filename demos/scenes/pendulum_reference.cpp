@@ -87,4 +87,14 @@ double centre_angle(const PinnedBallPendulum& p, const PendulumState& s) {
                     p.rod_length * std::cos(s.theta) + p.radius * std::cos(s.phi));
 }
 
+std::pair<double, double> centre_angle_and_rate(const PinnedBallPendulum& p, const PendulumState& s) {
+  const double x = p.rod_length * std::cos(s.theta) + p.radius * std::cos(s.phi);  // down
+  const double y = p.rod_length * std::sin(s.theta) + p.radius * std::sin(s.phi);  // across
+  const double x_rate = -p.rod_length * std::sin(s.theta) * s.theta_rate - p.radius * std::sin(s.phi) * s.phi_rate;
+  const double y_rate = p.rod_length * std::cos(s.theta) * s.theta_rate + p.radius * std::cos(s.phi) * s.phi_rate;
+  return {std::atan2(y, x), (x * y_rate - y * x_rate) / (x * x + y * y)};
+}
+
+double swing_phase(double angle, double rate, double w) { return std::atan2(-rate / w, angle); }
+
 }  // namespace cps::scenes

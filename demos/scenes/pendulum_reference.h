@@ -1,4 +1,6 @@
 #pragma once
+#include <utility>
+
 // An independent reference for the pendulum wave: one pendulum in reduced coordinates.
 //
 // A massless rod of length l is pinned at a fixed pivot and at a point on the surface of a ball
@@ -49,5 +51,19 @@ PendulumState integrate_rk4(const PinnedBallPendulum& p, PendulumState start, do
 /// Angle (rad) of the ball centre seen from the pivot, from the downward vertical:
 /// atan2(l sin th + r sin ph, l cos th + r cos ph).
 double centre_angle(const PinnedBallPendulum& p, const PendulumState& s);
+
+/// The centre angle (rad, as centre_angle) and its rate (rad/s).
+std::pair<double, double> centre_angle_and_rate(const PinnedBallPendulum& p,
+                                                const PendulumState& s);
+
+/// The phase (rad, in (-pi, pi]) of a swing at `angle` (rad) and `rate` (rad/s): its angle in
+/// the plane (angle, -rate / w), w the slow mode's small-oscillation frequency (rad/s, > 0).
+double swing_phase(double angle, double rate, double w);
+
+/// RK4 step (s) of the pendulum wave's reference (Sec. 10.3's scene, pendulum_wave.cpp). RK4's
+/// error falls as step^4: over the scene's 62 s the phase of its shortest rod stays within
+/// 2e-6 deg of that at a fifth of this step (a test checks both), far below the phase errors
+/// the scene measures (tenths of a degree and more).
+inline constexpr double kPendulumWaveReferenceStep = 5e-4;
 
 }  // namespace cps::scenes

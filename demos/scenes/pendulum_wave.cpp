@@ -24,7 +24,6 @@ constexpr double kMass = 0.1;              // kg
 constexpr double kSpacing = 0.05;          // m between fixed points along x
 constexpr double kPivotHeight = 1.0;       // m
 constexpr double kReleaseDeg = 15.0;       // release angle from the vertical, in the y-z plane
-constexpr double kReferenceStep = 1e-4;    // s, RK4 step of the reduced-coordinate reference
 constexpr double kGravity = 10.0;          // m/s^2
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
@@ -47,24 +46,12 @@ double swing_rate(const World& world, int n) {
   return (-v.z() * d.y() + d.z() * v.y()) / (d.y() * d.y() + d.z() * d.z());
 }
 
-// The reference's centre angle (rad) and its rate (rad/s), as centre_angle.
-std::pair<double, double> reference_angle(const PinnedBallPendulum& p, const PendulumState& s) {
-  const double x = p.rod_length * std::cos(s.theta) + p.radius * std::cos(s.phi);  // down
-  const double y = p.rod_length * std::sin(s.theta) + p.radius * std::sin(s.phi);  // across
-  const double x_rate = -p.rod_length * std::sin(s.theta) * s.theta_rate - p.radius * std::sin(s.phi) * s.phi_rate;
-  const double y_rate = p.rod_length * std::cos(s.theta) * s.theta_rate + p.radius * std::cos(s.phi) * s.phi_rate;
-  return {std::atan2(y, x), (x * y_rate - y * x_rate) / (x * x + y * y)};
-}
-
-// The phase (rad) of a swing at `angle` (rad) and `rate` (rad/s): its angle in the plane
-// (angle, -rate / w), w the slow mode's small-oscillation frequency (rad/s).
-double swing_phase(double angle, double rate, double w) { return std::atan2(-rate / w, angle); }
-
 // The reference state of a pendulum of rod length l (m) at t (s), carried on from `from` at
 // from_t (s) by RK4 unless known: every run of the scene at the same dt samples the same times,
-// and the 50 references cost 31 million RK4 steps over its 62 s, so they are kept (by l and t to
-// the microsecond) for the runs after the first (a report runs the scene dozens of times), up to
-// kReferenceCacheSize states (about 40 MB: the samples of 62 s at two or three dts).
+// and the 50 references cost 6.2 million RK4 steps over its 62 s (about a second), so they are
+// kept (by l and t to the microsecond) for the runs after the first (a report runs the scene
+// dozens of times), up to kReferenceCacheSize states (about 40 MB: the samples of 62 s at two or
+// three dts).
 constexpr std::size_t kReferenceCacheSize = 400000;
 PendulumState reference_at(const PinnedBallPendulum& p, const PendulumState& from, double from_t, double t) {
   static std::mutex mutex;
@@ -75,7 +62,7 @@ PendulumState reference_at(const PinnedBallPendulum& p, const PendulumState& fro
     const auto it = cache.find(key);
     if (it != cache.end()) return it->second;
   }
-  const PendulumState s = integrate_rk4(p, from, t - from_t, kReferenceStep);
+  const PendulumState s = integrate_rk4(p, from, t - from_t, kPendulumWaveReferenceStep);
   const std::lock_guard<std::mutex> lock(mutex);
   if (cache.size() < kReferenceCacheSize) cache.emplace(key, s);
   return s;
@@ -134,9 +121,10 @@ class PendulumWaveMetrics final : public Metrics {
     if (world_ && !reference_.empty()) {
       for (int n = 0; n < kPendulums; ++n) {
         const PinnedBallPendulum& p = pendulum_[static_cast<std::size_t>(n)];
-        const PendulumState s = integrate_rk4(p, reference_[static_cast<std::size_t>(n)],
-                                              std::max(0.0, world_->time() - reference_time_), kReferenceStep);
-        const double diff = std::remainder(swing_angle(*world_, n) - reference_angle(p, s).first,
+        const PendulumState s =
+            integrate_rk4(p, reference_[static_cast<std::size_t>(n)],
+                          std::max(0.0, world_->time() - reference_time_), kPendulumWaveReferenceStep);
+        const double diff = std::remainder(swing_angle(*world_, n) - centre_angle_and_rate(p, s).first,
                                            2.0 * std::numbers::pi);
         final_angle_error = std::max(final_angle_error, std::abs(diff) * kDeg);
       }
@@ -154,8 +142,9 @@ class PendulumWaveMetrics final : public Metrics {
   }
 
  private:
-  // Every kPhaseSample: the reference carried to now (RK4, kReferenceStep), each pendulum's phase
-  // error (unwrapped from the last sample) and angle error, and their largest so far.
+  // Every kPhaseSample: the reference carried to now (RK4, kPendulumWaveReferenceStep), each
+  // pendulum's phase error (unwrapped from the last sample) and angle error, and their largest so
+  // far.
   void sample_phases(const World& world) {
     const double t = world.time();
     if (reference_.empty()) {
@@ -178,7 +167,7 @@ class PendulumWaveMetrics final : public Metrics {
       const auto k = static_cast<std::size_t>(n);
       const PinnedBallPendulum& p = pendulum_[k];
       reference_[k] = reference_at(p, reference_[k], reference_time_, t);
-      const auto [ref_angle, ref_rate] = reference_angle(p, reference_[k]);
+      const auto [ref_angle, ref_rate] = centre_angle_and_rate(p, reference_[k]);
       const double angle = swing_angle(world, n);
       const double w = frequency_[k];
       const double d = std::remainder(swing_phase(angle, swing_rate(world, n), w) -

@@ -503,6 +503,42 @@ void add_crossing(double t0, double a0, double t1, double a1, std::vector<double
 
 }  // namespace
 
+TEST_CASE("the pendulum wave's reference step is converged: RK4's error falls as step^4 and "
+          "its phase error over 62 s is under 2e-6 deg", "[scene][pendulum_wave]") {
+  // The scene's shortest rod (period 60 s / 100, the fastest swing) released at 15 deg, sampled
+  // as the scene samples it (every 0.02 s to 62 s). RK4's global error is C h^4, so against a
+  // fifth of the step the difference is the error at h to 1 - 1/625, and at 2h it is 16 times
+  // that.
+  const double h = scenes::kPendulumWaveReferenceStep;
+  const scenes::PinnedBallPendulum p{scenes::rod_length_for_period(60.0 / 100.0, 0.02, 10.0), 0.02, 10.0};
+  const double w = scenes::slow_mode_frequency(p);
+  const double release = 15.0 * M_PI / 180.0;
+  const auto phases = [&](double step) {
+    std::vector<double> out;
+    scenes::PendulumState s{release, release, 0.0, 0.0};
+    for (int k = 1; k <= 3100; ++k) {
+      s = scenes::integrate_rk4(p, s, 0.02, step);
+      const auto [angle, rate] = scenes::centre_angle_and_rate(p, s);
+      out.push_back(scenes::swing_phase(angle, rate, w));
+    }
+    return out;
+  };
+  const std::vector<double> fine = phases(h / 5.0);
+  const auto largest_difference = [&](const std::vector<double>& coarse) {
+    double largest = 0.0;  // deg
+    for (std::size_t k = 0; k < fine.size(); ++k) {
+      largest = std::max(largest, std::abs(std::remainder(coarse[k] - fine[k], 2.0 * M_PI)) * 180.0 / M_PI);
+    }
+    return largest;
+  };
+  const double at_h = largest_difference(phases(h));
+  const double at_2h = largest_difference(phases(2.0 * h));
+  INFO("phase difference against step / 5: " << at_h << " deg at the step, " << at_2h << " deg at twice it");
+  CHECK(at_h < 2e-6);
+  CHECK(at_h > 0.0);
+  CHECK(at_2h / at_h == Approx(16.0).epsilon(0.25));
+}
+
 TEST_CASE("the pendulum wave's phase error is a phase: it matches the zero crossings of the "
           "exact pendulum and is not bounded by the swing", "[scene][pendulum_wave]") {
   // At dt = 1/60 s semi-implicit Euler runs the fastest pendulum (100 swings in 60 s) fast by

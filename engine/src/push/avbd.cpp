@@ -15,7 +15,8 @@
 //   the initial guess dx = v dt + g a dt^2, theta = w dt, a = clamp((v - v_prev) . g / |g|^2,
 //   0, 1) (the adaptive warm start of VBD, as the demo).
 // Then `iterations` sweeps of block coordinate descent over the bodies (Gauss-Seidel, the last
-// body added first, as the 3D demo's lists), each body solving with Eigen's LDLT the 6 x 6 system (Eqs. 4-6, 13, 17)
+// body added first, as the 3D demo's lists), each body solving the 6 x 6 system by LDL^T
+// without pivoting, the factorisation of the 2D demo's 3 x 3 body solve (Eqs. 4-6, 13, 17)
 //   H dq = -g,  H = M / dt^2 + sum_j k_j J_j J_j^T + G_j,
 //               g = M / dt^2 (q - y) + sum_j J_j f_j,  f_j = clamp(k_j C_j + lambda_j, limits)
 // with M = diag(m, m, m, I) and J_j the 6-gradient of constraint j for this body; G_j the
@@ -63,7 +64,6 @@
 
 #include "../buffers.h"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -92,6 +92,35 @@ Quat exp_map(const Vec3& theta) {
   const double angle = theta.norm();
   if (angle < 1e-12) return Quat::Identity();
   return Quat(Eigen::AngleAxisd(angle, theta / angle));
+}
+
+// x (6) with H x = g for a symmetric positive definite H (6 x 6): LDL^T without pivoting, as
+// the 2D demo solves its bodies' 3 x 3 systems (source/maths.h solve; Golub & Van Loan, Matrix
+// Computations, 4th ed., Alg. 4.1.2). A zero pivot gives a non-finite x.
+Vec6 solve_ldlt(const Mat6& H, const Vec6& g) {
+  Mat6 L;  // strictly lower part: the unit lower factor's entries
+  Vec6 d;  // D's diagonal
+  for (int i = 0; i < 6; ++i) {
+    double pivot = H(i, i);
+    for (int k = 0; k < i; ++k) pivot -= L(i, k) * L(i, k) * d[k];
+    d[i] = pivot;
+    for (int j = i + 1; j < 6; ++j) {
+      double e = H(j, i);
+      for (int k = 0; k < i; ++k) e -= L(j, k) * L(i, k) * d[k];
+      L(j, i) = e / pivot;
+    }
+  }
+  Vec6 x;
+  for (int i = 0; i < 6; ++i) {  // L y = g
+    double y = g[i];
+    for (int k = 0; k < i; ++k) y -= L(i, k) * x[k];
+    x[i] = y;
+  }
+  for (int i = 0; i < 6; ++i) x[i] /= d[i];  // D z = y
+  for (int i = 5; i >= 0; --i) {  // L^T x = z
+    for (int k = i + 1; k < 6; ++k) x[i] -= L(k, i) * x[k];
+  }
+  return x;
 }
 
 Vec6 axis_gradient(const Vec3& k, const Vec3& r) {
@@ -396,7 +425,7 @@ class Avbd final : public PushMethod {
         H.diagonal() += std::abs(f) * lump;
       }
     }
-    const Vec6 step = H.ldlt().solve(g);
+    const Vec6 step = solve_ldlt(H, g);
     if (!step.allFinite()) return;
     s.dx -= step.head<3>();
     s.theta -= step.tail<3>();

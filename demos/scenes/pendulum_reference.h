@@ -1,6 +1,4 @@
 #pragma once
-#include <utility>
-
 // An independent reference for the pendulum wave: one pendulum in reduced coordinates.
 //
 // A massless rod of length l is pinned at a fixed pivot and at a point on the surface of a ball
@@ -15,6 +13,8 @@
 // Linearised about rest, det(K - w^2 M) = 0 gives
 //   l k w^4 - g (r^2 + k + r l) w^2 + g^2 r = 0,
 // whose smaller root is the slow (pendulum) mode; the larger one is the ball wobbling on its pin.
+
+#include <utility>
 
 namespace cps::scenes {
 

@@ -56,7 +56,7 @@ double centre_angle(const PinnedBallPendulum& p, const PendulumState& s);
 std::pair<double, double> centre_angle_and_rate(const PinnedBallPendulum& p,
                                                 const PendulumState& s);
 
-/// The phase (rad, in (-pi, pi]) of a swing at `angle` (rad) and `rate` (rad/s): its angle in
+/// The phase (rad, in [-pi, pi]) of a swing at `angle` (rad) and `rate` (rad/s): its angle in
 /// the plane (angle, -rate / w), w the slow mode's small-oscillation frequency (rad/s, > 0).
 double swing_phase(double angle, double rate, double w);
 

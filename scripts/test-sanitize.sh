@@ -11,7 +11,8 @@
 # the renderer and the caption page), built alone. The tests' own files are not instrumented
 # (docs/testing.md: the code they call is). Every test, these included, runs in the
 # Release build of the test command (scripts/test.sh); the command-line tests, which start cps
-# hundreds of times, run only there, so that .ci/run stays under 25 minutes on 2 cores.
+# hundreds of times, run only there. Not in .ci/run (it would take CI over 25 minutes on 2 cores):
+# run it by hand before a change to the engine, the renderer, the scenes or the analysis lands.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/deps.sh

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -560,50 +561,62 @@ struct PrefetchStream {
   }
 };
 
+// The fewest runs in a block that the threads claim (BlockClaims; count): claiming (an atomic
+// exchange on a shared line) stays a small part of a block.
+constexpr std::size_t kMinBlockRuns = 16;
+
 // Coloured PGS, thread t of `workers` (every thread runs this with its own t): per sweep, the
-// overflow's runs on thread 0 in order, then each colour's runs split evenly among the threads,
-// with a barrier after each colour. The runs of a colour share no movable body: each writes only
-// its own lambdas and its bodies' w, and reads a contact row's lambda only from its own run
-// (a manifold's rows are one run or runs of different colours).
+// overflow's runs on thread 0 in order, then each colour's runs in blocks that the threads claim
+// as they come (BlockClaims), with a barrier after each colour. The runs of a colour share no
+// movable body: each writes only its own lambdas and its bodies' w, and reads a contact row's
+// lambda only from its own run (a manifold's rows are one run or runs of different colours).
 template <bool kCoupled, class PackedRow>
 [[gnu::always_inline]] inline void coloured_sweeps_body(MatrixFreeSystem& s, int iterations, std::vector<double>& lambda,
                      Workers* workers, int t) {
   const SweepData<PackedRow> d = sweep_data<PackedRow>(s, lambda);
   const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
-  const auto k_t = static_cast<std::size_t>(t);
   const bool prefetch = prefetching<PackedRow>(s);
   const std::size_t row_count = packed<PackedRow>(s).size();
   const std::size_t coupling_size = coupling_of<PackedRow>(s).size();
+  std::optional<BlockClaims> claims;
+  if (threads > 1) claims.emplace(*workers, t);
   bool couple = !s.coupling_ready;
   for (int it = 0; it < iterations; ++it) {
     for (std::size_t k = 0; k < ConstraintGraph::kColours; ++k) {
       const std::size_t begin = s.sweep_start[k];
       const std::size_t count = s.sweep_start[k + 1] - begin;
       if (count == 0) continue;  // every thread sees the same counts
-      std::size_t first = 0;
-      std::size_t last = count;
-      if (k == 0) {
-        if (t != 0) last = 0;
-      } else {
-        first = count * k_t / threads;
-        last = count * (k_t + 1) / threads;
-      }
       const MatrixFreeSystem::Run* runs = s.runs.data() + begin;
       PrefetchStream row_stream(d.rows + row_count);
       PrefetchStream coupling_stream(d.coupling + coupling_size);
-      for (std::size_t i = first; i < last; ++i) {
-        const MatrixFreeSystem::Run& run = runs[i];
-        if (prefetch) {
-          const PackedRow* r = d.rows + run.begin;
-          row_stream.upto(r, r + run.count * run.lanes);
-          if (run.offset >= 0) {
-            const auto* g = d.coupling + run.offset;
-            coupling_stream.upto(g, g + run.lanes * run.count * (run.count - 1) / 2);
+      const auto sweep_runs = [&](std::size_t first, std::size_t last) {
+        for (std::size_t i = first; i < last; ++i) {
+          const MatrixFreeSystem::Run& run = runs[i];
+          if (prefetch) {
+            const PackedRow* r = d.rows + run.begin;
+            row_stream.upto(r, r + run.count * run.lanes);
+            if (run.offset >= 0) {
+              const auto* g = d.coupling + run.offset;
+              coupling_stream.upto(g, g + run.lanes * run.count * (run.count - 1) / 2);
+            }
           }
+          sweep_run<kCoupled, true>(d, run, lambda, couple);
         }
-        sweep_run<kCoupled, true>(d, run, lambda, couple);
+      };
+      if (!claims) {
+        sweep_runs(0, count);
+        continue;
       }
-      if (workers != nullptr) workers->sync();
+      if (k == 0) {  // the overflow: in order, on thread 0
+        if (t == 0) sweep_runs(0, count);
+      } else {
+        const std::size_t blocks = std::clamp(count / kMinBlockRuns, std::size_t{1}, workers->max_blocks());
+        claims->stage(blocks);
+        for (std::size_t block; claims->next(block);) {
+          sweep_runs(count * block / blocks, count * (block + 1) / blocks);
+        }
+      }
+      workers->sync();
     }
     couple = false;
   }

@@ -35,6 +35,7 @@ class Workers {
   /// times on every thread.
   template <class Task>
   void run(Task& task) {
+    ++tasks_;  // published to the workers by start()
     if (count_ == 1) {
       task(0);
       return;
@@ -45,6 +46,11 @@ class Workers {
     task(0);
     finish();
   }
+
+  /// Most blocks a thread in a stage that BlockClaims hands out (count).
+  static constexpr std::size_t kBlocksPerThread = 8;
+  /// Most blocks a stage BlockClaims hands out may have: kBlocksPerThread times count().
+  std::size_t max_blocks() const { return block_stamps_.size(); }
 
   /// Waits until every thread of the running task has reached this call (a barrier); nothing
   /// with one thread. It spins for about kSpins pauses before it sleeps: a sweep meets a
@@ -79,6 +85,14 @@ class Workers {
   std::atomic<std::uint32_t> generation_{0};  // tasks started (and the stop)
   std::atomic<int> running_{0};               // workers still in the current task
   std::atomic<bool> stop_{false};
+  // BlockClaims' claims: per block, the stamp of the last stage that claimed it (each on a line
+  // of its own: the threads write them), and the tasks run so far.
+  struct alignas(64) BlockStamp {
+    std::atomic<std::uint64_t> stamp{0};
+  };
+  std::vector<BlockStamp> block_stamps_;
+  std::uint64_t tasks_ = 0;
+  friend class BlockClaims;
   void (*call_)(void*, int) = nullptr;
   void* task_ = nullptr;
   std::vector<std::thread> threads_;
@@ -104,6 +118,71 @@ void parallel_for(Workers* workers, std::size_t count, std::size_t min_parallel,
   workers->run(share);
 }
 
+/// Thread t's claims on the blocks of the stages of a task that `workers` runs, as Box2D v3's
+/// solver hands out a stage's blocks (erincatto/box2d src/solver.c, b2ExecuteMainStage): each
+/// thread first claims the blocks of its own even share, in order, then any block still
+/// unclaimed, from the last one down. On even cores each thread sweeps the same share in every
+/// stage (its caches hold it); a thread on a slower core (a busy neighbour on a virtual machine)
+/// leaves the end of its share to the others instead of holding them at the barrier. For stages
+/// whose blocks write only their own results (one graph colour), so the result is the same for
+/// every thread count and schedule. Every thread of the task makes one BlockClaims at the
+/// task's start and, for every such stage in the same order, calls stage() and then next() until
+/// it returns false; the stages are separated by Workers::sync(). No errors.
+class BlockClaims {
+ public:
+  BlockClaims(Workers& workers, int t)
+      : stamps_(workers.block_stamps_.data()),
+        threads_(static_cast<std::size_t>(workers.count())),
+        t_(static_cast<std::size_t>(t)),
+        stamp_(workers.tasks_ << 32) {}
+
+  /// Begins a stage of `blocks` blocks (count in [1, Workers::max_blocks()], the same on every
+  /// thread).
+  void stage(std::size_t blocks) {
+    ++stamp_;
+    next_ = blocks * t_ / threads_;
+    own_end_ = blocks * (t_ + 1) / threads_;
+    steal_ = blocks;
+  }
+
+  /// The next block this thread claims in the stage, into `block`; false when none is left.
+  bool next(std::size_t& block) {
+    while (next_ < own_end_) {
+      if (claim(next_)) {
+        block = next_++;
+        return true;
+      }
+      ++next_;
+    }
+    while (steal_ > 0) {
+      --steal_;
+      if (claim(steal_)) {
+        block = steal_;
+        return true;
+      }
+    }
+    return false;
+  }
+
+ private:
+  bool claim(std::size_t k) {
+    std::atomic<std::uint64_t>& s = stamps_[k].stamp;
+    std::uint64_t seen = s.load(std::memory_order_relaxed);
+    while (seen < stamp_) {
+      if (s.compare_exchange_weak(seen, stamp_, std::memory_order_relaxed)) return true;
+    }
+    return false;
+  }
+
+  Workers::BlockStamp* stamps_;
+  std::size_t threads_;
+  std::size_t t_;
+  std::uint64_t stamp_;  // the task in the high half, its stage in the low
+  std::size_t next_ = 0;
+  std::size_t own_end_ = 0;
+  std::size_t steal_ = 0;
+};
+
 /// Runs fn(k) for every chunk k in [0, chunks) on the threads of `workers`, each thread taking
 /// the next chunk no thread has taken yet (so uneven chunks even out); with no workers or one
 /// thread, in order on the calling thread. For chunks that write only their own results, so the
@@ -128,6 +207,7 @@ inline Workers::Workers(int count) : count_(count < 1 ? 1 : count) {
   const unsigned cores = std::thread::hardware_concurrency();  // 0: unknown
   if (cores != 0 && static_cast<unsigned>(count_) > cores) spins_ = idle_spins_ = 0;
   try {
+    block_stamps_ = std::vector<BlockStamp>(kBlocksPerThread * static_cast<std::size_t>(count_));
     threads_.reserve(static_cast<std::size_t>(count_ - 1));
     for (int t = 1; t < count_; ++t) threads_.emplace_back([this, t] { loop(t); });
   } catch (...) {

@@ -40,16 +40,19 @@ using LaneMask = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t
 inline constexpr int kLanes = 4;
 
 /// A body's state in the soft step's solver (soft_step.cpp; after the n bodies, zero stand-ins
-/// for the static bodies and the world).
-struct SolverBody {
+/// for the static bodies and the world). Four whole cache lines, ordered by what the sweeps read:
+/// the warm start the first two (v, w, I^-1, 1/m), the solve and relax also the third and the
+/// fourth (dp, dR), the integration dq.
+struct alignas(64) SolverBody {
   Vec3 v = Vec3::Zero();       // m/s
   Vec3 w = Vec3::Zero();       // rad/s
-  Vec3 dp = Vec3::Zero();      // m: displacement since the start of the step
-  Quat dq = Quat::Identity();  // rotation since the start of the step
-  Mat3 dR = Mat3::Identity();  // dq as a matrix, once a substep
   Mat3 inv_I = Mat3::Zero();   // 1/(kg m^2), world frame, start of the step
   double inv_mass = 0.0;       // 1/kg
+  Vec3 dp = Vec3::Zero();      // m: displacement since the start of the step
+  Mat3 dR = Mat3::Identity();  // dq as a matrix, once a substep
+  Quat dq = Quat::Identity();  // rotation since the start of the step
 };
+static_assert(sizeof(SolverBody) == 256, "a solver body fills four cache lines");
 
 /// Box3D's soft coefficients of one kind of row over a substep (b3MakeSoft; soft_step.cpp).
 struct Softness {

@@ -53,6 +53,7 @@ struct alignas(64) SolverBody {
   Quat dq = Quat::Identity();  // rotation since the start of the step
 };
 static_assert(sizeof(SolverBody) == 256, "a solver body fills four cache lines");
+static_assert(offsetof(SolverBody, dp) == 128, "what the warm start reads fills the first two lines");
 
 /// Box3D's soft coefficients of one kind of row over a substep (b3MakeSoft; soft_step.cpp).
 struct Softness {
@@ -386,16 +387,20 @@ template <bool kBias>
 
 inline constexpr std::size_t kPrefetchAhead = 2;  // groups
 
+// The bytes at the start of a SolverBody that the warm start reads (v, w, I^-1, 1/m).
+inline constexpr std::size_t kWarmStartBodyBytes = offsetof(SolverBody, dp);
+
 // Asks for the cache lines of group i + kPrefetchAhead of [groups, groups + count) ahead of its
-// sweep, where s.prefetch: its bodies, and the group and its points. The groups and points are
-// streamed in order, but the hardware's own prefetching fell behind them (docs/benchmarks.md).
+// sweep, where s.prefetch: the first body_bytes of each of its bodies, and the group and its
+// points. The groups and points are streamed in order, but the hardware's own prefetching fell
+// behind them (docs/benchmarks.md).
 [[gnu::always_inline]] inline void prefetch(const LaneGroup* groups, std::size_t i, std::size_t count,
-                                            const LaneSweep& s) {
+                                            const LaneSweep& s, std::size_t body_bytes = sizeof(SolverBody)) {
   if (!s.prefetch || i + kPrefetchAhead >= count) return;
   const LaneGroup& g = groups[i + kPrefetchAhead];
   for (int l = 0; l < kLanes; ++l) {
-    if (g.a[l] >= 0) detail::prefetch_lines<true>(s.bodies + g.a[l], sizeof(SolverBody));
-    if (g.b[l] >= 0) detail::prefetch_lines<true>(s.bodies + g.b[l], sizeof(SolverBody));
+    if (g.a[l] >= 0) detail::prefetch_lines<true>(s.bodies + g.a[l], body_bytes);
+    if (g.b[l] >= 0) detail::prefetch_lines<true>(s.bodies + g.b[l], body_bytes);
   }
   detail::prefetch_lines<true>(&g, sizeof(LaneGroup));
   detail::prefetch_lines<true>(s.points + g.first_point, static_cast<std::size_t>(g.points) * sizeof(LanePoint));
@@ -407,7 +412,7 @@ inline constexpr std::size_t kPrefetchAhead = 2;  // groups
 /// and each manifold's friction and twist applied to the bodies (soft_step.cpp's warm_start()).
 CPS_LANES_CLONES inline void warm_start_lanes(const LaneGroup* groups, std::size_t count, const LaneSweep& s) {
   for (std::size_t i = 0; i < count; ++i) {
-    lanes::prefetch(groups, i, count, s);
+    lanes::prefetch(groups, i, count, s, lanes::kWarmStartBodyBytes);
     lanes::warm_start_group(groups[i], s);
   }
 }

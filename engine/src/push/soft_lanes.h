@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
 #define CPS_LANES_CLONES __attribute__((target_clones("avx2", "default")))
@@ -180,56 +181,100 @@ struct LaneBody {
   bool moving[kLanes];
 };
 
+// A SolverBody read as 32 doubles: four of them at a time (one 32-byte quarter of a cache line)
+// are one load. The fields' places, in doubles (Eigen stores a Mat3 column by column):
+// v 0-2, w 3-5, inv_I 6-14, inv_mass 15, dp 16-18, dR 19-27.
+static_assert(offsetof(SolverBody, v) == 0 && offsetof(SolverBody, w) == 3 * sizeof(double) &&
+                  offsetof(SolverBody, inv_I) == 6 * sizeof(double) &&
+                  offsetof(SolverBody, inv_mass) == 15 * sizeof(double) &&
+                  offsetof(SolverBody, dR) == 19 * sizeof(double),
+              "gather() and scatter() read the solver body in this order");
+
+// Four doubles from p (32-byte aligned).
+[[gnu::always_inline]] inline Lanes load4(const double* p) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// The 4 x 4 transpose: lane l of c[k] is lane k of r[l] (two rounds of shuffles, no arithmetic).
+[[gnu::always_inline]] inline void transpose(const Lanes (&r)[kLanes], Lanes (&c)[kLanes]) {
+  const Lanes t0 = __builtin_shufflevector(r[0], r[1], 0, 4, 2, 6);
+  const Lanes t1 = __builtin_shufflevector(r[0], r[1], 1, 5, 3, 7);
+  const Lanes t2 = __builtin_shufflevector(r[2], r[3], 0, 4, 2, 6);
+  const Lanes t3 = __builtin_shufflevector(r[2], r[3], 1, 5, 3, 7);
+  c[0] = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
+  c[1] = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
+  c[2] = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
+  c[3] = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
+}
+
+// Doubles 4 k to 4 k + 3 of the four bodies, one field a Lanes (c[i]: double 4 k + i).
+[[gnu::always_inline]] inline void gather_quarter(const SolverBody* const* body, int k, Lanes (&c)[kLanes]) {
+  Lanes r[kLanes];
+  for (int l = 0; l < kLanes; ++l) r[l] = load4(reinterpret_cast<const double*>(body[l]) + 4 * k);
+  transpose(r, c);
+}
+
 // The lanes' bodies of `index` (kLanes body indices, -1 for the stand-in); their positions (dp,
-// dR) and inverse inertias only when asked for. (GCC 12 warns that the members it assigns may be
-// used uninitialized: it does not see that a sweep reads only what it gathered.)
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-[[gnu::always_inline]] inline void gather(LaneBody& L, const int* index, const LaneSweep& s, bool positions,
-                                          bool inertia) {
+// dR) only when asked for. A quarter of each body's line at a time, transposed (as Box3D's
+// b3GatherBodies): the same numbers as reading them one by one.
+[[gnu::always_inline]] inline void gather(LaneBody& L, const int* index, const LaneSweep& s, bool positions) {
   for (int l = 0; l < kLanes; ++l) {
     L.moving[l] = index[l] >= 0;
     L.body[l] = L.moving[l] ? s.bodies + index[l] : s.stand_in;
   }
-  const SolverBody& b0 = *L.body[0];
-  const SolverBody& b1 = *L.body[1];
-  const SolverBody& b2 = *L.body[2];
-  const SolverBody& b3 = *L.body[3];
-  L.v.x = Lanes{b0.v.x(), b1.v.x(), b2.v.x(), b3.v.x()};
-  L.v.y = Lanes{b0.v.y(), b1.v.y(), b2.v.y(), b3.v.y()};
-  L.v.z = Lanes{b0.v.z(), b1.v.z(), b2.v.z(), b3.v.z()};
-  L.w.x = Lanes{b0.w.x(), b1.w.x(), b2.w.x(), b3.w.x()};
-  L.w.y = Lanes{b0.w.y(), b1.w.y(), b2.w.y(), b3.w.y()};
-  L.w.z = Lanes{b0.w.z(), b1.w.z(), b2.w.z(), b3.w.z()};
-  L.inv_mass = Lanes{b0.inv_mass, b1.inv_mass, b2.inv_mass, b3.inv_mass};
-  if (positions) {
-    L.dp.x = Lanes{b0.dp.x(), b1.dp.x(), b2.dp.x(), b3.dp.x()};
-    L.dp.y = Lanes{b0.dp.y(), b1.dp.y(), b2.dp.y(), b3.dp.y()};
-    L.dp.z = Lanes{b0.dp.z(), b1.dp.z(), b2.dp.z(), b3.dp.z()};
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) L.dR.m[r][c] = Lanes{b0.dR(r, c), b1.dR(r, c), b2.dR(r, c), b3.dR(r, c)};
-    }
-  }
-  if (inertia) {
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) L.inv_I.m[r][c] = Lanes{b0.inv_I(r, c), b1.inv_I(r, c), b2.inv_I(r, c), b3.inv_I(r, c)};
-    }
-  }
+  Lanes c[kLanes];
+  gather_quarter(L.body, 0, c);  // v, w.x
+  L.v = {c[0], c[1], c[2]};
+  L.w.x = c[3];
+  gather_quarter(L.body, 1, c);  // w.y, w.z, I^-1 (0, 0), (1, 0)
+  L.w.y = c[0];
+  L.w.z = c[1];
+  L.inv_I.m[0][0] = c[2];
+  L.inv_I.m[1][0] = c[3];
+  gather_quarter(L.body, 2, c);  // I^-1 (2, 0), (0, 1), (1, 1), (2, 1)
+  L.inv_I.m[2][0] = c[0];
+  L.inv_I.m[0][1] = c[1];
+  L.inv_I.m[1][1] = c[2];
+  L.inv_I.m[2][1] = c[3];
+  gather_quarter(L.body, 3, c);  // I^-1 (0, 2), (1, 2), (2, 2), 1/m
+  L.inv_I.m[0][2] = c[0];
+  L.inv_I.m[1][2] = c[1];
+  L.inv_I.m[2][2] = c[2];
+  L.inv_mass = c[3];
+  if (!positions) return;
+  gather_quarter(L.body, 4, c);  // dp, dR (0, 0)
+  L.dp = {c[0], c[1], c[2]};
+  L.dR.m[0][0] = c[3];
+  gather_quarter(L.body, 5, c);  // dR (1, 0), (2, 0), (0, 1), (1, 1)
+  L.dR.m[1][0] = c[0];
+  L.dR.m[2][0] = c[1];
+  L.dR.m[0][1] = c[2];
+  L.dR.m[1][1] = c[3];
+  gather_quarter(L.body, 6, c);  // dR (2, 1), (0, 2), (1, 2), (2, 2)
+  L.dR.m[2][1] = c[0];
+  L.dR.m[0][2] = c[1];
+  L.dR.m[1][2] = c[2];
+  L.dR.m[2][2] = c[3];
 }
 
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic pop
-#endif
-
 // Writes the lanes' velocities back to their moving bodies (a stand-in's stay zero: it has no
-// mass and no inverse inertia).
+// mass and no inverse inertia), transposed back: the first quarter of a body's line whole (v,
+// w.x), then w.y and w.z.
 [[gnu::always_inline]] inline void scatter(const LaneBody& L) {
+  using Pair = double __attribute__((vector_size(2 * sizeof(double))));
+  Lanes r[kLanes];
+  transpose({L.v.x, L.v.y, L.v.z, L.w.x}, r);
+  const Lanes even = __builtin_shufflevector(L.w.y, L.w.z, 0, 4, 2, 6);  // lanes 0 and 2
+  const Lanes odd = __builtin_shufflevector(L.w.y, L.w.z, 1, 5, 3, 7);   // lanes 1 and 3
+  const Pair yz[kLanes] = {__builtin_shufflevector(even, even, 0, 1), __builtin_shufflevector(odd, odd, 0, 1),
+                           __builtin_shufflevector(even, even, 2, 3), __builtin_shufflevector(odd, odd, 2, 3)};
   for (int l = 0; l < kLanes; ++l) {
     if (!L.moving[l]) continue;
-    L.body[l]->v = Vec3(L.v.x[l], L.v.y[l], L.v.z[l]);
-    L.body[l]->w = Vec3(L.w.x[l], L.w.y[l], L.w.z[l]);
+    auto* p = reinterpret_cast<double*>(L.body[l]);
+    std::memcpy(p, &r[l], sizeof r[l]);
+    std::memcpy(p + 4, &yz[l], sizeof yz[l]);
   }
 }
 
@@ -277,8 +322,8 @@ struct LaneRow {
 [[gnu::always_inline]] inline void warm_start_group(const LaneGroup& g, const LaneSweep& s) {
   LaneBody A;
   LaneBody B;
-  gather(A, g.a, s, false, true);
-  gather(B, g.b, s, false, true);
+  gather(A, g.a, s, false);
+  gather(B, g.b, s, false);
   const LanePoint* q = s.points + g.first_point;
   for (int k = 0; k < g.points; ++k) apply(q[k], row_of(q[k], A, B), q[k].impulse, A, B);
   if (s.friction) {
@@ -368,8 +413,8 @@ template <bool kBias>
   const bool friction = !kBias && s.friction;
   LaneBody A;
   LaneBody B;
-  gather(A, g.a, s, true, true);
-  gather(B, g.b, s, true, true);
+  gather(A, g.a, s, true);
+  gather(B, g.b, s, true);
   LanePoint* q = s.points + g.first_point;
   LaneTotal* totals = s.totals != nullptr ? s.totals + g.first_point : nullptr;
   const LaneMask stiff = g.touches_static != 0.0;

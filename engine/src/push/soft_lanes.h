@@ -72,19 +72,21 @@ struct LaneVec3 {
 
 /// Point k of each lane's manifold (zero in a lane whose manifold has fewer points): the scalar
 /// sweep's ContactPoint and its normal row, in lanes, in the order a sweep reads them. Units as
-/// there: axis unit, r_a and r_b m, mass kg, impulse N s, separation and lever arm m. Its
-/// I^-1 (r x axis) are formed in the sweep from the bodies' I^-1, as prepare formed them, so that
-/// a point streams 104 bytes a lane instead of 168; its step's total impulse is kept apart
-/// (LaneSweep::totals), summed only where a contact has a restitution target.
+/// there: r_a and r_b m, mass kg, impulse N s, separation and lever arm m. Its row's axis is
+/// its manifold's normal (every point of a Manifold has the same), read from the group
+/// (lanes::axis_of); its I^-1 (r x axis) are formed in the sweep from the bodies' I^-1, as
+/// prepare formed them: so a point streams 80 bytes a lane instead of 168. Its step's total
+/// impulse is kept apart (LaneSweep::totals), summed only where a contact has a restitution
+/// target.
 struct LanePoint {
   LaneVec3 r_a;
   LaneVec3 r_b;
-  LaneVec3 axis;
   Lanes base_separation{};
   Lanes mass{};
   Lanes impulse{};
   Lanes lever_arm{};
 };
+static_assert(sizeof(LanePoint) == 10 * sizeof(Lanes), "a point streams 80 bytes a lane");
 
 /// A point's total normal impulse over the step (N s), per lane (a struct, so that containers
 /// keep the lanes' alignment).
@@ -287,20 +289,29 @@ struct LaneRow {
   LaneVec3 Irn_b;
 };
 
-[[gnu::always_inline]] inline LaneRow row_of(const LanePoint& q, const LaneBody& A, const LaneBody& B) {
+[[gnu::always_inline]] inline LaneRow row_of(const LanePoint& q, const LaneVec3& axis, const LaneBody& A,
+                                              const LaneBody& B) {
   LaneRow row;
-  row.rn_a = cross(q.r_a, q.axis);
-  row.rn_b = cross(q.r_b, q.axis);
+  row.rn_a = cross(q.r_a, axis);
+  row.rn_b = cross(q.r_b, axis);
   row.Irn_a = mul(A.inv_I, row.rn_a);
   row.Irn_b = mul(B.inv_I, row.rn_b);
   return row;
 }
 
-// soft_step.cpp's apply(): impulse P along a point's normal row, -P to a, +P to b.
-[[gnu::always_inline]] inline void apply(const LanePoint& q, const LaneRow& row, Lanes P, LaneBody& A, LaneBody& B) {
-  A.v = A.v - (A.inv_mass * P) * q.axis;
+// Point k's axis in each lane: its manifold's normal, or zero in a lane whose manifold has no
+// point k (as a zero point's row: its impulse stays +0 and adds exactly nothing to the bodies).
+[[gnu::always_inline]] inline LaneVec3 axis_of(const LaneGroup& g, int k) {
+  const LaneMask has = splat(static_cast<double>(k)) < g.count;
+  return {select(has, g.normal.x, splat(0.0)), select(has, g.normal.y, splat(0.0)),
+          select(has, g.normal.z, splat(0.0))};
+}
+
+// soft_step.cpp's apply(): impulse P along a point's normal row (its axis), -P to a, +P to b.
+[[gnu::always_inline]] inline void apply(const LaneVec3& axis, const LaneRow& row, Lanes P, LaneBody& A, LaneBody& B) {
+  A.v = A.v - (A.inv_mass * P) * axis;
   A.w = A.w - P * row.Irn_a;
-  B.v = B.v + (B.inv_mass * P) * q.axis;
+  B.v = B.v + (B.inv_mass * P) * axis;
   B.w = B.w + P * row.Irn_b;
 }
 
@@ -325,7 +336,10 @@ struct LaneRow {
   gather(A, g.a, s, false);
   gather(B, g.b, s, false);
   const LanePoint* q = s.points + g.first_point;
-  for (int k = 0; k < g.points; ++k) apply(q[k], row_of(q[k], A, B), q[k].impulse, A, B);
+  for (int k = 0; k < g.points; ++k) {
+    const LaneVec3 axis = axis_of(g, k);
+    apply(axis, row_of(q[k], axis, A, B), q[k].impulse, A, B);
+  }
   if (s.friction) {
     apply_friction(g, g.impulse1 * g.t1 + g.impulse2 * g.t2, A, B);
     apply_twist(g, g.twist_impulse, A, B);
@@ -334,13 +348,13 @@ struct LaneRow {
   scatter(B);
 }
 
-// soft_step.cpp's solve_normal() for point q of each lane; `stiff` marks the lanes whose
-// manifold has a static body; `total` the point's sum over the step, or null.
+// soft_step.cpp's solve_normal() for point q of each lane, along `axis` (axis_of); `stiff` marks
+// the lanes whose manifold has a static body; `total` the point's sum over the step, or null.
 template <bool kBias>
-[[gnu::always_inline]] inline Lanes solve_normal(LanePoint& q, LaneMask stiff, LaneTotal* total, LaneBody& A, LaneBody& B,
-                                                 const LaneSweep& s) {
+[[gnu::always_inline]] inline Lanes solve_normal(LanePoint& q, const LaneVec3& axis, LaneMask stiff, LaneTotal* total,
+                                                 LaneBody& A, LaneBody& B, const LaneSweep& s) {
   const LaneVec3 ds = (B.dp - A.dp) + (mul(B.dR, q.r_b) - mul(A.dR, q.r_a));
-  const Lanes sep = dot(q.axis, ds) + q.base_separation;
+  const Lanes sep = dot(axis, ds) + q.base_separation;
   const LaneMask speculative = sep > 0.0;
   Lanes bias = select(speculative, sep * s.inv_h, splat(0.0));
   Lanes mass_scale = splat(1.0);
@@ -357,14 +371,14 @@ template <bool kBias>
     mass_scale = select(speculative, mass_scale, k_mass);
     impulse_scale = select(speculative, impulse_scale, k_impulse);
   }
-  const LaneRow row = row_of(q, A, B);
-  const Lanes speed = (dot(q.axis, B.v - A.v) + dot(row.rn_b, B.w)) - dot(row.rn_a, A.w);
+  const LaneRow row = row_of(q, axis, A, B);
+  const Lanes speed = (dot(axis, B.v - A.v) + dot(row.rn_b, B.w)) - dot(row.rn_a, A.w);
   const Lanes old = q.impulse;
   Lanes next = old - q.mass * (mass_scale * speed + bias) - impulse_scale * old;
   next = select(next < 0.0, splat(0.0), next);  // std::max(next, 0)
   q.impulse = next;
   if (total != nullptr) total->impulse = total->impulse + next;
-  apply(q, row, next - old, A, B);
+  apply(axis, row, next - old, A, B);
   return next;
 }
 
@@ -421,7 +435,7 @@ template <bool kBias>
   Lanes total = splat(0.0);
   Lanes twist_limit = splat(0.0);
   for (int k = 0; k < g.points; ++k) {
-    const Lanes next = solve_normal<kBias>(q[k], stiff, totals != nullptr ? totals + k : nullptr, A, B, s);
+    const Lanes next = solve_normal<kBias>(q[k], axis_of(g, k), stiff, totals != nullptr ? totals + k : nullptr, A, B, s);
     total = total + next;
     twist_limit = twist_limit + q[k].lever_arm * next;
   }

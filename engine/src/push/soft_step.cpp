@@ -701,7 +701,6 @@ class SoftStep final : public PushMethod {
   static void zero_lane(LanePoint& q, int l) {
     put(q.r_a, l, Vec3::Zero());
     put(q.r_b, l, Vec3::Zero());
-    put(q.axis, l, Vec3::Zero());
     at(q.base_separation, l) = 0.0;
     at(q.mass, l) = 0.0;
     at(q.impulse, l) = 0.0;
@@ -720,7 +719,6 @@ class SoftStep final : public PushMethod {
     for (std::size_t i = 0; i < count; ++i) {
       const ContactPoint& p = points[i];
       LanePoint& lp = q[i];
-      put(lp.axis, l, p.normal.axis);
       put(lp.r_a, l, p.r_a);
       put(lp.r_b, l, p.r_b);
       at(lp.mass, l) = p.normal.mass;
@@ -770,7 +768,7 @@ class SoftStep final : public PushMethod {
       p.row = static_cast<int>(first_row_[k] + i);
       p.r_a = Vec3(q[i].r_a.x[l], q[i].r_a.y[l], q[i].r_a.z[l]);
       p.r_b = Vec3(q[i].r_b.x[l], q[i].r_b.y[l], q[i].r_b.z[l]);
-      p.normal.axis = Vec3(q[i].axis.x[l], q[i].axis.y[l], q[i].axis.z[l]);
+      p.normal.axis = Vec3(group.normal.x[l], group.normal.y[l], group.normal.z[l]);
       p.normal.impulse = q[i].impulse[l];
       p.total_impulse = totals != nullptr ? totals[i].impulse[l] : 0.0;
       p.restitution = restitution_targets_.empty() ? 0.0 : restitution_targets_[static_cast<std::size_t>(p.row)];

@@ -511,6 +511,55 @@ TEST_CASE("cps bench --scene steps the world parameters it is given", "[cli][ben
   fs::remove_all(dir);
 }
 
+TEST_CASE("cps bench --growth gives the slopes of the times and rows it prints", "[cli][bench]") {
+  const fs::path dir = fresh_dir("bench_growth");
+  const Result r = cps("bench --quick --json --growth pyramid --sizes 100,300 --friction 0 --solver coloured-pgs", dir);
+  REQUIRE(r.exit_code == 0);
+  const nlohmann::json g = nlohmann::json::parse(r.out)["growth_series"];
+  INFO(g.dump());
+  CHECK(g["family"] == "pyramid_N");
+  CHECK(g["assembly"] == "matrix-free");
+  CHECK(g["parameters"]["friction"] == "0");
+  CHECK(g["parameters"]["solver"] == "coloured-pgs");
+  REQUIRE(g["points"].size() == 2);
+  const nlohmann::json& a = g["points"][0];
+  const nlohmann::json& b = g["points"][1];
+  CHECK(a["scene"] == "pyramid_100");
+  CHECK(b["scene"] == "pyramid_300");
+  // A log-log slope over two points is the ratio of the logarithms' differences.
+  const auto slope = [&](const char* key) {
+    return std::log(b[key].get<double>() / a[key].get<double>()) /
+           std::log(b["bodies"].get<double>() / a["bodies"].get<double>());
+  };
+  CHECK(g["slope_against_bodies"].get<double>() == Approx(slope("us_per_step")).epsilon(1e-9));
+  CHECK(g["rows_slope_against_bodies"].get<double>() == Approx(slope("rows_per_step")).epsilon(1e-9));
+  CHECK(g["slope_against_rows"].get<double>() ==
+        Approx(std::log(b["us_per_step"].get<double>() / a["us_per_step"].get<double>()) /
+               std::log(b["rows_per_step"].get<double>() / a["rows_per_step"].get<double>()))
+            .epsilon(1e-9));
+  for (const nlohmann::json* p : {&a, &b}) {
+    CHECK((*p)["us_per_body"].get<double>() ==
+          Approx((*p)["us_per_step"].get<double>() / (*p)["bodies"].get<double>()).epsilon(1e-12));
+  }
+  // The paper's push solves once a step: no relax, so no relax slope; the solve has one.
+  CHECK(g["stage_slopes_against_bodies"]["relax"].is_null());
+  CHECK(g["stage_slopes_against_bodies"]["solve"].is_number());
+  // Bad input is refused before any work, naming what is allowed.
+  const auto refused = [&](const std::string& args, const std::string& named) {
+    const Result bad = cps(args, dir);
+    INFO(args << "\n" << bad.err);
+    CHECK(bad.exit_code == 2);
+    CHECK(bad.err.find(named) != std::string::npos);
+  };
+  refused("bench --growth pyramid --sizes 100,100", "two different sizes");
+  refused("bench --growth pyramid --sizes 100,30000", "1..20000");
+  refused("bench --growth random --sizes 1,2", "pyramid_N");
+  refused("bench --sizes 100,300", "--growth");
+  refused("bench --growth pyramid --scene stack", "--scene");
+  refused("bench --growth pyramid --sizes 100,300 --max-work 1000", "--max-work");
+  fs::remove_all(dir);
+}
+
 TEST_CASE("cps report never overwrites a foreign report.md, CSV or run.json", "[cli][output]") {
   const fs::path dir = fresh_dir("report_foreign");
   // A complete sweep to merge (the intersecting stack's quick one), computed and timed on one

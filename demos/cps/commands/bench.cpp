@@ -353,7 +353,9 @@ struct BenchOptions {
   bool json = false;       // one JSON document on stdout instead of Markdown tables
   std::vector<std::string> scenes;  // only these scenes, physics table only (empty: every table)
   double max_work = kDefaultMaxWork;  // body-iterations a --scene may step
-  scenes::Overrides overrides;      // world parameters of the --scene runs
+  scenes::Overrides overrides;      // world parameters of the --scene or --growth runs
+  std::string growth;               // a scaled family: only its cost growth (empty: not asked)
+  std::vector<int> sizes;           // --growth's sizes (empty: default_growth_sizes)
 };
 
 // The physics table's scenes: the paper's, then scaled ones (larger ones unless quick).
@@ -482,9 +484,141 @@ nlohmann::json warm_start_table(const std::vector<std::string>& names, bool quic
   return rows;
 }
 
-// The cost growth table (matrix-free): log-log slopes of time per step against bodies and rows.
+// One scene of a cost-growth series: its bodies and its cost over the window.
+struct GrowthPoint {
+  std::string scene;
+  double bodies = 0.0;
+  StepCost cost;
+};
+
+// The sizes of the cost-growth table when none are given.
+std::vector<int> default_growth_sizes(bool quick) {
+  return quick ? std::vector<int>{100, 300, 1000} : std::vector<int>{100, 300, 1000, 3000, 5000};
+}
+
+// A growth point's window: 3 steps (quick) or 6 from the scene's bench start, 5 timed repeats.
+constexpr int kGrowthRepeats = 5;
+int growth_steps(bool quick) { return quick ? 3 : 6; }
+
+// The scaled scene family_N for each size, each checked against max_work (body-iterations: the
+// steps to the window, the window untimed, timed kGrowthRepeats times and once with stage
+// timing). Throws UsageError for an unknown family (listing the families), a size the family
+// does not take (its range) or a run past max_work.
+std::vector<const scenes::Scene*> growth_scenes(const std::string& family, const std::vector<int>& sizes,
+                                                const scenes::Overrides& overrides, bool quick,
+                                                double max_work) {
+  std::string families;
+  bool known = false;
+  for (const std::string_view f : scenes::scaled_families()) {
+    families += (families.empty() ? "" : ", ") + std::string(f);
+    known = known || f.starts_with(family + "_N ");
+  }
+  if (!known) throw UsageError("--growth " + family + ": not a scaled scene family; allowed: " + families);
+  std::vector<int> distinct = sizes;
+  std::sort(distinct.begin(), distinct.end());
+  if (std::unique(distinct.begin(), distinct.end()) - distinct.begin() < 2) {
+    throw UsageError("--sizes: a slope needs at least two different sizes");
+  }
+  std::vector<const scenes::Scene*> out;
+  for (const int n : sizes) {
+    const scenes::Scene* found = scenes::find_scene(family + "_" + std::to_string(n));
+    if (found == nullptr) {
+      std::string why = "not a size of the family";
+      try {
+        (void)scenes::scaled_scene(family, n);
+      } catch (const std::invalid_argument& e) {
+        why = e.what();
+      }
+      throw UsageError("--sizes " + std::to_string(n) + ": " + why);
+    }
+    out.push_back(found);
+    const scenes::Scene& scene = *found;
+    const scenes::Run run = make_run_or_usage_error(scene, overrides);
+    const WorldDef& def = run.world.def();
+    const double steps = std::round(scene.bench.start_s / def.dt) + (kGrowthRepeats + 2.0) * growth_steps(quick);
+    check_work("the steps of " + std::string(scene.name) + " (to its window, then through it once untimed, " +
+                   std::to_string(kGrowthRepeats) + " times timed and once by stage)",
+               run.world.bodies().size(), def, steps * def.dt, max_work,
+               "give smaller --sizes, or raise --max-work");
+  }
+  return out;
+}
+
+// Each scene's cost over its window (step_cost; the assembly its world parameters give).
+std::vector<GrowthPoint> measure_growth(const std::vector<const scenes::Scene*>& series,
+                                        const scenes::Overrides& overrides, bool quick) {
+  std::vector<GrowthPoint> points;
+  for (const scenes::Scene* scene : series) {
+    notes() << "bench: " << scene->name << "\n";
+    const WorldDef def = scenes::world_def_with(*scene, overrides);
+    GrowthPoint p;
+    p.scene = std::string(scene->name);
+    p.bodies = static_cast<double>(scenes::make_run(*scene, overrides).world.bodies().size());
+    p.cost = step_cost(*scene, overrides, def.assembly, scene->bench.start_s, growth_steps(quick), kGrowthRepeats);
+    points.push_back(std::move(p));
+  }
+  return points;
+}
+
+// Log-log slope of y(point) against bodies; NaN when y is not > 0 at every point (a stage the
+// method does not run) or fewer than two different body counts.
+template <class Y>
+double growth_slope(const std::vector<GrowthPoint>& points, Y&& y) {
+  std::vector<std::pair<double, double>> xy;
+  for (const GrowthPoint& p : points) {
+    const double v = y(p);
+    if (!(v > 0.0)) return std::nan("");
+    xy.emplace_back(p.bodies, v);
+  }
+  return log_log_slope(xy);
+}
+
+// A stage's slope is given where it takes at least this share of every point's stage-timed step
+// (dimensionless): below it the stage's time is a few timer reads, and its slope noise.
+constexpr double kSlopeShare = 0.01;
+
+// The slopes of a series: the step's against bodies and against rows, the rows' against bodies,
+// and each stage's against bodies (null where growth_slope is NaN or the stage is below
+// kSlopeShare of a point's step).
+nlohmann::json growth_slopes(const std::vector<GrowthPoint>& points) {
+  const auto or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  std::vector<std::pair<double, double>> by_rows;
+  for (const GrowthPoint& p : points) by_rows.emplace_back(std::max(p.cost.rows, 1.0), p.cost.us);
+  nlohmann::json stages = nlohmann::json::object();
+  for (const auto& [name, stage] : kStages) {
+    stages[name] = or_null(growth_slope(points, [stage](const GrowthPoint& p) {
+      const double t = p.cost.stages.*stage;
+      return t >= kSlopeShare * p.cost.stages.total() ? t : 0.0;
+    }));
+  }
+  return {{"slope_against_bodies", or_null(growth_slope(points, [](const GrowthPoint& p) { return p.cost.us; }))},
+          {"slope_against_rows", or_null(log_log_slope(by_rows))},
+          {"rows_slope_against_bodies", or_null(growth_slope(points, [](const GrowthPoint& p) { return p.cost.rows; }))},
+          {"stage_slopes_against_bodies", stages}};
+}
+
+// The JSON of one point: bodies, rows, us per step (thread CPU, or wall on threads) and per
+// body, and the stages' us per step (wall, from the stage-timed repeat).
+nlohmann::json growth_point_json(const GrowthPoint& p) {
+  return {{"scene", p.scene},
+          {"bodies", p.bodies},
+          {"rows_per_step", p.cost.rows},
+          {"us_per_step", p.cost.us},
+          {"us_per_body", p.cost.us / p.bodies},
+          {"stages_us_per_step", stages_json(p.cost.stages)}};
+}
+
+// A slope as a table cell: two decimals, or "-" where there is none.
+std::string slope_cell(const nlohmann::json& v) {
+  if (v.is_null()) return "-";
+  char cell[32];
+  std::snprintf(cell, sizeof cell, "%.2f", v.get<double>());
+  return cell;
+}
+
+// The cost growth table (matrix-free, each family at its own settings): log-log slopes of time
+// per step against bodies and rows.
 nlohmann::json growth_table(bool quick, bool markdown) {
-  constexpr int k_repeats = 5;
   if (markdown) {
     std::printf("\n## Cost growth (matrix-free): log-log slope of time per step against bodies\n\n"
                 "Also against the rows per step: a larger pile has more contacts per body (fewer "
@@ -492,43 +626,84 @@ nlohmann::json growth_table(bool quick, bool markdown) {
                 "| family | bodies: us/step (rows/step) | slope against bodies | slope against rows "
                 "|\n|---|---|---|---|\n");
   }
-  const std::vector<int> sizes = quick ? std::vector<int>{100, 300, 1000}
-                                       : std::vector<int>{100, 300, 1000, 3000, 5000};
   nlohmann::json families = nlohmann::json::array();
   for (const char* family : {"pyramid", "funnel"}) {
-    std::vector<std::pair<double, double>> by_bodies;
-    std::vector<std::pair<double, double>> by_rows;
-    nlohmann::json points = nlohmann::json::array();
+    const std::vector<GrowthPoint> points =
+        measure_growth(growth_scenes(family, default_growth_sizes(quick), {}, quick, kMaxMaxWork), {}, quick);
+    nlohmann::json series = nlohmann::json::array();
     std::string cells;
-    for (const int n : sizes) {
-      const std::string name = std::string(family) + "_" + std::to_string(n);
-      notes() << "bench: " << name << "\n";
-      const scenes::Scene& scene = *scenes::find_scene(name);
-      const double bodies = static_cast<double>(scenes::make_run(scene).world.bodies().size());
-      const StepCost cost =
-          step_cost(scene, {}, Assembly::matrix_free, scene.bench.start_s, quick ? 3 : 6, k_repeats);
-      by_bodies.emplace_back(bodies, cost.us);
-      by_rows.emplace_back(std::max(cost.rows, 1.0), cost.us);
-      points.push_back({{"scene", name},
-                        {"bodies", bodies},
-                        {"rows_per_step", cost.rows},
-                        {"matrix_free_us_per_step", cost.us}});
+    for (const GrowthPoint& p : points) {
+      series.push_back({{"scene", p.scene},
+                        {"bodies", p.bodies},
+                        {"rows_per_step", p.cost.rows},
+                        {"matrix_free_us_per_step", p.cost.us}});
       char cell[96];
-      std::snprintf(cell, sizeof cell, "%s%.0f: %.0f (%.0f)", cells.empty() ? "" : ", ", bodies,
-                    cost.us, cost.rows);
+      std::snprintf(cell, sizeof cell, "%s%.0f: %.0f (%.0f)", cells.empty() ? "" : ", ", p.bodies, p.cost.us,
+                    p.cost.rows);
       cells += cell;
     }
-    const double slope_bodies = log_log_slope(by_bodies);
-    const double slope_rows = log_log_slope(by_rows);
+    const nlohmann::json slopes = growth_slopes(points);
     families.push_back({{"family", std::string(family) + "_N"},
-                        {"points", points},
-                        {"slope_against_bodies", slope_bodies},
-                        {"slope_against_rows", slope_rows}});
+                        {"points", series},
+                        {"slope_against_bodies", slopes["slope_against_bodies"]},
+                        {"slope_against_rows", slopes["slope_against_rows"]}});
     if (markdown) {
-      std::printf("| %s_N | %s | %.2f | %.2f |\n", family, cells.c_str(), slope_bodies, slope_rows);
+      std::printf("| %s_N | %s | %s | %s |\n", family, cells.c_str(),
+                  slope_cell(slopes["slope_against_bodies"]).c_str(), slope_cell(slopes["slope_against_rows"]).c_str());
     }
   }
   return families;
+}
+
+// `cps bench --growth FAMILY`: the series family_N over `sizes` with the world parameters given,
+// point by point and stage by stage, in us per body, with every slope (growth_slopes).
+nlohmann::json growth_series_table(const std::string& family, const std::vector<const scenes::Scene*>& series,
+                                   const scenes::Overrides& overrides, bool quick, bool markdown) {
+  const std::vector<GrowthPoint> points = measure_growth(series, overrides, quick);
+  const WorldDef def = scenes::world_def_with(*series.front(), overrides);
+  nlohmann::json parameters = nlohmann::json::object();
+  for (const auto& [parameter, value] : overrides.values) parameters[std::string(parameter->name)] = parameter->format(value);
+  nlohmann::json out = {{"family", family + "_N"},
+                        {"parameters", parameters},
+                        {"assembly", def.assembly == Assembly::explicit_matrices ? "explicit" : "matrix-free"},
+                        {"threads", def.threads},
+                        {"clock", def.threads > 1 ? "wall" : "thread_cpu"},
+                        {"steps", growth_steps(quick)},
+                        {"repeats", kGrowthRepeats},
+                        {"points", nlohmann::json::array()}};
+  for (const GrowthPoint& p : points) out["points"].push_back(growth_point_json(p));
+  const nlohmann::json slopes = growth_slopes(points);
+  out.update(slopes);
+  if (!markdown) return out;
+  std::string given;
+  for (const auto& [parameter, value] : overrides.values) {
+    given += " --" + std::string(parameter->flag) + " " + parameter->format(value);
+  }
+  std::printf("## Cost growth of %s_N (%s; %s)\n\n"
+              "us per step: the median of %d repeats of %d steps from each scene's bench start (%s); "
+              "the stages: one more repeat with the engine's stage timing on (wall clock), in us "
+              "per step per body; a stage's slope where it takes at least %.0f %% of every step.\n\n"
+              "| scene | bodies | rows/step | us/step | us/body",
+              family.c_str(), out["assembly"].get<std::string>().c_str(),
+              given.empty() ? "each scene's own parameters" : ("given:" + given).c_str(), kGrowthRepeats,
+              growth_steps(quick), def.threads > 1 ? "wall clock" : "this thread's CPU time", 100.0 * kSlopeShare);
+  for (const auto& [name, stage] : kStages) std::printf(" | %s", name);
+  std::printf(" |\n|---|---|---|---|---");
+  for (std::size_t k = 0; k < std::size(kStages); ++k) std::printf("|---");
+  std::printf("|\n");
+  for (const GrowthPoint& p : points) {
+    std::printf("| %s | %.0f | %.0f | %.0f | %.3f", p.scene.c_str(), p.bodies, p.cost.rows, p.cost.us,
+                p.cost.us / p.bodies);
+    for (const auto& [name, stage] : kStages) std::printf(" | %.3f", 1e6 * (p.cost.stages.*stage) / p.bodies);
+    std::printf(" |\n");
+  }
+  std::printf("| slope against bodies | | %s | %s | |", slope_cell(slopes["rows_slope_against_bodies"]).c_str(),
+              slope_cell(slopes["slope_against_bodies"]).c_str());
+  for (const auto& [name, stage] : kStages) {
+    std::printf(" %s |", slope_cell(slopes["stage_slopes_against_bodies"][name]).c_str());
+  }
+  std::printf("\n\nSlope of us/step against rows/step: %s.\n", slope_cell(slopes["slope_against_rows"]).c_str());
+  return out;
 }
 
 // The tables, as Markdown (or one JSON document) on stdout; progress on stderr. quick: fewer
@@ -546,10 +721,24 @@ int run_bench(const BenchOptions& o) {
     throw UsageError("--scene and --rendering exclude each other: --scene times the physics of "
                      "the named scenes, --rendering only the rendering table");
   }
-  if (!o.overrides.values.empty() && o.scenes.empty()) {
+  if (!o.growth.empty() && (!o.scenes.empty() || o.rendering)) {
+    throw UsageError("--growth times one scaled family's series alone; leave out --scene and --rendering");
+  }
+  if (o.growth.empty() && !o.sizes.empty()) {
+    throw UsageError("--sizes gives the sizes of --growth's series; give --growth FAMILY with it");
+  }
+  if (!o.overrides.values.empty() && o.scenes.empty() && o.growth.empty()) {
     throw UsageError("world parameters (--" + std::string(o.overrides.values.front().first->flag) +
-                     " and the like) apply to the scenes of --scene; the full tables run each "
-                     "scene at its own settings");
+                     " and the like) apply to the scenes of --scene or --growth; the full tables "
+                     "run each scene at its own settings");
+  }
+  if (!o.growth.empty()) {
+    const std::vector<const scenes::Scene*> series = growth_scenes(
+        o.growth, o.sizes.empty() ? default_growth_sizes(o.quick) : o.sizes, o.overrides, o.quick, o.max_work);
+    nlohmann::json out = {{"engine_version", engine_version()}, {"quick", o.quick}};
+    out["growth_series"] = growth_series_table(o.growth, series, o.overrides, o.quick, !o.json);
+    if (o.json) std::printf("%s\n", out.dump(2).c_str());
+    return 0;
   }
   if (o.overrides.find("assembly") != nullptr) {
     throw UsageError("--assembly: cps bench times every scene under both assemblies (explicit "
@@ -601,6 +790,17 @@ Command add_bench(CLI::App& app) {
                   "time only these scenes (a name, a scaled scene such as funnel_500, 'all' or 'stress'; "
                   "repeatable): the physics table alone, each scene over its window")
       ->check(kNotEmpty);
+  sub->add_option("--growth", o->growth,
+                  "time only the cost growth of one scaled scene family (pyramid, funnel, stack, "
+                  "pendulum_wave or pendulum_grid: FAMILY_N for each of --sizes) at the world "
+                  "parameters given: us per step and per body, by stage, and the log-log slopes "
+                  "against bodies and rows")
+      ->check(kNotEmpty);
+  sub->add_option("--sizes", o->sizes,
+                  "the sizes N of --growth's scenes, comma-separated, at least two different, each "
+                  "in the family's range; default 100,300,1000,3000,5000 (with --quick 100,300,1000)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 1000000));
   add_seed_option(*sub, o->scenes);
   add_max_work_option(*sub, o->max_work);
   add_world_options(*sub, o->overrides);

@@ -71,6 +71,7 @@ declare -A KIND=(
   ['*:--expect-hash']=hash ['*:--run']=run_id ['*:--merge']=merge
   ['simulate:scene']=scene_one ['render:scene']=scene_many ['figure:scene']=scene_figure
   ['report:scene']=scene_report ['bench:--scene']=scene_bench
+  ['bench:--growth']=family ['bench:--sizes']=sizes
   ['scene:scene']=scene_one ['scene:--out']=out_json ['*:--seed']=seed
   ['export:scene']=scene_one ['export:--out']=out_glb ['*:--max-work']=max_work
   ['export:--fclib']=out_hdf5 ['export:--at']=steps
@@ -123,6 +124,8 @@ MERGE_DUP=$root/merge-dup  # a copy of its CSV: every run twice with MERGE_SRC, 
 MERGE_NAN=$root/merge-nan  # its first run with us_per_step nan, made below
 BASE['report:--out']="report --run $RUN_ID;report --merge $MERGE_SRC;report intersecting_stack --quick;report push --quick"
 BASE['report:--run']='report --out out'
+BASE['bench:--growth']='bench --quick --sizes 1,2'
+BASE['bench:--sizes']='bench --quick --growth stack'
 BASE['simulate:--at']='simulate stack --seconds 0.1 --solver-error e.csv'
 BASE['simulate:--sweeps']='simulate stack --seconds 0.1 --solver-error e.csv'
 BASE['report:--merge']='report --out out'
@@ -240,6 +243,11 @@ bad_values() {  # KIND [CHOICES...] -> one bad value per line
     shard)  # I/N: whole numbers, 1 <= I <= N <= 100000, or 'slurm' in a Slurm array task
       printf '%s\n' "" 1 / 1/ /3 0/3 4/3 -1/3 1/0 1/-3 1/100001 1/3/ 1//3 a/3 1/b +1/3 " 1/3" \
         "1/3 " 1.5/3 1e0/3 0x1/3 3/3.0 4294967297/4294967298 nan/3 SLURM ;;
+    family)  # a scaled scene family's name (stack, pyramid, funnel, pendulum_wave, pendulum_grid)
+      printf '%s\n' "" nosuch STACK "stack " " stack" stack_N stack_1 random paper all stack,funnel ;;
+    sizes)  # comma-separated sizes, at least two different, each in the family's range (stack: 1..40)
+      printf '%s\n' "" , x -1 0 1.5 1e3 0x10 " 1" "1 " "1;2" nan 1 1,1 41 1,41 1000001 4294967297 \
+        1,,2 1,2, ,1,2 +1,2 1,2x ;;
     merge)  # folders holding report CSVs
       printf '%s\n' "" nosuch file file/sub adir /dev/null ;;
     scene_one | scene_many | scene_figure | scene_report | scene_bench)
@@ -362,6 +370,9 @@ EXTRA=(
   "--repeats|report push --quick --out out --repeats 7"
   "--max-work|report push --quick --out out --max-work 1"
   "--max-work|bench --quick --scene intersecting_stack --max-work 1"
+  "--max-work|bench --quick --growth pyramid --sizes 100,20000 --max-work 1e6"
+  "--rendering|bench --quick --growth stack --sizes 1,2 --rendering"
+  "--growth|bench --quick --sizes 1,2"
   "MiB/--fps|export funnel_2000 --seconds 99.989 --fps 1000 --out out/f.glb"
   "MiB/--fps|export pendulum_wave_2000 --seconds 4 --fps 1000 --out out/p.glb"
 )
@@ -397,6 +408,7 @@ CONTROLS=(
   "simulate stack --seconds 0.1 --push xpbd --xpbd-substeps 1000 --xpbd-compliance 1e6 --solver jacobi"
   "simulate stack --seconds 0.1 --push avbd --avbd-beta 0 --avbd-alpha 1 --avbd-gamma 0 --avbd-post-iterations 100"
   "report intersecting_stack --list-runs --out out --max-work 1e18"
+  "bench --quick --growth stack --sizes 2,1 --friction 0"
   "report intersecting_stack --list-runs --out out --repeats 3"  # the ends of --repeats' range
   "report intersecting_stack --list-runs --out out --repeats 100"
   "report --run $RUN_ID --out out --repeats 3 --max-work 3600"  # exactly (3 + 2) x 720

@@ -7,42 +7,12 @@
 #include "options/options.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cstdio>
 #include <iostream>
 #include <stdexcept>
 #include <utility>
 
 namespace cps::cli {
-namespace {
-
-// The comma-separated integers of `text`, each in [lo, hi]; `option` and `what` name them in
-// messages.
-std::vector<long long> parse_counts(const std::string& text, long long lo, long long hi,
-                                    const std::string& option, const std::string& what) {
-  std::vector<long long> out;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t end = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, end - start);
-    long long value = 0;
-    const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
-    if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || value < lo ||
-        value > hi) {
-      throw UsageError(option + " " + text + ": '" + item + "' is not " + what +
-                       ": give comma-separated integers in [" + std::to_string(lo) + ", " +
-                       std::to_string(hi) + "]");
-    }
-    out.push_back(value);
-    if (end == text.size()) break;
-    start = end + 1;
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
-}  // namespace
 
 std::vector<std::int64_t> parse_steps(const std::string& at, std::int64_t total_steps,
                                       const std::string& option) {

@@ -277,6 +277,30 @@ void add_seed(CLI::App& cmd, std::function<void(std::uint64_t)> apply) {
 
 }  // namespace
 
+std::vector<long long> parse_counts(const std::string& text, long long lo, long long hi,
+                                    const std::string& option, const std::string& what) {
+  std::vector<long long> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    long long value = 0;
+    const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
+    if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || value < lo ||
+        value > hi) {
+      throw UsageError(option + " " + text + ": '" + item + "' is not " + what +
+                       ": give comma-separated integers in [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "]");
+    }
+    out.push_back(value);
+    if (end == text.size()) break;
+    start = end + 1;
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 void add_seed_option(CLI::App& cmd, std::string& scene) {
   add_seed(cmd, [&scene](std::uint64_t seed) { scene = with_seed(scene, seed); });
 }

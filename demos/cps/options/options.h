@@ -70,6 +70,12 @@ void add_max_work_option(CLI::App& cmd, double& max_work);
 void check_work(const std::string& what, std::size_t bodies, const WorldDef& def, double seconds,
                 double max_work, const std::string& lower);
 
+/// The comma-separated integers of `text`, each in [lo, hi], sorted and without repeats. Throws
+/// UsageError naming `option`, the text, the bad item and the range for an empty item, a sign,
+/// a fraction, trailing text or a value out of range; `what` names an item ("a step of this run").
+std::vector<long long> parse_counts(const std::string& text, long long lo, long long hi,
+                                    const std::string& option, const std::string& what);
+
 /// `lower` for check_work in a command that takes the world options: `shorter` (how to shorten
 /// the run), --dt, --iterations, and --soft-substeps, --tgs-substeps or --xpbd-substeps when
 /// def's push is soft, tgs or xpbd.

@@ -486,9 +486,10 @@ nlohmann::json warm_start_table(const std::vector<std::string>& names, bool quic
 
 // One scene of a cost-growth series: its bodies and its cost over the window.
 struct GrowthPoint {
+  const scenes::Scene* source = nullptr;
   std::string scene;
-  double bodies = 0.0;
-  StepCost cost;
+  double bodies = 0.0;  // as the scene is built, static ones included
+  StepCost cost;        // filled by measure_growth
 };
 
 // The sizes of the cost-growth table when none are given.
@@ -500,13 +501,13 @@ std::vector<int> default_growth_sizes(bool quick) {
 constexpr int kGrowthRepeats = 5;
 int growth_steps(bool quick) { return quick ? 3 : 6; }
 
-// The scaled scene family_N for each size (sorted, without repeats), each checked against max_work (body-iterations: the
-// steps to the window, the window untimed, timed kGrowthRepeats times and once with stage
-// timing). Throws UsageError for an unknown family (listing the families), a size the family
-// does not take (its range) or a run past max_work.
-std::vector<const scenes::Scene*> growth_scenes(const std::string& family, const std::vector<int>& sizes,
-                                                const scenes::Overrides& overrides, bool quick,
-                                                double max_work) {
+// The points of the scaled scenes family_N, one per size (sizes sorted, without repeats), each
+// checked against max_work (body-iterations: the steps to the window, the window untimed, timed
+// kGrowthRepeats times and once with stage timing); their costs not yet measured. Throws
+// UsageError for an unknown family (listing the families), fewer than two sizes, a size the
+// family does not take (its range) or a run past max_work.
+std::vector<GrowthPoint> growth_points(const std::string& family, const std::vector<int>& sizes,
+                                       const scenes::Overrides& overrides, bool quick, double max_work) {
   std::string families;
   bool known = false;
   for (const std::string_view f : scenes::scaled_families()) {
@@ -515,7 +516,7 @@ std::vector<const scenes::Scene*> growth_scenes(const std::string& family, const
   }
   if (!known) throw UsageError("--growth " + family + ": not a scaled scene family; allowed: " + families);
   if (sizes.size() < 2) throw UsageError("--sizes: a slope needs at least two different sizes");
-  std::vector<const scenes::Scene*> out;
+  std::vector<GrowthPoint> out;
   for (const int n : sizes) {
     const scenes::Scene* found = scenes::find_scene(family + "_" + std::to_string(n));
     if (found == nullptr) {
@@ -527,9 +528,9 @@ std::vector<const scenes::Scene*> growth_scenes(const std::string& family, const
       }
       throw UsageError("--sizes " + std::to_string(n) + ": " + why);
     }
-    out.push_back(found);
     const scenes::Scene& scene = *found;
     const scenes::Run run = make_run_or_usage_error(scene, overrides);
+    out.push_back({found, std::string(scene.name), static_cast<double>(run.world.bodies().size()), {}});
     const WorldDef& def = run.world.def();
     const double steps = std::round(scene.bench.start_s / def.dt) + (kGrowthRepeats + 2.0) * growth_steps(quick);
     check_work("the steps of " + std::string(scene.name) + " (to its window, then through it once untimed, " +
@@ -540,20 +541,14 @@ std::vector<const scenes::Scene*> growth_scenes(const std::string& family, const
   return out;
 }
 
-// Each scene's cost over its window (step_cost; the assembly its world parameters give).
-std::vector<GrowthPoint> measure_growth(const std::vector<const scenes::Scene*>& series,
-                                        const scenes::Overrides& overrides, bool quick) {
-  std::vector<GrowthPoint> points;
-  for (const scenes::Scene* scene : series) {
-    notes() << "bench: " << scene->name << "\n";
-    const WorldDef def = scenes::world_def_with(*scene, overrides);
-    GrowthPoint p;
-    p.scene = std::string(scene->name);
-    p.bodies = static_cast<double>(scenes::make_run(*scene, overrides).world.bodies().size());
-    p.cost = step_cost(*scene, overrides, def.assembly, scene->bench.start_s, growth_steps(quick), kGrowthRepeats);
-    points.push_back(std::move(p));
+// Each point's cost over its scene's window (step_cost; the assembly its world parameters give).
+void measure_growth(std::vector<GrowthPoint>& points, const scenes::Overrides& overrides, bool quick) {
+  for (GrowthPoint& p : points) {
+    notes() << "bench: " << p.scene << "\n";
+    const scenes::Scene& scene = *p.source;
+    const Assembly assembly = scenes::world_def_with(scene, overrides).assembly;
+    p.cost = step_cost(scene, overrides, assembly, scene.bench.start_s, growth_steps(quick), kGrowthRepeats);
   }
-  return points;
 }
 
 // Log-log slope of y(point) against bodies; NaN when y is not > 0 at every point (a stage the
@@ -624,8 +619,8 @@ nlohmann::json growth_table(bool quick, bool markdown) {
   }
   nlohmann::json families = nlohmann::json::array();
   for (const char* family : {"pyramid", "funnel"}) {
-    const std::vector<GrowthPoint> points =
-        measure_growth(growth_scenes(family, default_growth_sizes(quick), {}, quick, kMaxMaxWork), {}, quick);
+    std::vector<GrowthPoint> points = growth_points(family, default_growth_sizes(quick), {}, quick, kMaxMaxWork);
+    measure_growth(points, {}, quick);
     nlohmann::json series = nlohmann::json::array();
     std::string cells;
     for (const GrowthPoint& p : points) {
@@ -651,12 +646,12 @@ nlohmann::json growth_table(bool quick, bool markdown) {
   return families;
 }
 
-// `cps bench --growth FAMILY`: the series family_N over `sizes` with the world parameters given,
+// `cps bench --growth FAMILY`: the points of growth_points measured with the world parameters given,
 // point by point and stage by stage, in us per body, with every slope (growth_slopes).
-nlohmann::json growth_series_table(const std::string& family, const std::vector<const scenes::Scene*>& series,
+nlohmann::json growth_series_table(const std::string& family, std::vector<GrowthPoint> points,
                                    const scenes::Overrides& overrides, bool quick, bool markdown) {
-  const std::vector<GrowthPoint> points = measure_growth(series, overrides, quick);
-  const WorldDef def = scenes::world_def_with(*series.front(), overrides);
+  measure_growth(points, overrides, quick);
+  const WorldDef def = scenes::world_def_with(*points.front().source, overrides);
   nlohmann::json parameters = nlohmann::json::object();
   for (const auto& [parameter, value] : overrides.values) parameters[std::string(parameter->name)] = parameter->format(value);
   nlohmann::json out = {{"family", family + "_N"},
@@ -734,10 +729,9 @@ int run_bench(const BenchOptions& o) {
       sizes.clear();
       for (const long long n : parse_counts(o.sizes, 1, 1000000, "--sizes", "a size")) sizes.push_back(static_cast<int>(n));
     }
-    const std::vector<const scenes::Scene*> series =
-        growth_scenes(o.growth, sizes, o.overrides, o.quick, o.max_work);
+    std::vector<GrowthPoint> points = growth_points(o.growth, sizes, o.overrides, o.quick, o.max_work);
     nlohmann::json out = {{"engine_version", engine_version()}, {"quick", o.quick}};
-    out["growth_series"] = growth_series_table(o.growth, series, o.overrides, o.quick, !o.json);
+    out["growth_series"] = growth_series_table(o.growth, std::move(points), o.overrides, o.quick, !o.json);
     if (o.json) std::printf("%s\n", out.dump(2).c_str());
     return 0;
   }

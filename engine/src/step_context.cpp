@@ -7,15 +7,30 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace cps {
 
+namespace {
+
+// A copy of v with v's capacity: a step buffer copied with its contents grows, in the copy's later
+// steps, when the original's would (a plain copy has only room for its contents).
+template <class T>
+std::vector<T> with_capacity(const std::vector<T>& v) {
+  std::vector<T> out;
+  out.reserve(v.capacity());
+  out.assign(v.begin(), v.end());
+  return out;
+}
+
+}  // namespace
+
 StepContext::StepContext(const StepContext& other)
-    : manifolds(other.manifolds),
-      rows(other.rows),
+    : manifolds(with_capacity(other.manifolds)),
+      rows(with_capacity(other.rows)),
       layout(other.layout),
-      lambda(other.lambda),
-      lambda_second(other.lambda_second),
+      lambda(with_capacity(other.lambda)),
+      lambda_second(with_capacity(other.lambda_second)),
       warm_start(other.warm_start ? std::make_unique<WarmStartCache>(*other.warm_start) : nullptr),
       recycler(other.recycler ? std::make_unique<ContactRecycler>(*other.recycler) : nullptr),
       counters(other.counters),

@@ -61,8 +61,10 @@ class StageTimer {
 /// body (N, N m). Buffers keep their storage from step to step (no allocation once grown).
 struct StepContext {
   StepContext() = default;
-  /// Copies the last step's results (manifolds, rows, both lambdas), the warm-start cache, the
-  /// recycled contacts, the counters and the stage timing; the buffers and the solver start empty (nothing in them outlives a step).
+  /// Copies the last step's results (manifolds, rows, both lambdas; each with the original's
+  /// capacity, so that the copy's next steps grow them when the original's would), the
+  /// warm-start cache, the recycled contacts, the counters and the stage timing; the buffers and
+  /// the solver start empty (nothing in them outlives a step). Throws std::bad_alloc.
   StepContext(const StepContext& other);
   StepContext& operator=(const StepContext&) = delete;
   StepContext(StepContext&&) noexcept = default;

@@ -96,9 +96,10 @@ class World {
  public:
   /// Throws std::invalid_argument if def is invalid (see WorldDef::validate).
   explicit World(const WorldDef& def = {});
-  /// A copy has the same parameters, bodies, constraints, last-step results, counters and warm
-  /// start cache (so it steps on exactly as the original would); its step buffers start empty
-  /// (they hold nothing from one step to the next).
+  /// A copy has the same parameters, bodies, constraints, last-step results (with the
+  /// original's storage, so that they grow when the original's would), counters and warm start
+  /// cache (so it steps on exactly as the original would); its step buffers start empty (they
+  /// hold nothing from one step to the next) and grow in its first step. Throws std::bad_alloc.
   World(const World& other);
   World& operator=(const World& other);
   World(World&&) noexcept;

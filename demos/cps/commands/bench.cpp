@@ -65,9 +65,10 @@ constexpr std::pair<const char*, double StageTimes::*> kStages[] = {
 // (to 0 when the window starts the run); a copy of it is then stepped through the window once
 // untimed and `repeats` times timed, each from a fresh copy of the same state, so every repeat
 // times the same window. A copy's step buffers start empty (World's copy constructor), so each
-// copy takes the step before the window untimed: its buffers then hold their working size when
-// the clock starts, as a running world's do (Box3D's benchmark likewise times from its second
-// step), and no repeat times their first allocation and page faults. The median repeat's time
+// copy takes the step before the window untimed: that step allocates them (each with room for
+// twice what it needs) and touches their pages, so the clock does not time their first
+// allocation (Box3D's benchmark likewise times from its second step); a later step of the window
+// may still grow one past that room. The median repeat's time
 // per step counts: this thread's CPU time, or the wall-clock time when the world steps on more
 // than one thread (WorldDef::threads). One more repeat, not in
 // the median, runs with the engine's stage timing on (World::set_stage_timing) for the stages'

@@ -68,11 +68,10 @@ constexpr std::pair<const char*, double StageTimes::*> kStages[] = {
 // copy takes the step before the window untimed: that step allocates them (each with room for
 // twice what it needs) and touches their pages, so the clock does not time their first
 // allocation (Box3D's benchmark likewise times from its second step); a later step of the window
-// may still grow one past that room. The median repeat's time
-// per step counts: this thread's CPU time, or the wall-clock time when the world steps on more
-// than one thread (WorldDef::threads). One more repeat, not in
-// the median, runs with the engine's stage timing on (World::set_stage_timing) for the stages'
-// shares of a step. start_s >= 0 (s); steps >= 1; repeats >= 1. warm_start, if set, replaces the
+// may still grow one past that room. The median repeat's time per step counts: this thread's CPU
+// time, or the wall-clock time when the world steps on more than one thread (WorldDef::threads).
+// One more repeat, not in the median, runs with the engine's stage timing on
+// (World::set_stage_timing) for the stages' shares of a step. start_s >= 0 (s); steps >= 1; repeats >= 1. warm_start, if set, replaces the
 // scene's warm starting factor (dimensionless, [0, 1]) from the start.
 StepCost step_cost(const scenes::Scene& scene, const scenes::Overrides& overrides,
                    Assembly assembly, double start_s, int steps, int repeats,

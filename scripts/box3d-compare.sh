@@ -163,9 +163,9 @@ if [ -n "$growth" ]; then
     --contact-push-max-speed 3 --dt 0.016666666666666666)
   for ((r = 0; r < rounds; ++r)); do
     "$cps" bench --growth pyramid --sizes "$growth" --solver coloured-pgs --row-precision float --json \
-      2> "$work/cps.err" > "$work/cps-paper-$r.json" || { cat "$work/cps.err" >&2; exit 1; }
+      2> "$work/cps.err" > "$work/cps-paper-$r.json" || { status=$?; cat "$work/cps.err" >&2; exit "$status"; }
     "$cps" bench --growth pyramid --sizes "$growth" "${box3d_world[@]}" --json \
-      2> "$work/cps.err" > "$work/cps-soft-$r.json" || { cat "$work/cps.err" >&2; exit 1; }
+      2> "$work/cps.err" > "$work/cps-soft-$r.json" || { status=$?; cat "$work/cps.err" >&2; exit "$status"; }
     # Box3D's wall with as many cubes as pyramid_N has boxes (its bodies but the ground).
     python3 -c 'import json, sys
 for p in json.load(sys.stdin)["growth_series"]["points"]:

@@ -192,7 +192,7 @@ box3d_runs = [[line.split() for line in open("%s/box3d-%d.txt" % (work, r)).read
 cubes = [int(c) for _, c in box3d_runs[0]]
 box3d = [statistics.median(1000 * float(run[i][0]) / cubes[i] for run in box3d_runs) for i in range(len(cubes))]
 step = lambda per_body, n: [p * m for p, m in zip(per_body, n)]
-print("us a step a body, median of %d rounds:" % rounds)
+print("us a step a body (Box3D's cubes; cps's bodies, the ground among them), medians of %d rounds:" % rounds)
 print()
 print("| cubes | Box3D | cps at Box3D's world | cps / Box3D | cps at the paper's defaults (coloured-pgs, float rows) |")
 print("|---|---|---|---|---|")

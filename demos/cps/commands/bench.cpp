@@ -71,8 +71,9 @@ constexpr std::pair<const char*, double StageTimes::*> kStages[] = {
 // may still grow one past that room. The median repeat's time per step counts: this thread's CPU
 // time, or the wall-clock time when the world steps on more than one thread (WorldDef::threads).
 // One more repeat, not in the median, runs with the engine's stage timing on
-// (World::set_stage_timing) for the stages' shares of a step. start_s >= 0 (s); steps >= 1; repeats >= 1. warm_start, if set, replaces the
-// scene's warm starting factor (dimensionless, [0, 1]) from the start.
+// (World::set_stage_timing) for the stages' shares of a step. start_s >= 0 (s); steps >= 1;
+// repeats >= 1. warm_start, if set, replaces the scene's warm starting factor (dimensionless,
+// [0, 1]) from the start.
 StepCost step_cost(const scenes::Scene& scene, const scenes::Overrides& overrides,
                    Assembly assembly, double start_s, int steps, int repeats,
                    std::optional<double> warm_start = std::nullopt) {

@@ -1,6 +1,7 @@
 // The step context (see step_context.h).
 #include "step_context.h"
 
+#include "buffers.h"
 #include "integrator.h"
 
 #include <algorithm>
@@ -14,11 +15,13 @@ namespace cps {
 namespace {
 
 // A copy of v with v's capacity: a step buffer copied with its contents grows, in the copy's later
-// steps, when the original's would (a plain copy has only room for its contents).
+// steps, when the original's would (a plain copy has only room for its contents). A large one
+// asks for huge pages as the original did (reserve_with_headroom).
 template <class T>
 std::vector<T> with_capacity(const std::vector<T>& v) {
   std::vector<T> out;
   out.reserve(v.capacity());
+  if (out.capacity() * sizeof(T) >= detail::kHugePagesFrom) detail::advise_huge_pages(out.data(), out.capacity() * sizeof(T));
   out.assign(v.begin(), v.end());
   return out;
 }

@@ -20,8 +20,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <random>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace cps;
@@ -108,6 +110,56 @@ TEST_CASE("coloured PGS sweeps every row once, and a colour's runs share no mova
       CHECK(colours.colours[static_cast<std::size_t>(mine)] != colours.colours[static_cast<std::size_t>(theirs)]);
     }
   }
+}
+
+TEST_CASE("coloured PGS cuts the rows into the longest runs on one pair that a run may be",
+          "[coloured]") {
+  // 40 bodies, every fourth static, and 20,000 rows in stretches on one pair of 1 to 60 rows
+  // (longer than a run may be) and two of 7,000, some against the world. Stretches that follow
+  // on the same pair make one.
+  std::vector<Body> bodies(40);
+  for (std::size_t i = 0; i < bodies.size(); ++i) bodies[i].inv_mass = i % 4 == 0 ? 0.0 : 1.0;
+  std::mt19937 random(7);
+  std::uniform_int_distribution<int> body(0, 39);
+  std::uniform_int_distribution<int> length(1, 60);
+  std::vector<ConstraintRow> rows;
+  for (int stretch = 0; rows.size() < 20000; ++stretch) {
+    const int a = body(random);
+    int b = body(random);
+    if (b == a || b % 5 == 0) b = kWorldBody;
+    const std::size_t n = stretch == 50 || stretch == 250 ? 7000 : static_cast<std::size_t>(length(random));
+    for (std::size_t k = 0; k < n; ++k) {
+      ConstraintRow row;
+      row.body_a = stretch % 2 == 0 ? a : b;
+      row.body_b = stretch % 2 == 0 ? b : a;
+      rows.push_back(row);
+    }
+  }
+  const auto moving = [&](int b) {
+    return b == kWorldBody || bodies[static_cast<std::size_t>(b)].is_static() ? -1 : b;
+  };
+  // A row's movable bodies in its order, a static body or the world last (a run's a and b).
+  const auto pair_of = [&](std::size_t r) {
+    const int a = moving(rows[r].body_a);
+    const int b = moving(rows[r].body_b);
+    return a < 0 ? std::pair{b, a} : std::pair{a, b};
+  };
+  RowColours colours;
+  colour_rows(rows, bodies, MatrixFreeSystem::kMaxRun, colours);
+  // The runs tile the rows in order, each on one pair, and each ends at the longest a run may be
+  // or where the pair changes.
+  std::size_t next = 0;
+  for (const RowColours::Run& x : colours.runs) {
+    REQUIRE(static_cast<std::size_t>(x.begin) == next);
+    REQUIRE(x.count >= 1);
+    REQUIRE(x.count <= MatrixFreeSystem::kMaxRun);
+    next += static_cast<std::size_t>(x.count);
+    for (std::size_t r = static_cast<std::size_t>(x.begin); r < next; ++r) {
+      REQUIRE(pair_of(r) == std::pair{x.a, x.b});
+    }
+    if (x.count < MatrixFreeSystem::kMaxRun && next < rows.size()) REQUIRE(pair_of(next) != pair_of(next - 1));
+  }
+  REQUIRE(next == rows.size());
 }
 
 TEST_CASE("coloured PGS solves the same LCP as PGS: the engine's sweeps on the captured system "

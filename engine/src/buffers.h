@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <iterator>
+#include <type_traits>
 #include <vector>
 
 namespace cps::detail {
@@ -32,9 +33,44 @@ void reserve_with_headroom(std::vector<T, A>& v, std::size_t n) {
   std::vector<T, A> bigger(v.get_allocator());
   bigger.reserve(2 * n);
   advise_huge_pages(bigger.data(), bigger.capacity() * sizeof(T));
-  bigger.insert(bigger.end(), std::make_move_iterator(v.begin()), std::make_move_iterator(v.end()));
+  if constexpr (std::is_nothrow_move_constructible_v<T> || !std::is_copy_constructible_v<T>) {
+    bigger.insert(bigger.end(), std::make_move_iterator(v.begin()), std::make_move_iterator(v.end()));
+  } else {  // as reserve does: v stays whole if a copy throws
+    bigger.insert(bigger.end(), v.begin(), v.end());
+  }
   v.swap(bigger);
 }
+
+/// A copy of v with v's capacity (a plain copy has room for its contents only), on huge pages
+/// from kHugePagesFrom bytes as reserve_with_headroom's storage: a copied step buffer then grows,
+/// in the copy's steps, when the original's would. Errors: std::bad_alloc.
+template <class T, class A>
+std::vector<T, A> copy_with_capacity(const std::vector<T, A>& v) {
+  std::vector<T, A> out(v.get_allocator());
+  out.reserve(v.capacity());
+  if (out.capacity() * sizeof(T) >= kHugePagesFrom) advise_huge_pages(out.data(), out.capacity() * sizeof(T));
+  out.assign(v.begin(), v.end());
+  return out;
+}
+
+/// A std::vector whose copies keep its capacity (copy_with_capacity): for the caches that a step
+/// reuses, so that a copied world (a bench repeat) does not grow them again in its first steps.
+template <class T>
+class KeptBuffer : public std::vector<T> {
+ public:
+  KeptBuffer() = default;
+  KeptBuffer(const KeptBuffer& other) : std::vector<T>(copy_with_capacity(other.as_vector())) {}
+  KeptBuffer(KeptBuffer&&) noexcept = default;
+  KeptBuffer& operator=(const KeptBuffer& other) {
+    if (this != &other) std::vector<T>::operator=(copy_with_capacity(other.as_vector()));
+    return *this;
+  }
+  KeptBuffer& operator=(KeptBuffer&&) noexcept = default;
+  ~KeptBuffer() = default;
+
+ private:
+  const std::vector<T>& as_vector() const { return *this; }
+};
 
 /// resize(n) after reserve_with_headroom(n): new elements are value-initialised, old ones kept.
 template <class T, class A>

@@ -86,12 +86,15 @@ bool ContactRecycler::recycle(int a, int b, const std::vector<Body>& bodies, dou
 }
 
 void ContactRecycler::keep(const Manifold& m, const std::vector<Body>& bodies, std::size_t found) {
-  if (next_count_ == next_.size()) next_.emplace_back();
+  if (next_count_ == next_.size()) {
+    detail::reserve_with_headroom(next_, next_count_ + 1);
+    next_.emplace_back();
+  }
   keep_at(next_count_++, m, bodies, found);
 }
 
 void ContactRecycler::resize_kept(std::size_t count) {
-  if (next_.size() < count) next_.resize(count);
+  if (next_.size() < count) detail::resize_with_headroom(next_, count);
   next_count_ = count;
 }
 

@@ -12,6 +12,8 @@
 #include "cps/body.h"
 #include "cps/collision.h"
 
+#include "buffers.h"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -89,10 +91,10 @@ class ContactRecycler {
   // that a copy moves only what is used.
   static void copy_used(const Cached& from, Cached& to);
 
-  std::vector<Cached> last_;  // the last step's, in pair order
+  detail::KeptBuffer<Cached> last_;  // the last step's, in pair order
   // This step's: its first next_count_ entries. The vector only grows (its entries are made once
   // and then written over), so a step builds no entries it already has storage for.
-  std::vector<Cached> next_;
+  detail::KeptBuffer<Cached> next_;
   std::size_t next_count_ = 0;
 };
 

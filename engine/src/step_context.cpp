@@ -12,28 +12,12 @@
 
 namespace cps {
 
-namespace {
-
-// A copy of v with v's capacity: a step buffer copied with its contents grows, in the copy's later
-// steps, when the original's would (a plain copy has only room for its contents). A large one
-// asks for huge pages as the original did (reserve_with_headroom).
-template <class T>
-std::vector<T> with_capacity(const std::vector<T>& v) {
-  std::vector<T> out;
-  out.reserve(v.capacity());
-  if (out.capacity() * sizeof(T) >= detail::kHugePagesFrom) detail::advise_huge_pages(out.data(), out.capacity() * sizeof(T));
-  out.assign(v.begin(), v.end());
-  return out;
-}
-
-}  // namespace
-
 StepContext::StepContext(const StepContext& other)
-    : manifolds(with_capacity(other.manifolds)),
-      rows(with_capacity(other.rows)),
+    : manifolds(detail::copy_with_capacity(other.manifolds)),
+      rows(detail::copy_with_capacity(other.rows)),
       layout(other.layout),
-      lambda(with_capacity(other.lambda)),
-      lambda_second(with_capacity(other.lambda_second)),
+      lambda(detail::copy_with_capacity(other.lambda)),
+      lambda_second(detail::copy_with_capacity(other.lambda_second)),
       warm_start(other.warm_start ? std::make_unique<WarmStartCache>(*other.warm_start) : nullptr),
       recycler(other.recycler ? std::make_unique<ContactRecycler>(*other.recycler) : nullptr),
       counters(other.counters),

@@ -10,6 +10,7 @@
 #include "cps/collision.h"
 #include "cps/constraint.h"
 #include "cps/parameters.h"
+#include "buffers.h"
 #include "workers.h"
 
 #include <cstdint>
@@ -151,31 +152,31 @@ class WarmStartCache {
     double older[2];    // its contact row's lambda (N) one step earlier (first, second solve);
                         // 0 if it is new
   };
-  std::vector<CachedManifold> manifolds_;
-  std::vector<CachedPoint> points_;
-  std::vector<CachedPoint> next_points_;  // store() builds here, then swaps with points_
+  detail::KeptBuffer<CachedManifold> manifolds_;
+  detail::KeptBuffer<CachedPoint> points_;
+  detail::KeptBuffer<CachedPoint> next_points_;  // store() builds here, then swaps with points_
   // Per cached point, its CachedRows when store() kept them (has_rows_); after a store by the
   // manifold rule (end_store()) they are not kept and read as 0 (has_second_ and has_friction_
   // are false then).
-  std::vector<CachedRows> rows_;
-  std::vector<CachedRows> next_rows_;
+  detail::KeptBuffer<CachedRows> rows_;
+  detail::KeptBuffer<CachedRows> next_rows_;
   bool has_rows_ = false;
-  std::vector<double> rods_first_;
-  std::vector<double> rods_second_;
-  std::vector<double> rods_older_first_;   // the rods' lambdas one step earlier (N)
-  std::vector<double> rods_older_second_;
+  detail::KeptBuffer<double> rods_first_;
+  detail::KeptBuffer<double> rods_second_;
+  detail::KeptBuffer<double> rods_older_first_;   // the rods' lambdas one step earlier (N)
+  detail::KeptBuffer<double> rods_older_second_;
   bool has_second_ = false;
   bool has_friction_ = false;
   // This step: per point, the cached point it matched (-1: none) and its t1.
-  std::vector<int> match_;
-  std::vector<int> pair_match_;  // per manifold: its pair's cached manifold, or -1
-  std::vector<Vec3> tangents_;
+  detail::KeptBuffer<int> match_;
+  detail::KeptBuffer<int> pair_match_;  // per manifold: its pair's cached manifold, or -1
+  detail::KeptBuffer<Vec3> tangents_;
   bool tangents_fresh_ = false;  // match() has run since the last store(): tangents_ are the step's
-  std::vector<unsigned char> same_points_;  // per manifold: same_points()
+  detail::KeptBuffer<unsigned char> same_points_;  // per manifold: same_points()
   std::size_t matched_ = 0;
   // Per manifold of the step: the points of the manifolds before it (match() and store()).
-  std::vector<std::size_t> first_point_;
-  std::vector<std::size_t> matched_by_thread_;  // match(): points matched by each thread
+  detail::KeptBuffer<std::size_t> first_point_;
+  detail::KeptBuffer<std::size_t> matched_by_thread_;  // match(): points matched by each thread
 };
 
 }  // namespace cps

@@ -14,14 +14,19 @@ namespace {
 class ExplicitSolver final : public ConstraintSolver {
  public:
   void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-               SolverKind kind, RowPrecision /*precision*/, Workers* /*workers*/) override {
+               SolverKind kind, RowPrecision /*precision*/, Workers* /*workers*/,
+               const std::vector<RowSpan>* spans) override {
     inv_inertia_.resize(bodies.size());
     for (std::size_t i = 0; i < bodies.size(); ++i) inv_inertia_[i] = bodies[i].inv_inertia_world();
     system_ = assemble_matrices(rows, bodies);
     order_.clear();
     if (kind == SolverKind::coloured_pgs) {
       // The matrix-free path's runs and colours, so that both sweep the rows in one order.
-      colour_rows(rows, bodies, MatrixFreeSystem::kMaxRun, colours_);
+      if (spans != nullptr) {
+        colour_spans(*spans, rows.size(), bodies, MatrixFreeSystem::kMaxRun, colours_);
+      } else {
+        colour_rows(rows, bodies, MatrixFreeSystem::kMaxRun, colours_);
+      }
       cps::sweep_order(colours_, order_);
     }
   }
@@ -83,8 +88,9 @@ class ExplicitSolver final : public ConstraintSolver {
 class MatrixFreeSolver final : public ConstraintSolver {
  public:
   void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-               SolverKind kind, RowPrecision precision, Workers* workers) override {
-    cps::prepare(system_, rows, bodies, kind, workers, precision);
+               SolverKind kind, RowPrecision precision, Workers* workers,
+               const std::vector<RowSpan>* spans) override {
+    cps::prepare(system_, rows, bodies, kind, workers, precision, spans);
   }
 
   void solve(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,

@@ -9,6 +9,7 @@
 #include "cps/body.h"
 #include "cps/constraint.h"
 #include "cps/parameters.h"
+#include "row_colours.h"
 #include "system.h"
 #include "workers.h"
 
@@ -44,9 +45,13 @@ class ConstraintSolver {
   /// (SolverKind::coloured_pgs: the rows' colours and sweep order too, row_colours.h). The
   /// matrix-free path packs the rows on `workers`' threads (nullptr: the calling thread), with
   /// the same result for every count. `precision`: how the matrix-free path stores its packed
-  /// rows (RowPrecision); the explicit path assembles in double and ignores it.
+  /// rows (RowPrecision); the explicit path assembles in double and ignores it. `spans`: the
+  /// rows' stretches on the same two bodies (colour_spans), from which coloured PGS cuts its
+  /// runs without reading every row; nullptr: cut from the rows. Throws std::invalid_argument
+  /// when the spans do not cover the rows.
   virtual void prepare(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
-                       SolverKind kind, RowPrecision precision, Workers* workers) = 0;
+                       SolverKind kind, RowPrecision precision, Workers* workers,
+                       const std::vector<RowSpan>* spans) = 0;
 
   /// Solves A lambda = b with settings.iterations sweeps, b of Eq. 6.2.9 from the bodies'
   /// momenta as they are now (read with the world inverse inertia of prepare(), so that the

@@ -815,11 +815,15 @@ bool coloured_lanes_allowed() { return lanes_allowed.load(); }
 
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
              const std::vector<Body>& bodies, SolverKind kind, Workers* workers,
-             RowPrecision precision) {
+             RowPrecision precision, const std::vector<RowSpan>* spans) {
   const int n = static_cast<int>(bodies.size());
   s.runs_ready = false;  // built below (coloured PGS) or by the first PGS solve (Jacobi: never)
   if (kind == SolverKind::coloured_pgs) {
-    colour_rows(rows, bodies, MatrixFreeSystem::kMaxRun, s.colours);
+    if (spans == nullptr) {
+      colour_rows(rows, bodies, MatrixFreeSystem::kMaxRun, s.colours);
+    } else {
+      colour_spans(*spans, rows.size(), bodies, MatrixFreeSystem::kMaxRun, s.colours);
+    }
     coloured_order(s, detail::coloured_lanes_allowed());
     detail::resize_with_headroom(s.position, rows.size());
     for (std::size_t i = 0; i < s.perm.size(); ++i) s.position[static_cast<std::size_t>(s.perm[i])] = static_cast<int>(i);

@@ -104,10 +104,14 @@ struct MatrixFreeSystem {
 /// colouring stays on one). `precision`: j, M^-1 j^T, the bounds and mu stored in double or
 /// rounded to float (so is the coupling of a run, which the first sweep forms),
 /// A_jj and the coupling then formed from the stored numbers (so the sweeps solve that system
-/// consistently). Source: Eq. 6.2.9, A_jj = j M^-1 j^T. No errors.
+/// consistently). `spans`: the rows' stretches on the same two bodies (colour_spans), given by
+/// the row builder so that coloured PGS cuts its runs without reading every row; nullptr: cut
+/// from the rows (the same runs). Source: Eq. 6.2.9, A_jj = j M^-1 j^T. Throws
+/// std::invalid_argument when the spans' counts do not add up to c.
 void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
              const std::vector<Body>& bodies, SolverKind kind, Workers* workers = nullptr,
-             RowPrecision precision = RowPrecision::double_precision);
+             RowPrecision precision = RowPrecision::double_precision,
+             const std::vector<RowSpan>* spans = nullptr);
 
 /// Fills s.b (c): b_j = v_j / dt - j_j . (v1 / dt + M^-1 f_ext) (Eq. 6.2.9) with f_ext (6n:
 /// force and torque per body, N and N m; the explicit path reads the same vector), v1 from the

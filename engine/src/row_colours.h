@@ -35,12 +35,29 @@ struct RowColours {
   std::vector<int> colours;         ///< per run: its colour
 };
 
+/// Consecutive rows on the same two bodies, as ConstraintRow names them (an index or kWorldBody):
+/// a manifold's contact rows, its friction rows, a rod's row. The row builder knows them from
+/// the manifolds, so the cut need not read every row.
+struct RowSpan {
+  int body_a = kWorldBody;
+  int body_b = kWorldBody;
+  int count = 0;  ///< rows, >= 1
+};
+
 /// Cuts rows (c, bodies by index or kWorldBody) into runs of at most max_run (>= 1) rows on the
 /// same movable bodies (a static body and the world count as none; a run's one movable body is
 /// its a), colours the runs (ConstraintGraph::add) and orders them by colour, into out. bodies:
 /// n, the rows' bodies. No errors (rows must name bodies below n or kWorldBody).
 void colour_rows(const std::vector<ConstraintRow>& rows, const std::vector<Body>& bodies,
                  int max_run, RowColours& out);
+
+/// colour_rows for the c = `rows` rows that `spans` lay out in order (span k's rows follow span
+/// k - 1's): the same runs, colours and order as colour_rows over those rows, from the spans
+/// alone (a span on the same movable bodies as the span before it continues its run). Reads
+/// O(spans), not O(c). Spans must name bodies below n or kWorldBody. Throws
+/// std::invalid_argument when a count is below 1 or the counts do not add up to c.
+void colour_spans(const std::vector<RowSpan>& spans, std::size_t rows, const std::vector<Body>& bodies,
+                  int max_run, RowColours& out);
 
 /// The rows of `colours` in sweep order (c indices into the rows given to colour_rows), into
 /// order. No errors.

@@ -108,6 +108,10 @@ struct StepContext {
   };
   std::vector<NarrowShare> narrow_shares;  ///< per chunk; not copied with the context
   std::vector<std::size_t> first_points;   ///< per manifold: its points before it (World::build_rows)
+  /// Coloured PGS: the rows' stretches on the same two bodies in row order (World::build_rows:
+  /// each manifold's contact rows, each one's friction rows, each rod's row), from which
+  /// prepare() cuts the runs without reading every row; empty for the other solvers.
+  std::vector<RowSpan> row_spans;
   /// The contact and friction rows of `rows` that World::build_rows left unwritten for a push
   /// method that does not read them (PushMethod::reads_contact_rows), for World::rows to write
   /// when they are asked for: the row parameters, whether the warm start chose the friction

@@ -496,11 +496,25 @@ void World::build_rows() {
   // point's friction rows right after its contact row).
   // Manifold k's contact rows start at its first point, its friction rows at points plus twice
   // that: each manifold writes only its own rows, so the threads share the manifolds.
+  // Coloured PGS cuts its runs from the same layout as spans of rows on one pair (row_colours.h).
   std::vector<std::size_t>& first_point = ctx.first_points;
   detail::resize_with_headroom(first_point, ctx.manifolds.size());
-  for (std::size_t k = 0, p = 0; k < ctx.manifolds.size(); ++k) {
+  std::vector<RowSpan>& spans = ctx.row_spans;
+  const bool with_spans = def_.solver == SolverKind::coloured_pgs;
+  const std::size_t manifolds = ctx.manifolds.size();
+  detail::resize_with_headroom(spans, with_spans ? manifolds * (friction ? 2 : 1) + distances_.size() : 0);
+  for (std::size_t k = 0, p = 0; k < manifolds; ++k) {
+    const Manifold& m = ctx.manifolds[k];
     first_point[k] = p;
-    p += static_cast<std::size_t>(ctx.manifolds[k].count);
+    p += static_cast<std::size_t>(m.count);
+    if (!with_spans) continue;
+    spans[k] = RowSpan{m.body_a, m.body_b, m.count};
+    if (friction) spans[manifolds + k] = RowSpan{m.body_a, m.body_b, 2 * m.count};
+  }
+  if (with_spans) {
+    for (std::size_t r = 0, first = manifolds * (friction ? 2 : 1); r < distances_.size(); ++r) {
+      spans[first + r] = RowSpan{distances_[r].body_a, distances_[r].body_b, 1};
+    }
   }
   rows.resize(ctx.layout.first_rod());  // rows left from the last step are written whole
   // A method that does not read them (the soft step) leaves them to World::rows.

@@ -23,6 +23,7 @@
 #include <random>
 #include <set>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -54,6 +55,44 @@ Eigen::VectorXd gravity_forces(const scenes::Run& run) {
   }
   return f_ext;
 }
+
+// 40 bodies, every fourth static, and 20,000 rows in stretches on one pair of 1 to 60 rows
+// (longer than a run may be) and two of 7,000, some against the world: the rows and the same
+// stretches as spans. Stretches that follow on the same pair make one run.
+struct Stretches {
+  std::vector<Body> bodies;
+  std::vector<RowSpan> spans;
+  std::vector<ConstraintRow> rows;
+};
+
+Stretches random_stretches() {
+  Stretches out;
+  out.bodies.resize(40);
+  for (std::size_t i = 0; i < out.bodies.size(); ++i) out.bodies[i].inv_mass = i % 4 == 0 ? 0.0 : 1.0;
+  std::mt19937 random(7);
+  std::uniform_int_distribution<int> body(0, 39);
+  std::uniform_int_distribution<int> length(1, 60);
+  for (int stretch = 0; out.rows.size() < 20000; ++stretch) {
+    const int a = body(random);
+    int b = body(random);
+    if (b == a || b % 5 == 0) b = kWorldBody;
+    const std::size_t n = stretch == 50 || stretch == 250 ? 7000 : static_cast<std::size_t>(length(random));
+    ConstraintRow row;
+    row.body_a = stretch % 2 == 0 ? a : b;
+    row.body_b = stretch % 2 == 0 ? b : a;
+    out.rows.insert(out.rows.end(), n, row);
+    out.spans.push_back(RowSpan{row.body_a, row.body_b, static_cast<int>(n)});
+  }
+  return out;
+}
+
+// Block runs swept one by one, not side by side in lanes, while it lives.
+struct LanesOff {
+  LanesOff() { detail::allow_coloured_lanes(false); }
+  ~LanesOff() { detail::allow_coloured_lanes(true); }
+  LanesOff(const LanesOff&) = delete;
+  LanesOff& operator=(const LanesOff&) = delete;
+};
 
 }  // namespace
 
@@ -114,27 +153,9 @@ TEST_CASE("coloured PGS sweeps every row once, and a colour's runs share no mova
 
 TEST_CASE("coloured PGS cuts the rows into the longest runs on one pair that a run may be",
           "[coloured]") {
-  // 40 bodies, every fourth static, and 20,000 rows in stretches on one pair of 1 to 60 rows
-  // (longer than a run may be) and two of 7,000, some against the world. Stretches that follow
-  // on the same pair make one.
-  std::vector<Body> bodies(40);
-  for (std::size_t i = 0; i < bodies.size(); ++i) bodies[i].inv_mass = i % 4 == 0 ? 0.0 : 1.0;
-  std::mt19937 random(7);
-  std::uniform_int_distribution<int> body(0, 39);
-  std::uniform_int_distribution<int> length(1, 60);
-  std::vector<ConstraintRow> rows;
-  for (int stretch = 0; rows.size() < 20000; ++stretch) {
-    const int a = body(random);
-    int b = body(random);
-    if (b == a || b % 5 == 0) b = kWorldBody;
-    const std::size_t n = stretch == 50 || stretch == 250 ? 7000 : static_cast<std::size_t>(length(random));
-    for (std::size_t k = 0; k < n; ++k) {
-      ConstraintRow row;
-      row.body_a = stretch % 2 == 0 ? a : b;
-      row.body_b = stretch % 2 == 0 ? b : a;
-      rows.push_back(row);
-    }
-  }
+  const Stretches stretches = random_stretches();
+  const std::vector<Body>& bodies = stretches.bodies;
+  const std::vector<ConstraintRow>& rows = stretches.rows;
   const auto moving = [&](int b) {
     return b == kWorldBody || bodies[static_cast<std::size_t>(b)].is_static() ? -1 : b;
   };
@@ -160,6 +181,61 @@ TEST_CASE("coloured PGS cuts the rows into the longest runs on one pair that a r
     if (x.count < MatrixFreeSystem::kMaxRun && next < rows.size()) REQUIRE(pair_of(next) != pair_of(next - 1));
   }
   REQUIRE(next == rows.size());
+}
+
+TEST_CASE("coloured PGS cuts the same runs from the row builder's spans as from the rows",
+          "[coloured]") {
+  SECTION("stretches on random pairs, longer and shorter than a run") {
+    const Stretches stretches = random_stretches();
+    RowColours from_rows;
+    RowColours from_spans;
+    colour_rows(stretches.rows, stretches.bodies, MatrixFreeSystem::kMaxRun, from_rows);
+    colour_spans(stretches.spans, stretches.rows.size(), stretches.bodies, MatrixFreeSystem::kMaxRun, from_spans);
+    REQUIRE(from_spans.runs.size() == from_rows.runs.size());
+    for (std::size_t i = 0; i < from_rows.runs.size(); ++i) {
+      const RowColours::Run& x = from_rows.runs[i];
+      const RowColours::Run& y = from_spans.runs[i];
+      REQUIRE(std::tuple{y.begin, y.count, y.a, y.b} == std::tuple{x.begin, x.count, x.a, x.b});
+    }
+    CHECK(from_spans.colours == from_rows.colours);
+    CHECK(from_spans.order == from_rows.order);
+    CHECK(from_spans.start == from_rows.start);
+    // Spans that do not cover the rows, or an empty span, are refused.
+    CHECK_THROWS_AS(colour_spans(stretches.spans, stretches.rows.size() + 1, stretches.bodies,
+                                 MatrixFreeSystem::kMaxRun, from_spans),
+                    std::invalid_argument);
+    std::vector<RowSpan> empty_span = stretches.spans;
+    empty_span.push_back(RowSpan{0, 1, 0});
+    CHECK_THROWS_AS(colour_spans(empty_span, stretches.rows.size(), stretches.bodies,
+                                 MatrixFreeSystem::kMaxRun, from_spans),
+                    std::invalid_argument);
+  }
+  SECTION("a world's steps: the sweep order of its solve is that of its rows' cut") {
+    // Boxes on boxes and the static ground, balls on the funnel's static walls, balls on rods to
+    // the world, chains of rods between bodies, a random pile: the row builder's spans give the
+    // order that cutting its rows gives.
+    // Lanes off, so that the matrix-free order is the colours' runs in order too.
+    const LanesOff lanes_off;
+    for (const char* scene : {"pyramid_100", "funnel", "pendulum_grid", "chain_20", "heavy_rope", "random"}) {
+      CAPTURE(scene);
+      scenes::Overrides o;
+      o.set("solver", SolverKind::coloured_pgs);
+      scenes::Run run = scenes::make_run(*scenes::find_scene(scene), o);
+      std::vector<int> swept;
+      run.world.set_solve_observer([&](const StepSystem& s) {
+        if (s.solve == 0) swept = s.order;
+      });
+      for (int step = 0; step < 40; ++step) {
+        swept.clear();
+        run.step();
+        RowColours colours;
+        std::vector<int> cut;
+        colour_rows(run.world.rows(), run.world.bodies(), MatrixFreeSystem::kMaxRun, colours);
+        sweep_order(colours, cut);
+        REQUIRE(swept == cut);
+      }
+    }
+  }
 }
 
 TEST_CASE("coloured PGS solves the same LCP as PGS: the engine's sweeps on the captured system "

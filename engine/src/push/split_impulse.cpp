@@ -102,7 +102,7 @@ class SplitImpulse final : public PushMethod {
       assembly_ = assembly;
     }
     zero_force_.setZero(f_momentum.size());  // no allocation once it has the size
-    solver_->prepare(rows_, bodies, settings.kind, settings.precision, settings.workers);
+    solver_->prepare(rows_, bodies, settings.kind, settings.precision, settings.workers, nullptr);
     solver_->solve(rows_, bodies, zero_force_, TargetTerms::push_from_rest, settings, lambda_,
                    nullptr);
     add_constraint_forces(rows_, lambda_, f_momentum, f_position);  // + J_p^T lambda_p

@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 // The 32-byte vectors of the coloured sweeps (Wide) pass by value only between always-inlined
 // functions, so no call uses the ABI that -Wpsabi warns of (it warns at the end of the file, where
@@ -744,53 +745,89 @@ void build_runs(MatrixFreeSystem& s) {
   s.runs_ready = true;
 }
 
-// Coloured PGS's sweep order: s.perm (position -> row) and s.runs with s.sweep_start, colour
-// by colour as sweep_order() takes them. In each colour but the overflow, block runs with a
-// movable body and the same row count go kLanes at a time into a lane group (Run::lanes), as
-// they come in row order; the others, and a count's last runs short of a group, run on their
-// own. The runs of a colour share no movable body, so their order within it changes no number.
-void coloured_order(MatrixFreeSystem& s, bool lanes) {
+// Coloured PGS's sweep order: s.perm (position -> row), its inverse s.position, and s.runs with
+// s.sweep_start, colour by colour as sweep_order() takes them. In each colour but the overflow,
+// block runs with a movable body and the same row count go kLanes at a time into a lane group
+// (Run::lanes), as they come in row order; the others, and a count's last runs short of a group,
+// run on their own. The runs of a colour share no movable body, so their order within it
+// changes no number. Each colour's runs and rows are counted first, so that the colours are
+// then laid out on `workers`' threads at once, each into its own ranges: the same order for
+// every thread count.
+void coloured_order(MatrixFreeSystem& s, bool lanes, Workers* workers) {
   constexpr int kL = MatrixFreeSystem::kLanes;
   constexpr int kMax = MatrixFreeSystem::kMaxRun;
+  constexpr auto kColours = static_cast<std::size_t>(ConstraintGraph::kColours);
   const RowColours& colours = s.colours;
-  s.perm.clear();
-  s.runs.clear();
-  const RowColours::Run* last = colours.runs.empty() ? nullptr : &colours.runs.back();
-  detail::reserve_with_headroom(s.perm, last == nullptr ? 0 : static_cast<std::size_t>(last->begin + last->count));
-  detail::reserve_with_headroom(s.runs, colours.runs.size());
-  int position = 0;
-  const auto alone = [&](const RowColours::Run& x) {
-    s.runs.push_back({position, x.count, -1, 1});
-    for (int row = x.begin; row < x.begin + x.count; ++row) s.perm.push_back(row);
-    position += x.count;
+  // The runs of the colour swept k-th, in row order.
+  const auto runs_of = [&](std::size_t k) {
+    const auto c = static_cast<std::size_t>(sweep_colour(static_cast<int>(k)));
+    return std::pair{colours.order.data() + colours.start[c], colours.order.data() + colours.start[c + 1]};
   };
-  std::array<std::array<std::size_t, kL>, kMax + 1> waiting{};  // per row count: runs (indices)
-  std::array<int, kMax + 1> waits{};
-  for (int k = 0; k < ConstraintGraph::kColours; ++k) {
-    const auto c = static_cast<std::size_t>(sweep_colour(k));
-    s.sweep_start[static_cast<std::size_t>(k)] = s.runs.size();
-    for (std::size_t i = colours.start[c]; i < colours.start[c + 1]; ++i) {
-      const RowColours::Run& x = colours.runs[colours.order[i]];
-      if (!lanes || k == 0 || x.count < MatrixFreeSystem::kMinBlock || x.a < 0) {
+  // Whether run x of the colour swept k-th goes into a lane group.
+  const auto grouped = [&](std::size_t k, const RowColours::Run& x) {
+    return lanes && k != 0 && x.count >= MatrixFreeSystem::kMinBlock && x.a >= 0;
+  };
+  // Per colour: its runs once grouped (whole groups of each row count, the rest alone) and rows.
+  ColourStarts run_start{};
+  ColourStarts row_start{};
+  parallel_chunks(workers, kColours, [&](std::size_t k) {
+    std::array<std::size_t, kMax + 1> of_count{};  // grouped runs per row count
+    std::size_t runs = 0;
+    std::size_t rows = 0;
+    for (auto [i, end] = runs_of(k); i != end; ++i) {
+      const RowColours::Run& x = colours.runs[*i];
+      rows += static_cast<std::size_t>(x.count);
+      if (grouped(k, x)) {
+        ++of_count[static_cast<std::size_t>(x.count)];
+      } else {
+        ++runs;
+      }
+    }
+    for (const std::size_t n : of_count) runs += n / kL + n % kL;
+    run_start[k + 1] = runs;
+    row_start[k + 1] = rows;
+  });
+  for (std::size_t k = 0; k < kColours; ++k) {
+    run_start[k + 1] += run_start[k];
+    row_start[k + 1] += row_start[k];
+  }
+  s.sweep_start = run_start;
+  detail::resize_with_headroom(s.runs, run_start.back());
+  detail::resize_with_headroom(s.perm, row_start.back());
+  detail::resize_with_headroom(s.position, row_start.back());
+  parallel_chunks(workers, kColours, [&](std::size_t k) {
+    MatrixFreeSystem::Run* run = s.runs.data() + run_start[k];
+    auto position = static_cast<int>(row_start[k]);
+    const auto place = [&](int row) {
+      s.perm[static_cast<std::size_t>(position)] = row;
+      s.position[static_cast<std::size_t>(row)] = position;
+      ++position;
+    };
+    const auto alone = [&](const RowColours::Run& x) {
+      *run++ = {position, x.count, -1, 1};
+      for (int row = x.begin; row < x.begin + x.count; ++row) place(row);
+    };
+    std::array<std::array<std::size_t, kL>, kMax + 1> waiting{};  // per row count: runs (indices)
+    std::array<int, kMax + 1> waits{};
+    for (auto [i, end] = runs_of(k); i != end; ++i) {
+      const RowColours::Run& x = colours.runs[*i];
+      if (!grouped(k, x)) {
         alone(x);
         continue;
       }
       const auto m = static_cast<std::size_t>(x.count);
-      waiting[m][static_cast<std::size_t>(waits[m]++)] = colours.order[i];
+      waiting[m][static_cast<std::size_t>(waits[m]++)] = *i;
       if (waits[m] < kL) continue;
       waits[m] = 0;
-      s.runs.push_back({position, x.count, -1, kL});
+      *run++ = {position, x.count, -1, kL};
       for (int row = 0; row < x.count; ++row) {
-        for (std::size_t lane = 0; lane < kL; ++lane) s.perm.push_back(colours.runs[waiting[m][lane]].begin + row);
+        for (std::size_t lane = 0; lane < kL; ++lane) place(colours.runs[waiting[m][lane]].begin + row);
       }
-      position += kL * x.count;
     }
     for (std::size_t m = 0; m <= kMax; ++m) {
       for (int w = 0; w < waits[m]; ++w) alone(colours.runs[waiting[m][static_cast<std::size_t>(w)]]);
-      waits[m] = 0;
     }
-  }
-  s.sweep_start.back() = s.runs.size();
+  });
 }
 
 // Coloured PGS: the coupling blocks' places of the runs coloured_order() made.
@@ -824,9 +861,7 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     } else {
       colour_spans(*spans, rows.size(), bodies, MatrixFreeSystem::kMaxRun, s.colours);
     }
-    coloured_order(s, detail::coloured_lanes_allowed());
-    detail::resize_with_headroom(s.position, rows.size());
-    for (std::size_t i = 0; i < s.perm.size(); ++i) s.position[static_cast<std::size_t>(s.perm[i])] = static_cast<int>(i);
+    coloured_order(s, detail::coloured_lanes_allowed(), workers);
   } else {
     s.perm.clear();
     s.position.clear();

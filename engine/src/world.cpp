@@ -23,7 +23,7 @@ namespace {
 // World::steps_in_process.
 std::atomic<std::int64_t> steps_begun{0};
 
-// Fewest bodies or manifolds the row stage shares among threads (count): below it waking them
+// Fewest bodies or manifolds a stage of the step shares among threads (count): below it waking them
 // (microseconds, tens on a virtual machine) costs about what the work does.
 constexpr std::size_t kMinParallelRows = 256;
 
@@ -253,9 +253,11 @@ void World::collide_pairs(Workers* workers) {
   // The rotation matrix of each box and plane, once: the broad phase's bounds and the narrow
   // phase both read it (spheres need none).
   rotations_.resize(bodies_.size());
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    if (bodies_[i].shape.kind != ShapeKind::sphere) rotations_[i] = bodies_[i].rotation();
-  }
+  parallel_for(workers, bodies_.size(), kMinParallelRows, [this](int, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (bodies_[i].shape.kind != ShapeKind::sphere) rotations_[i] = bodies_[i].rotation();
+    }
+  });
   // The push method may widen the speculative distance per body (push_method.h): the broad phase
   // then grows every bound by the largest, so that it lists a superset of the pairs.
   const bool per_body = push_->contact_margins(def_, bodies_, margins_);

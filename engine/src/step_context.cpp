@@ -47,8 +47,8 @@ void StepContext::prepare() {
     solver_assembly = def->assembly;
   }
   StageTimer timer(*this, &StageTimes::prepare);
-  const bool spans = def->solver == SolverKind::coloured_pgs && !row_spans.empty();
-  solver->prepare(rows, *bodies, def->solver, def->row_precision, workers(), spans ? &row_spans : nullptr);
+  const bool coloured = def->solver == SolverKind::coloured_pgs;  // build_rows wrote the spans
+  solver->prepare(rows, *bodies, def->solver, def->row_precision, workers(), coloured ? &row_spans : nullptr);
 }
 
 void StepContext::solve(const SolveSettings& s, TargetTerms terms, std::vector<double>& out,

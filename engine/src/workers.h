@@ -4,10 +4,13 @@
 // index and they meet at barriers between the stages. Between tasks the workers spin a while
 // before they sleep, as Box2D v3's and enkiTS's workers do: a step runs a dozen short tasks
 // with a little serial work between them, and waking a sleeping thread costs tens of
-// microseconds on a virtual machine. With more threads than the processor runs at once, none
-// spins: a spinning thread would hold a core that the thread it waits for needs.
+// microseconds on a virtual machine. The spins are timed by the clock, not counted in pauses: a
+// pause takes from a few to over a hundred cycles by the processor (Box2D v3's solver notes the
+// same). With more threads than the processor runs at once, none spins: a spinning thread would
+// hold a core that the thread it waits for needs.
 
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <thread>
@@ -16,7 +19,7 @@
 namespace cps {
 
 /// `count` threads (>= 1; less is taken as 1): the calling thread and count - 1 kept workers,
-/// which sleep between tasks (after kIdleSpins pauses; at once when count exceeds
+/// which sleep between tasks (after spinning kIdleSpin; at once when count exceeds
 /// std::thread::hardware_concurrency()). Not copyable. Errors: the constructor throws
 /// std::system_error when a thread cannot be started (or std::bad_alloc), after joining those
 /// it started.
@@ -53,9 +56,9 @@ class Workers {
   std::size_t max_blocks() const { return block_stamps_.size(); }
 
   /// Waits until every thread of the running task has reached this call (a barrier); nothing
-  /// with one thread. It spins for about kSpins pauses before it sleeps: a sweep meets a
-  /// barrier after each graph colour, some microseconds apart, while waking a sleeping thread
-  /// takes tens of microseconds on a virtual machine.
+  /// with one thread. It spins for up to kSpin before it sleeps: a sweep meets a barrier after
+  /// each graph colour, some microseconds apart, while waking a sleeping thread takes tens of
+  /// microseconds on a virtual machine.
   void sync();
 
  private:
@@ -64,22 +67,23 @@ class Workers {
   void loop(int t);
   void stop_and_join();
 
-  /// Pauses a waiting thread spins for before it sleeps, at a barrier and while the caller
-  /// waits for a task's end (count; about 10 to 40 us).
-  static constexpr int kSpins = 2000;
-  /// Pauses an idle worker spins for before it sleeps, waiting for the next task (count; about
-  /// 0.2 to 1 ms, by the processor's pause: longer than the serial work between a step's tasks).
-  static constexpr int kIdleSpins = 20000;
+  /// How long a waiting thread spins before it sleeps, at a barrier and while the caller waits
+  /// for a task's end (typically 0.5 ms: longer than the threads' shares of a stage differ).
+  static constexpr std::chrono::microseconds kSpin{500};
+  /// How long an idle worker spins before it sleeps, waiting for the next task (typically 2 ms:
+  /// longer than the serial work between a step's tasks, a caller's per-step bookkeeping
+  /// included; a worker that sleeps there wakes late for the next task).
+  static constexpr std::chrono::microseconds kIdleSpin{2000};
 
-  // Spins for up to `spins` pauses while value == old, then sleeps until it changes.
+  // Spins for up to `spin` while value == old, then sleeps until it changes.
   template <class T>
-  static void wait_while(const std::atomic<T>& value, T old, int spins);
+  static void wait_while(const std::atomic<T>& value, T old, std::chrono::microseconds spin);
 
   int count_ = 1;
-  // kSpins and kIdleSpins, or 0 when there are more threads than the processor runs at once: a
+  // kSpin and kIdleSpin, or 0 when there are more threads than the processor runs at once: a
   // thread that spins then holds a core the thread it waits for may need (set once).
-  int spins_ = kSpins;
-  int idle_spins_ = kIdleSpins;
+  std::chrono::microseconds spin_ = kSpin;
+  std::chrono::microseconds idle_spin_ = kIdleSpin;
   std::atomic<int> arrived_{0};               // threads at the current barrier
   std::atomic<std::uint32_t> phase_{0};       // barriers passed
   std::atomic<std::uint32_t> generation_{0};  // tasks started (and the stop)
@@ -205,7 +209,7 @@ void parallel_chunks(Workers* workers, std::size_t chunks, Fn&& fn) {
 
 inline Workers::Workers(int count) : count_(count < 1 ? 1 : count) {
   const unsigned cores = std::thread::hardware_concurrency();  // 0: unknown
-  if (cores != 0 && static_cast<unsigned>(count_) > cores) spins_ = idle_spins_ = 0;
+  if (cores != 0 && static_cast<unsigned>(count_) > cores) spin_ = idle_spin_ = std::chrono::microseconds{0};
   try {
     block_stamps_ = std::vector<BlockStamp>(kBlocksPerThread * static_cast<std::size_t>(count_));
     threads_.reserve(static_cast<std::size_t>(count_ - 1));
@@ -219,12 +223,20 @@ inline Workers::Workers(int count) : count_(count < 1 ? 1 : count) {
 inline Workers::~Workers() { stop_and_join(); }
 
 template <class T>
-inline void Workers::wait_while(const std::atomic<T>& value, T old, int spins) {
-  for (int i = 0; i < spins; ++i) {
-    if (value.load(std::memory_order_acquire) != old) return;
+inline void Workers::wait_while(const std::atomic<T>& value, T old, std::chrono::microseconds spin) {
+  if (value.load(std::memory_order_acquire) != old) return;
+  if (spin.count() > 0) {
+    // The clock is read every 64 pauses (a microsecond or more), at tens of nanoseconds a read.
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point until = Clock::now() + spin;
+    do {
+      for (int i = 0; i < 64; ++i) {
+        if (value.load(std::memory_order_acquire) != old) return;
 #if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
+        __builtin_ia32_pause();
 #endif
+      }
+    } while (Clock::now() < until);
   }
   while (value.load(std::memory_order_acquire) == old) value.wait(old, std::memory_order_acquire);
 }
@@ -239,7 +251,7 @@ inline void Workers::sync() {
     phase_.notify_all();
     return;
   }
-  wait_while(phase_, phase, spins_);
+  wait_while(phase_, phase, spin_);
 }
 
 inline void Workers::stop_and_join() {
@@ -261,14 +273,14 @@ inline void Workers::start() {
 inline void Workers::finish() {
   for (int left = running_.load(std::memory_order_acquire); left != 0;
        left = running_.load(std::memory_order_acquire)) {
-    wait_while(running_, left, spins_);
+    wait_while(running_, left, spin_);
   }
 }
 
 inline void Workers::loop(int t) {
   std::uint32_t seen = 0;
   for (;;) {
-    wait_while(generation_, seen, idle_spins_);
+    wait_while(generation_, seen, idle_spin_);
     seen = generation_.load(std::memory_order_acquire);
     if (stop_.load(std::memory_order_acquire)) return;
     call_(task_, t);

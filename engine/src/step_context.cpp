@@ -127,7 +127,7 @@ void StepContext::store_warm_start() {
 void StepContext::integrate(const Eigen::VectorXd& f_position, const Eigen::VectorXd& f_momentum,
                             double h) {
   StageTimer timer(*this, &StageTimes::integrate);
-  cps::integrate(*bodies, f_position, f_momentum, h, def->rotation);
+  cps::integrate(*bodies, f_position, f_momentum, h, def->rotation, workers());
 }
 
 }  // namespace cps

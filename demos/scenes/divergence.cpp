@@ -47,6 +47,7 @@ class DivergenceMetrics final : public Metrics {
 std::optional<Divergence> divergence_sign(const World& world) {
   const std::vector<Body>& bodies = world.bodies();
   char why[200];
+  double smallest = std::numeric_limits<double>::infinity();  // of every movable body (m)
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
     if (b.is_static()) continue;
@@ -55,7 +56,11 @@ std::optional<Divergence> divergence_sign(const World& world) {
       std::snprintf(why, sizeof why, "body %zu's state is not finite", i);
       return Divergence{world.time(), why, true};
     }
+    smallest = std::min(smallest, smallest_size(b));
   }
+  // A contact deeper than its smaller body is deeper than the smallest movable body: when none
+  // is, the pass below (which reads both bodies of every manifold) finds nothing.
+  if (!(deepest_contact(world) > smallest)) return std::nullopt;
   for (const Manifold& m : world.manifolds()) {
     const double size = std::min(smallest_size(bodies[static_cast<std::size_t>(m.body_a)]),
                                  smallest_size(bodies[static_cast<std::size_t>(m.body_b)]));

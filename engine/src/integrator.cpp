@@ -32,7 +32,7 @@ void integrate(std::vector<Body>& bodies, const Eigen::VectorXd& f_position,
                const Eigen::VectorXd& f_momentum, double dt, RotationUpdate rotation, Workers* workers) {
   // Fewest bodies shared among threads (count): below it waking them costs about what the work does.
   constexpr std::size_t kMinParallel = 256;
-  parallel_for(workers, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+  parallel_blocks(workers, bodies.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       Body& body = bodies[i];
       if (body.is_static()) continue;

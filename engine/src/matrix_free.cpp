@@ -867,7 +867,7 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
     s.position.clear();
   }
   detail::resize_with_headroom(s.inv_inertia, bodies.size());
-  parallel_for(workers, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+  parallel_blocks(workers, bodies.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) s.inv_inertia[i] = bodies[i].inv_inertia_world();
   });
   detail::resize_with_headroom(s.diagonal, rows.size());
@@ -918,7 +918,7 @@ void prepare(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   // Every row packed into out (s.rows or s.float_rows), then the coloured runs' coupling.
   const auto pack_all = [&]<class PackedRow>(std::vector<PackedRow>& out) {
     detail::resize_with_headroom(out, rows.size());
-    parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    parallel_blocks(workers, rows.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
       if (s.perm.empty()) {
         for (std::size_t i = begin; i < end; ++i) s.diagonal[i] = pack(rows[i], rows[i].normal_row, out[i]);
         return;
@@ -957,7 +957,7 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   detail::resize_with_headroom(s.b, rows.size());
   // a = v1 / dt + M^-1 f_ext per body, in w's storage (solve() overwrites it).
   detail::resize_with_headroom(s.w, bodies.size() + 1);
-  parallel_for(workers, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+  parallel_blocks(workers, bodies.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Body& body = bodies[i];
       Vec6& a = s.w[i];
@@ -973,7 +973,7 @@ void rhs(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows,
   s.w.back().setZero();
   const int fixed_slot = static_cast<int>(bodies.size());
   with_rows(s, [&](const auto& packed_rows) {
-    parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    parallel_blocks(workers, rows.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
       if (terms == TargetTerms::push_from_rest) {  // the bodies at rest, no external force: b = v / dt
         for (std::size_t i = begin; i < end; ++i) s.b[i] = target_velocity(rows[row_at(s, i)], terms) / dt;
         return;
@@ -1064,7 +1064,7 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
         workers->run(task);
       }
       detail::resize_with_headroom(lambda, rows.size());
-      parallel_for(workers, rows.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+      parallel_blocks(workers, rows.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j) lambda[static_cast<std::size_t>(s.perm[j])] = l[j];
       });
     } else {
@@ -1079,7 +1079,7 @@ void solve(MatrixFreeSystem& s, const std::vector<ConstraintRow>& rows, Friction
 void constraint_forces(const MatrixFreeSystem& s, const std::vector<Body>& bodies,
                        const Eigen::VectorXd& f_ext, Eigen::VectorXd& f, Workers* workers) {
   f.resize(f_ext.size());  // same size every step: no allocation
-  parallel_for(workers, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+  parallel_blocks(workers, bodies.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const auto k = static_cast<Eigen::Index>(6 * i);
       f.segment<6>(k) = f_ext.segment<6>(k);

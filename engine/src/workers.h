@@ -187,6 +187,28 @@ class BlockClaims {
   std::size_t steal_ = 0;
 };
 
+/// Runs fn(begin, end) over blocks that cover the items [0, count) in order, on the threads of
+/// `workers`, each thread claiming blocks as BlockClaims hands them out: first those of its own
+/// even share, then any still unclaimed, from the last one down. A thread that is done early then
+/// takes over the end of a slower thread's share instead of waiting for it at the task's end.
+/// With no workers, one thread, or fewer than `min_parallel` items (count), fn(0, count) on the
+/// calling thread. For work whose items write only their own results, so the result is the same
+/// for every thread count and schedule. fn must not throw.
+template <class Fn>
+void parallel_blocks(Workers* workers, std::size_t count, std::size_t min_parallel, Fn&& fn) {
+  if (workers == nullptr || workers->count() == 1 || count < min_parallel) {
+    fn(std::size_t{0}, count);
+    return;
+  }
+  const std::size_t blocks = count < workers->max_blocks() ? count : workers->max_blocks();
+  auto task = [&](int t) {
+    BlockClaims claims(*workers, t);
+    claims.stage(blocks);
+    for (std::size_t block; claims.next(block);) fn(count * block / blocks, count * (block + 1) / blocks);
+  };
+  workers->run(task);
+}
+
 /// Runs fn(k) for every chunk k in [0, chunks) on the threads of `workers`, each thread taking
 /// the next chunk no thread has taken yet (so uneven chunks even out); with no workers or one
 /// thread, in order on the calling thread. For chunks that write only their own results, so the

@@ -253,7 +253,7 @@ void World::collide_pairs(Workers* workers) {
   // The rotation matrix of each box and plane, once: the broad phase's bounds and the narrow
   // phase both read it (spheres need none).
   rotations_.resize(bodies_.size());
-  parallel_for(workers, bodies_.size(), kMinParallelRows, [this](int, std::size_t begin, std::size_t end) {
+  parallel_blocks(workers, bodies_.size(), kMinParallelRows, [this](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       if (bodies_[i].shape.kind != ShapeKind::sphere) rotations_[i] = bodies_[i].rotation();
     }
@@ -429,7 +429,7 @@ void World::write_contact_rows(const std::vector<Body>& bodies, const RowParams&
   const auto velocity = [&](int body) -> const BodyVelocity& {
     return ctx.may_bounce ? velocities_[static_cast<std::size_t>(body)] : unread;
   };
-  parallel_for(workers, ctx.manifolds.size(), kMinParallelRows, [&](int, std::size_t begin, std::size_t end) {
+  parallel_blocks(workers, ctx.manifolds.size(), kMinParallelRows, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const Manifold& m = ctx.manifolds[k];
       const std::size_t first = ctx.first_points[k];
@@ -473,7 +473,7 @@ void World::build_rows() {
       velocity_known_[static_cast<std::size_t>(m.body_a)] = 1;
       velocity_known_[static_cast<std::size_t>(m.body_b)] = 1;
     }
-    parallel_for(workers, bodies_.size(), kMinParallelRows, [this](int, std::size_t begin, std::size_t end) {
+    parallel_blocks(workers, bodies_.size(), kMinParallelRows, [this](std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) {
         if (velocity_known_[k]) velocities_[k] = body_velocity(bodies_[k]);
       }

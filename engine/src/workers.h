@@ -6,11 +6,11 @@
 // with a little serial work between them, and waking a sleeping thread costs tens of
 // microseconds on a virtual machine. The spins are timed by the clock, not counted in pauses: a
 // pause takes from a few to over a hundred cycles by the processor (Box2D v3's solver notes the
-// same). A spin pauses first, then yields the core between reads, as the solver workers of Box2D
-// v3 and Box3D do (src/solver.c). With more threads than the processor runs at once, none spins:
-// a spinning thread would hold a core that the thread it waits for needs.
+// same). A waiting thread does not yield the core while it spins: beside a busy process a yield
+// hands the core to that process for its time slice, not to the thread waited for
+// (docs/benchmarks.md). With more threads than the processor runs at once, none spins: a spinning
+// thread would hold a core that the thread it waits for needs.
 
-#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -70,17 +70,14 @@ class Workers {
   void stop_and_join();
 
   /// How long a waiting thread spins before it sleeps, at a barrier and while the caller waits
-  /// for a task's end (typically 0.1 ms: longer than the threads' arrivals differ once the blocks
+  /// for a task's end (typically 50 us: longer than the threads' arrivals differ once the blocks
   /// even out; a longer spin holds a core that a preempted thread of the task needs while other
   /// processes run).
-  static constexpr std::chrono::microseconds kSpin{100};
-  /// How long an idle worker spins before it sleeps, waiting for the next task (typically 2 ms:
-  /// longer than the serial work between a step's tasks, a caller's per-step bookkeeping
-  /// included; a worker that sleeps there wakes late for the next task).
-  static constexpr std::chrono::microseconds kIdleSpin{2000};
-  /// The first part of a spin, in pauses; the rest yields the core between reads (typically
-  /// 50 us: far longer than the threads' arrivals at a barrier usually differ, microseconds).
-  static constexpr std::chrono::microseconds kPauseSpin{50};
+  static constexpr std::chrono::microseconds kSpin{50};
+  /// How long an idle worker spins before it sleeps, waiting for the next task (typically 1 ms:
+  /// longer than the serial work between a step's tasks, a caller's per-step bookkeeping of 0.5
+  /// to 0.8 ms included; a worker that sleeps there wakes late for the next task).
+  static constexpr std::chrono::microseconds kIdleSpin{1000};
 
   // Spins for up to `spin` while value == old, then sleeps until it changes.
   template <class T>
@@ -255,13 +252,9 @@ template <class T>
 inline void Workers::wait_while(const std::atomic<T>& value, T old, std::chrono::microseconds spin) {
   if (value.load(std::memory_order_acquire) != old) return;
   if (spin.count() > 0) {
-    // Pauses for the first kPauseSpin, then yields the core between reads until `spin` has
-    // passed: a thread that waits for this one but lost its core (another process runs) gets it
-    // back, while on an idle machine a yield returns at once. The clock is read every 64 pauses
-    // (a microsecond or more), at tens of nanoseconds a read.
+    // The clock is read every 64 pauses (a microsecond or more), at tens of nanoseconds a read.
     using Clock = std::chrono::steady_clock;
-    const Clock::time_point start = Clock::now();
-    const Clock::time_point pause_until = start + std::min(spin, kPauseSpin);
+    const Clock::time_point until = Clock::now() + spin;
     do {
       for (int i = 0; i < 64; ++i) {
         if (value.load(std::memory_order_acquire) != old) return;
@@ -269,12 +262,7 @@ inline void Workers::wait_while(const std::atomic<T>& value, T old, std::chrono:
         __builtin_ia32_pause();
 #endif
       }
-    } while (Clock::now() < pause_until);
-    const Clock::time_point until = start + spin;
-    while (Clock::now() < until) {
-      if (value.load(std::memory_order_acquire) != old) return;
-      std::this_thread::yield();
-    }
+    } while (Clock::now() < until);
   }
   while (value.load(std::memory_order_acquire) == old) value.wait(old, std::memory_order_acquire);
 }

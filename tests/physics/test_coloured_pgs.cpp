@@ -20,6 +20,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
@@ -456,6 +457,37 @@ TEST_CASE("BlockClaims hands every block of every stage to exactly one thread", 
           if (n != (b < blocks ? 1 : 0)) ++wrong;
         }
       }
+      CHECK(wrong == 0);
+    }
+  }
+}
+
+TEST_CASE("parallel_blocks hands every item to exactly one call, in ranges inside [0, count)",
+          "[threads]") {
+  // Counts below the sharing threshold, below, at and past the most blocks, and a large odd one,
+  // with no workers and on 1 to 4 threads: each item's calls are counted.
+  constexpr std::size_t kMinParallel = 4;
+  for (int threads = 0; threads <= 4; ++threads) {  // 0: no workers
+    CAPTURE(threads);
+    std::optional<Workers> pool;
+    if (threads > 0) pool.emplace(threads);
+    Workers* workers = pool ? &*pool : nullptr;
+    const std::size_t most = pool ? pool->max_blocks() : 8;
+    for (const std::size_t count : {std::size_t{0}, std::size_t{1}, kMinParallel - 1, kMinParallel, most - 1,
+                                    most, most + 1, std::size_t{10007}}) {
+      CAPTURE(count);
+      std::vector<std::atomic<int>> calls(count);
+      std::atomic<int> bad_ranges{0};
+      parallel_blocks(workers, count, kMinParallel, [&](std::size_t begin, std::size_t end) {
+        if (begin > end || end > count) {
+          bad_ranges.fetch_add(1);
+          return;
+        }
+        for (std::size_t i = begin; i < end; ++i) calls[i].fetch_add(1);
+      });
+      CHECK(bad_ranges.load() == 0);
+      int wrong = 0;
+      for (const auto& c : calls) wrong += c.load() == 1 ? 0 : 1;
       CHECK(wrong == 0);
     }
   }

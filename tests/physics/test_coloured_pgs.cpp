@@ -462,7 +462,7 @@ TEST_CASE("BlockClaims hands every block of every stage to exactly one thread", 
   }
 }
 
-TEST_CASE("parallel_blocks hands every item to exactly one call, in ranges inside [0, count)",
+TEST_CASE("parallel_blocks hands every item to exactly one call, in ranges within the items",
           "[threads]") {
   // Counts below the sharing threshold, below, at and past the most blocks, and a large odd one,
   // with no workers and on 1 to 4 threads: each item's calls are counted.

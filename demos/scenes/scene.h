@@ -222,7 +222,8 @@ struct Run {
 /// Builds a scene's world. Throws std::invalid_argument if the parameters are invalid.
 Run make_run(const Scene& scene, const Overrides& overrides = {});
 
-/// Deepest penetration (m) among the contacts of the world's last step; 0 if none.
+/// Deepest penetration (m) among the contacts of the world's last step; 0 if none
+/// (World::deepest_contact).
 double deepest_contact(const World& world);
 
 /// Kinetic energy of all bodies (J), translational plus rotational.

@@ -397,14 +397,6 @@ double max_penetration_now(const World& world) {
   return deepest;
 }
 
-double deepest_contact(const World& world) {
-  double deepest = 0.0;
-  for (const Manifold& m : world.manifolds()) {
-    for (int i = 0; i < m.count; ++i) {
-      deepest = std::max(deepest, m.contacts[static_cast<std::size_t>(i)].depth);
-    }
-  }
-  return deepest;
-}
+double deepest_contact(const World& world) { return world.deepest_contact(); }
 
 }  // namespace cps::scenes

@@ -14,6 +14,9 @@ namespace cps {
 
 StepContext::StepContext(const StepContext& other)
     : manifolds(detail::copy_with_capacity(other.manifolds)),
+      first_points(detail::copy_with_capacity(other.first_points)),
+      contact_points(other.contact_points),
+      deepest_contact(other.deepest_contact),
       rows(detail::copy_with_capacity(other.rows)),
       layout(other.layout),
       lambda(detail::copy_with_capacity(other.lambda)),
@@ -121,7 +124,7 @@ void StepContext::notify_observer(const SolveSettings& s, TargetTerms terms,
 
 void StepContext::store_warm_start() {
   StageTimer timer(*this, &StageTimes::store);
-  if (warm()) warm_start->store(manifolds, rows, distances->size(), lambda, lambda_second, workers());
+  if (warm()) warm_start->store(manifolds, rows, distances->size(), lambda, lambda_second, workers(), &first_points);
 }
 
 void StepContext::integrate(const Eigen::VectorXd& f_position, const Eigen::VectorXd& f_momentum,

@@ -77,6 +77,10 @@ struct StepContext {
   const std::vector<DistanceConstraint>* distances = nullptr;
 
   std::vector<Manifold> manifolds;    ///< Sec. 4: the manifolds of this step's collide stage
+  /// Per manifold: the contact points of the manifolds before it (World::collide, with them).
+  std::vector<std::size_t> first_points;
+  std::size_t contact_points = 0;  ///< the contact points of all manifolds (World::collide)
+  double deepest_contact = 0.0;    ///< m: the largest contact depth, 0 when none is positive
   std::vector<ConstraintRow> rows;    ///< Sec. 5: c rows: contacts, friction, rods
   RowLayout layout;                   ///< where each kind of row sits in `rows`
   std::vector<double> lambda;         ///< c, N: the solve that sets the step's result (see lambda_pending)
@@ -105,9 +109,10 @@ struct StepContext {
     std::vector<std::size_t> found;
     std::size_t first = 0;   ///< its first manifold's place in the step's manifolds
     std::size_t points = 0;  ///< contact points in its manifolds
+    std::size_t first_point = 0;  ///< its first manifold's first point in the step's
+    double deepest = 0.0;         ///< m: its deepest contact, 0 when none is positive
   };
   std::vector<NarrowShare> narrow_shares;  ///< per chunk; not copied with the context
-  std::vector<std::size_t> first_points;   ///< per manifold: its points before it (World::build_rows)
   /// Coloured PGS: the rows' stretches on the same two bodies in row order (World::build_rows:
   /// each manifold's contact rows, each one's friction rows, each rod's row), from which
   /// prepare() cuts the runs without reading every row; empty for the other solvers.

@@ -4,6 +4,7 @@
 #include "buffers.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 namespace cps {
@@ -35,6 +36,16 @@ std::size_t first_points(const std::vector<Manifold>& manifolds, std::vector<std
   return n;
 }
 
+// first_points(manifolds, first), from the collide stage's count `given` where it has one entry
+// a manifold (a copy, not a pass over the manifolds).
+std::size_t first_points(const std::vector<Manifold>& manifolds, const std::vector<std::size_t>* given,
+                         std::vector<std::size_t>& first) {
+  if (given == nullptr || given->size() != manifolds.size()) return first_points(manifolds, first);
+  detail::reserve_with_headroom(first, given->size());
+  first.assign(given->begin(), given->end());
+  return manifolds.empty() ? 0 : first.back() + static_cast<std::size_t>(manifolds.back().count);
+}
+
 // Whether the rows hold two friction rows per point (rows = points + 2 points + rods).
 bool rows_have_friction(std::size_t points, std::size_t rows, std::size_t rods) {
   return points > 0 && rows == 3 * points + rods;
@@ -42,16 +53,16 @@ bool rows_have_friction(std::size_t points, std::size_t rows, std::size_t rods) 
 
 }  // namespace
 
-void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* workers) {
+void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* workers,
+                           const std::vector<std::size_t>* counted) {
   // Every entry is written below, by its manifold.
-  const std::size_t points = first_points(manifolds, first_point_);
+  const std::size_t points = first_points(manifolds, counted, first_point_);
   detail::resize_with_headroom(match_, points);
   detail::resize_with_headroom(tangents_, points);
   detail::resize_with_headroom(same_points_, manifolds.size());
   detail::resize_with_headroom(pair_match_, manifolds.size());
-  const auto threads = static_cast<std::size_t>(workers != nullptr ? workers->count() : 1);
-  detail::assign_with_headroom(matched_by_thread_, threads, std::size_t{0});
-  parallel_for(workers, manifolds.size(), kMinParallel, [&](int t, std::size_t begin, std::size_t end) {
+  std::atomic<std::size_t> matched_points{0};
+  parallel_blocks(workers, manifolds.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
     if (begin == end) return;
     std::size_t matched = 0;
     // Both lists are in pair order: walk the cached one along (a missing or extra pair, or any
@@ -108,10 +119,9 @@ void WarmStartCache::match(const std::vector<Manifold>& manifolds, Workers* work
       }
       same_points_[index] = same_pair && matched_here == m.count && manifolds_[j].count == m.count;
     }
-    matched_by_thread_[static_cast<std::size_t>(t)] = matched;
+    matched_points.fetch_add(matched, std::memory_order_relaxed);
   });
-  matched_ = 0;
-  for (const std::size_t m : matched_by_thread_) matched_ += m;
+  matched_ = matched_points.load(std::memory_order_relaxed);
   tangents_fresh_ = true;
 }
 
@@ -212,9 +222,9 @@ void WarmStartCache::initial_guesses(const std::vector<Manifold>& manifolds,
 void WarmStartCache::store(const std::vector<Manifold>& manifolds,
                            const std::vector<ConstraintRow>& rows, std::size_t rods,
                            const std::vector<double>& first, const std::vector<double>& second,
-                           Workers* workers) {
+                           Workers* workers, const std::vector<std::size_t>* counted) {
   const std::size_t c = rows.size();
-  const std::size_t points = first_points(manifolds, first_point_);
+  const std::size_t points = first_points(manifolds, counted, first_point_);
   has_friction_ = rows_have_friction(points, c, rods);
   has_second_ = !second.empty();
   // The friction rows' directions: match()'s t1 and n x t1 when this step's match() chose them
@@ -224,7 +234,7 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
   detail::resize_with_headroom(next_points_, points);
   detail::resize_with_headroom(next_rows_, points);
   // Each manifold writes only its own entry and points.
-  parallel_for(workers, manifolds.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+  parallel_blocks(workers, manifolds.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
     for (std::size_t index = begin; index < end; ++index) {
       const Manifold& m = manifolds[index];
       std::size_t k = first_point_[index];
@@ -275,8 +285,9 @@ void WarmStartCache::store(const std::vector<Manifold>& manifolds,
   }
 }
 
-void WarmStartCache::begin_store(const std::vector<Manifold>& manifolds) {
-  const std::size_t points = first_points(manifolds, first_point_);
+void WarmStartCache::begin_store(const std::vector<Manifold>& manifolds,
+                                 const std::vector<std::size_t>* counted) {
+  const std::size_t points = first_points(manifolds, counted, first_point_);
   has_friction_ = false;
   has_second_ = false;
   detail::resize_with_headroom(manifolds_, manifolds.size());

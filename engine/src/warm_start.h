@@ -57,7 +57,11 @@ class WarmStartCache {
   /// the projection is shorter than 1/2, tangent_basis instead); for a new point tangent_basis's
   /// t1 (the paper's choice, Sec. 5.4). Shared among `workers`' threads (nullptr: the calling
   /// thread; the same result for every count), as initial_guesses() and store() are.
-  void match(const std::vector<Manifold>& manifolds, Workers* workers = nullptr);
+  /// counted: per manifold, the points of the manifolds before it, as the collide stage counted
+  /// them (StepContext::first_points); null or of another size: counted here. So for store()
+  /// and begin_store().
+  void match(const std::vector<Manifold>& manifolds, Workers* workers = nullptr,
+             const std::vector<std::size_t>* counted = nullptr);
 
   /// The t1 picked by match() for the points of one manifold, m.count of them, for
   /// append_friction_rows; first_point: the number of points in the manifolds before it. Valid
@@ -85,7 +89,8 @@ class WarmStartCache {
   /// step's match(), its friction rows along tangents() (World::build_rows).
   void store(const std::vector<Manifold>& manifolds, const std::vector<ConstraintRow>& rows,
              std::size_t rods, const std::vector<double>& first,
-             const std::vector<double>& second, Workers* workers = nullptr);
+             const std::vector<double>& second, Workers* workers = nullptr,
+             const std::vector<std::size_t>* counted = nullptr);
 
   /// WarmStartRule::manifold, after match(): the contact row's lambda (N) of the cached point
   /// that this step's point k (its contact row) matched, 0 for a new point.
@@ -109,7 +114,8 @@ class WarmStartCache {
   /// any thread, each manifold its own), then end_store(). The cached points keep match()'s
   /// t1 (tangents()) and only their contact row's lambda; the sustained rule of another method
   /// finds no friction and, lacking an older lambda, starts the contacts from 0.
-  void begin_store(const std::vector<Manifold>& manifolds);
+  void begin_store(const std::vector<Manifold>& manifolds,
+                   const std::vector<std::size_t>* counted = nullptr);
   /// Manifold m of the step (`manifold`, as given to begin_store()) with its points' contact
   /// lambdas normal[0, manifold.count) (N), its friction force (N, a world vector) and twist
   /// (N m about its normal). No errors.
@@ -176,7 +182,6 @@ class WarmStartCache {
   std::size_t matched_ = 0;
   // Per manifold of the step: the points of the manifolds before it (match() and store()).
   detail::KeptBuffer<std::size_t> first_point_;
-  detail::KeptBuffer<std::size_t> matched_by_thread_;  // match(): points matched by each thread
 };
 
 }  // namespace cps

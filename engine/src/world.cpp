@@ -76,6 +76,7 @@ void World::set_stage_timing(bool on) {
   ctx_->time_stages = on;
 }
 const std::vector<Manifold>& World::manifolds() const { return ctx_->manifolds; }
+double World::deepest_contact() const { return ctx_->deepest_contact; }
 const std::vector<ConstraintRow>& World::rows() const { return settled_context().rows; }
 
 const StepContext& World::settled_context() const {
@@ -225,12 +226,18 @@ void World::collide() {
   Workers* workers = ctx_->workers();
   // On threads the manifolds keep their storage and count until the join resizes them (so that
   // only those past last step's count are made, not every one); any error clears them first.
-  if (workers == nullptr || !def_.collision) manifolds.clear();
+  const auto clear = [this, &manifolds] {
+    manifolds.clear();
+    ctx_->first_points.clear();
+    ctx_->contact_points = 0;
+    ctx_->deepest_contact = 0.0;
+  };
+  if (workers == nullptr || !def_.collision) clear();
   if (!def_.collision) return;
   try {
     collide_pairs(workers);
   } catch (...) {
-    manifolds.clear();
+    clear();
     throw;
   }
 }
@@ -245,10 +252,21 @@ void copy_used_contacts(const Manifold& from, Manifold& to) {
   to.anchor_shift = from.anchor_shift;
   std::copy_n(from.contacts.begin(), from.count, to.contacts.begin());
 }
+
+// The largest depth of m's contacts and `deepest` (m; a NaN depth is passed over).
+double deeper(const Manifold& m, double deepest) {
+  for (int i = 0; i < m.count; ++i) deepest = std::max(deepest, m.contacts[static_cast<std::size_t>(i)].depth);
+  return deepest;
+}
 }  // namespace
 
 void World::collide_pairs(Workers* workers) {
   std::vector<Manifold>& manifolds = ctx_->manifolds;
+  // Counted with the manifolds, where they are at hand: each one's first point, all points and
+  // the deepest contact (the later stages and the world's readers take them from here).
+  std::vector<std::size_t>& first_points = ctx_->first_points;
+  first_points.clear();
+  double deepest = 0.0;
   StepCounters& counters = ctx_->counters;
   // The rotation matrix of each box and plane, once: the broad phase's bounds and the narrow
   // phase both read it (spheres need none).
@@ -316,7 +334,9 @@ void World::collide_pairs(Workers* workers) {
     if (recycler != nullptr) recycler->keep(m, bodies_, found);
     counters.recycled += found != ContactRecycler::kNone ? 1 : 0;
     counters.contacts += m.count;
+    first_points.push_back(points);
     points += static_cast<std::size_t>(m.count);
+    deepest = deeper(m, deepest);
     if (points > kMaxContactPoints) too_many_points();
   };
   counters.pairs_tested += static_cast<std::int64_t>(pairs_.size());
@@ -348,6 +368,7 @@ void World::collide_pairs(Workers* workers) {
     std::size_t front_used = 0;      // manifolds the calling thread made in place
     std::size_t front_points = 0;    // their contact points
     std::size_t front_recycled = 0;  // those of them recycled
+    double front_deepest = 0.0;      // their deepest contact
     const auto front = [&] {
       Cursor cursor;
       for (std::size_t i = 0, end = front_chunks * kPairsPerChunk; i < end; ++i) {
@@ -357,7 +378,9 @@ void World::collide_pairs(Workers* workers) {
         if (narrow(pairs_[i], m, cursor)) {
           if (recycler != nullptr) recycler->keep(m, bodies_, cursor.found);
           front_recycled += cursor.found != ContactRecycler::kNone ? 1 : 0;
+          first_points.push_back(front_points);
           front_points += static_cast<std::size_t>(m.count);
+          front_deepest = deeper(m, front_deepest);
           ++front_used;
         }
       }
@@ -370,6 +393,7 @@ void World::collide_pairs(Workers* workers) {
       share.found.clear();
       Cursor cursor = recycler != nullptr ? recycler->cursor_at(pairs_[begin].first, pairs_[begin].second) : Cursor{};
       share.points = 0;
+      share.deepest = 0.0;
       for (std::size_t i = begin; i < end; ++i) {
         if (share.used == share.manifolds.size()) share.manifolds.emplace_back();
         Manifold& m = share.manifolds[share.used];
@@ -377,6 +401,7 @@ void World::collide_pairs(Workers* workers) {
         if (narrow(pairs_[i], m, cursor)) {
           share.found.push_back(cursor.found);
           share.points += static_cast<std::size_t>(m.count);
+          share.deepest = deeper(m, share.deepest);
           ++share.used;
         }
       }
@@ -393,28 +418,36 @@ void World::collide_pairs(Workers* workers) {
     // for recycling) on the threads.
     std::size_t count = front_used;
     points += front_points;
+    deepest = front_deepest;
     counters.contacts += static_cast<std::int64_t>(front_points);
     counters.recycled += static_cast<std::int64_t>(front_recycled);
     for (std::size_t k = front_chunks; k < chunks; ++k) {
       StepContext::NarrowShare& share = shares[k];
       share.first = count;
+      share.first_point = points;
       count += share.used;
       points += share.points;
+      deepest = std::max(deepest, share.deepest);
       counters.contacts += static_cast<std::int64_t>(share.points);
       for (const std::size_t found : share.found) counters.recycled += found != ContactRecycler::kNone ? 1 : 0;
     }
     if (points > kMaxContactPoints) too_many_points();
     manifolds.resize(count);
+    detail::resize_with_headroom(first_points, count);
     if (recycler != nullptr) recycler->resize_kept(count);
     parallel_chunks(workers, chunks - front_chunks, [&](std::size_t j) {
       const StepContext::NarrowShare& share = shares[front_chunks + j];
-      for (std::size_t i = 0; i < share.used; ++i) {
+      for (std::size_t i = 0, p = share.first_point; i < share.used; ++i) {
+        first_points[share.first + i] = p;
+        p += static_cast<std::size_t>(share.manifolds[i].count);
         copy_used_contacts(share.manifolds[i], manifolds[share.first + i]);
         if (recycler != nullptr) recycler->keep_at(share.first + i, share.manifolds[i], bodies_, share.found[i]);
       }
     });
   }
   if (recycler != nullptr) recycler->end_step();
+  ctx_->contact_points = points;
+  ctx_->deepest_contact = deepest;
 }
 
 // The contact and friction rows of every manifold of the step (build_rows' layout), from
@@ -456,7 +489,7 @@ void World::build_rows() {
   push_->adjust_rows(def_, params);  // the paper's methods leave params as they are
   // The row count is known from the manifolds: make room once, with headroom (no allocation in
   // steady state).
-  const std::size_t points = contact_point_count(ctx.manifolds);
+  const std::size_t points = ctx.contact_points;
   // Two friction rows a point (write_friction_rows).
   const bool friction = params.friction > 0.0 || params.body_friction;
   ctx.layout = RowLayout{.points = points, .friction = friction, .rods = distances_.size()};
@@ -484,7 +517,7 @@ void World::build_rows() {
   const bool warm = def_.warm_start > 0.0;
   if (warm) {
     if (!ctx.warm_start) ctx.warm_start = std::make_unique<WarmStartCache>();
-    ctx.warm_start->match(ctx.manifolds, ctx.workers());
+    ctx.warm_start->match(ctx.manifolds, ctx.workers(), &ctx.first_points);
   } else if (ctx.warm_start) {
     ctx.warm_start->clear();
   }
@@ -499,21 +532,20 @@ void World::build_rows() {
   // Manifold k's contact rows start at its first point, its friction rows at points plus twice
   // that: each manifold writes only its own rows, so the threads share the manifolds.
   // Coloured PGS cuts its runs from the same layout as spans of rows on one pair (row_colours.h).
-  std::vector<std::size_t>& first_point = ctx.first_points;
-  detail::resize_with_headroom(first_point, ctx.manifolds.size());
+  // (ctx.first_points: counted by the collide stage.)
   std::vector<RowSpan>& spans = ctx.row_spans;
   const bool with_spans = def_.solver == SolverKind::coloured_pgs;
   const std::size_t manifolds = ctx.manifolds.size();
   detail::resize_with_headroom(spans, with_spans ? manifolds * (friction ? 2 : 1) + distances_.size() : 0);
-  for (std::size_t k = 0, p = 0; k < manifolds; ++k) {
-    const Manifold& m = ctx.manifolds[k];
-    first_point[k] = p;
-    p += static_cast<std::size_t>(m.count);
-    if (!with_spans) continue;
-    spans[k] = RowSpan{m.body_a, m.body_b, m.count};
-    if (friction) spans[manifolds + k] = RowSpan{m.body_a, m.body_b, 2 * m.count};
-  }
   if (with_spans) {
+    // Each manifold writes its own spans.
+    parallel_blocks(workers, manifolds, kMinParallelRows, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const Manifold& m = ctx.manifolds[k];
+        spans[k] = RowSpan{m.body_a, m.body_b, m.count};
+        if (friction) spans[manifolds + k] = RowSpan{m.body_a, m.body_b, 2 * m.count};
+      }
+    });
     for (std::size_t r = 0, first = manifolds * (friction ? 2 : 1); r < distances_.size(); ++r) {
       spans[first + r] = RowSpan{distances_[r].body_a, distances_[r].body_b, 1};
     }

@@ -656,3 +656,44 @@ TEST_CASE("every point of a manifold has its first point's normal, bit for bit",
   CHECK(points > 1000);  // the pile has manifolds of several points to check
   CHECK(world.counters().recycled > 0);  // and recycled ones among them (over all the steps)
 }
+
+// World::deepest_contact is counted while the collide stage makes the manifolds, on each thread
+// its own share: it must equal the largest depth read back from every contact of manifolds(),
+// exactly (a maximum does not depend on the order). A random pile of boxes and balls with a
+// speculative margin (negative depths among the positive ones), recycled and reduced manifolds,
+// on one to three threads.
+TEST_CASE("the world's deepest contact is the largest depth among its manifolds' contacts",
+          "[collision]") {
+  const int threads = GENERATE(1, 2, 3);
+  WorldDef def;
+  def.push = PushMode::soft;
+  def.contact_margin = 0.02;
+  def.contact_recycle_distance = 0.05;
+  def.manifold_points = ManifoldPoints::four;
+  def.threads = threads;
+  World world(def);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  world.add_body(BodyDef{.shape = Shape::plane(Vec3::UnitY(), 0.0), .is_static = true});
+  for (int i = 0; i < 300; ++i) {
+    const Vec3 at(4.0 * unit(random) - 2.0, 0.2 + 6.0 * unit(random), 4.0 * unit(random) - 2.0);
+    const double size = 0.1 + 0.3 * unit(random);
+    add_turned(world, random, i % 3 == 0 ? Shape::sphere(size) : Shape::box(Vec3::Constant(size)), false, at);
+  }
+  CHECK(world.deepest_contact() == 0.0);  // before the first step: no manifolds
+  int overlapping_steps = 0;
+  for (int step = 0; step < 90; ++step) {
+    world.step();
+    double deepest = 0.0;
+    for (const Manifold& m : world.manifolds()) {
+      for (int i = 0; i < m.count; ++i) deepest = std::max(deepest, m.contacts[static_cast<std::size_t>(i)].depth);
+    }
+    INFO("step " << step << ", " << threads << " threads");
+    REQUIRE(world.deepest_contact() == deepest);
+    overlapping_steps += deepest > 0.0 ? 1 : 0;
+  }
+  CHECK(overlapping_steps > 45);  // the pile overlaps: the check compares positive depths
+  CHECK(world.counters().recycled > 0);
+  const World copy = world;
+  CHECK(copy.deepest_contact() == world.deepest_contact());
+}

@@ -148,6 +148,11 @@ class World {
   const StageTimes& stage_times() const;
   /// Manifolds found by the last step's collision stage (normals from a to b, depths in m).
   const std::vector<Manifold>& manifolds() const;
+  /// The largest depth (m) of the contacts in manifolds(): how far the bodies overlapped where
+  /// the last step found them (Sec. 4); 0 before the first step and when no depth is positive
+  /// (a speculative contact's is negative). Counted while colliding, so it reads no manifold.
+  /// No errors.
+  double deepest_contact() const;
   /// Rows built by the last step (c of them) and lambda of its first solve (c, N). Under a push
   /// method that does not read its contact and friction rows (the soft step), those are written
   /// at the first call after the step, from the bodies as they were at its start: the same rows;

@@ -104,6 +104,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -289,7 +290,7 @@ class SoftStep final : public PushMethod {
     const auto threads = static_cast<std::size_t>(workers_->count());
     detail::resize_with_headroom(solver_bodies_, n + threads);
     detail::resize_with_headroom(inertia_, n);
-    parallel_for(workers_, n, kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    parallel_blocks(workers_, n, kMinParallel, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const Body& body = bodies[i];
         SolverBody& s = solver_bodies_[i];
@@ -316,7 +317,7 @@ class SoftStep final : public PushMethod {
     slop_ = def.penetration_slop;
     max_push_ = def.contact_push_max_speed;
 
-    const std::size_t points = contact_point_count(ctx.manifolds);
+    const std::size_t points = ctx.contact_points;
     const bool friction = ctx.layout.friction;  // the rows carry each pair's mu
     const bool coupled = def.friction_model == FrictionModel::coupled;
     // Box3D's friction centre weight: 1 for touching points, falling to 0 past twice the
@@ -328,12 +329,9 @@ class SoftStep final : public PushMethod {
         friction && def.warm_start > 0.0 && ctx.warm_start != nullptr ? ctx.warm_start->tangents(0) : nullptr;
     const std::vector<DistanceConstraint>& distances = *ctx.distances;
     colour(ctx.manifolds, distances, moving);
-    // Each manifold's first contact row (its points' rows follow in order).
-    detail::resize_with_headroom(first_row_, ctx.manifolds.size());
-    for (std::size_t k = 0, g = 0; k < ctx.manifolds.size(); ++k) {
-      first_row_[k] = g;
-      g += static_cast<std::size_t>(ctx.manifolds[k].count);
-    }
+    // Each manifold's first contact row (its points' rows follow in order): its first point.
+    detail::reserve_with_headroom(first_row_, ctx.first_points.size());
+    first_row_.assign(ctx.first_points.begin(), ctx.first_points.end());
     // The manifolds and their points stored colour by colour (manifold_order_), so that a
     // colour's sweep reads them in order; written here in ctx's order, which reads ctx's
     // manifolds, rows and warm start in order: manifold k goes to slot slot_[k], its points from
@@ -373,8 +371,8 @@ class SoftStep final : public PushMethod {
     // With lanes, a colour's manifold goes straight into its group's lane (lane_of()) and only
     // the overflow's into its slot. Each manifold writes only its own slot, points and lane:
     // shared among the threads.
-    detail::assign_with_headroom(restitution_by_thread_, threads, static_cast<unsigned char>(0));
-    parallel_for(workers_, count, kMinParallel, [&](int t, std::size_t begin, std::size_t end) {
+    std::atomic<bool> any_target{false};
+    parallel_blocks(workers_, count, kMinParallel, [&](std::size_t begin, std::size_t end) {
       bool restitution = false;
       ManifoldFriction f;
       std::array<ContactPoint, kMaxManifoldPoints> scratch;
@@ -391,8 +389,9 @@ class SoftStep final : public PushMethod {
                         restitution;
         }
       }
-      if (restitution) restitution_by_thread_[static_cast<std::size_t>(t)] = 1;
+      if (restitution) any_target.store(true, std::memory_order_relaxed);
     });
+    restitution_ = any_target.load(std::memory_order_relaxed);
     if (lanes_) {
       // The step's total normal impulses matter only to the restitution (apply_restitution()).
       const bool restitution = any_restitution();
@@ -509,7 +508,7 @@ class SoftStep final : public PushMethod {
 
   // Whether a contact of the step has a restitution target (prepare's per-thread flags).
   bool any_restitution() const {
-    return std::find(restitution_by_thread_.begin(), restitution_by_thread_.end(), 1) != restitution_by_thread_.end();
+    return restitution_;
   }
 
   // A static body and the world are -1 in the sweeps (body()).
@@ -1140,7 +1139,7 @@ class SoftStep final : public PushMethod {
   // Stage "store impulses": the bodies' momenta.
   void store_momenta(StepContext& ctx) {
     std::vector<Body>& bodies = *ctx.bodies;
-    parallel_for(workers_, bodies.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    parallel_blocks(workers_, bodies.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         Body& body = bodies[i];
         if (body.is_static()) continue;
@@ -1156,8 +1155,8 @@ class SoftStep final : public PushMethod {
   // 1/s), into the cache; and the rods'.
   void store_warm_start(StepContext& ctx, double inv_h) {
     WarmStartCache& cache = *ctx.warm_start;
-    cache.begin_store(ctx.manifolds);
-    parallel_for(workers_, manifolds_.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    cache.begin_store(ctx.manifolds, &ctx.first_points);
+    parallel_blocks(workers_, manifolds_.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
       std::array<double, kMaxManifoldPoints> normal{};
       for (std::size_t k = begin; k < end; ++k) {
         if (k + 2 * kManifoldsAhead < end) prefetch_manifold(ctx.manifolds[k + 2 * kManifoldsAhead]);
@@ -1200,7 +1199,7 @@ class SoftStep final : public PushMethod {
     // world has friction, every manifold has them) by their manifolds, the rods' by the rods.
     detail::resize_with_headroom(ctx.lambda, ctx.rows.size());
     // In ctx's order, which writes the rows and reads the warm-start cache's tangents in order.
-    parallel_for(workers, manifolds_.size(), kMinParallel, [&](int, std::size_t begin, std::size_t end) {
+    parallel_blocks(workers, manifolds_.size(), kMinParallel, [&](std::size_t begin, std::size_t end) {
       ManifoldFriction f;
       std::array<ContactPoint, kMaxManifoldPoints> scratch;
       for (std::size_t k = begin; k < end; ++k) {
@@ -1272,7 +1271,7 @@ class SoftStep final : public PushMethod {
   std::vector<Mat3> inertia_;              // n: I (kg m^2, world frame) at the start of the step
   const Vec3* cached_tangents_ = nullptr;  // the warm-start cache's t1 per point of the step, or null
   std::vector<ContactPoint> contacts_;     // one per contact row, by manifold in colour order
-  std::vector<unsigned char> restitution_by_thread_;  // per thread: 1 when one of its contacts has a restitution target
+  bool restitution_ = false;  // prepare(): whether some contact has a restitution target
   std::vector<ManifoldFriction> manifolds_;     // one per manifold, in colour order
   std::vector<Rod> rods_;                  // one per distance constraint, in colour order
   bool lanes_ = false;                     // the colours' manifolds are swept in lanes (soft_lanes.h)

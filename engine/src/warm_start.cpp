@@ -36,8 +36,8 @@ std::size_t first_points(const std::vector<Manifold>& manifolds, std::vector<std
   return n;
 }
 
-// first_points(manifolds, first), from the collide stage's count `given` where it has one entry
-// a manifold (a copy, not a pass over the manifolds).
+// first_points(manifolds, first), copied from the collide stage's count `given` where that has
+// one entry per manifold (no pass over the manifolds).
 std::size_t first_points(const std::vector<Manifold>& manifolds, const std::vector<std::size_t>* given,
                          std::vector<std::size_t>& first) {
   if (given == nullptr || given->size() != manifolds.size()) return first_points(manifolds, first);

@@ -506,7 +506,7 @@ class SoftStep final : public PushMethod {
     for (int i = 0; i < manifolds[k].count; ++i) __builtin_prefetch(&q[i].impulse, 0, 3);
   }
 
-  // Whether a contact of the step has a restitution target (prepare's per-thread flags).
+  // Whether a contact of the step has a restitution target (set by prepare).
   bool any_restitution() const {
     return restitution_;
   }
